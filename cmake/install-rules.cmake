@@ -1,0 +1,36 @@
+# Installs both libraries, their headers, the pdp tool and one CMake package
+# "pdp": consumers write find_package(pdp CONFIG REQUIRED) and link
+# awcc::awcc and/or synth::synth.
+include(CMakePackageConfigHelpers)
+
+set(PDP_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/pdp")
+
+install(TARGETS awcc EXPORT awccTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(TARGETS synth EXPORT synthTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY libawcc/include/awcc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${PROJECT_BINARY_DIR}/generated/awcc/version.hpp
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/awcc)
+install(DIRECTORY libsynth/include/synth DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+install(EXPORT awccTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
+install(EXPORT synthTargets NAMESPACE synth:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
+
+configure_package_config_file(cmake/pdpConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/pdpConfig.cmake
+  INSTALL_DESTINATION ${PDP_INSTALL_CMAKEDIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/pdpConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/pdpConfig.cmake ${PROJECT_BINARY_DIR}/pdpConfigVersion.cmake
+  DESTINATION ${PDP_INSTALL_CMAKEDIR})
+
+if(PDP_BUILD_TOOLS)
+  install(TARGETS pdp RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()

@@ -1,0 +1,27 @@
+#pragma once
+// Physical quantities written with units, as a hydraulics lab writes them:
+// "5mm", "7.15 mm", "500kHz", "300s", "10m/s", "25%". A plain number is taken
+// in SI units (metres, seconds, hertz, metres per second, volts).
+
+#include <string>
+#include <string_view>
+
+namespace awcc {
+
+enum class Dimension { dimensionless, length, time, frequency, velocity, voltage };
+
+/// SI unit symbol of a dimension ("m", "s", "Hz", "m/s", "V", "").
+std::string_view si_unit(Dimension dimension);
+
+/// Units accepted for a dimension, for error messages ("m, cm, mm, um").
+std::string accepted_units(Dimension dimension);
+
+/// Parses a number with an optional unit into SI. Throws std::invalid_argument
+/// with a message that names the text, the expected kind of quantity and the
+/// units accepted. Non-finite numbers are refused.
+double parse_quantity(std::string_view text, Dimension dimension);
+
+/// Formats an SI value with a readable unit ("5mm", "500kHz", "0.1s").
+std::string format_quantity(double si_value, Dimension dimension);
+
+}  // namespace awcc

@@ -1,0 +1,122 @@
+#include "awcc/units.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fmt/format.h>
+#include <stdexcept>
+#include <vector>
+
+namespace awcc {
+namespace {
+
+struct Unit {
+  std::string_view symbol;
+  double scale;  // SI value of one unit
+};
+
+std::vector<Unit> units_of(Dimension dimension) {
+  switch (dimension) {
+    case Dimension::dimensionless:
+      return {{"", 1.0}, {"%", 0.01}};
+    case Dimension::length:
+      return {{"m", 1.0}, {"cm", 1e-2}, {"mm", 1e-3}, {"um", 1e-6}, {"µm", 1e-6}};
+    case Dimension::time:
+      return {{"s", 1.0}, {"ms", 1e-3}, {"us", 1e-6}, {"µs", 1e-6}, {"ns", 1e-9},
+              {"min", 60.0}, {"h", 3600.0}};
+    case Dimension::frequency:
+      return {{"Hz", 1.0}, {"kHz", 1e3}, {"MHz", 1e6}, {"GHz", 1e9}};
+    case Dimension::velocity:
+      return {{"m/s", 1.0}, {"cm/s", 1e-2}, {"mm/s", 1e-3}, {"km/h", 1.0 / 3.6}};
+    case Dimension::voltage:
+      return {{"V", 1.0}, {"mV", 1e-3}};
+  }
+  return {};
+}
+
+std::string_view dimension_name(Dimension dimension) {
+  switch (dimension) {
+    case Dimension::dimensionless: return "a plain number";
+    case Dimension::length: return "a length";
+    case Dimension::time: return "a time";
+    case Dimension::frequency: return "a frequency";
+    case Dimension::velocity: return "a velocity";
+    case Dimension::voltage: return "a voltage";
+  }
+  return "a quantity";
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  return s;
+}
+
+}  // namespace
+
+std::string_view si_unit(Dimension dimension) { return units_of(dimension).front().symbol; }
+
+std::string accepted_units(Dimension dimension) {
+  std::string out;
+  for (const auto& u : units_of(dimension)) {
+    if (u.symbol.empty()) continue;
+    if (!out.empty()) out += ", ";
+    out += u.symbol;
+  }
+  return out;
+}
+
+double parse_quantity(std::string_view text, Dimension dimension) {
+  const std::string_view s = trim(text);
+  double value = 0.0;
+  const char* first = s.data();
+  const char* last = s.data() + s.size();
+  if (!s.empty() && *first == '+') ++first;  // from_chars refuses a leading '+'
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  auto fail = [&](std::string_view why) -> double {
+    const std::string units = accepted_units(dimension);
+    std::string hint;
+    if (dimension == Dimension::dimensionless) {
+      hint = "write a plain number, or a percentage such as 25%";
+    } else {
+      hint = fmt::format("write a number with one of the units {} (a plain number is in {})", units,
+                         si_unit(dimension));
+    }
+    throw std::invalid_argument(
+        fmt::format("'{}' is not {}: {}; {}", text, dimension_name(dimension), why, hint));
+  };
+  if (ec != std::errc{} || ptr == first) return fail("no number at its start");
+  if (!std::isfinite(value)) return fail("the number is not finite");
+  const std::string_view unit = trim(std::string_view(ptr, static_cast<std::size_t>(last - ptr)));
+  for (const auto& u : units_of(dimension)) {
+    if (u.symbol == unit) return value * u.scale;
+  }
+  return fail(fmt::format("unknown unit '{}'", unit));
+}
+
+std::string format_quantity(double si_value, Dimension dimension) {
+  if (!std::isfinite(si_value)) return fmt::format("{}", si_value);
+  const double a = std::fabs(si_value);
+  std::string_view symbol = si_unit(dimension);
+  double scale = 1.0;
+  switch (dimension) {
+    case Dimension::length:
+      if (a != 0.0 && a < 1e-3) { symbol = "um"; scale = 1e-6; }
+      else if (a != 0.0 && a < 1.0) { symbol = "mm"; scale = 1e-3; }
+      else if (a == 0.0) { symbol = "mm"; scale = 1e-3; }
+      break;
+    case Dimension::time:
+      if (a != 0.0 && a < 1e-3) { symbol = "us"; scale = 1e-6; }
+      else if (a != 0.0 && a < 1.0) { symbol = "ms"; scale = 1e-3; }
+      break;
+    case Dimension::frequency:
+      if (a >= 1e6) { symbol = "MHz"; scale = 1e6; }
+      else if (a >= 1e3) { symbol = "kHz"; scale = 1e3; }
+      break;
+    default:
+      break;
+  }
+  return fmt::format("{:.10g}{}", si_value / scale, symbol);
+}
+
+}  // namespace awcc

@@ -1,0 +1,120 @@
+#pragma once
+// The scene of the synthetic probe (METHOD.md section 5): the flow, the
+// bubbles, the probe and the acquisition. The defaults are the base case of
+// Buergler et al. (2024). Each field has one name, used alike as TOML key and
+// as command-line option (--name), listed with its unit by scene_fields().
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "awcc/units.hpp"
+
+namespace synth {
+
+struct Vec3 {
+  double x = 0.0, y = 0.0, z = 0.0;
+  friend bool operator==(const Vec3&, const Vec3&) = default;
+};
+
+/// When bubbles enter the control volume.
+enum class ArrivalRule {
+  equal_time,     ///< equal inter-arrival times (the paper's rule, default)
+  poisson_time,   ///< Poisson process in time
+  equal_space,    ///< equally spaced along the flow (enter as the flow advances)
+  poisson_space,  ///< Poisson process along the flow
+};
+
+/// Time stepping of the Ornstein-Uhlenbeck velocity.
+enum class VelocityUpdate {
+  exact,  ///< u' a + sigma sqrt(1 - a^2) eta, a = exp(-dt/T): exact for every dt/T
+  euler,  ///< the paper's Euler step, for comparison; refused for dt/T > 2
+};
+
+struct Scene {
+  // Flow.
+  double velocity = 10.0;                 ///< mean streamwise velocity, m/s
+  double tu = 0.25;                       ///< streamwise turbulence intensity Tu_x, -
+  double tu_y = 0.125;                    ///< transverse intensity Tu_y, -
+  double tu_z = 0.125;                    ///< vertical intensity Tu_z, -
+  double time_scale = 0.1;                ///< integral time scale T_x, s
+  std::optional<double> time_scale_y;     ///< T_y, s (default: time_scale)
+  std::optional<double> time_scale_z;     ///< T_z, s (default: time_scale)
+  double rho_xy = 0.0;                    ///< velocity correlation u_x u_y, -
+  double rho_xz = -0.45;                  ///< velocity correlation u_x u_z, -
+  double rho_yz = 0.0;                    ///< velocity correlation u_y u_z, -
+  // Bubbles.
+  double void_fraction = 0.25;            ///< c, -
+  double bubble_diameter = 3e-3;          ///< volume-equivalent (median) diameter d_b, m
+  double diameter_log_sd = 0.0;           ///< std of ln(d_b); 0 = all equal, > 0 = log-normal
+  double aspect_ratio = 1.0;              ///< ellipsoid semi-axis along x over the lateral ones
+  ArrivalRule arrival = ArrivalRule::equal_time;
+  int overlap_retries = 10;               ///< lateral positions tried to avoid an overlap
+  // Probe.
+  double dx = 5e-3;                       ///< trailing tip minus leading tip, streamwise, m
+  double dy = 1e-3;                       ///< ... lateral, m
+  double dz = 0.0;                        ///< ... vertical, m
+  std::vector<Vec3> tips;                 ///< explicit tips (m); when set, dx/dy/dz are ignored
+  // Acquisition.
+  double fs = 500e3;                      ///< sampling rate per channel, Hz
+  double duration = 300.0;                ///< record length, s
+  std::uint64_t seed = 1;                 ///< random seed
+  // Numerics.
+  VelocityUpdate velocity_update = VelocityUpdate::exact;
+  double realisation_step = 0.0;          ///< velocity step dt_r, s; 0 = automatic
+  // Raw-voltage rendering (--signal voltage).
+  double voltage_water = 4.0;             ///< water level, V (conductivity probe: water high)
+  double voltage_air = 0.3;               ///< air level, V
+  double voltage_time_constant = 2e-6;    ///< first-order rise/fall time constant, s
+  double voltage_noise = 0.02;            ///< Gaussian noise std, V
+  double voltage_full_scale = 5.0;        ///< int16 full scale (32768 counts), V
+
+  /// Tip positions in metres: `tips` when given, else {0, (dx, dy, dz)}.
+  [[nodiscard]] std::vector<Vec3> probe_tips() const;
+  [[nodiscard]] double time_scale_of(int component) const;
+  [[nodiscard]] double tu_of(int component) const;
+  /// Velocity time step actually used: realisation_step, or when 0,
+  /// min(T_min / 50, transit / 10) with transit = max tip spread / velocity
+  /// (bubble diameter / velocity for a one-tip probe), so that the step
+  /// resolves both the integral time scale and the tip-to-tip transit.
+  [[nodiscard]] double effective_realisation_step() const;
+  /// Record length in samples, round(duration * fs).
+  [[nodiscard]] std::int64_t sample_count() const;
+
+  /// Empty when the scene is valid; otherwise one message per problem, each
+  /// naming the field, its value and the allowed range.
+  [[nodiscard]] std::vector<std::string> validate() const;
+};
+
+/// A scene field as the user writes it.
+struct SceneField {
+  std::string_view name;        ///< TOML key and CLI option name
+  awcc::Dimension dimension;    ///< unit family for parsing "5mm" etc.
+  std::string_view help;        ///< one line, with the unit
+  /// Sets the field from text ("5mm", "0.25", "poisson-time", "0,0,0;5mm,1mm,0").
+  /// Throws std::invalid_argument naming the problem.
+  void (*parse)(Scene&, std::string_view);
+  /// Current value as text with its unit (for --help defaults and reports).
+  std::string (*format)(const Scene&);
+};
+
+/// Every user-settable field of Scene, in the order shown by --help.
+std::span<const SceneField> scene_fields();
+
+/// Sets one field by name; throws std::invalid_argument (unknown field or bad value).
+void set_scene_field(Scene& scene, std::string_view name, std::string_view text);
+
+/// Reads a scene TOML file over `scene` (fields absent from the file keep their
+/// values). Keys are the field names; values are numbers in SI units or strings
+/// with units ("5mm"). Throws std::runtime_error naming the file, the key and
+/// the fix. Does not validate: call Scene::validate() afterwards.
+void load_scene_toml(const std::filesystem::path& path, Scene& scene);
+
+std::string_view to_string(ArrivalRule rule);
+std::string_view to_string(VelocityUpdate update);
+
+}  // namespace synth

@@ -1,0 +1,27 @@
+#pragma once
+// The JSON sidecar "<name>.truth.json" beside each synthetic recording: the
+// scene, probe geometry, fs, seed, toolkit version and the truth. Keys are
+// snake_case, values in SI units; documented in docs/output.md.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "synth/recording.hpp"
+#include "synth/truth.hpp"
+
+namespace synth {
+
+/// The scene as JSON: every field under its snake_case name, SI units.
+nlohmann::json scene_to_json(const Scene& scene);
+
+/// The truth as JSON: "imposed" and "realised" objects and more.
+nlohmann::json truth_to_json(const Truth& truth);
+
+/// The whole sidecar for a recording written with `options`.
+nlohmann::json sidecar_json(const Truth& truth, const RecordingOptions& options,
+                            const std::filesystem::path& recording);
+
+/// "dir/rec.flac" -> "dir/rec.truth.json".
+std::filesystem::path sidecar_path(const std::filesystem::path& recording);
+
+}  // namespace synth

@@ -1,0 +1,96 @@
+#pragma once
+// The synthetic probe: bubbles carried by the fluid past point tips
+// (METHOD.md 5.2-5.4), with each tip's air intervals found exactly.
+//
+// Geometry. The probe's centre is the middle of the tips' bounding box. The
+// control volume has edges L_i = spread_i + 4 a_max,i (spread_i the tips'
+// extent along i, a_max,i the largest bubble semi-axis along i: 2 d_b for
+// spheres). Bubbles enter at x = -L_x/2 at a uniform (y, z) of the cross
+// section A = L_y L_z, at the rate F_cv = c |u| A / E[V_b], so that a tip sees
+// the void fraction c. No slip: every bubble moves with the fluid, so all
+// bubbles share one displacement D(t) and bubble k sits at
+//
+//   x_k(t) = E_k + D(t) - D(t_k),     t >= t_k (its entry time).
+//
+// The cross-section is periodic (y and z taken modulo L_y, L_z): the common
+// transverse drift during the transit (sigma_y x L_x / u, about 1 mm in the
+// base case) would otherwise empty a strip along one wall of the control
+// volume and the downstream tip would see up to ~5 % less air than c. With
+// the periodic tile the lateral bubble field stays homogeneous whatever the
+// drift. Overlap avoidance uses the same minimum-image rule.
+//
+// Piercing. The velocity is constant over each realisation step, so D(t) is
+// piecewise linear and, over one step, the tip-relative position of a bubble is
+// q + v s. Tip j is inside an ellipsoid with semi-axes a when
+// |(q + v s) / a|^2 < 1: a quadratic in s whose roots are the exact entry and
+// exit times. Sample n is air when the tip is inside at t = n / fs, i.e. for
+// n in (t_in fs, t_out fs). Only bubbles whose streamwise position can reach a
+// tip during the step are tested: they are held sorted by their entry
+// displacement D_x(t_k), so the candidates are one contiguous range.
+//
+// Memory does not grow with duration: velocities are generated a chunk at a
+// time and bubbles are retired once well downstream (R_back = max(2 L_x,
+// 4 sigma_x T_x) past the last tip, so that a reversal of the flow can bring
+// them back only if it exceeds that; Truth::reentries_missed counts steps where
+// it could have). The air intervals (16 bytes per chord) and, on request, the
+// velocity history are the only outputs that grow.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "awcc/air_intervals.hpp"
+#include "synth/scene.hpp"
+#include "synth/truth.hpp"
+
+namespace synth {
+
+struct SynthesisOptions {
+  std::int64_t chunk_steps = 1 << 16;   ///< velocity steps generated at a time (results do not depend on it)
+  bool keep_velocity_history = false;   ///< keep the streamwise history for window-averaged truth (8 bytes a step)
+  bool keep_reference_data = false;     ///< keep every bubble and step velocity for brute-force checks (tests only)
+  std::function<void(double)> progress; ///< called with the fraction done, once per chunk
+};
+
+/// A bubble as generated: what a brute-force reference needs to place it.
+struct BubbleRecord {
+  double t_entry = 0.0;   ///< s
+  Vec3 entry;             ///< entry point relative to the probe centre, m
+  Vec3 key;               ///< common displacement D(t_entry), m
+  Vec3 semi_axes;         ///< m
+};
+
+/// Inputs of the brute-force reference (keep_reference_data).
+struct ReferenceData {
+  double t_start = 0.0;              ///< time of step 0 (negative: pre-roll fills the control volume), s
+  double step = 0.0;                 ///< s
+  std::vector<Vec3> velocities;      ///< velocity of every step from t_start
+  std::vector<BubbleRecord> bubbles; ///< in entry order
+  std::vector<Vec3> tips;            ///< tip positions relative to the probe centre, m
+  Vec3 control_volume;               ///< edges L_x, L_y, L_z (lateral edges are periodic), m
+};
+
+struct Synthesis {
+  std::vector<awcc::AirIntervals> signals;   ///< one per tip, in tip order
+  Truth truth;
+  std::optional<VelocityHistory> history;    ///< with keep_velocity_history
+  std::optional<ReferenceData> reference;    ///< with keep_reference_data
+};
+
+/// Synthesises a valid scene (throws std::invalid_argument listing
+/// Scene::validate() messages otherwise).
+Synthesis synthesise(const Scene& scene, const SynthesisOptions& options = {});
+
+/// Reference piercing by testing every sample of every tip against every
+/// candidate bubble (the dense method the exact one replaces): returns one 0/1
+/// vector per tip. For tests and the benchmark.
+std::vector<std::vector<std::uint8_t>> brute_force_signals(const Scene& scene, const ReferenceData& reference);
+
+/// Same, but for each sample also the largest |q/a|^2 - 1 sign margin: for
+/// every tip and sample, the value min over bubbles of |(x_tip - x_k)/a|^2 (1
+/// on the surface). Lets a test tell a genuine disagreement from a sample that
+/// sits on a bubble surface to rounding.
+std::vector<std::vector<double>> brute_force_distances(const Scene& scene, const ReferenceData& reference);
+
+}  // namespace synth

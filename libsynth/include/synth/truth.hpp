@@ -1,0 +1,82 @@
+#pragma once
+// What the synthetic probe knows and a real probe never does: the imposed
+// scene, the statistics actually realised by the random velocity series and
+// bubbles, and the window-averaged true velocity over any interval.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "synth/scene.hpp"
+
+namespace synth {
+
+/// Statistics of the generated velocity series over the record [0, duration).
+/// Time averages of the piecewise-constant velocity the bubbles follow.
+struct RealisedFlow {
+  std::array<double, 3> mean_velocity{};          ///< m/s (x, y, z)
+  std::array<double, 3> rms_velocity{};           ///< standard deviation, m/s
+  std::array<double, 3> turbulence_intensity{};   ///< rms / |mean velocity vector|, -
+  /// Integral of the autocorrelation from lag 0 to its first zero (trapezoid
+  /// rule on a series decimated to ~20 points per imposed T), s. Empty for a
+  /// component without fluctuation.
+  std::array<std::optional<double>, 3> integral_time_scale{};
+  std::optional<double> rho_xy, rho_xz, rho_yz;   ///< correlation coefficients, -
+  std::int64_t steps = 0;                         ///< velocity steps in the record
+};
+
+struct TipTruth {
+  Vec3 position;                      ///< m, as given in the scene
+  double void_fraction = 0.0;         ///< air samples / samples, -
+  std::int64_t bubbles_pierced = 0;   ///< distinct bubbles whose piercing overlaps the record
+  std::int64_t chords = 0;            ///< air intervals in the sampled signal
+};
+
+struct PairTruth {
+  int first = 0, second = 0;               ///< tip indices
+  std::int64_t pierced_by_both = 0;        ///< distinct bubbles pierced by both tips in the record
+};
+
+struct Truth {
+  Scene imposed;
+  double realisation_step = 0.0;           ///< dt_r actually used, s
+  double control_volume[3] = {0, 0, 0};    ///< edges L_x, L_y, L_z, m
+  double bubble_rate = 0.0;                ///< bubbles entering the control volume per second, 1/s
+  double expected_pierce_rate = 0.0;       ///< mean pierce rate of a tip, c u E[pi a_y a_z] / E[V], 1/s
+  RealisedFlow realised;
+  std::vector<TipTruth> tips;
+  std::vector<PairTruth> pairs;
+  std::int64_t bubbles_generated = 0;      ///< bubbles entering during [0, duration)
+  std::int64_t overlaps_unresolved = 0;    ///< bubbles placed overlapping after all retries
+  std::int64_t reentries_missed = 0;       ///< steps where a retired bubble could have come back (0 expected)
+  std::int64_t sample_count = 0;
+
+  /// A readable multi-line summary.
+  [[nodiscard]] std::string report() const;
+};
+
+/// Window-averaged true streamwise velocity <u_x>_W = (1/(t1 - t0)) integral
+/// of u_x over [t0, t1), answered in O(1) from the cumulative displacement
+/// at each velocity step.
+class VelocityHistory {
+ public:
+  VelocityHistory() = default;
+  VelocityHistory(double step, std::vector<double> cumulative_displacement)
+      : step_(step), displacement_(std::move(cumulative_displacement)) {}
+
+  /// Mean of u_x over [t0, t1), m/s; t0 < t1 within the record. For t0 == t1
+  /// the velocity at t0.
+  [[nodiscard]] double mean_velocity(double t0, double t1) const;
+  /// Streamwise displacement since t = 0, m.
+  [[nodiscard]] double displacement(double t) const;
+  [[nodiscard]] double step() const { return step_; }
+  [[nodiscard]] double end_time() const { return step_ * static_cast<double>(displacement_.size() - 1); }
+
+ private:
+  double step_ = 0.0;
+  std::vector<double> displacement_;  // X_k at t = k step, X_0 = 0
+};
+
+}  // namespace synth

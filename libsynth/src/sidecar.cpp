@@ -1,0 +1,128 @@
+#include "synth/sidecar.hpp"
+
+#include "awcc/version.hpp"
+
+namespace synth {
+
+using nlohmann::json;
+
+namespace {
+
+json optional_number(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+}  // namespace
+
+json scene_to_json(const Scene& s) {
+  json tips = json::array();
+  for (const auto& t : s.probe_tips()) tips.push_back(vec(t));
+  return json{
+      {"velocity", s.velocity},
+      {"tu", s.tu},
+      {"tu_y", s.tu_y},
+      {"tu_z", s.tu_z},
+      {"time_scale", json::array({s.time_scale_of(0), s.time_scale_of(1), s.time_scale_of(2)})},
+      {"rho_xy", s.rho_xy},
+      {"rho_xz", s.rho_xz},
+      {"rho_yz", s.rho_yz},
+      {"void_fraction", s.void_fraction},
+      {"bubble_diameter", s.bubble_diameter},
+      {"diameter_log_sd", s.diameter_log_sd},
+      {"aspect_ratio", s.aspect_ratio},
+      {"arrival", std::string(to_string(s.arrival))},
+      {"overlap_retries", s.overlap_retries},
+      {"dx", s.dx},
+      {"dy", s.dy},
+      {"dz", s.dz},
+      {"tips", tips},
+      {"fs", s.fs},
+      {"duration", s.duration},
+      {"seed", s.seed},
+      {"velocity_update", std::string(to_string(s.velocity_update))},
+      {"realisation_step", s.effective_realisation_step()},
+      {"voltage_water", s.voltage_water},
+      {"voltage_air", s.voltage_air},
+      {"voltage_time_constant", s.voltage_time_constant},
+      {"voltage_noise", s.voltage_noise},
+      {"voltage_full_scale", s.voltage_full_scale},
+  };
+}
+
+json truth_to_json(const Truth& t) {
+  const Scene& s = t.imposed;
+  const auto& r = t.realised;
+  json void_fraction = json::array(), pierced = json::array(), chords = json::array();
+  for (const auto& tip : t.tips) {
+    void_fraction.push_back(tip.void_fraction);
+    pierced.push_back(tip.bubbles_pierced);
+    chords.push_back(tip.chords);
+  }
+  json pairs = json::array();
+  for (const auto& p : t.pairs) {
+    pairs.push_back({{"tips", json::array({p.first, p.second})}, {"pierced_by_both", p.pierced_by_both}});
+  }
+  json scales = json::array();
+  for (const auto& v : r.integral_time_scale) scales.push_back(optional_number(v));
+  return json{
+      {"imposed",
+       {{"mean_velocity", json::array({s.velocity, 0.0, 0.0})},
+        {"turbulence_intensity", json::array({s.tu, s.tu_y, s.tu_z})},
+        {"integral_time_scale", json::array({s.time_scale_of(0), s.time_scale_of(1), s.time_scale_of(2)})},
+        {"rho_xy", s.rho_xy},
+        {"rho_xz", s.rho_xz},
+        {"rho_yz", s.rho_yz},
+        {"void_fraction", s.void_fraction},
+        {"bubble_diameter", s.bubble_diameter},
+        {"pierce_rate", t.expected_pierce_rate}}},
+      {"realised",
+       {{"mean_velocity", r.mean_velocity},
+        {"rms_velocity", r.rms_velocity},
+        {"turbulence_intensity", r.turbulence_intensity},
+        {"integral_time_scale", scales},
+        {"rho_xy", optional_number(r.rho_xy)},
+        {"rho_xz", optional_number(r.rho_xz)},
+        {"rho_yz", optional_number(r.rho_yz)},
+        {"void_fraction", void_fraction},
+        {"bubbles_pierced", pierced},
+        {"chords", chords},
+        {"pierced_by_both", pairs},
+        {"bubbles_generated", t.bubbles_generated},
+        {"overlaps_unresolved", t.overlaps_unresolved},
+        {"reentries_missed", t.reentries_missed},
+        {"velocity_steps", r.steps}}},
+      {"realisation_step", t.realisation_step},
+      {"control_volume", json::array({t.control_volume[0], t.control_volume[1], t.control_volume[2]})},
+      {"bubble_rate", t.bubble_rate},
+      {"sample_count", t.sample_count},
+  };
+}
+
+json sidecar_json(const Truth& truth, const RecordingOptions& options, const std::filesystem::path& recording) {
+  json out = truth_to_json(truth);
+  json tips = json::array();
+  for (const auto& tip : truth.tips) tips.push_back(vec(tip.position));
+  out["toolkit"] = {{"name", "pdp"}, {"version", awcc::version}};
+  out["recording"] = {{"file", recording.filename().string()},
+                      {"format", std::string(to_string(options.format))},
+                      {"signal", std::string(to_string(options.signal))},
+                      {"channels", truth.tips.size()},
+                      {"sample_type", "int16"},
+                      {"volts_per_count", options.signal == SignalKind::voltage
+                                              ? json(truth.imposed.voltage_full_scale / 32768.0)
+                                              : json(nullptr)}};
+  out["scene"] = scene_to_json(truth.imposed);
+  out["probe"] = {{"tips", tips}, {"leading_tip", 0}};
+  out["fs"] = truth.imposed.fs;
+  out["seed"] = truth.imposed.seed;
+  return out;
+}
+
+std::filesystem::path sidecar_path(const std::filesystem::path& recording) {
+  std::filesystem::path p = recording;
+  p.replace_extension();
+  p += ".truth.json";
+  return p;
+}
+
+}  // namespace synth

@@ -1,0 +1,650 @@
+#include "synth/synthesiser.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <fmt/format.h>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include "synth/random.hpp"
+#include "synth/velocity.hpp"
+
+namespace synth {
+namespace {
+
+// Bubble sizes: d = d_b exp(s z), z standard normal truncated to |z| <= 3 so
+// that the control volume (sized by the largest bubble) stays finite.
+struct SizeModel {
+  double median = 0.0;
+  double log_sd = 0.0;
+  double aspect = 1.0;
+  double max_diameter = 0.0;
+  double x_factor = 1.0;        // semi-axis along x = (d/2) x_factor
+  double lateral_factor = 1.0;  // lateral semi-axes = (d/2) lateral_factor
+
+  explicit SizeModel(const Scene& s)
+      : median(s.bubble_diameter), log_sd(s.diameter_log_sd), aspect(s.aspect_ratio) {
+    max_diameter = median * std::exp(3.0 * log_sd);
+    // Volume kept equal to the sphere of diameter d: a_x a_y a_z = (d/2)^3.
+    x_factor = std::cbrt(aspect * aspect);
+    lateral_factor = 1.0 / std::cbrt(aspect);
+  }
+
+  double draw(Rng& rng) const {
+    if (log_sd == 0.0) return median;
+    double z;
+    do z = rng.normal(); while (std::fabs(z) > 3.0);
+    return median * std::exp(log_sd * z);
+  }
+
+  // E[d^k] of the truncated log-normal, by Simpson's rule on z in [-3, 3].
+  double moment(double k) const {
+    if (log_sd == 0.0) return std::pow(median, k);
+    const int n = 600;
+    const double h = 6.0 / n;
+    double num = 0.0, den = 0.0;
+    for (int i = 0; i <= n; ++i) {
+      const double z = -3.0 + h * i;
+      const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+      const double pdf = std::exp(-0.5 * z * z);
+      num += w * pdf * std::pow(median * std::exp(log_sd * z), k);
+      den += w * pdf;
+    }
+    return num / den;
+  }
+};
+
+// Minimum-image separation on a periodic interval of the given length.
+double wrap(double separation, double length) {
+  return separation - length * std::nearbyint(separation / length);
+}
+
+struct ActiveBubble {
+  Vec3 key;        // D(t_entry)
+  Vec3 entry;      // relative to the probe centre
+  Vec3 inv_axes;   // 1 / semi-axes
+  double a_x;      // semi-axis along x
+  double radius;   // d/2, for overlap tests in the sphere-mapped space
+  double t_entry;
+  std::uint64_t serial;
+  std::uint64_t pierced_mask = 0;
+};
+
+struct Pending {
+  double diameter;
+  double first_key;  // D_x when it first tried to enter
+};
+
+struct OpenPierce {
+  std::uint64_t serial;
+  double t_in;
+};
+
+// Streaming velocity statistics for the truth.
+class FlowAccumulator {
+ public:
+  FlowAccumulator(const Scene& scene, double dt) : dt_(dt) {
+    mean_ = {scene.velocity, 0.0, 0.0};
+    const double t_min = std::min({scene.time_scale_of(0), scene.time_scale_of(1), scene.time_scale_of(2)});
+    const double t_max = std::max({scene.time_scale_of(0), scene.time_scale_of(1), scene.time_scale_of(2)});
+    decimation_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(t_min / (20.0 * dt))));
+    const double lags = std::ceil(10.0 * t_max / (static_cast<double>(decimation_) * dt));
+    lags_ = static_cast<std::size_t>(std::clamp(lags, 16.0, 4000.0));
+    for (auto& r : ring_) r.assign(lags_ + 1, 0.0);
+    for (auto& p : lagged_) p.assign(lags_ + 1, 0.0);
+  }
+
+  void add(const Vec3& u) {
+    const double y[3] = {u.x - mean_[0], u.y - mean_[1], u.z - mean_[2]};
+    for (int i = 0; i < 3; ++i) {
+      sum_[i] += y[i];
+      for (int j = i; j < 3; ++j) cross_[i][j] += y[i] * y[j];
+    }
+    if (count_ % decimation_ == 0) {
+      const std::size_t slot = decimated_ % (lags_ + 1);
+      const std::size_t available = std::min<std::size_t>(decimated_, lags_);
+      for (int i = 0; i < 3; ++i) {
+        auto& ring = ring_[i];
+        auto& lagged = lagged_[i];
+        ring[slot] = y[i];
+        for (std::size_t k = 0; k <= available; ++k) {
+          lagged[k] += y[i] * ring[(slot + lags_ + 1 - k) % (lags_ + 1)];
+        }
+        dsum_[i] += y[i];
+      }
+      ++decimated_;
+    }
+    ++count_;
+  }
+
+  RealisedFlow finish() const {
+    RealisedFlow out;
+    out.steps = count_;
+    if (count_ == 0) return out;
+    const double n = static_cast<double>(count_);
+    double m[3], var[3];
+    for (int i = 0; i < 3; ++i) {
+      m[i] = sum_[i] / n;
+      out.mean_velocity[i] = mean_[i] + m[i];
+      var[i] = std::max(0.0, cross_[i][i] / n - m[i] * m[i]);
+      out.rms_velocity[i] = std::sqrt(var[i]);
+    }
+    const double speed = std::hypot(out.mean_velocity[0], out.mean_velocity[1], out.mean_velocity[2]);
+    for (int i = 0; i < 3; ++i) out.turbulence_intensity[i] = speed > 0.0 ? out.rms_velocity[i] / speed : 0.0;
+    auto rho = [&](int i, int j) -> std::optional<double> {
+      const double denom = std::sqrt(var[i] * var[j]);
+      if (!(denom > 0.0)) return std::nullopt;
+      return (cross_[i][j] / n - m[i] * m[j]) / denom;
+    };
+    out.rho_xy = rho(0, 1);
+    out.rho_xz = rho(0, 2);
+    out.rho_yz = rho(1, 2);
+    for (int i = 0; i < 3; ++i) out.integral_time_scale[i] = integral_scale(i);
+    return out;
+  }
+
+ private:
+  std::optional<double> integral_scale(int i) const {
+    const auto nd = static_cast<std::size_t>(decimated_);
+    if (nd < 4) return std::nullopt;
+    const double mean = dsum_[i] / static_cast<double>(nd);
+    auto cov = [&](std::size_t k) {
+      return lagged_[i][k] / static_cast<double>(nd - k) - mean * mean;
+    };
+    const double c0 = cov(0);
+    if (!(c0 > 1e-300)) return std::nullopt;
+    const std::size_t max_lag = std::min(lags_, nd - 2);
+    const double h = static_cast<double>(decimation_) * dt_;
+    double integral = 0.0;
+    double previous = 1.0;
+    for (std::size_t k = 1; k <= max_lag; ++k) {
+      const double r = cov(k) / c0;
+      if (r <= 0.0) {
+        // Up to the zero crossing, by linear interpolation.
+        const double frac = previous / (previous - r);
+        integral += 0.5 * previous * frac * h;
+        return integral;
+      }
+      integral += 0.5 * (previous + r) * h;
+      previous = r;
+    }
+    return integral;
+  }
+
+  double dt_;
+  std::array<double, 3> mean_{};
+  std::int64_t count_ = 0;
+  double sum_[3] = {0, 0, 0};
+  double cross_[3][3] = {};
+  std::int64_t decimation_ = 1;
+  std::size_t lags_ = 16;
+  std::size_t decimated_ = 0;
+  double dsum_[3] = {0, 0, 0};
+  std::array<std::vector<double>, 3> ring_;
+  std::array<std::vector<double>, 3> lagged_;
+};
+
+class Synthesiser {
+ public:
+  Synthesiser(const Scene& scene, const SynthesisOptions& options)
+      : scene_(scene), options_(options), sizes_(scene), bubble_rng_(scene.seed, Stream::bubbles) {
+    dt_ = scene.effective_realisation_step();
+    fs_ = scene.fs;
+    duration_ = scene.duration;
+    samples_ = scene.sample_count();
+
+    const auto tips = scene.probe_tips();
+    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (const auto& t : tips) {
+      lo = {std::min(lo.x, t.x), std::min(lo.y, t.y), std::min(lo.z, t.z)};
+      hi = {std::max(hi.x, t.x), std::max(hi.y, t.y), std::max(hi.z, t.z)};
+    }
+    const Vec3 centre{0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z)};
+    for (const auto& t : tips) tips_.push_back({t.x - centre.x, t.y - centre.y, t.z - centre.z});
+    tip_x_min_ = lo.x - centre.x;
+    tip_x_max_ = hi.x - centre.x;
+
+    a_x_max_ = 0.5 * sizes_.max_diameter * sizes_.x_factor;
+    const double a_lat_max = 0.5 * sizes_.max_diameter * sizes_.lateral_factor;
+    length_[0] = (hi.x - lo.x) + 4.0 * a_x_max_;
+    length_[1] = (hi.y - lo.y) + 4.0 * a_lat_max;
+    length_[2] = (hi.z - lo.z) + 4.0 * a_lat_max;
+    entry_x_ = -0.5 * length_[0];
+
+    const double mean_volume = std::numbers::pi / 6.0 * sizes_.moment(3.0);
+    const double area = length_[1] * length_[2];
+    rate_ = scene.void_fraction * scene.velocity * area / mean_volume;
+    // Tip pierce rate: flux of bubble cross-sections pi a_y a_z through the tip.
+    const double mean_section = std::numbers::pi * 0.25 * sizes_.lateral_factor * sizes_.lateral_factor *
+                                sizes_.moment(2.0);
+    expected_pierce_rate_ = scene.void_fraction * scene.velocity * mean_section / mean_volume;
+    spacing_ = scene.velocity / rate_;  // metres of flow between entries (space rules)
+    reversal_allowance_ = std::max(2.0 * length_[0], 4.0 * scene.velocity * scene.tu * scene.time_scale_of(0));
+
+    // Pre-roll: enough flow before t = 0 for the control volume to be in its
+    // stationary state when the record starts.
+    pre_steps_ = static_cast<std::int64_t>(std::ceil(2.0 * length_[0] / scene.velocity / dt_)) + 1;
+    t_start_ = -static_cast<double>(pre_steps_) * dt_;
+    record_steps_ = static_cast<std::int64_t>(std::ceil(duration_ / dt_));
+
+    open_.resize(tips_.size());
+    pierces_.resize(tips_.size());
+    pair_counts_.assign(tips_.size() * tips_.size(), 0);
+    tip_counts_.assign(tips_.size(), 0);
+
+    const bool time_rule = scene.arrival == ArrivalRule::equal_time || scene.arrival == ArrivalRule::poisson_time;
+    const bool poisson = scene.arrival == ArrivalRule::poisson_time || scene.arrival == ArrivalRule::poisson_space;
+    // First arrival: a uniform phase (equal spacing) or an exponential gap.
+    const double first = poisson ? bubble_rng_.exponential() : bubble_rng_.uniform();
+    if (time_rule) {
+      next_time_ = t_start_ + first / rate_;
+    } else {
+      next_key_ = first * spacing_;
+    }
+    time_rule_ = time_rule;
+    poisson_ = poisson;
+  }
+
+  Synthesis run() {
+    Synthesis out;
+    VelocityProcess velocity(scene_, dt_);
+    FlowAccumulator flow(scene_, dt_);
+    std::vector<double> history;
+    if (options_.keep_velocity_history) {
+      history.reserve(static_cast<std::size_t>(record_steps_) + 1);
+      history.push_back(0.0);
+    }
+    if (options_.keep_reference_data) {
+      out.reference.emplace();
+      out.reference->t_start = t_start_;
+      out.reference->step = dt_;
+      out.reference->tips = tips_;
+      out.reference->control_volume = {length_[0], length_[1], length_[2]};
+    }
+
+    const std::int64_t total = pre_steps_ + record_steps_;
+    const std::int64_t chunk = std::max<std::int64_t>(1, options_.chunk_steps);
+    std::vector<Vec3> buffer(static_cast<std::size_t>(std::min(chunk, total)));
+    for (std::int64_t first = 0; first < total; first += chunk) {
+      const std::int64_t n = std::min(chunk, total - first);
+      std::span<Vec3> block(buffer.data(), static_cast<std::size_t>(n));
+      velocity.generate(block);
+      for (std::int64_t i = 0; i < n; ++i) {
+        const std::int64_t step = first + i;
+        const Vec3& u = block[static_cast<std::size_t>(i)];
+        const double t = t_start_ + static_cast<double>(step) * dt_;
+        if (options_.keep_reference_data) out.reference->velocities.push_back(u);
+        advance(t, u);
+        if (step >= pre_steps_) {
+          flow.add(u);
+          if (options_.keep_velocity_history) history.push_back(history.back() + u.x * dt_);
+        }
+      }
+      if (options_.progress) options_.progress(static_cast<double>(first + n) / static_cast<double>(total));
+    }
+    finish_open();
+    for (const auto& b : bubbles_) tally(b);
+    if (options_.keep_reference_data) out.reference->bubbles = std::move(records_);
+
+    // Signals and truth.
+    Truth& truth = out.truth;
+    truth.imposed = scene_;
+    truth.realisation_step = dt_;
+    for (int i = 0; i < 3; ++i) truth.control_volume[i] = length_[i];
+    truth.bubble_rate = rate_;
+    truth.expected_pierce_rate = expected_pierce_rate_;
+    truth.realised = flow.finish();
+    truth.bubbles_generated = generated_;
+    truth.overlaps_unresolved = overlaps_unresolved_;
+    truth.reentries_missed = reentries_missed_;
+    truth.sample_count = samples_;
+    const auto given_tips = scene_.probe_tips();
+    for (std::size_t j = 0; j < tips_.size(); ++j) {
+      awcc::AirIntervals signal;
+      signal.fs = fs_;
+      signal.sample_count = samples_;
+      signal.intervals = std::move(pierces_[j]);
+      awcc::normalise(signal.intervals);
+      TipTruth tip;
+      tip.position = given_tips[j];
+      tip.void_fraction = signal.void_fraction();
+      tip.chords = static_cast<std::int64_t>(signal.intervals.size());
+      tip.bubbles_pierced = tip_counts_[j];
+      truth.tips.push_back(tip);
+      out.signals.push_back(std::move(signal));
+      for (std::size_t k = j + 1; k < tips_.size(); ++k) {
+        truth.pairs.push_back({static_cast<int>(j), static_cast<int>(k), pair_counts_[j * tips_.size() + k]});
+      }
+    }
+    if (options_.keep_velocity_history) out.history.emplace(dt_, std::move(history));
+    return out;
+  }
+
+ private:
+  // One velocity step [t, t + dt) at constant velocity u.
+  void advance(double t, const Vec3& u) {
+    const Vec3 d_next{d_.x + u.x * dt_, d_.y + u.y * dt_, d_.z + u.z * dt_};
+    arrivals(t, u, d_next);
+    pierce(t, u, d_next);
+    retire(d_next);
+    d_ = d_next;
+  }
+
+  void arrivals(double t, const Vec3& u, const Vec3& d_next) {
+    // Bubbles that found no free lateral position earlier try again first,
+    // at the start of this step.
+    place_pending(t, d_);
+    const double t_end = t + dt_;
+    if (time_rule_) {
+      while (next_time_ < t_end) {
+        const double s = next_time_ - t;
+        arrive(next_time_, {d_.x + u.x * s, d_.y + u.y * s, d_.z + u.z * s});
+        next_time_ += (poisson_ ? bubble_rng_.exponential() : 1.0) / rate_;
+      }
+    } else {
+      // A bubble enters each time the displacement first passes the next mark.
+      while (next_key_ <= d_next.x) {
+        const double s = std::clamp((next_key_ - d_.x) / u.x, 0.0, dt_);
+        arrive(t + s, {next_key_, d_.y + u.y * s, d_.z + u.z * s});
+        next_key_ += (poisson_ ? bubble_rng_.exponential() : 1.0) * spacing_;
+      }
+    }
+  }
+
+  // A bubble due at t_entry with the common displacement `key`.
+  void arrive(double t_entry, const Vec3& key) {
+    const double diameter = sizes_.draw(bubble_rng_);
+    pending_.push_back({diameter, key.x});
+    place_pending(t_entry, key);
+  }
+
+  // Places waiting bubbles in arrival order. Bubbles never move relative to
+  // each other, so an overlap at entry is an overlap for ever. When every
+  // lateral position tried overlaps a neighbour, the bubble waits and tries
+  // again at the next step, until the flow has advanced by one largest
+  // diameter; then it is placed overlapping (Truth::overlaps_unresolved).
+  // Waiting keeps the bubble flux (a bubble is late, never lost) and lets the
+  // void fraction reach c above the jamming limit of random sequential
+  // placement (about 0.38 for spheres), where placing overlapping bubbles at
+  // once would lose the overlapped volume.
+  void place_pending(double t_entry, const Vec3& key) {
+    while (!pending_.empty()) {
+      const Pending& p = pending_.front();
+      const bool must_place = key.x - p.first_key > 2.0 * a_x_max_;
+      if (!try_place(p.diameter, t_entry, key, must_place)) return;
+      pending_.pop_front();
+    }
+  }
+
+  bool try_place(double diameter, double t_entry, const Vec3& key, bool must_place) {
+    ActiveBubble b;
+    b.key = key;
+    b.radius = 0.5 * diameter;
+    b.a_x = b.radius * sizes_.x_factor;
+    const double a_lat = b.radius * sizes_.lateral_factor;
+    b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
+    b.t_entry = t_entry;
+
+    // Test the neighbours in the sphere-mapped space (x scaled by 1/x_factor,
+    // lateral by 1/lateral_factor) where every bubble is a sphere of radius
+    // d/2. The cross-section is periodic for this test (minimum image): with
+    // hard lateral walls the retries would push bubbles towards the walls,
+    // away from the tips, and the tips would see a void fraction well below c
+    // (0.19 instead of 0.25 in the base case).
+    const double reach = 2.0 * a_x_max_;
+    auto lo = std::partition_point(bubbles_.begin(), bubbles_.end(),
+                                   [&](const ActiveBubble& o) { return o.key.x < key.x - reach; });
+    auto hi = std::partition_point(lo, bubbles_.end(), [&](const ActiveBubble& o) { return o.key.x <= key.x + reach; });
+    bool placed = false;
+    for (int attempt = 0; attempt <= scene_.overlap_retries; ++attempt) {
+      b.entry = {entry_x_, (bubble_rng_.uniform() - 0.5) * length_[1], (bubble_rng_.uniform() - 0.5) * length_[2]};
+      bool overlaps = false;
+      for (auto it = lo; it != hi && !overlaps; ++it) {
+        // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
+        const double sx = (it->key.x - key.x) / sizes_.x_factor;
+        const double sy = wrap(b.entry.y - it->entry.y - (key.y - it->key.y), length_[1]) / sizes_.lateral_factor;
+        const double sz = wrap(b.entry.z - it->entry.z - (key.z - it->key.z), length_[2]) / sizes_.lateral_factor;
+        const double r = b.radius + it->radius;
+        overlaps = sx * sx + sy * sy + sz * sz < r * r;
+      }
+      if (!overlaps) {
+        placed = true;
+        break;
+      }
+    }
+    if (!placed && !must_place) return false;
+    if (!placed) ++overlaps_unresolved_;
+    b.serial = serial_++;
+    if (t_entry >= 0.0 && t_entry < duration_) ++generated_;
+    if (options_.keep_reference_data) {
+      records_.push_back({t_entry, b.entry, b.key, {b.a_x, 1.0 / b.inv_axes.y, 1.0 / b.inv_axes.z}});
+    }
+    // Keep sorted by key.x: nearly always an append.
+    auto pos = bubbles_.end();
+    while (pos != bubbles_.begin() && std::prev(pos)->key.x > key.x) --pos;
+    bubbles_.insert(pos, b);
+    return true;
+  }
+
+  void pierce(double t, const Vec3& u, const Vec3& d_next) {
+    const double d_lo = std::min(d_.x, d_next.x);
+    const double d_hi = std::max(d_.x, d_next.x);
+    // Bubble x relative to tip j: entry_x + D_x - key_x - P_jx, inside only if |.| < a_x.
+    const double key_lo = entry_x_ + d_lo - tip_x_max_ - a_x_max_;
+    const double key_hi = entry_x_ + d_hi - tip_x_min_ + a_x_max_;
+    if (key_lo < max_retired_key_) ++reentries_missed_;
+    auto it = std::partition_point(bubbles_.begin(), bubbles_.end(),
+                                   [&](const ActiveBubble& b) { return b.key.x < key_lo; });
+    for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
+      ActiveBubble& b = *it;
+      const double s0 = std::max(0.0, b.t_entry - t);
+      if (s0 >= dt_) continue;
+      for (std::size_t j = 0; j < tips_.size(); ++j) pierce_tip(b, j, t, s0, u);
+    }
+  }
+
+  void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
+    const Vec3& p = tips_[j];
+    const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
+    const double qy = (wrap(b.entry.y + d_.y - b.key.y, length_[1]) - p.y) * b.inv_axes.y;
+    const double qz = (wrap(b.entry.z + d_.z - b.key.z, length_[2]) - p.z) * b.inv_axes.z;
+    const double vx = u.x * b.inv_axes.x, vy = u.y * b.inv_axes.y, vz = u.z * b.inv_axes.z;
+    const double a = vx * vx + vy * vy + vz * vz;
+    const double bh = qx * vx + qy * vy + qz * vz;
+    const double c = qx * qx + qy * qy + qz * qz - 1.0;
+
+    // Roots of a s^2 + 2 bh s + c = 0: the tip is inside for s in (r1, r2).
+    double r1 = 0.0, r2 = 0.0;
+    bool crosses = false;
+    if (a > 0.0) {
+      const double disc = bh * bh - a * c;
+      if (disc > 0.0) {
+        const double sq = std::sqrt(disc);
+        const double qq = -(bh + std::copysign(sq, bh));
+        r1 = qq / a;
+        r2 = qq != 0.0 ? c / qq : -r1;
+        if (r1 > r2) std::swap(r1, r2);
+        crosses = true;
+      }
+    } else if (c < 0.0) {
+      r1 = -std::numeric_limits<double>::infinity();
+      r2 = std::numeric_limits<double>::infinity();
+      crosses = true;
+    }
+
+    auto& open = open_[j];
+    auto found = std::find_if(open.begin(), open.end(), [&](const OpenPierce& o) { return o.serial == b.serial; });
+    if (found != open.end()) {
+      if (!crosses || r2 <= s0) {
+        emit(j, b, found->t_in, t + s0);
+        open.erase(found);
+      } else if (r2 < dt_) {
+        emit(j, b, found->t_in, t + r2);
+        open.erase(found);
+      }
+      return;
+    }
+    if (!crosses || r2 <= s0 || r1 >= dt_) return;
+    const double t_in = t + std::max(r1, s0);
+    if (r2 < dt_) {
+      emit(j, b, t_in, t + r2);
+    } else {
+      open.push_back({b.serial, t_in});
+    }
+  }
+
+  void emit(std::size_t j, ActiveBubble& b, double t_in, double t_out) {
+    if (t_out <= 0.0 || t_in >= duration_) return;
+    b.pierced_mask |= std::uint64_t{1} << j;
+    // Samples strictly inside (t_in, t_out).
+    const auto start = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(t_in * fs_)) + 1);
+    const auto stop = std::min<std::int64_t>(samples_, static_cast<std::int64_t>(std::ceil(t_out * fs_)));
+    if (start < stop) pierces_[j].push_back({start, stop});
+  }
+
+  void retire(const Vec3& d_next) {
+    const double limit = entry_x_ + std::min(d_.x, d_next.x) - tip_x_max_ - a_x_max_ - reversal_allowance_;
+    while (!bubbles_.empty() && bubbles_.front().key.x < limit) {
+      max_retired_key_ = std::max(max_retired_key_, bubbles_.front().key.x);
+      tally(bubbles_.front());
+      bubbles_.pop_front();
+    }
+  }
+
+  void finish_open() {
+    for (std::size_t j = 0; j < tips_.size(); ++j) {
+      for (const auto& o : open_[j]) {
+        auto it = std::find_if(bubbles_.begin(), bubbles_.end(),
+                               [&](const ActiveBubble& b) { return b.serial == o.serial; });
+        if (it != bubbles_.end()) emit(j, *it, o.t_in, duration_);
+      }
+      open_[j].clear();
+    }
+  }
+
+  void tally(const ActiveBubble& b) {
+    if (b.pierced_mask == 0) return;
+    const std::size_t n = tips_.size();
+    for (std::size_t j = 0; j < n; ++j) {
+      if (!(b.pierced_mask >> j & 1u)) continue;
+      ++tip_counts_[j];
+      for (std::size_t k = j + 1; k < n; ++k) {
+        if (b.pierced_mask >> k & 1u) ++pair_counts_[j * n + k];
+      }
+    }
+  }
+
+  const Scene& scene_;
+  const SynthesisOptions& options_;
+  SizeModel sizes_;
+  Rng bubble_rng_;
+  double dt_ = 0.0, fs_ = 0.0, duration_ = 0.0;
+  std::int64_t samples_ = 0;
+  std::vector<Vec3> tips_;
+  double tip_x_min_ = 0.0, tip_x_max_ = 0.0;
+  double a_x_max_ = 0.0;
+  double length_[3] = {0, 0, 0};
+  double entry_x_ = 0.0;
+  double rate_ = 0.0, expected_pierce_rate_ = 0.0, spacing_ = 0.0;
+  double reversal_allowance_ = 0.0;
+  std::int64_t pre_steps_ = 0, record_steps_ = 0;
+  double t_start_ = 0.0;
+  bool time_rule_ = true, poisson_ = false;
+  double next_time_ = 0.0, next_key_ = 0.0;
+
+  Vec3 d_{};  // common displacement at the current step start
+  std::deque<ActiveBubble> bubbles_;
+  std::deque<Pending> pending_;
+  std::vector<BubbleRecord> records_;
+  std::uint64_t serial_ = 0;
+  double max_retired_key_ = -std::numeric_limits<double>::infinity();
+  std::vector<std::vector<OpenPierce>> open_;
+  std::vector<std::vector<awcc::AirInterval>> pierces_;
+  std::vector<std::int64_t> pair_counts_;
+  std::vector<std::int64_t> tip_counts_;
+  std::int64_t generated_ = 0, overlaps_unresolved_ = 0, reentries_missed_ = 0;
+};
+
+template <class PerSample>
+void for_each_sample_min_form(const Scene& scene, const ReferenceData& ref, PerSample&& per_sample) {
+  // Bubbles sorted by key.x for a candidate range per sample (as wide as any
+  // bubble can be), then a plain point-in-ellipsoid test at t = n / fs.
+  std::vector<BubbleRecord> bubbles = ref.bubbles;
+  std::sort(bubbles.begin(), bubbles.end(), [](const auto& a, const auto& b) { return a.key.x < b.key.x; });
+  double a_max = 0.0;
+  double entry_x = 0.0;
+  for (const auto& b : bubbles) {
+    a_max = std::max(a_max, b.semi_axes.x);
+    entry_x = b.entry.x;
+  }
+  double tip_lo = 1e300, tip_hi = -1e300;
+  for (const auto& p : ref.tips) {
+    tip_lo = std::min(tip_lo, p.x);
+    tip_hi = std::max(tip_hi, p.x);
+  }
+  // Displacement at every step start.
+  std::vector<Vec3> d(ref.velocities.size() + 1);
+  for (std::size_t k = 0; k < ref.velocities.size(); ++k) {
+    const Vec3& u = ref.velocities[k];
+    d[k + 1] = {d[k].x + u.x * ref.step, d[k].y + u.y * ref.step, d[k].z + u.z * ref.step};
+  }
+  const std::int64_t n_samples = scene.sample_count();
+  const double fs = scene.fs;
+  for (std::int64_t n = 0; n < n_samples; ++n) {
+    const double t = static_cast<double>(n) / fs;
+    auto k = static_cast<std::size_t>(std::floor((t - ref.t_start) / ref.step));
+    k = std::min(k, ref.velocities.size() - 1);
+    const double s = t - (ref.t_start + static_cast<double>(k) * ref.step);
+    const Vec3& u = ref.velocities[k];
+    const Vec3 dt{d[k].x + u.x * s, d[k].y + u.y * s, d[k].z + u.z * s};
+    const double lo = entry_x + dt.x - tip_hi - a_max;
+    const double hi = entry_x + dt.x - tip_lo + a_max;
+    auto it = std::partition_point(bubbles.begin(), bubbles.end(), [&](const auto& b) { return b.key.x < lo; });
+    for (std::size_t j = 0; j < ref.tips.size(); ++j) {
+      double best = std::numeric_limits<double>::infinity();
+      for (auto b = it; b != bubbles.end() && b->key.x <= hi; ++b) {
+        if (!(t > b->t_entry)) continue;
+        const double x = (b->entry.x + dt.x - b->key.x - ref.tips[j].x) / b->semi_axes.x;
+        const double y = (wrap(b->entry.y + dt.y - b->key.y, ref.control_volume.y) - ref.tips[j].y) / b->semi_axes.y;
+        const double z = (wrap(b->entry.z + dt.z - b->key.z, ref.control_volume.z) - ref.tips[j].z) / b->semi_axes.z;
+        best = std::min(best, x * x + y * y + z * z);
+      }
+      per_sample(j, n, best);
+    }
+  }
+}
+
+}  // namespace
+
+Synthesis synthesise(const Scene& scene, const SynthesisOptions& options) {
+  const auto errors = scene.validate();
+  if (!errors.empty()) {
+    std::string message = "invalid scene:";
+    for (const auto& e : errors) message += "\n  " + e;
+    throw std::invalid_argument(message);
+  }
+  Synthesiser synthesiser(scene, options);
+  return synthesiser.run();
+}
+
+std::vector<std::vector<std::uint8_t>> brute_force_signals(const Scene& scene, const ReferenceData& reference) {
+  std::vector<std::vector<std::uint8_t>> out(reference.tips.size(),
+                                             std::vector<std::uint8_t>(static_cast<std::size_t>(scene.sample_count())));
+  for_each_sample_min_form(scene, reference, [&](std::size_t j, std::int64_t n, double form) {
+    out[j][static_cast<std::size_t>(n)] = form < 1.0 ? 1 : 0;
+  });
+  return out;
+}
+
+std::vector<std::vector<double>> brute_force_distances(const Scene& scene, const ReferenceData& reference) {
+  std::vector<std::vector<double>> out(reference.tips.size(),
+                                       std::vector<double>(static_cast<std::size_t>(scene.sample_count())));
+  for_each_sample_min_form(scene, reference, [&](std::size_t j, std::int64_t n, double form) {
+    out[j][static_cast<std::size_t>(n)] = form;
+  });
+  return out;
+}
+
+}  // namespace synth

@@ -1,0 +1,33 @@
+// pdp: the dual-tip phase-detection probe toolkit's command line.
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "awcc/version.hpp"
+#include "synth_command.hpp"
+
+int main(int argc, char** argv) {
+  // Logs go to stderr; results to files or stdout.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("pdp"));
+  spdlog::set_pattern("%^[%l]%$ %v");
+
+  CLI::App app{"pdp: dual-tip phase-detection probe toolkit (AWCC processing, synthetic probe)"};
+  app.set_version_flag("--version", std::string("pdp ") + awcc::version);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace | debug | info | warn | error | off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
+      ->capture_default_str();
+  app.parse_complete_callback([&]() { spdlog::set_level(spdlog::level::from_str(log_level)); });
+  app.require_subcommand(1);
+
+  pdp::SynthOptions synth_options;
+  auto* synth_command = pdp::setup_synth(app, synth_options);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  if (synth_command->parsed()) return pdp::run_synth(synth_options);
+  return 0;
+}

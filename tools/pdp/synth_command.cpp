@@ -1,0 +1,124 @@
+#include "synth_command.hpp"
+
+#include <chrono>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "awcc/atomic_output.hpp"
+#include "synth/recording.hpp"
+#include "synth/sidecar.hpp"
+#include "synth/synthesiser.hpp"
+#include "terminal.hpp"
+
+namespace pdp {
+
+CLI::App* setup_synth(CLI::App& app, SynthOptions& options) {
+  auto* cmd = app.add_subcommand("synth", "Synthesise a scene: write a recording and its <name>.truth.json sidecar");
+  cmd->add_option("--config", options.config, "scene TOML file; command-line fields override it")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", options.output, "recording to write (.flac, .wav, .w64, .rf64)")->required();
+  cmd->add_option("--signal", options.signal, "binary (0 water, 1 air) or voltage (raw int16 counts)")
+      ->check(CLI::IsMember({"binary", "voltage"}))
+      ->capture_default_str();
+  cmd->add_option("--format", options.format, "flac | wav | w64 | rf64 [default: from the extension]")
+      ->check(CLI::IsMember({"flac", "wav", "w64", "rf64"}));
+  cmd->add_option("--flac-compression", options.flac_compression, "FLAC compression level, 0 fastest to 1 smallest")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", options.quiet, "do not print the truth summary");
+
+  const synth::Scene defaults;
+  const auto fields = synth::scene_fields();
+  options.field_values.resize(fields.size());
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const auto& f = fields[i];
+    auto* opt = cmd->add_option(fmt::format("--{}", f.name), options.field_values[i],
+                                fmt::format("{} [default: {}]", f.help, f.format(defaults)));
+    opt->group("Scene (same names in the TOML file; units allowed, e.g. 5mm, 500kHz, 300s)");
+    options.field_options.push_back(opt);
+  }
+  return cmd;
+}
+
+int run_synth(const SynthOptions& options) {
+  synth::Scene scene;
+  if (!options.config.empty()) {
+    try {
+      synth::load_scene_toml(options.config, scene);
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+      return 2;
+    }
+  }
+  const auto fields = synth::scene_fields();
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    if (options.field_options[i]->count() == 0) continue;
+    try {
+      fields[i].parse(scene, options.field_values[i]);
+    } catch (const std::exception& e) {
+      spdlog::error("--{}: {}", fields[i].name, e.what());
+      return 2;
+    }
+  }
+  const std::string source = options.config.empty() ? "the command line" : options.config + " and the command line";
+  if (const auto errors = scene.validate(); !errors.empty()) {
+    spdlog::error("invalid scene (from {}):", source);
+    for (const auto& e : errors) spdlog::error("  {}", e);
+    return 2;
+  }
+
+  synth::RecordingOptions recording;
+  recording.signal = options.signal == "voltage" ? synth::SignalKind::voltage : synth::SignalKind::binary;
+  recording.flac_compression = options.flac_compression;
+  if (!options.format.empty()) {
+    recording.format = *synth::format_from_extension("x." + options.format);
+  } else if (auto f = synth::format_from_extension(options.output)) {
+    recording.format = *f;
+  } else {
+    spdlog::error("{}: unknown recording extension; use .flac, .wav, .w64 or .rf64, or give --format",
+                  options.output);
+    return 2;
+  }
+  if (const auto why = synth::check_recordable(scene, scene.probe_tips().size(), recording.format); !why.empty()) {
+    spdlog::error("{}: {}", options.output, why);
+    return 2;
+  }
+
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    synth::Synthesis synthesis;
+    {
+      Progress progress("synthesising");
+      synth::SynthesisOptions so;
+      so.progress = [&progress](double f) { progress(f); };
+      synthesis = synth::synthesise(scene, so);
+    }
+    const double t_synth = seconds_since(start);
+    if (synthesis.truth.reentries_missed > 0) {
+      spdlog::warn("{} steps where the flow reversed beyond the bubble retirement allowance; some piercings may be "
+                   "missing",
+                   synthesis.truth.reentries_missed);
+    }
+    const auto write_start = std::chrono::steady_clock::now();
+    {
+      Progress progress("writing");
+      recording.progress = [&progress](double f) { progress(f); };
+      const std::filesystem::path out = options.output;
+      const auto sidecar = synth::sidecar_path(out);
+      awcc::write_atomically(out, [&](const std::filesystem::path& temporary) {
+        synth::write_recording(temporary, scene, synthesis.signals, recording);
+        awcc::write_text_atomically(sidecar, synth::sidecar_json(synthesis.truth, recording, out).dump(2) + "\n");
+      });
+      spdlog::info("wrote {} and {}", out.string(), sidecar.string());
+    }
+    spdlog::info("synthesis {:.2f} s, file {:.2f} s, peak memory {:.0f} MB", t_synth, seconds_since(write_start),
+                 peak_memory_mb());
+    if (!options.quiet) fmt::print("{}", synthesis.truth.report());
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace pdp
