@@ -57,8 +57,16 @@ struct SizeModel {
 };
 
 // Minimum-image separation on a periodic interval of the given length.
-double wrap(double separation, double length) {
-  return separation - length * std::nearbyint(separation / length);
+// Separations are rarely more than one period off (bubbles live for a few
+// milliseconds), so a loop beats a call to nearbyint on this hot path.
+inline double wrap(double separation, double length) {
+  const double half = 0.5 * length;
+  separation -= length * static_cast<double>(separation > half);
+  separation += length * static_cast<double>(separation < -half);
+  if (separation > half || separation < -half) [[unlikely]] {
+    separation -= length * std::nearbyint(separation / length);
+  }
+  return separation;
 }
 
 struct ActiveBubble {
@@ -70,6 +78,33 @@ struct ActiveBubble {
   double t_entry;
   std::uint64_t serial;
   std::uint64_t pierced_mask = 0;
+};
+
+// Active bubbles sorted by key.x: a vector with a moving head, so that the
+// candidate searches run on contiguous memory (a std::deque's iterators made
+// them the hot spot). Appends dominate; retirement advances the head.
+class BubbleQueue {
+ public:
+  using iterator = std::vector<ActiveBubble>::iterator;
+  iterator begin() { return items_.begin() + static_cast<std::ptrdiff_t>(head_); }
+  iterator end() { return items_.end(); }
+  [[nodiscard]] bool empty() const { return head_ == items_.size(); }
+  ActiveBubble& front() { return items_[head_]; }
+  void pop_front() {
+    if (++head_ >= 4096 && 2 * head_ >= items_.size()) {
+      items_.erase(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(head_));
+      head_ = 0;
+    }
+  }
+  void insert_sorted(const ActiveBubble& b) {
+    auto pos = end();
+    while (pos != begin() && std::prev(pos)->key.x > b.key.x) --pos;
+    items_.insert(pos, b);
+  }
+
+ private:
+  std::vector<ActiveBubble> items_;
+  std::size_t head_ = 0;
 };
 
 struct Pending {
@@ -109,9 +144,10 @@ class FlowAccumulator {
         auto& ring = ring_[i];
         auto& lagged = lagged_[i];
         ring[slot] = y[i];
-        for (std::size_t k = 0; k <= available; ++k) {
-          lagged[k] += y[i] * ring[(slot + lags_ + 1 - k) % (lags_ + 1)];
-        }
+        // ring[slot - k] for k <= slot, then wrapped around the end.
+        const std::size_t direct = std::min(available, slot);
+        for (std::size_t k = 0; k <= direct; ++k) lagged[k] += y[i] * ring[slot - k];
+        for (std::size_t k = direct + 1; k <= available; ++k) lagged[k] += y[i] * ring[slot + lags_ + 1 - k];
         dsum_[i] += y[i];
       }
       ++decimated_;
@@ -421,27 +457,25 @@ class Synthesiser {
     if (options_.keep_reference_data) {
       records_.push_back({t_entry, b.entry, b.key, {b.a_x, 1.0 / b.inv_axes.y, 1.0 / b.inv_axes.z}});
     }
-    // Keep sorted by key.x: nearly always an append.
-    auto pos = bubbles_.end();
-    while (pos != bubbles_.begin() && std::prev(pos)->key.x > key.x) --pos;
-    bubbles_.insert(pos, b);
+        bubbles_.insert_sorted(b);
     return true;
   }
 
   void pierce(double t, const Vec3& u, const Vec3& d_next) {
     const double d_lo = std::min(d_.x, d_next.x);
     const double d_hi = std::max(d_.x, d_next.x);
-    // Bubble x relative to tip j: entry_x + D_x - key_x - P_jx, inside only if |.| < a_x.
-    const double key_lo = entry_x_ + d_lo - tip_x_max_ - a_x_max_;
-    const double key_hi = entry_x_ + d_hi - tip_x_min_ + a_x_max_;
-    if (key_lo < max_retired_key_) ++reentries_missed_;
-    auto it = std::partition_point(bubbles_.begin(), bubbles_.end(),
-                                   [&](const ActiveBubble& b) { return b.key.x < key_lo; });
-    for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
-      ActiveBubble& b = *it;
-      const double s0 = std::max(0.0, b.t_entry - t);
-      if (s0 >= dt_) continue;
-      for (std::size_t j = 0; j < tips_.size(); ++j) pierce_tip(b, j, t, s0, u);
+    if (entry_x_ + d_lo - tip_x_max_ - a_x_max_ < max_retired_key_) ++reentries_missed_;
+    // Bubble x relative to tip j is entry_x + D_x - key_x - P_jx, and the tip
+    // can be inside only if |.| < a_x: one contiguous range of keys per tip.
+    for (std::size_t j = 0; j < tips_.size(); ++j) {
+      const double key_lo = entry_x_ + d_lo - tips_[j].x - a_x_max_;
+      const double key_hi = entry_x_ + d_hi - tips_[j].x + a_x_max_;
+      auto it = std::partition_point(bubbles_.begin(), bubbles_.end(),
+                                     [&](const ActiveBubble& b) { return b.key.x < key_lo; });
+      for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
+        const double s0 = std::max(0.0, it->t_entry - t);
+        pierce_tip(*it, j, t, s0, u);
+      }
     }
   }
 
@@ -555,7 +589,7 @@ class Synthesiser {
   double next_time_ = 0.0, next_key_ = 0.0;
 
   Vec3 d_{};  // common displacement at the current step start
-  std::deque<ActiveBubble> bubbles_;
+  BubbleQueue bubbles_;
   std::deque<Pending> pending_;
   std::vector<BubbleRecord> records_;
   std::uint64_t serial_ = 0;
