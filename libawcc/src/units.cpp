@@ -18,7 +18,7 @@ struct Unit {
 std::vector<Unit> units_of(Dimension dimension) {
   switch (dimension) {
     case Dimension::dimensionless:
-      return {{"", 1.0}, {"%", 0.01}};
+      return {{"%", 0.01}};
     case Dimension::length:
       return {{"m", 1.0}, {"cm", 1e-2}, {"mm", 1e-3}, {"um", 1e-6}, {"µm", 1e-6}};
     case Dimension::time:
@@ -54,7 +54,9 @@ std::string_view trim(std::string_view s) {
 
 }  // namespace
 
-std::string_view si_unit(Dimension dimension) { return units_of(dimension).front().symbol; }
+std::string_view si_unit(Dimension dimension) {
+  return dimension == Dimension::dimensionless ? std::string_view{} : units_of(dimension).front().symbol;
+}
 
 std::string accepted_units(Dimension dimension) {
   std::string out;
@@ -88,6 +90,7 @@ double parse_quantity(std::string_view text, Dimension dimension) {
   if (ec != std::errc{} || ptr == first) return fail("no number at its start");
   if (!std::isfinite(value)) return fail("the number is not finite");
   const std::string_view unit = trim(std::string_view(ptr, static_cast<std::size_t>(last - ptr)));
+  if (unit.empty()) return value;  // a plain number is SI
   for (const auto& u : units_of(dimension)) {
     if (u.symbol == unit) return value * u.scale;
   }

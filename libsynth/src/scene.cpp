@@ -29,7 +29,10 @@ double Scene::tu_of(int component) const {
 }
 
 double Scene::effective_realisation_step() const {
-  if (realisation_step > 0.0) return realisation_step;
+  // Shrunk to duration / (a whole number of steps) so that the steps tile the
+  // record exactly and the realised statistics are time averages over it.
+  auto tile = [this](double step) { return duration / std::ceil(duration / step - 1e-9); };
+  if (realisation_step > 0.0) return tile(realisation_step);
   const double t_min = std::min({time_scale_of(0), time_scale_of(1), time_scale_of(2)});
   const auto p = probe_tips();
   double spread = 0.0;
@@ -39,7 +42,7 @@ double Scene::effective_realisation_step() const {
     }
   }
   if (spread <= 0.0) spread = bubble_diameter;
-  return std::min(t_min / 50.0, spread / velocity / 10.0);
+  return tile(std::min(t_min / 50.0, spread / velocity / 10.0));
 }
 
 std::int64_t Scene::sample_count() const {

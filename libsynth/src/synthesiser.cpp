@@ -110,6 +110,7 @@ class BubbleQueue {
 struct Pending {
   double diameter;
   double first_key;  // D_x when it first tried to enter
+  double next_try;   // D_x at which to try again
 };
 
 struct OpenPierce {
@@ -368,48 +369,62 @@ class Synthesiser {
     d_ = d_next;
   }
 
+  // Arrivals and retries of waiting bubbles during the step, in time order.
   void arrivals(double t, const Vec3& u, const Vec3& d_next) {
-    // Bubbles that found no free lateral position earlier try again first,
-    // at the start of this step.
-    place_pending(t, d_);
-    const double t_end = t + dt_;
-    if (time_rule_) {
-      while (next_time_ < t_end) {
-        const double s = next_time_ - t;
-        arrive(next_time_, {d_.x + u.x * s, d_.y + u.y * s, d_.z + u.z * s});
-        next_time_ += (poisson_ ? bubble_rng_.exponential() : 1.0) / rate_;
+    auto at = [&](double s) { return Vec3{d_.x + u.x * s, d_.y + u.y * s, d_.z + u.z * s}; };
+    double cursor = 0.0;  // offset into the step of the last event
+    for (;;) {
+      double s_arrival;
+      if (time_rule_) {
+        s_arrival = next_time_ - t;
+      } else {
+        // A bubble enters each time the displacement first passes the next mark.
+        s_arrival = next_key_ <= d_next.x ? std::clamp((next_key_ - d_.x) / u.x, 0.0, dt_) : dt_;
       }
-    } else {
-      // A bubble enters each time the displacement first passes the next mark.
-      while (next_key_ <= d_next.x) {
-        const double s = std::clamp((next_key_ - d_.x) / u.x, 0.0, dt_);
-        arrive(t + s, {next_key_, d_.y + u.y * s, d_.z + u.z * s});
+      double s_retry = dt_;
+      if (!pending_.empty()) {
+        const double target = pending_.front().next_try;
+        if (target <= d_.x) s_retry = cursor;
+        else if (u.x > 0.0 && target <= d_next.x) s_retry = (target - d_.x) / u.x;
+      }
+      s_retry = std::max(s_retry, cursor);
+      if (s_arrival >= dt_ && s_retry >= dt_) break;
+      if (s_retry < s_arrival) {
+        cursor = s_retry;
+        place_pending(t + s_retry, at(s_retry));
+        continue;
+      }
+      cursor = std::max(cursor, s_arrival);
+      Vec3 key = at(s_arrival);
+      if (!time_rule_) key.x = next_key_;
+      pending_.push_back({sizes_.draw(bubble_rng_), key.x, key.x});
+      place_pending(t + s_arrival, key);
+      if (time_rule_) {
+        next_time_ += (poisson_ ? bubble_rng_.exponential() : 1.0) / rate_;
+      } else {
         next_key_ += (poisson_ ? bubble_rng_.exponential() : 1.0) * spacing_;
       }
     }
   }
 
-  // A bubble due at t_entry with the common displacement `key`.
-  void arrive(double t_entry, const Vec3& key) {
-    const double diameter = sizes_.draw(bubble_rng_);
-    pending_.push_back({diameter, key.x});
-    place_pending(t_entry, key);
-  }
-
   // Places waiting bubbles in arrival order. Bubbles never move relative to
   // each other, so an overlap at entry is an overlap for ever. When every
   // lateral position tried overlaps a neighbour, the bubble waits and tries
-  // again at the next step, until the flow has advanced by one largest
-  // diameter; then it is placed overlapping (Truth::overlaps_unresolved).
-  // Waiting keeps the bubble flux (a bubble is late, never lost) and lets the
-  // void fraction reach c above the jamming limit of random sequential
-  // placement (about 0.38 for spheres), where placing overlapping bubbles at
-  // once would lose the overlapped volume.
+  // again each time the flow has advanced by a quarter of the largest
+  // diameter, until it has advanced by one largest diameter; then it is
+  // placed overlapping (Truth::overlaps_unresolved). Waiting keeps the bubble
+  // flux (a bubble is late, never lost) and lets the void fraction reach c
+  // above the jamming limit of random sequential placement (about 0.38 for
+  // spheres), where placing overlapping bubbles at once would lose the
+  // overlapped volume.
   void place_pending(double t_entry, const Vec3& key) {
     while (!pending_.empty()) {
-      const Pending& p = pending_.front();
-      const bool must_place = key.x - p.first_key > 2.0 * a_x_max_;
-      if (!try_place(p.diameter, t_entry, key, must_place)) return;
+      Pending& p = pending_.front();
+      const bool must_place = key.x - p.first_key >= 2.0 * a_x_max_;
+      if (!try_place(p.diameter, t_entry, key, must_place)) {
+        p.next_try = std::max(p.next_try, key.x) + 0.5 * a_x_max_;
+        return;
+      }
       pending_.pop_front();
     }
   }

@@ -53,7 +53,7 @@ struct Scene {
   double diameter_log_sd = 0.0;           ///< std of ln(d_b); 0 = all equal, > 0 = log-normal
   double aspect_ratio = 1.0;              ///< ellipsoid semi-axis along x over the lateral ones
   ArrivalRule arrival = ArrivalRule::equal_time;
-  int overlap_retries = 10;               ///< lateral positions tried to avoid an overlap
+  int overlap_retries = 30;               ///< lateral positions tried to avoid an overlap
   // Probe.
   double dx = 5e-3;                       ///< trailing tip minus leading tip, streamwise, m
   double dy = 1e-3;                       ///< ... lateral, m
@@ -80,7 +80,9 @@ struct Scene {
   /// Velocity time step actually used: realisation_step, or when 0,
   /// min(T_min / 50, transit / 10) with transit = max tip spread / velocity
   /// (bubble diameter / velocity for a one-tip probe), so that the step
-  /// resolves both the integral time scale and the tip-to-tip transit.
+  /// resolves both the integral time scale and the tip-to-tip transit; then
+  /// shrunk to duration / ceil(duration / step) so the record holds a whole
+  /// number of steps.
   [[nodiscard]] double effective_realisation_step() const;
   /// Record length in samples, round(duration * fs).
   [[nodiscard]] std::int64_t sample_count() const;
