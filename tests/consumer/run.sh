@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Usage: run.sh BUILD_DIR SCRATCH CONSUMER_SOURCE CMAKE
+set -euo pipefail
+build=$1 scratch=$2 source=$3 cmake=$4
+rm -rf "$scratch" && mkdir -p "$scratch"
+"$cmake" --install "$build" --prefix "$scratch/prefix" >/dev/null
+test -x "$scratch/prefix/bin/pdp"
+test -f "$scratch/prefix/include/awcc/version.hpp"
+"$cmake" -S "$source" -B "$scratch/build" -DCMAKE_PREFIX_PATH="$scratch/prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
+"$cmake" --build "$scratch/build" >/dev/null
+"$scratch/build/consumer"
+"$scratch/prefix/bin/pdp" --version
