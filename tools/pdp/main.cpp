@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/version.hpp"
+#include "process_command.hpp"
 #include "synth_command.hpp"
 
 int main(int argc, char** argv) {
@@ -22,6 +23,8 @@ int main(int argc, char** argv) {
 
   pdp::SynthOptions synth_options;
   auto* synth_command = pdp::setup_synth(app, synth_options);
+  pdp::ProcessCommandOptions process_options;
+  auto* process_command = pdp::setup_process(app, process_options);
 
   try {
     app.parse(argc, argv);
@@ -29,5 +32,6 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   if (synth_command->parsed()) return pdp::run_synth(synth_options);
+  if (process_command->parsed()) return pdp::run_process(process_options);
   return 0;
 }

@@ -1,0 +1,54 @@
+#pragma once
+// FFT plans for correlation: a plan object owns its FFTW plans and scratch
+// buffers and is reused for every transform of its size; a cache hands out one
+// plan per size. Sizes are rounded up to products of 2, 3, 5 and 7, which
+// FFTW transforms fastest.
+
+#include <complex>
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <span>
+
+namespace awcc {
+
+/// Smallest n >= minimum whose prime factors are all 2, 3, 5 or 7.
+std::size_t fast_fft_size(std::size_t minimum);
+
+/// Real-to-complex forward and complex-to-real inverse transforms of size n.
+class FftPlan {
+ public:
+  explicit FftPlan(std::size_t n);
+  ~FftPlan();
+  FftPlan(const FftPlan&) = delete;
+  FftPlan& operator=(const FftPlan&) = delete;
+
+  [[nodiscard]] std::size_t size() const { return n_; }
+  /// Time-domain buffer (n values).
+  [[nodiscard]] std::span<double> real() { return {real_, n_}; }
+  /// Spectrum buffer (n / 2 + 1 values).
+  [[nodiscard]] std::span<std::complex<double>> spectrum() {
+    return {reinterpret_cast<std::complex<double>*>(spectrum_), n_ / 2 + 1};
+  }
+  void forward();  ///< real() -> spectrum()
+  void inverse();  ///< spectrum() -> real(), unnormalised (scaled by n)
+
+ private:
+  std::size_t n_;
+  double* real_ = nullptr;
+  void* spectrum_ = nullptr;
+  void* forward_ = nullptr;
+  void* inverse_ = nullptr;
+};
+
+/// One plan per size, created on first use (plan creation is serialised:
+/// FFTW's planner is not thread-safe).
+class FftPlanCache {
+ public:
+  FftPlan& get(std::size_t n);
+
+ private:
+  std::map<std::size_t, std::unique_ptr<FftPlan>> plans_;
+};
+
+}  // namespace awcc

@@ -1,0 +1,70 @@
+#pragma once
+// Processing one recording end to end: read (two passes, block by block),
+// binarise the leading and trailing tips, phase statistics per tip, and FSCC.
+// Results are value types with a readable report and a JSON form whose keys
+// are documented in docs/output.md.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "awcc/binarisation.hpp"
+#include "awcc/fscc.hpp"
+#include "awcc/phase_statistics.hpp"
+#include "awcc/recording.hpp"
+
+namespace awcc {
+
+struct ProcessOptions {
+  ReaderOptions reader;
+  int leading_channel = 0;            ///< channel index of the leading tip
+  int trailing_channel = 1;           ///< channel index of the trailing tip
+  BinarisationOptions binarisation;
+  double dx = 0.0;                    ///< streamwise tip separation, m (required for velocities)
+  double dy = 0.0;                    ///< lateral tip separation, m (reported)
+  bool fscc = true;                   ///< run FSCC
+  FsccOptions fscc_options;
+  int histogram_bins = 50;            ///< chord-time histogram bins
+  std::int64_t block_frames = 1 << 16;  ///< frames read at a time
+
+  [[nodiscard]] std::string validate() const;
+};
+
+struct TipResult {
+  int channel = 0;
+  Threshold threshold;
+  PhaseStatistics phase;
+};
+
+/// The two binary signals of a recording (what AWCC and FSCC consume).
+struct BinarisedRecording {
+  RecordingInfo info;
+  Threshold leading_threshold, trailing_threshold;
+  AirIntervals leading, trailing;
+};
+
+struct ProcessResult {
+  RecordingInfo info;
+  double dx = 0.0, dy = 0.0;
+  std::vector<TipResult> tips;        ///< leading tip first
+  std::optional<FsccResult> fscc;
+  double seconds = 0.0;               ///< wall time of the processing
+
+  [[nodiscard]] std::string report() const;
+};
+
+/// Reads and binarises the two tips' channels. Throws std::runtime_error
+/// naming the file and the problem.
+BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options);
+
+/// Phase statistics (and FSCC) from binarised signals.
+ProcessResult process_binarised(const BinarisedRecording& recording, const ProcessOptions& options);
+
+/// Both of the above.
+ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options);
+
+nlohmann::json to_json(const ProcessResult& result);
+
+}  // namespace awcc

@@ -1,0 +1,86 @@
+#pragma once
+// Reading probe recordings, block by block, whatever wrote them.
+//
+// Formats:
+//  - every container libsndfile reads (WAV, W64, RF64, FLAC, AIFF, ...);
+//  - the UQ LabVIEW .dat layout: two little-endian int32 (rows, channels), then
+//    rows x channels little-endian int16, volts = counts * 5 / 32768;
+//  - headerless raw files with a stated layout (sample type, byte order,
+//    channels, header bytes, volts per count);
+//  - CSV/TSV columns (header row optional, a time column optional).
+// Every reader hands out interleaved float volts (frames x channels) in
+// blocks, so memory does not depend on the file's length; rewind() starts
+// again for a second pass. Damaged input is refused with a message naming the
+// file, what is wrong, where, and the fix.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace awcc {
+
+enum class InputFormat { automatic, sndfile, uq_dat, raw, csv };
+enum class SampleType { int16, int32, float32, float64 };
+enum class ByteOrder { little, big };
+
+std::string_view to_string(InputFormat format);
+std::string_view to_string(SampleType type);
+
+/// Layout of a headerless raw file (all fields stated by the user).
+struct RawLayout {
+  SampleType sample_type = SampleType::int16;
+  ByteOrder byte_order = ByteOrder::little;
+  int channels = 2;
+  std::int64_t header_bytes = 0;   ///< bytes to skip at the start
+  double volts_per_count = 1.0;    ///< V per integer count (or per float unit)
+};
+
+struct CsvLayout {
+  char delimiter = 0;              ///< 0 = detect (comma, tab, semicolon, blanks)
+  std::optional<bool> header;      ///< empty = detect (a first row with a non-number is a header)
+  int time_column = -2;            ///< -2 = detect by header name (time, t, time_s, seconds), -1 = none
+};
+
+struct ReaderOptions {
+  InputFormat format = InputFormat::automatic;
+  RawLayout raw;
+  CsvLayout csv;
+  double fs = 0.0;                 ///< Hz; required for raw files and CSV without a time column; overrides otherwise
+  double volts_per_count = 0.0;    ///< overrides the file's scale when > 0 (sndfile integer data, .dat)
+};
+
+struct RecordingInfo {
+  std::filesystem::path path;
+  InputFormat format = InputFormat::automatic;
+  std::string description;         ///< e.g. "FLAC, int16", "UQ .dat", "CSV (3 columns, time in column 0)"
+  int channels = 0;                ///< data channels (a CSV time column is not one)
+  double fs = 0.0;                 ///< Hz
+  std::int64_t frames = -1;        ///< -1 when unknown before reading (CSV)
+  double quantum = 0.0;            ///< volts per count for integer samples, 0 for floating data
+  bool volts_known = false;        ///< values are in volts (not normalised units)
+};
+
+class Recording {
+ public:
+  virtual ~Recording() = default;
+  [[nodiscard]] const RecordingInfo& info() const { return info_; }
+  /// Reads up to max_frames frames into `out` (at least max_frames x channels
+  /// floats, interleaved volts). Returns the frames read; 0 at the end.
+  /// Throws std::runtime_error on damaged data (naming file and position).
+  virtual std::int64_t read(std::span<float> out, std::int64_t max_frames) = 0;
+  /// Back to the first frame.
+  virtual void rewind() = 0;
+
+ protected:
+  RecordingInfo info_;
+};
+
+/// Opens a recording (detecting the format by content and extension unless
+/// told). Throws std::runtime_error naming the file, the problem and the fix.
+std::unique_ptr<Recording> open_recording(const std::filesystem::path& path, const ReaderOptions& options = {});
+
+}  // namespace awcc

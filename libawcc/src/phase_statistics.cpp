@@ -1,0 +1,115 @@
+#include "awcc/phase_statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace awcc {
+namespace {
+
+double quantile(const std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return 0.0;
+  const double pos = p * static_cast<double>(sorted.size() - 1);
+  const auto k = static_cast<std::size_t>(std::floor(pos));
+  const double frac = pos - static_cast<double>(k);
+  if (k + 1 >= sorted.size()) return sorted.back();
+  return sorted[k] + frac * (sorted[k + 1] - sorted[k]);
+}
+
+Histogram histogram_of(const std::vector<double>& sorted, int bins) {
+  Histogram h;
+  if (sorted.empty() || bins <= 0) return h;
+  const double top = quantile(sorted, 0.99);
+  h.bin_width = top > 0.0 ? top / bins : 1.0;
+  h.counts.assign(static_cast<std::size_t>(bins), 0);
+  for (double v : sorted) {
+    auto k = static_cast<std::size_t>(std::max(0.0, std::floor(v / h.bin_width)));
+    ++h.counts[std::min(k, h.counts.size() - 1)];
+  }
+  return h;
+}
+
+double variance(const std::vector<double>& v, double mean) {
+  if (v.size() < 2) return 0.0;
+  double s = 0.0;
+  for (double x : v) s += (x - mean) * (x - mean);
+  return s / static_cast<double>(v.size() - 1);
+}
+
+}  // namespace
+
+Summary summarise(std::vector<double> values) {
+  Summary s;
+  s.count = static_cast<std::int64_t>(values.size());
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  const double n = static_cast<double>(values.size());
+  s.mean = sum / n;
+  s.std = std::sqrt(variance(values, s.mean));
+  s.min = values.front();
+  s.max = values.back();
+  s.median = quantile(values, 0.5);
+  for (std::size_t i = 0; i < s.percentiles.size(); ++i) s.percentiles[i] = quantile(values, Summary::levels[i] / 100.0);
+  const double half = 1.96 * s.std / std::sqrt(n);
+  s.mean_ci95 = {s.mean - half, s.mean + half};
+  const double spread = 1.96 * std::sqrt(n) / 2.0;
+  const auto rank = [&](double r) {
+    return values[static_cast<std::size_t>(std::clamp(std::round(r), 0.0, n - 1.0))];
+  };
+  s.median_ci95 = {rank(n / 2.0 - spread - 0.5), rank(n / 2.0 + spread - 0.5)};
+  return s;
+}
+
+PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisticsOptions& options) {
+  PhaseStatistics p;
+  const double fs = signal.fs;
+  p.duration = fs > 0.0 ? static_cast<double>(signal.sample_count) / fs : 0.0;
+  p.void_fraction = signal.void_fraction();
+  std::vector<double> air, water, arrivals;
+  const auto& iv = signal.intervals;
+  for (std::size_t i = 0; i < iv.size(); ++i) {
+    const bool complete = iv[i].start > 0 && iv[i].stop < signal.sample_count;
+    if (complete) air.push_back(static_cast<double>(iv[i].stop - iv[i].start) / fs);
+    if (i + 1 < iv.size()) {
+      water.push_back(static_cast<double>(iv[i + 1].start - iv[i].stop) / fs);
+      if (i > 0 || iv[i].start > 0) arrivals.push_back(static_cast<double>(iv[i + 1].start - iv[i].start) / fs);
+    }
+  }
+  const auto n = static_cast<double>(air.size());
+  p.bubble_count_rate = p.duration > 0.0 ? n / p.duration : 0.0;
+  p.air_chord_time = summarise(air);
+  p.water_chord_time = summarise(water);
+  p.interarrival_time = summarise(arrivals);
+  {
+    std::vector<double> sorted_air = air, sorted_water = water;
+    std::sort(sorted_air.begin(), sorted_air.end());
+    std::sort(sorted_water.begin(), sorted_water.end());
+    p.air_chord_histogram = histogram_of(sorted_air, options.histogram_bins);
+    p.water_chord_histogram = histogram_of(sorted_water, options.histogram_bins);
+  }
+  // Confidence intervals of c and F (alternating renewal process, see header).
+  p.void_fraction_ci95 = {p.void_fraction, p.void_fraction};
+  p.bubble_count_rate_ci95 = {p.bubble_count_rate, p.bubble_count_rate};
+  if (air.size() >= 2 && water.size() >= 2) {
+    const double ma = p.air_chord_time.mean, mw = p.water_chord_time.mean;
+    const double va = variance(air, ma), vw = variance(water, mw);
+    const double m = ma + mw;
+    const double c = p.void_fraction;
+    const double se_c = std::sqrt(((1 - c) * (1 - c) * va + c * c * vw) / (n * m * m));
+    p.void_fraction_ci95 = {std::max(0.0, c - 1.96 * se_c), std::min(1.0, c + 1.96 * se_c)};
+    const double se_f = p.bubble_count_rate * std::sqrt((va + vw) / (m * m) / n);
+    p.bubble_count_rate_ci95 = {std::max(0.0, p.bubble_count_rate - 1.96 * se_f), p.bubble_count_rate + 1.96 * se_f};
+  }
+  if (options.velocity) {
+    const double u = *options.velocity;
+    std::vector<double> lengths;
+    lengths.reserve(air.size());
+    for (double t : air) lengths.push_back(t * std::fabs(u));
+    p.air_chord_length = summarise(lengths);
+    if (p.bubble_count_rate > 0.0) p.sauter_diameter = 1.5 * std::fabs(u) * p.void_fraction / p.bubble_count_rate;
+  }
+  return p;
+}
+
+}  // namespace awcc

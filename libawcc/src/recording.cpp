@@ -1,0 +1,555 @@
+#include "awcc/recording.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sndfile.h>
+#include <stdexcept>
+#include <vector>
+
+namespace awcc {
+
+std::string_view to_string(InputFormat format) {
+  switch (format) {
+    case InputFormat::automatic: return "auto";
+    case InputFormat::sndfile: return "sndfile";
+    case InputFormat::uq_dat: return "dat";
+    case InputFormat::raw: return "raw";
+    case InputFormat::csv: return "csv";
+  }
+  return "?";
+}
+
+std::string_view to_string(SampleType type) {
+  switch (type) {
+    case SampleType::int16: return "int16";
+    case SampleType::int32: return "int32";
+    case SampleType::float32: return "float32";
+    case SampleType::float64: return "float64";
+  }
+  return "?";
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const fs::path& path, std::string_view what) {
+  throw std::runtime_error(fmt::format("{}: {}", path.string(), what));
+}
+
+std::string lower_extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+void check_finite(const fs::path& path, std::span<const float> values, std::int64_t first_frame, int channels) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) [[unlikely]] {
+      fail(path, fmt::format("sample {} of channel {} (frame {}) is {}; the recording is damaged: repair or cut "
+                             "it before processing",
+                             first_frame + static_cast<std::int64_t>(i) / channels, static_cast<int>(i) % channels,
+                             first_frame + static_cast<std::int64_t>(i) / channels,
+                             std::isnan(values[i]) ? "NaN" : "infinite"));
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// libsndfile containers.
+
+class SndfileRecording final : public Recording {
+ public:
+  SndfileRecording(const fs::path& path, const ReaderOptions& options) {
+    SF_INFO sf{};
+    file_ = sf_open(path.c_str(), SFM_READ, &sf);
+    if (!file_) {
+      fail(path, fmt::format("not a readable audio file (libsndfile: {}); check the file or give --format", 
+                             sf_strerror(nullptr)));
+    }
+    if (sf.channels <= 0 || sf.samplerate <= 0) fail(path, "the audio header has no channels or no sampling rate");
+    info_.path = path;
+    info_.format = InputFormat::sndfile;
+    info_.channels = sf.channels;
+    info_.fs = options.fs > 0.0 ? options.fs : sf.samplerate;
+    info_.frames = sf.frames;
+    SF_FORMAT_INFO major{};
+    major.format = sf.format & SF_FORMAT_TYPEMASK;
+    sf_command(file_, SFC_GET_FORMAT_INFO, &major, sizeof(major));
+    int bits = 0;
+    switch (sf.format & SF_FORMAT_SUBMASK) {
+      case SF_FORMAT_PCM_S8: case SF_FORMAT_PCM_U8: bits = 8; break;
+      case SF_FORMAT_PCM_16: bits = 16; break;
+      case SF_FORMAT_PCM_24: bits = 24; break;
+      case SF_FORMAT_PCM_32: bits = 32; break;
+      default: bits = 0;
+    }
+    floating_ = bits == 0;
+    // Values as counts for integer data, as stored for floating data.
+    sf_command(file_, SFC_SET_NORM_FLOAT, nullptr, SF_FALSE);
+    double vpc = options.volts_per_count;
+    if (vpc <= 0.0) vpc = sidecar_volts_per_count(path);
+    info_.volts_known = vpc > 0.0 || floating_;
+    if (floating_) {
+      scale_ = vpc > 0.0 ? vpc : 1.0;
+      info_.quantum = 0.0;
+    } else {
+      // Unknown scale: full scale is 1 (normalised units).
+      scale_ = vpc > 0.0 ? vpc : 1.0 / std::ldexp(1.0, bits - 1);
+      info_.quantum = scale_;
+    }
+    info_.description = fmt::format("{} ({}, {})", major.name ? major.name : "audio",
+                                    floating_ ? "floating point" : fmt::format("{}-bit integer", bits),
+                                    info_.volts_known ? "volts" : "normalised units");
+  }
+  ~SndfileRecording() override {
+    if (file_) sf_close(file_);
+  }
+
+  std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
+    const sf_count_t got = sf_readf_float(file_, out.data(), max_frames);
+    if (got < 0) fail(info_.path, "read error");
+    const auto n = static_cast<std::size_t>(got) * static_cast<std::size_t>(info_.channels);
+    if (scale_ != 1.0) {
+      const auto s = static_cast<float>(scale_);
+      for (std::size_t i = 0; i < n; ++i) out[i] *= s;
+    }
+    if (floating_) check_finite(info_.path, out.first(n), position_, info_.channels);
+    position_ += got;
+    if (got == 0 && info_.frames >= 0 && position_ < info_.frames) {
+      fail(info_.path, fmt::format("the header announces {} frames but the data ends after {}: the file is truncated",
+                                   info_.frames, position_));
+    }
+    return got;
+  }
+
+  void rewind() override {
+    sf_seek(file_, 0, SEEK_SET);
+    position_ = 0;
+  }
+
+ private:
+  static double sidecar_volts_per_count(const fs::path& path) {
+    fs::path side = path;
+    side.replace_extension();
+    side += ".truth.json";
+    std::ifstream in(side);
+    if (!in) return 0.0;
+    try {
+      const auto j = nlohmann::json::parse(in);
+      const auto& v = j.at("recording").at("volts_per_count");
+      return v.is_number() ? v.get<double>() : 0.0;
+    } catch (const std::exception&) {
+      return 0.0;
+    }
+  }
+
+  SNDFILE* file_ = nullptr;
+  bool floating_ = false;
+  double scale_ = 1.0;
+  std::int64_t position_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+// Binary layouts: UQ .dat and raw.
+
+template <class T>
+T load(const char* p, bool swap) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  if (swap) {
+    char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    std::reverse(b, b + sizeof(T));
+    std::memcpy(&v, b, sizeof(T));
+  }
+  return v;
+}
+
+std::size_t sample_size(SampleType t) {
+  switch (t) {
+    case SampleType::int16: return 2;
+    case SampleType::int32: return 4;
+    case SampleType::float32: return 4;
+    case SampleType::float64: return 8;
+  }
+  return 2;
+}
+
+class BinaryRecording final : public Recording {
+ public:
+  BinaryRecording(const fs::path& path, RecordingInfo info, RawLayout layout)
+      : layout_(layout), in_(path, std::ios::binary) {
+    info_ = std::move(info);
+    if (!in_) fail(path, "cannot open for reading");
+    frame_bytes_ = sample_size(layout.sample_type) * static_cast<std::size_t>(layout.channels);
+    swap_ = (layout.byte_order == ByteOrder::big) != (std::endian::native == std::endian::big);
+    rewind();
+  }
+
+  std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
+    const std::int64_t n = std::min(max_frames, info_.frames - position_);
+    if (n <= 0) return 0;
+    bytes_.resize(static_cast<std::size_t>(n) * frame_bytes_);
+    in_.read(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
+    if (in_.gcount() != static_cast<std::streamsize>(bytes_.size())) {
+      fail(info_.path, fmt::format("the data ends early, after frame {} of {}: the file is truncated", position_,
+                                   info_.frames));
+    }
+    const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(layout_.channels);
+    const auto scale = static_cast<float>(layout_.volts_per_count);
+    const char* p = bytes_.data();
+    switch (layout_.sample_type) {
+      case SampleType::int16:
+        if (!swap_) {
+          for (std::size_t i = 0; i < count; ++i) {
+            std::int16_t v;
+            std::memcpy(&v, p + 2 * i, 2);
+            out[i] = static_cast<float>(v) * scale;
+          }
+        } else {
+          for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<float>(load<std::int16_t>(p + 2 * i, true)) * scale;
+        }
+        break;
+      case SampleType::int32:
+        for (std::size_t i = 0; i < count; ++i) {
+          out[i] = static_cast<float>(static_cast<double>(load<std::int32_t>(p + 4 * i, swap_)) * layout_.volts_per_count);
+        }
+        break;
+      case SampleType::float32:
+        for (std::size_t i = 0; i < count; ++i) out[i] = load<float>(p + 4 * i, swap_) * scale;
+        check_finite(info_.path, out.first(count), position_, layout_.channels);
+        break;
+      case SampleType::float64:
+        for (std::size_t i = 0; i < count; ++i) {
+          const double v = load<double>(p + 8 * i, swap_) * layout_.volts_per_count;
+          out[i] = static_cast<float>(v);
+          if (!std::isfinite(v) || std::fabs(v) > 3.0e38) out[i] = std::numeric_limits<float>::quiet_NaN();
+        }
+        check_finite(info_.path, out.first(count), position_, layout_.channels);
+        break;
+    }
+    position_ += n;
+    return n;
+  }
+
+  void rewind() override {
+    in_.clear();
+    in_.seekg(layout_.header_bytes);
+    position_ = 0;
+  }
+
+ private:
+  RawLayout layout_;
+  std::ifstream in_;
+  std::size_t frame_bytes_ = 0;
+  bool swap_ = false;
+  std::int64_t position_ = 0;
+  std::vector<char> bytes_;
+};
+
+std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions& options, std::uintmax_t size) {
+  if (size < 8) fail(path, fmt::format("{} bytes is too short for a UQ .dat header (8 bytes)", size));
+  std::ifstream in(path, std::ios::binary);
+  char header[8];
+  in.read(header, 8);
+  const auto rows = load<std::int32_t>(header, std::endian::native == std::endian::big);
+  const auto channels = load<std::int32_t>(header + 4, std::endian::native == std::endian::big);
+  if (rows <= 0 || channels <= 0 || channels > 64) {
+    fail(path, fmt::format("the .dat header says {} rows and {} channels, which is not a UQ .dat header; if the file "
+                           "is headerless, read it with --format raw and its layout",
+                           rows, channels));
+  }
+  const std::uintmax_t expected = 8 + static_cast<std::uintmax_t>(rows) * static_cast<std::uintmax_t>(channels) * 2;
+  if (size < expected) {
+    fail(path, fmt::format("the .dat header announces {} rows x {} channels ({} bytes) but the file has {} bytes: it is "
+                           "truncated; recover the full recording",
+                           rows, channels, expected, size));
+  }
+  if (size > expected) {
+    fail(path, fmt::format("the .dat header announces {} rows x {} channels ({} bytes) but the file has {} bytes: the "
+                           "header does not describe the data; check the acquisition or read it with --format raw",
+                           rows, channels, expected, size));
+  }
+  RawLayout layout;
+  layout.sample_type = SampleType::int16;
+  layout.channels = channels;
+  layout.header_bytes = 8;
+  layout.volts_per_count = options.volts_per_count > 0.0 ? options.volts_per_count : 5.0 / 32768.0;
+  RecordingInfo info;
+  info.path = path;
+  info.format = InputFormat::uq_dat;
+  info.description = "UQ LabVIEW .dat (int16, +/-5 V)";
+  info.channels = channels;
+  info.fs = options.fs;
+  if (!(info.fs > 0.0)) {
+    fail(path, "a .dat file does not store its sampling rate; give it with --fs (e.g. --fs 20kHz)");
+  }
+  info.frames = rows;
+  info.quantum = layout.volts_per_count;
+  info.volts_known = true;
+  return std::make_unique<BinaryRecording>(path, std::move(info), layout);
+}
+
+std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& options, std::uintmax_t size) {
+  const RawLayout& layout = options.raw;
+  if (layout.channels <= 0 || layout.channels > 1024) fail(path, fmt::format("raw layout: {} channels is not possible", layout.channels));
+  if (layout.header_bytes < 0 || static_cast<std::uintmax_t>(layout.header_bytes) > size) {
+    fail(path, fmt::format("raw layout: {} header bytes to skip, but the file has {} bytes", layout.header_bytes, size));
+  }
+  if (!(options.fs > 0.0)) fail(path, "a raw file does not store its sampling rate; give it with --fs (e.g. --fs 500kHz)");
+  const std::uintmax_t data = size - static_cast<std::uintmax_t>(layout.header_bytes);
+  const std::uintmax_t frame = sample_size(layout.sample_type) * static_cast<std::uintmax_t>(layout.channels);
+  if (data % frame != 0) {
+    fail(path, fmt::format("raw layout: {} data bytes are not a whole number of {}-byte frames ({} channels of {}); "
+                           "check --raw-channels, --raw-type and --raw-header",
+                           data, frame, layout.channels, to_string(layout.sample_type)));
+  }
+  if (data == 0) fail(path, "the raw file holds no samples");
+  RecordingInfo info;
+  info.path = path;
+  info.format = InputFormat::raw;
+  info.description = fmt::format("raw {} {}-endian, {} channels", to_string(layout.sample_type),
+                                 layout.byte_order == ByteOrder::little ? "little" : "big", layout.channels);
+  info.channels = layout.channels;
+  info.fs = options.fs;
+  info.frames = static_cast<std::int64_t>(data / frame);
+  const bool integer = layout.sample_type == SampleType::int16 || layout.sample_type == SampleType::int32;
+  info.quantum = integer ? layout.volts_per_count : 0.0;
+  info.volts_known = true;
+  return std::make_unique<BinaryRecording>(path, std::move(info), layout);
+}
+
+// ---------------------------------------------------------------------------
+// CSV / TSV.
+
+std::vector<std::string_view> split(std::string_view line, char delimiter) {
+  std::vector<std::string_view> cells;
+  if (delimiter == ' ') {
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+      if (i >= line.size()) break;
+      std::size_t j = i;
+      while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
+      cells.push_back(line.substr(i, j - i));
+      i = j;
+    }
+    return cells;
+  }
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t end = line.find(delimiter, start);
+    cells.push_back(line.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start));
+    if (end == std::string_view::npos) break;
+    start = end + 1;
+  }
+  return cells;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '"')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r' || s.back() == '"')) s.remove_suffix(1);
+  return s;
+}
+
+bool parse_number(std::string_view cell, double& value) {
+  cell = trim(cell);
+  if (cell.empty()) return false;
+  const char* first = cell.data();
+  if (*first == '+') ++first;
+  const auto [ptr, ec] = std::from_chars(first, cell.data() + cell.size(), value);
+  return ec == std::errc{} && ptr == cell.data() + cell.size();
+}
+
+class CsvRecording final : public Recording {
+ public:
+  CsvRecording(const fs::path& path, const ReaderOptions& options) : in_(path, std::ios::binary) {
+    if (!in_) fail(path, "cannot open for reading");
+    info_.path = path;
+    info_.format = InputFormat::csv;
+    std::string first;
+    std::streampos data_start = 0;
+    // Skip blank lines at the top.
+    do {
+      data_start = in_.tellg();
+      if (!std::getline(in_, first)) fail(path, "the CSV file holds no rows");
+    } while (trim(first).empty());
+    delimiter_ = options.csv.delimiter;
+    if (!delimiter_) {
+      if (first.find('\t') != std::string::npos) delimiter_ = '\t';
+      else if (first.find(',') != std::string::npos) delimiter_ = ',';
+      else if (first.find(';') != std::string::npos) delimiter_ = ';';
+      else delimiter_ = ' ';
+    }
+    const auto cells = split(first, delimiter_);
+    bool all_numbers = true;
+    double v;
+    for (auto c : cells) all_numbers = all_numbers && parse_number(c, v);
+    const bool header = options.csv.header.value_or(!all_numbers);
+    columns_ = static_cast<int>(cells.size());
+    time_column_ = options.csv.time_column;
+    if (time_column_ == -2) {
+      time_column_ = -1;
+      if (header) {
+        for (int i = 0; i < columns_; ++i) {
+          std::string name(trim(cells[static_cast<std::size_t>(i)]));
+          std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+          if (name == "time" || name == "t" || name == "time_s" || name == "time (s)" || name == "seconds" || name == "s") {
+            time_column_ = i;
+            break;
+          }
+        }
+      }
+    }
+    if (time_column_ >= columns_) {
+      fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_));
+    }
+    line_ = header ? 1 : 0;
+    if (!header) {
+      in_.clear();
+      in_.seekg(data_start);
+    }
+    data_start_ = in_.tellg();
+    first_line_ = line_;
+    info_.channels = columns_ - (time_column_ >= 0 ? 1 : 0);
+    if (info_.channels <= 0) fail(path, "the CSV file has no data column besides its time column");
+    if (options.fs > 0.0) {
+      info_.fs = options.fs;
+    } else if (time_column_ >= 0) {
+      info_.fs = fs_from_time_column();
+    } else {
+      fail(path, "the CSV file has no time column; give the sampling rate with --fs, or name a time column with "
+                 "--time-column");
+    }
+    info_.volts_known = true;
+    info_.quantum = 0.0;
+    info_.description = fmt::format("CSV ({} columns{}{})", columns_, header ? ", header row" : "",
+                                    time_column_ >= 0 ? fmt::format(", time in column {}", time_column_) : "");
+    rewind();
+  }
+
+  std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
+    std::int64_t n = 0;
+    std::string line;
+    while (n < max_frames && std::getline(in_, line)) {
+      ++line_;
+      if (trim(line).empty()) continue;
+      const auto cells = split(line, delimiter_);
+      if (static_cast<int>(cells.size()) != columns_) {
+        fail(info_.path, fmt::format("line {} has {} cells where the first row has {}; fix or remove the line", line_,
+                                     cells.size(), columns_));
+      }
+      int k = 0;
+      for (int c = 0; c < columns_; ++c) {
+        double v;
+        if (!parse_number(cells[static_cast<std::size_t>(c)], v)) {
+          fail(info_.path, fmt::format("line {}, column {}: '{}' is not a number; fix the cell or remove the line",
+                                       line_, c + 1, trim(cells[static_cast<std::size_t>(c)])));
+        }
+        if (!std::isfinite(v)) {
+          fail(info_.path, fmt::format("line {}, column {}: the value is not finite; the recording is damaged", line_, c + 1));
+        }
+        if (c == time_column_) continue;
+        out[static_cast<std::size_t>(n * info_.channels + k++)] = static_cast<float>(v);
+      }
+      ++n;
+    }
+    return n;
+  }
+
+  void rewind() override {
+    in_.clear();
+    in_.seekg(data_start_);
+    line_ = first_line_;
+  }
+
+ private:
+  double fs_from_time_column() {
+    // The sampling interval from the first rows' time stamps (median step).
+    std::vector<double> times;
+    std::string line;
+    while (times.size() < 2001 && std::getline(in_, line)) {
+      if (trim(line).empty()) continue;
+      const auto cells = split(line, delimiter_);
+      double t;
+      if (static_cast<int>(cells.size()) != columns_ || !parse_number(cells[static_cast<std::size_t>(time_column_)], t)) break;
+      times.push_back(t);
+    }
+    if (times.size() < 2) fail(info_.path, "too few rows to take the sampling rate from the time column; give --fs");
+    std::vector<double> steps;
+    for (std::size_t i = 1; i < times.size(); ++i) steps.push_back(times[i] - times[i - 1]);
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+    const double dt = steps[steps.size() / 2];
+    if (!(dt > 0.0)) fail(info_.path, "the time column does not increase; give --fs or fix the column");
+    return 1.0 / dt;
+  }
+
+  std::ifstream in_;
+  char delimiter_ = ',';
+  int columns_ = 0;
+  int time_column_ = -1;
+  std::streampos data_start_ = 0;
+  std::int64_t line_ = 0, first_line_ = 0;
+};
+
+bool looks_like_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char buffer[512];
+  in.read(buffer, sizeof(buffer));
+  const auto n = in.gcount();
+  if (n <= 0) return false;
+  for (std::streamsize i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(buffer[i]);
+    if (c == 0 || (c < 32 && c != '\n' && c != '\r' && c != '\t')) return false;
+  }
+  return true;
+}
+
+bool audio_magic(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char m[4] = {0, 0, 0, 0};
+  in.read(m, 4);
+  const std::string_view s(m, 4);
+  return s == "RIFF" || s == "RIFX" || s == "RF64" || s == "fLaC" || s == "FORM" || s == "riff" || s == "OggS" ||
+         s == "caff" || s == ".snd";
+}
+
+}  // namespace
+
+std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOptions& options) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) fail(path, "no such file");
+  if (fs::is_directory(path, ec)) fail(path, "is a folder, not a recording");
+  const auto size = fs::file_size(path, ec);
+  if (ec) fail(path, fmt::format("cannot read: {}", ec.message()));
+  if (size == 0) fail(path, "the file is empty");
+  InputFormat format = options.format;
+  const std::string ext = lower_extension(path);
+  if (format == InputFormat::automatic) {
+    static const std::string_view audio_ext[] = {".wav", ".w64", ".rf64", ".flac", ".aif", ".aiff", ".aifc",
+                                                 ".au",  ".snd", ".caf",  ".ogg"};
+    if (ext == ".dat") format = InputFormat::uq_dat;
+    else if (audio_magic(path) || std::find(std::begin(audio_ext), std::end(audio_ext), ext) != std::end(audio_ext))
+      format = InputFormat::sndfile;
+    else if (ext == ".raw" || ext == ".bin" || ext == ".pcm") format = InputFormat::raw;
+    else if (ext == ".csv" || ext == ".tsv" || ext == ".txt" || looks_like_text(path)) format = InputFormat::csv;
+    else fail(path, "cannot tell the recording's format from its name or content; give --format sndfile|dat|raw|csv");
+  }
+  switch (format) {
+    case InputFormat::sndfile: return std::make_unique<SndfileRecording>(path, options);
+    case InputFormat::uq_dat: return open_uq_dat(path, options, size);
+    case InputFormat::raw: return open_raw(path, options, size);
+    case InputFormat::csv: return std::make_unique<CsvRecording>(path, options);
+    case InputFormat::automatic: break;
+  }
+  fail(path, "unknown format");
+}
+
+}  // namespace awcc
