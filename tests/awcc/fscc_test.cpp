@@ -1,0 +1,182 @@
+#include "awcc/fscc.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace {
+
+using awcc::AirIntervals;
+
+// A random telegraph signal of n samples: chords of 2..40 samples.
+AirIntervals telegraph(std::int64_t n, unsigned seed, double fs = 1000.0) {
+  std::mt19937 rng(seed);
+  std::vector<std::uint8_t> dense(static_cast<std::size_t>(n));
+  std::uint8_t state = 0;
+  std::int64_t next = 0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (i == next) {
+      state ^= 1;
+      next = i + 2 + static_cast<std::int64_t>(rng() % (state ? 10 : 40));
+    }
+    dense[static_cast<std::size_t>(i)] = state;
+  }
+  return awcc::from_dense(dense, fs);
+}
+
+AirIntervals shifted(const AirIntervals& s, std::int64_t delay) {
+  auto dense = awcc::to_dense(s);
+  std::vector<std::uint8_t> out(dense.size(), 0);
+  for (std::size_t i = 0; i < dense.size(); ++i) {
+    const auto j = static_cast<std::int64_t>(i) + delay;
+    if (j >= 0 && j < static_cast<std::int64_t>(dense.size())) out[static_cast<std::size_t>(j)] = dense[i];
+  }
+  return awcc::from_dense(out, s.fs);
+}
+
+TEST(LaggedProducts, EqualANaiveLongDoubleSum) {
+  const auto x = telegraph(50'000, 1), y = telegraph(50'000, 2);
+  const auto dx = awcc::to_dense(x), dy = awcc::to_dense(y);
+  awcc::FftPlanCache plans;
+  for (auto [t0, t1, kmin, kmax] : {std::tuple<std::int64_t, std::int64_t, std::int64_t, std::int64_t>{0, 50'000, -300, 700},
+                                    {1234, 40'000, 0, 999},
+                                    {0, 50'000, -5, -1},
+                                    {49'000, 50'000, 10, 2000}}) {
+    const auto fast = awcc::lagged_products(x, y, t0, t1, kmin, kmax, plans);
+    ASSERT_EQ(fast.size(), static_cast<std::size_t>(kmax - kmin + 1));
+    for (std::int64_t k = kmin; k <= kmax; k += 7) {
+      long double naive = 0;
+      for (std::int64_t t = t0; t < t1; ++t) {
+        const std::int64_t u = t + k;
+        if (u >= 0 && u < 50'000) naive += static_cast<long double>(dx[static_cast<std::size_t>(t)]) * dy[static_cast<std::size_t>(u)];
+      }
+      ASSERT_EQ(fast[static_cast<std::size_t>(k - kmin)], static_cast<double>(naive)) << "k " << k << " t0 " << t0;
+    }
+  }
+}
+
+TEST(Fscc, NormalisedCorrelationMatchesTheDefinition) {
+  const auto x = telegraph(20'000, 5), y = shifted(x, 17);
+  awcc::FsccOptions o;
+  o.max_lag = 0.05;  // 50 samples at 1 kHz
+  const auto r = awcc::fscc(x, y, 1.0, o);
+  const auto dx = awcc::to_dense(x), dy = awcc::to_dense(y);
+  long double mx = 0, my = 0;
+  for (std::size_t i = 0; i < dx.size(); ++i) {
+    mx += dx[i];
+    my += dy[i];
+  }
+  mx /= dx.size();
+  my /= dy.size();
+  long double qx = 0, qy = 0;
+  for (std::size_t i = 0; i < dx.size(); ++i) {
+    qx += (dx[i] - mx) * (dx[i] - mx);
+    qy += (dy[i] - my) * (dy[i] - my);
+  }
+  for (std::int64_t k = -50; k <= 50; k += 5) {
+    long double s = 0;
+    for (std::int64_t t = 0; t < 20'000; ++t) {
+      const std::int64_t u = t + k;
+      if (u < 0 || u >= 20'000) continue;
+      s += (dx[static_cast<std::size_t>(t)] - mx) * (dy[static_cast<std::size_t>(u)] - my);
+    }
+    EXPECT_NEAR(r.r12[static_cast<std::size_t>(k - r.r12_first_lag)], static_cast<double>(s / std::sqrt(qx * qy)), 1e-12)
+        << k;
+  }
+}
+
+TEST(Fscc, RecoversAPlantedDelayExactly) {
+  for (std::int64_t delay : {1, 17, 250}) {
+    const auto x = telegraph(100'000, 7, 500e3);
+    const auto y = shifted(x, delay);
+    awcc::FsccOptions o;
+    o.max_lag = 1e-3;  // 500 samples
+    const auto r = awcc::fscc(x, y, 5e-3, o);
+    ASSERT_TRUE(r.defined) << r.reason;
+    EXPECT_EQ(r.lag_samples, delay);
+    EXPECT_NEAR(r.velocity, 5e-3 / (static_cast<double>(delay) / 500e3), 1e-9);
+    EXPECT_GT(r.r12_max, 0.99);
+    ASSERT_TRUE(r.t05.has_value());
+    ASSERT_TRUE(r.tau05.has_value());
+    // A pure shift: R12 is R11 moved by the delay, so tau05 = T05 (half-width).
+    EXPECT_NEAR(*r.tau05, *r.t05, 1.0 / 500e3);
+  }
+}
+
+TEST(Fscc, ParabolicRefinementFindsAFractionalDelay) {
+  // y = average of x delayed by 20 and 21 samples (soft 0/0.5/1 is not
+  // binary, so build it at 10x the rate and decimate): the true delay is
+  // 20.5 samples; the integer peak is 20 or 21, the parabola lands near 20.5.
+  const auto fine = telegraph(400'000, 11, 10.0);
+  const auto y_fine = shifted(fine, 205);
+  auto decimate = [](const AirIntervals& s) {
+    const auto d = awcc::to_dense(s);
+    std::vector<std::uint8_t> out;
+    for (std::size_t i = 0; i < d.size(); i += 10) out.push_back(d[i]);
+    return awcc::from_dense(out, 1.0);
+  };
+  const auto x = decimate(fine), y = decimate(y_fine);
+  awcc::FsccOptions o;
+  o.max_lag = 100;
+  o.subsample = awcc::Subsample::parabolic;
+  const auto r = awcc::fscc(x, y, 1.0, o);
+  EXPECT_NEAR(r.lag, 20.5, 0.2);
+  o.subsample = awcc::Subsample::none;
+  const auto integer = awcc::fscc(x, y, 1.0, o);
+  EXPECT_EQ(integer.lag, static_cast<double>(integer.lag_samples));
+}
+
+TEST(Fscc, SegmentedMatchesNaivePearsonAverages) {
+  const auto x = telegraph(30'000, 21), y = shifted(x, 9);
+  awcc::FsccOptions o;
+  o.segments = 3;
+  o.felder_lags = true;
+  const auto r = awcc::fscc(x, y, 1.0, o);
+  ASSERT_TRUE(r.defined) << r.reason;
+  EXPECT_EQ(r.lag_samples, 9);
+  const auto dx = awcc::to_dense(x), dy = awcc::to_dense(y);
+  const std::int64_t length = 10'000;
+  for (std::int64_t k : {-199, -50, 0, 9, 300, 800}) {
+    long double acc = 0;
+    for (int s = 0; s < 3; ++s) {
+      const std::int64_t t0 = s * length + 199, t1 = (s + 1) * length - 800;
+      long double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+      const long double w = static_cast<long double>(t1 - t0);
+      for (std::int64_t t = t0; t < t1; ++t) {
+        const long double a = dx[static_cast<std::size_t>(t)], b = dy[static_cast<std::size_t>(t + k)];
+        sx += a; sy += b; sxx += a * a; syy += b * b; sxy += a * b;
+      }
+      acc += (sxy / w - sx / w * sy / w) / std::sqrt((sxx / w - sx * sx / (w * w)) * (syy / w - sy * sy / (w * w)));
+    }
+    EXPECT_NEAR(r.r12[static_cast<std::size_t>(k + 199)], static_cast<double>(acc / 3), 1e-12) << k;
+  }
+}
+
+TEST(Fscc, UndefinedResultsCarryAReason) {
+  const auto x = telegraph(10'000, 3);
+  AirIntervals empty;
+  empty.fs = x.fs;
+  empty.sample_count = x.sample_count;
+  const auto none = awcc::fscc(x, empty, 1.0, {});
+  EXPECT_FALSE(none.defined);
+  EXPECT_NE(none.reason.find("constant"), std::string::npos);
+  const auto backwards = awcc::fscc(shifted(x, 5), x, 1.0, {});
+  EXPECT_FALSE(backwards.defined);
+  EXPECT_NE(backwards.reason.find("not positive"), std::string::npos);
+  EXPECT_EQ(backwards.lag_samples, -5);
+}
+
+TEST(FftSize, IsSmoothAndLargeEnough) {
+  for (std::size_t n : {1u, 17u, 1000u, 65537u, 1234567u}) {
+    const auto m = awcc::fast_fft_size(n);
+    EXPECT_GE(m, n);
+    auto r = m;
+    for (std::size_t p : {2u, 3u, 5u, 7u})
+      while (r % p == 0) r /= p;
+    EXPECT_EQ(r, 1u) << m;
+    EXPECT_LE(m, 2 * n);
+  }
+}
+
+}  // namespace

@@ -1,0 +1,73 @@
+#include "awcc/phase_statistics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace {
+
+TEST(PhaseStatistics, HandComputedValues) {
+  // 100 samples at 10 Hz (10 s). Air: [0, 5) cut by the start, [20, 30),
+  // [50, 54), [80, 100) cut by the end. Complete chords: 10 and 4 samples.
+  awcc::AirIntervals s;
+  s.fs = 10.0;
+  s.sample_count = 100;
+  s.intervals = {{0, 5}, {20, 30}, {50, 54}, {80, 100}};
+  const auto p = awcc::phase_statistics(s);
+  EXPECT_DOUBLE_EQ(p.duration, 10.0);
+  EXPECT_DOUBLE_EQ(p.void_fraction, 39.0 / 100.0);
+  EXPECT_DOUBLE_EQ(p.bubble_count_rate, 2.0 / 10.0);  // two complete chords
+  EXPECT_EQ(p.air_chord_time.count, 2);
+  EXPECT_DOUBLE_EQ(p.air_chord_time.mean, 0.7);       // (1.0 + 0.4) / 2
+  EXPECT_DOUBLE_EQ(p.air_chord_time.median, 0.7);
+  EXPECT_NEAR(p.air_chord_time.std, std::sqrt(0.18), 1e-12);  // ((0.3)^2 + (0.3)^2) / 1
+  // Water chords between air chords: 15, 20, 26 samples.
+  EXPECT_EQ(p.water_chord_time.count, 3);
+  EXPECT_NEAR(p.water_chord_time.mean, 61.0 / 30.0, 1e-12);
+  EXPECT_DOUBLE_EQ(p.water_chord_time.median, 2.0);
+  // Arrivals between chord starts, except from the chord cut by the start:
+  // 50 - 20 = 30, 80 - 50 = 30 samples.
+  EXPECT_EQ(p.interarrival_time.count, 2);
+  EXPECT_DOUBLE_EQ(p.interarrival_time.mean, 3.0);
+  EXPECT_FALSE(p.sauter_diameter.has_value());
+
+  awcc::PhaseStatisticsOptions o;
+  o.velocity = 2.0;
+  const auto q = awcc::phase_statistics(s, o);
+  ASSERT_TRUE(q.sauter_diameter.has_value());
+  EXPECT_DOUBLE_EQ(*q.sauter_diameter, 1.5 * 2.0 * 0.39 / 0.2);
+  EXPECT_DOUBLE_EQ(q.air_chord_length->mean, 1.4);
+}
+
+TEST(Summary, PercentilesAndIntervals) {
+  std::vector<double> v;
+  for (int i = 1; i <= 101; ++i) v.push_back(i);
+  const auto s = awcc::summarise(v);
+  EXPECT_DOUBLE_EQ(s.median, 51.0);
+  EXPECT_DOUBLE_EQ(s.percentiles[0], 6.0);   // 5th: position 0.05 * 100 = 5 -> value 6
+  EXPECT_DOUBLE_EQ(s.percentiles[6], 96.0);
+  const double sd = std::sqrt(101.0 * 102.0 / 12.0);  // sample sd of 1..101 = sqrt(n(n+1)/12)
+  EXPECT_NEAR(s.std, sd, 1e-9);
+  EXPECT_NEAR(s.mean_ci95.upper - s.mean, 1.96 * sd / std::sqrt(101.0), 1e-9);
+  // Median CI: ranks 50.5 -/+ 1.96 * sqrt(101) / 2 = 9.85 -> values 41 and 61.
+  EXPECT_DOUBLE_EQ(s.median_ci95.lower, 41.0);
+  EXPECT_DOUBLE_EQ(s.median_ci95.upper, 61.0);
+}
+
+TEST(PhaseStatistics, ConstantChannelHasNoChords) {
+  awcc::AirIntervals s;
+  s.fs = 100;
+  s.sample_count = 1000;
+  const auto p = awcc::phase_statistics(s);
+  EXPECT_EQ(p.void_fraction, 0.0);
+  EXPECT_EQ(p.bubble_count_rate, 0.0);
+  s.intervals = {{0, 1000}};
+  const auto q = awcc::phase_statistics(s);
+  EXPECT_EQ(q.void_fraction, 1.0);
+  EXPECT_EQ(q.bubble_count_rate, 0.0);
+  for (double x : {q.void_fraction_ci95.lower, q.void_fraction_ci95.upper, q.air_chord_time.mean}) {
+    EXPECT_TRUE(std::isfinite(x));
+  }
+}
+
+}  // namespace

@@ -1,0 +1,242 @@
+#include "awcc/recording.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sndfile.h>
+#include <vector>
+
+#include "test_paths.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using awcc::open_recording;
+using awcc::ReaderOptions;
+
+fs::path scratch(const std::string& name) { return pdp_test::temp_dir() / ("reader_" + name); }
+
+template <class T>
+void write_binary(const fs::path& p, const std::vector<T>& values, const std::vector<char>& header = {}) {
+  std::ofstream f(p, std::ios::binary);
+  f.write(header.data(), static_cast<std::streamsize>(header.size()));
+  f.write(reinterpret_cast<const char*>(values.data()), static_cast<std::streamsize>(values.size() * sizeof(T)));
+}
+
+std::vector<char> dat_header(std::int32_t rows, std::int32_t channels) {
+  std::vector<char> h(8);
+  std::memcpy(h.data(), &rows, 4);
+  std::memcpy(h.data() + 4, &channels, 4);
+  return h;
+}
+
+std::vector<float> read_all(awcc::Recording& r, std::int64_t block = 7) {
+  std::vector<float> all, buf(static_cast<std::size_t>(block * r.info().channels));
+  for (;;) {
+    const auto n = r.read(buf, block);
+    if (n == 0) break;
+    all.insert(all.end(), buf.begin(), buf.begin() + n * r.info().channels);
+  }
+  return all;
+}
+
+std::string error_of(const fs::path& p, const ReaderOptions& o = {}) {
+  try {
+    auto r = open_recording(p, o);
+    read_all(*r);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return {};
+}
+
+TEST(UqDat, ReadsCountsAsVolts) {
+  const std::vector<std::int16_t> counts{0, 100, -32768, 32767, 26214, 1966};
+  const auto p = scratch("ok.dat");
+  write_binary(p, counts, dat_header(3, 2));
+  ReaderOptions o;
+  o.fs = 20e3;
+  auto r = open_recording(p, o);
+  EXPECT_EQ(r->info().format, awcc::InputFormat::uq_dat);
+  EXPECT_EQ(r->info().channels, 2);
+  EXPECT_EQ(r->info().frames, 3);
+  const auto v = read_all(*r, 2);
+  ASSERT_EQ(v.size(), counts.size());
+  for (std::size_t i = 0; i < v.size(); ++i) EXPECT_FLOAT_EQ(v[i], static_cast<float>(counts[i] * 5.0 / 32768.0));
+  r->rewind();
+  EXPECT_EQ(read_all(*r, 100), v);
+}
+
+TEST(UqDat, RefusesHeadersThatDoNotMatchTheData) {
+  ReaderOptions o;
+  o.fs = 20e3;
+  const auto truncated = scratch("truncated.dat");
+  write_binary(truncated, std::vector<std::int16_t>(10), dat_header(900000, 2));
+  EXPECT_NE(error_of(truncated, o).find("truncated"), std::string::npos) << error_of(truncated, o);
+  const auto lying = scratch("lying.dat");
+  write_binary(lying, std::vector<std::int16_t>(100), dat_header(10, 2));
+  EXPECT_NE(error_of(lying, o).find("does not describe the data"), std::string::npos) << error_of(lying, o);
+  const auto garbage = scratch("garbage.dat");
+  write_binary(garbage, std::vector<std::int16_t>(100), dat_header(-5, 2));
+  EXPECT_NE(error_of(garbage, o).find("not a UQ .dat header"), std::string::npos);
+  // No fs: a .dat file does not store it.
+  const auto fine = scratch("no_fs.dat");
+  write_binary(fine, std::vector<std::int16_t>(20), dat_header(10, 2));
+  EXPECT_NE(error_of(fine, {}).find("--fs"), std::string::npos) << error_of(fine, {});
+}
+
+TEST(Raw, ReadsEveryLayout) {
+  ReaderOptions o;
+  o.fs = 1000;
+  o.format = awcc::InputFormat::raw;
+  o.raw.channels = 3;
+  o.raw.header_bytes = 4;
+  o.raw.volts_per_count = 0.5;
+  {
+    const auto p = scratch("i32be.raw");
+    std::vector<char> bytes{'H', 'D', 'R', '!'};
+    for (std::int32_t v : {1, -2, 3, 40000, 5, 6}) {
+      for (int b = 3; b >= 0; --b) bytes.push_back(static_cast<char>((static_cast<std::uint32_t>(v) >> (8 * b)) & 0xff));
+    }
+    write_binary(p, bytes);
+    o.raw.sample_type = awcc::SampleType::int32;
+    o.raw.byte_order = awcc::ByteOrder::big;
+    auto r = open_recording(p, o);
+    const auto v = read_all(*r);
+    const std::vector<float> expected{0.5f, -1.0f, 1.5f, 20000.0f, 2.5f, 3.0f};
+    EXPECT_EQ(v, expected);
+  }
+  {
+    const auto p = scratch("f64.raw");
+    write_binary(p, std::vector<double>{0.25, 1.0, -3.5, 2.0, 4.0, 8.0}, {'x', 'x', 'x', 'x'});
+    o.raw.sample_type = awcc::SampleType::float64;
+    o.raw.byte_order = awcc::ByteOrder::little;
+    auto r = open_recording(p, o);
+    EXPECT_EQ(read_all(*r), (std::vector<float>{0.125f, 0.5f, -1.75f, 1.0f, 2.0f, 4.0f}));
+  }
+  {
+    // A size that is not a whole number of frames is refused.
+    const auto p = scratch("odd.raw");
+    write_binary(p, std::vector<std::int16_t>(7), {'x', 'x', 'x', 'x'});
+    o.raw.sample_type = awcc::SampleType::int16;
+    EXPECT_NE(error_of(p, o).find("whole number"), std::string::npos);
+  }
+}
+
+TEST(Raw, NaNAndInfinityAreRefusedWithTheirPosition) {
+  ReaderOptions o;
+  o.fs = 1000;
+  o.format = awcc::InputFormat::raw;
+  o.raw.channels = 2;
+  o.raw.sample_type = awcc::SampleType::float32;
+  const auto p = scratch("nan.raw");
+  write_binary(p, std::vector<float>{1, 2, 3, std::numeric_limits<float>::quiet_NaN(), 5, 6});
+  const auto e = error_of(p, o);
+  EXPECT_NE(e.find("NaN"), std::string::npos) << e;
+  EXPECT_NE(e.find("frame 1"), std::string::npos) << e;
+  write_binary(p, std::vector<float>{1, std::numeric_limits<float>::infinity()});
+  EXPECT_NE(error_of(p, o).find("infinite"), std::string::npos);
+}
+
+TEST(Csv, HeaderTimeColumnAndSamplingRate) {
+  const auto p = scratch("with_time.csv");
+  {
+    std::ofstream f(p);
+    f << "time,lead,trail\n";
+    for (int i = 0; i < 50; ++i) f << i * 1e-4 << "," << (i % 5 == 0 ? 0.2 : 4.0) << "," << 4.1 << "\n";
+  }
+  auto r = open_recording(p);
+  EXPECT_EQ(r->info().format, awcc::InputFormat::csv);
+  EXPECT_EQ(r->info().channels, 2);
+  EXPECT_NEAR(r->info().fs, 1e4, 1e-6);
+  const auto v = read_all(*r);
+  ASSERT_EQ(v.size(), 100u);
+  EXPECT_FLOAT_EQ(v[0], 0.2f);
+  EXPECT_FLOAT_EQ(v[2], 4.0f);
+  EXPECT_FLOAT_EQ(v[3], 4.1f);
+}
+
+TEST(Csv, TabsWithoutHeaderNeedFs) {
+  const auto p = scratch("plain.tsv");
+  {
+    std::ofstream f(p);
+    f << "1.5\t2.5\n3\t4\n";
+  }
+  EXPECT_NE(error_of(p).find("--fs"), std::string::npos);
+  ReaderOptions o;
+  o.fs = 100;
+  auto r = open_recording(p, o);
+  EXPECT_EQ(read_all(*r), (std::vector<float>{1.5f, 2.5f, 3.f, 4.f}));
+}
+
+TEST(Csv, TextCellInADataRowIsRefusedWithItsLine) {
+  const auto p = scratch("text.csv");
+  {
+    std::ofstream f(p);
+    f << "a,b\n1,2\n3,oops\n";
+  }
+  ReaderOptions o;
+  o.fs = 100;
+  const auto e = error_of(p, o);
+  EXPECT_NE(e.find("line 3, column 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("'oops'"), std::string::npos) << e;
+}
+
+TEST(Sndfile, ReadsIntegerAudioAsCountsTimesScale) {
+  const auto p = scratch("pcm.wav");
+  SF_INFO info{};
+  info.samplerate = 48000;
+  info.channels = 2;
+  info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
+  SNDFILE* f = sf_open(p.c_str(), SFM_WRITE, &info);
+  ASSERT_NE(f, nullptr);
+  const std::vector<short> counts{0, 1, -2, 32767, 26214, 1966};
+  sf_writef_short(f, counts.data(), 3);
+  sf_close(f);
+  ReaderOptions o;
+  o.volts_per_count = 5.0 / 32768.0;
+  auto r = open_recording(p, o);
+  EXPECT_EQ(r->info().fs, 48000);
+  EXPECT_TRUE(r->info().volts_known);
+  const auto v = read_all(*r);
+  for (std::size_t i = 0; i < counts.size(); ++i) EXPECT_FLOAT_EQ(v[i], static_cast<float>(counts[i] * 5.0 / 32768.0));
+  // Without a scale: counts / 32768, normalised units.
+  auto n = open_recording(p);
+  EXPECT_FALSE(n->info().volts_known);
+  EXPECT_FLOAT_EQ(read_all(*n)[1], 1.0f / 32768.0f);
+}
+
+TEST(Sndfile, FloatAudioWithNaNIsRefused) {
+  const auto p = scratch("nan.wav");
+  SF_INFO info{};
+  info.samplerate = 1000;
+  info.channels = 1;
+  info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
+  SNDFILE* f = sf_open(p.c_str(), SFM_WRITE, &info);
+  ASSERT_NE(f, nullptr);
+  const std::vector<float> values{0.1f, std::numeric_limits<float>::quiet_NaN()};
+  sf_writef_float(f, values.data(), 2);
+  sf_close(f);
+  EXPECT_NE(error_of(p).find("NaN"), std::string::npos) << error_of(p);
+}
+
+TEST(Detection, BadFilesGetClearMessages) {
+  const auto empty = scratch("empty.wav");
+  { std::ofstream f(empty); }
+  EXPECT_NE(error_of(empty).find("empty"), std::string::npos);
+  const auto text = scratch("notaudio.wav");
+  {
+    std::ofstream f(text);
+    f << "this is not audio at all\n";
+  }
+  EXPECT_NE(error_of(text).find("not a readable audio file"), std::string::npos) << error_of(text);
+  EXPECT_NE(error_of(scratch("missing.flac")).find("no such file"), std::string::npos);
+  const auto unknown = scratch("blob.xyz");
+  write_binary(unknown, std::vector<std::uint8_t>{0, 1, 2, 3, 200});
+  EXPECT_NE(error_of(unknown).find("--format"), std::string::npos);
+}
+
+}  // namespace
