@@ -97,9 +97,9 @@ double parse_quantity(std::string_view text, Dimension dimension) {
   return fail(fmt::format("unknown unit '{}'", unit));
 }
 
-std::string format_quantity(double si_value, Dimension dimension) {
-  if (!std::isfinite(si_value)) return fmt::format("{}", si_value);
-  const double a = std::fabs(si_value);
+std::string format_quantity(double value, Dimension dimension) {
+  if (!std::isfinite(value)) return fmt::format("{}", value);
+  const double a = std::fabs(value);
   std::string_view symbol = si_unit(dimension);
   double scale = 1.0;
   switch (dimension) {
@@ -119,7 +119,7 @@ std::string format_quantity(double si_value, Dimension dimension) {
     default:
       break;
   }
-  return fmt::format("{:.10g}{}", si_value / scale, symbol);
+  return fmt::format("{:.10g}{}", value / scale, symbol);
 }
 
 }  // namespace awcc

@@ -240,6 +240,15 @@ int run_process(const ProcessCommandOptions& o) {
   try {
     options = build_options(o);
     positions = positions_for(o);
+    // Inputs are never modified: refuse an output that is one of them.
+    for (const auto& output : {o.json, o.csv}) {
+      if (output.empty() || !std::filesystem::exists(output)) continue;
+      for (const auto& input : o.files) {
+        if (std::filesystem::equivalent(output, input)) {
+          throw std::invalid_argument(fmt::format("{} is an input recording; choose another output file", output));
+        }
+      }
+    }
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());
     return 2;

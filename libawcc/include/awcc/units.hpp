@@ -22,6 +22,6 @@ std::string accepted_units(Dimension dimension);
 double parse_quantity(std::string_view text, Dimension dimension);
 
 /// Formats an SI value with a readable unit ("5mm", "500kHz", "0.1s").
-std::string format_quantity(double si_value, Dimension dimension);
+std::string format_quantity(double value, Dimension dimension);
 
 }  // namespace awcc

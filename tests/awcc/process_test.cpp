@@ -1,0 +1,270 @@
+// End-to-end processing: synthetic recordings with known truth, the real
+// spillway recordings against an independent straightforward computation,
+// and bad input.
+#include "awcc/process.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+
+#include "synth/recording.hpp"
+#include "synth/synthesiser.hpp"
+#include "test_paths.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path spillway_dir() { return pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway"; }
+
+struct Written {
+  synth::Synthesis synthesis;
+  fs::path path;
+};
+
+Written write_scene(const synth::Scene& s, synth::SignalKind signal, const std::string& name) {
+  Written w{synth::synthesise(s), pdp_test::temp_dir() / name};
+  synth::RecordingOptions o;
+  o.signal = signal;
+  o.format = *synth::format_from_extension(w.path);
+  synth::write_recording(w.path, s, w.synthesis.signals, o);
+  return w;
+}
+
+std::int64_t complete_chords(const awcc::AirIntervals& s) {
+  std::int64_t n = 0;
+  for (const auto& iv : s.intervals) n += iv.start > 0 && iv.stop < s.sample_count;
+  return n;
+}
+
+TEST(ProcessSynthetic, BinaryFileGivesTheTruthExactly) {
+  synth::Scene s;
+  s.duration = 2.0;
+  s.tu = 0.05;
+  s.tu_y = s.tu_z = 0.025;
+  s.dy = 0.0;
+  const auto w = write_scene(s, synth::SignalKind::binary, "process_binary.flac");
+  awcc::ProcessOptions o;
+  o.dx = s.dx;
+  const auto r = awcc::process_recording(w.path, o);
+  ASSERT_EQ(r.tips.size(), 2u);
+  for (std::size_t j = 0; j < 2; ++j) {
+    EXPECT_TRUE(r.tips[j].threshold.binary_input);
+    EXPECT_DOUBLE_EQ(r.tips[j].phase.void_fraction, w.synthesis.truth.tips[j].void_fraction);
+    EXPECT_DOUBLE_EQ(r.tips[j].phase.bubble_count_rate,
+                     static_cast<double>(complete_chords(w.synthesis.signals[j])) / s.duration);
+  }
+  // Delay: transit dx / u = 250 samples. The FSCC peak sits at the most
+  // frequent transit time; with Tu = 0.05 the transit times spread by +/- 5 %
+  // around 250 samples and the mode of dx/u lies within 2 Tu^2 = 0.5 % of
+  // dx/u_mean; one sample of quantisation is 0.4 %. So 2 % is a safe bound.
+  ASSERT_TRUE(r.fscc && r.fscc->defined) << r.fscc->reason;
+  EXPECT_NEAR(r.fscc->velocity / w.synthesis.truth.realised.mean_velocity[0], 1.0, 0.02);
+  EXPECT_GT(r.fscc->r12_max, 0.5);
+}
+
+TEST(ProcessSynthetic, VoltageFileIsBinarisedBackToTheTruth) {
+  // Raw voltage with first-order edges (tau = 2 us, 0.2 samples at 100 kHz)
+  // and 0.02 V noise against a 3.7 V step: the 50 % threshold is crossed
+  // within one sample of each true edge and noise never reaches it (0.02 V vs
+  // 1.85 V: 90 sd). Each chord can gain or lose at most one sample at each end
+  // but the shifts of both edges are equal, so c changes by at most
+  // (number of chords) / N; chords are counted exactly.
+  synth::Scene s;
+  s.duration = 2.0;
+  s.fs = 100e3;
+  const auto w = write_scene(s, synth::SignalKind::voltage, "process_voltage.wav");
+  awcc::ProcessOptions o;
+  o.dx = s.dx;
+  o.reader.volts_per_count = s.voltage_full_scale / 32768.0;  // no sidecar beside this file
+  const auto r = awcc::process_recording(w.path, o);
+  for (std::size_t j = 0; j < 2; ++j) {
+    EXPECT_FALSE(r.tips[j].threshold.binary_input);
+    const auto& truth = w.synthesis.signals[j];
+    const double bound = static_cast<double>(truth.intervals.size()) / static_cast<double>(truth.sample_count);
+    EXPECT_NEAR(r.tips[j].phase.void_fraction, truth.void_fraction(), bound);
+    EXPECT_DOUBLE_EQ(r.tips[j].phase.bubble_count_rate, static_cast<double>(complete_chords(truth)) / s.duration);
+    // Modes are bin centres of 0.1 V bins next to the levels 0.3 V and 4.0 V
+    // (the noise puts each level on a bin edge, either side may win).
+    EXPECT_NEAR(r.tips[j].threshold.air_level, 0.3, 0.05 + 1e-9);
+    EXPECT_NEAR(r.tips[j].threshold.water_level, 4.0, 0.05 + 1e-9);
+  }
+}
+
+// --- The real recordings -------------------------------------------------
+
+struct Independent {
+  double void_fraction;
+  double bubble_count_rate;
+  double threshold;
+};
+
+// Straight from METHOD 2, without the library: 0.1 V bins, modes below and
+// above the middle of the observed range at bin centres, threshold halfway,
+// air below it; complete air runs per second.
+Independent independent(const fs::path& path, int channel) {
+  std::ifstream in(path, std::ios::binary);
+  std::int32_t rows = 0, channels = 0;
+  in.read(reinterpret_cast<char*>(&rows), 4);
+  in.read(reinterpret_cast<char*>(&channels), 4);
+  std::vector<std::int16_t> data(static_cast<std::size_t>(rows) * static_cast<std::size_t>(channels));
+  in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(data.size() * 2));
+  std::vector<double> v;
+  for (std::int32_t i = 0; i < rows; ++i) v.push_back(data[static_cast<std::size_t>(i * channels + channel)] * 5.0 / 32768.0);
+  double lo = v[0], hi = v[0];
+  for (double x : v) {
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  std::map<long, long> bins;
+  for (double x : v) ++bins[static_cast<long>(std::floor(x / 0.1))];
+  const double middle = (lo + hi) / 2;
+  long air_bin = 0, water_bin = 0, air_count = -1, water_count = -1;
+  for (auto [bin, count] : bins) {
+    const double centre = (static_cast<double>(bin) + 0.5) * 0.1;
+    if (centre < middle && count > air_count) air_bin = bin, air_count = count;
+    if (centre >= middle && count > water_count) water_bin = bin, water_count = count;
+  }
+  const double threshold = ((static_cast<double>(air_bin) + 0.5) * 0.1 + (static_cast<double>(water_bin) + 0.5) * 0.1) / 2;
+  long air = 0, runs = 0;
+  bool in_air = false;
+  long start = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const bool a = v[i] < threshold;
+    air += a;
+    if (a && !in_air) start = static_cast<long>(i);
+    if (!a && in_air && start > 0) ++runs;  // a run that began at sample 0 is cut
+    in_air = a;
+  }
+  return {static_cast<double>(air) / rows, static_cast<double>(runs) / (rows / 20000.0), threshold};
+}
+
+class Spillway : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::is_directory(spillway_dir())) {
+      GTEST_SKIP() << "the real recordings are not here: " << spillway_dir() << " (they sit beside the repository in CI)";
+    }
+  }
+  static fs::path file(int i) { return spillway_dir() / (i < 10 ? "dc157_0" + std::to_string(i) + ".dat" : "dc157_10.dat"); }
+  static awcc::ProcessOptions options() {
+    awcc::ProcessOptions o;
+    o.reader.fs = 20e3;
+    o.dx = 7.15e-3;
+    return o;
+  }
+};
+
+TEST_F(Spillway, VoidFractionAndCountRateEqualAnIndependentComputation) {
+  for (int i = 1; i <= 10; ++i) {
+    const auto r = awcc::process_recording(file(i), options());
+    EXPECT_EQ(r.info.frames, 900000);
+    for (int tip = 0; tip < 2; ++tip) {
+      const auto expected = independent(file(i), tip);
+      const auto& t = r.tips[static_cast<std::size_t>(tip)];
+      EXPECT_NEAR(t.threshold.threshold, expected.threshold, 1e-12) << i << " tip " << tip;
+      EXPECT_DOUBLE_EQ(t.phase.void_fraction, expected.void_fraction) << i << " tip " << tip;
+      EXPECT_DOUBLE_EQ(t.phase.bubble_count_rate, expected.bubble_count_rate) << i << " tip " << tip;
+    }
+  }
+}
+
+TEST_F(Spillway, VelocitiesArePlausibleAndStableBetweenFullAndSegmented) {
+  // A 26.6 degree stepped chute with 0.1 m steps: interfacial velocities of
+  // a few m/s. Full-record and Felder's segmented estimates must agree within
+  // 5 % (two samples of lag at ~50 samples).
+  for (int i = 3; i <= 10; ++i) {
+    auto o = options();
+    const auto full = awcc::process_recording(file(i), o);
+    o.fscc_options.segments = 15;
+    o.fscc_options.felder_lags = true;
+    const auto segmented = awcc::process_recording(file(i), o);
+    ASSERT_TRUE(full.fscc->defined) << i << ": " << full.fscc->reason;
+    ASSERT_TRUE(segmented.fscc->defined) << i << ": " << segmented.fscc->reason;
+    EXPECT_GT(full.fscc->velocity, 1.0) << i;
+    EXPECT_LT(full.fscc->velocity, 6.0) << i;
+    EXPECT_NEAR(segmented.fscc->velocity / full.fscc->velocity, 1.0, 0.05) << i;
+    EXPECT_GT(full.fscc->r12_max, 0.2) << i;
+  }
+}
+
+TEST_F(Spillway, FelderRuleSitsHalfABinAboveAndRaisesCAndFByAFewPercent) {
+  for (int i = 1; i <= 10; ++i) {
+    auto o = options();
+    o.fscc = false;
+    const auto centre = awcc::process_recording(file(i), o);
+    o.binarisation.rule = awcc::ThresholdRule::felder;
+    const auto felder = awcc::process_recording(file(i), o);
+    for (std::size_t tip = 0; tip < 2; ++tip) {
+      EXPECT_NEAR(felder.tips[tip].threshold.threshold - centre.tips[tip].threshold.threshold, 0.05, 1e-9) << i;
+      const double dc = felder.tips[tip].phase.void_fraction / centre.tips[tip].phase.void_fraction - 1;
+      const double df = felder.tips[tip].phase.bubble_count_rate / centre.tips[tip].phase.bubble_count_rate - 1;
+      EXPECT_GT(dc, 0.0) << i;
+      EXPECT_LT(dc, 0.04) << i;
+      EXPECT_GE(df, 0.0) << i;
+      EXPECT_LT(df, 0.04) << i;
+    }
+  }
+}
+
+// --- Bad input and edge cases -----------------------------------------------
+
+std::string process_error(const fs::path& p, const awcc::ProcessOptions& o) {
+  try {
+    awcc::process_recording(p, o);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return {};
+}
+
+void write_dat(const fs::path& p, const std::vector<std::int16_t>& interleaved, std::int32_t channels) {
+  std::ofstream f(p, std::ios::binary);
+  const std::int32_t rows = static_cast<std::int32_t>(interleaved.size()) / channels;
+  f.write(reinterpret_cast<const char*>(&rows), 4);
+  f.write(reinterpret_cast<const char*>(&channels), 4);
+  f.write(reinterpret_cast<const char*>(interleaved.data()), static_cast<std::streamsize>(interleaved.size() * 2));
+}
+
+TEST(ProcessInput, ChannelProblemsAreNamed) {
+  const auto single = pdp_test::temp_dir() / "single.dat";
+  write_dat(single, std::vector<std::int16_t>(1000, 100), 1);
+  awcc::ProcessOptions o;
+  o.reader.fs = 1000;
+  EXPECT_NE(process_error(single, o).find("channel 1 requested but the recording has 1 channel"), std::string::npos)
+      << process_error(single, o);
+  const auto two = pdp_test::temp_dir() / "two.dat";
+  write_dat(two, std::vector<std::int16_t>(1000, 100), 2);
+  o.trailing_channel = 5;
+  EXPECT_NE(process_error(two, o).find("channel 5"), std::string::npos);
+}
+
+TEST(ProcessInput, AConstantChannelIsNotAnError) {
+  // Leading tip: bubbles; trailing tip: constant water. c = 0, F = 0, and the
+  // velocity is undefined with its reason.
+  std::vector<std::int16_t> data;
+  for (int i = 0; i < 20000; ++i) {
+    data.push_back(static_cast<std::int16_t>((i / 37) % 5 == 0 ? 2000 + i % 3 : 27000 + i % 2));
+    data.push_back(27000);
+  }
+  const auto p = pdp_test::temp_dir() / "constant.dat";
+  write_dat(p, data, 2);
+  awcc::ProcessOptions o;
+  o.reader.fs = 20e3;
+  o.dx = 5e-3;
+  const auto r = awcc::process_recording(p, o);
+  EXPECT_NEAR(r.tips[0].phase.void_fraction, 0.2, 0.01);
+  EXPECT_EQ(r.tips[1].phase.void_fraction, 0.0);
+  EXPECT_EQ(r.tips[1].phase.bubble_count_rate, 0.0);
+  ASSERT_TRUE(r.fscc);
+  EXPECT_FALSE(r.fscc->defined);
+  EXPECT_NE(r.fscc->reason.find("constant"), std::string::npos);
+  const auto j = awcc::to_json(r);
+  EXPECT_TRUE(j["fscc"]["velocity"].is_null());
+  EXPECT_FALSE(j["fscc"]["reason"].is_null());
+}
+
+}  // namespace

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Command-line behaviour of `pdp process`: a summary, the JSON keys of
+# docs/output.md, a profile CSV, and bad input (message naming the file and
+# the problem, non-zero exit, no output file).
+# Usage: process_cli_test.sh PDP SCRATCH_DIR SOURCE_DIR
+set -u
+pdp=$1
+dir=$2/process_cli
+src=$3
+data=$src/../shared/data/felder-stepped-spillway
+rm -rf "$dir" && mkdir -p "$dir"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# A synthetic recording to process.
+"$pdp" --log-level warn synth -q --duration 1s --fs 100kHz --tu 0.05 --dy 0 -o "$dir/rec.flac" || fail "synth"
+
+# One file: summary on stdout, JSON with the documented keys.
+out=$("$pdp" process "$dir/rec.flac" --dx 5mm --json "$dir/one.json") || fail "process one file"
+grep -q "void fraction" <<<"$out" || fail "no summary on stdout"
+grep -q "FSCC: velocity" <<<"$out" || fail "no FSCC velocity in the summary"
+for key in tips threshold void_fraction bubble_count_rate chord_time_mean chord_time_median fscc velocity lag \
+  r12_max t05 tau05 turbulence_intensity_chanson; do
+  grep -q "\"$key\"" "$dir/one.json" || fail "JSON lacks $key"
+done
+
+# A profile: CSV rows on stdout, positions from the command line and a manifest.
+"$pdp" --log-level warn synth -q --duration 0.5s --fs 100kHz --seed 2 -o "$dir/rec2.flac"
+csv=$("$pdp" process "$dir/rec.flac" "$dir/rec2.flac" --dx 5mm --positions 2mm,8mm --json "$dir/profile.json") ||
+  fail "profile"
+[[ $(wc -l <<<"$csv") -eq 3 ]] || fail "profile CSV should have a header and 2 rows: $csv"
+head -1 <<<"$csv" | grep -q "^file,position,void_fraction,bubble_count_rate" || fail "profile CSV header"
+grep -q "^rec2.flac,0.008," <<<"$csv" || fail "profile CSV position"
+grep -q '"profile"' "$dir/profile.json" || fail "profile JSON"
+printf 'file,position\nrec.flac,14mm\nrec2.flac,20mm\n' >"$dir/manifest.csv"
+"$pdp" process "$dir/rec.flac" "$dir/rec2.flac" --dx 5mm --manifest "$dir/manifest.csv" --csv "$dir/profile.csv" ||
+  fail "manifest"
+grep -q "^rec.flac,0.014," "$dir/profile.csv" || fail "manifest position not applied"
+
+# Real recordings, when they are beside the repository.
+if [[ -d $data ]]; then
+  "$pdp" process "$data"/dc157_0{3,4}.dat --fs 20kHz --dx 7.15mm --segments 15 --felder-lags \
+    --threshold-rule felder >"$dir/real.csv" || fail "real recordings"
+  [[ $(wc -l <"$dir/real.csv") -eq 3 ]] || fail "real profile rows"
+fi
+
+expect_refusal() {  # name, message fragment, pdp process arguments...
+  local name=$1 fragment=$2
+  shift 2
+  local err
+  err=$("$pdp" process "$@" --json "$dir/$name.json" --csv "$dir/$name.csv" 2>&1 >/dev/null)
+  local status=$?
+  [[ $status -ne 0 ]] || fail "$name: exit status 0"
+  grep -q -- "$fragment" <<<"$err" || fail "$name: message lacks '$fragment': $err"
+  [[ ! -e $dir/$name.json && ! -e $dir/$name.csv ]] || fail "$name: wrote an output file"
+  ls -a "$dir" | grep -q partial && fail "$name: left a temporary file"
+}
+
+: >"$dir/empty.wav"
+expect_refusal empty "empty" "$dir/empty.wav" --dx 5mm
+python3 - "$dir" <<'PY'
+import struct, sys, math
+d = sys.argv[1]
+open(f"{d}/truncated.dat", "wb").write(struct.pack("<ii", 900000, 2) + b"\0" * 4000)
+open(f"{d}/lying.dat", "wb").write(struct.pack("<ii", 10, 2) + b"\0" * 4000)
+open(f"{d}/single.dat", "wb").write(struct.pack("<ii", 1000, 1) + struct.pack("<1000h", *([100, 20000] * 500)))
+open(f"{d}/nan.raw", "wb").write(struct.pack("<6f", 1.0, 2.0, float("nan"), 4.0, 5.0, 6.0))
+open(f"{d}/inf.raw", "wb").write(struct.pack("<4f", 1.0, float("inf"), 3.0, 4.0))
+open(f"{d}/textcell.csv", "w").write("lead,trail\n1.0,4.0\n1.1,x4.0\n")
+open(f"{d}/notaudio.wav", "w").write("hello, this is not a wave file\n" * 10)
+PY
+expect_refusal truncated "truncated" "$dir/truncated.dat" --fs 20kHz
+expect_refusal lying "does not describe the data" "$dir/lying.dat" --fs 20kHz
+expect_refusal notaudio "not a readable audio file" "$dir/notaudio.wav"
+expect_refusal nan "NaN" "$dir/nan.raw" --fs 1kHz --raw-type float32
+expect_refusal inf "infinite" "$dir/inf.raw" --fs 1kHz --raw-type float32
+expect_refusal badcell "line 3, column 2" "$dir/textcell.csv" --fs 1kHz
+expect_refusal single "has 1 channel" "$dir/single.dat" --fs 20kHz
+expect_refusal channel "channel 7" "$dir/rec.flac" --trailing-channel 7
+expect_refusal missing_fs "--fs" "$dir/single.dat"
+expect_refusal bad_unit "--dx" "$dir/rec.flac" --dx 5kg
+expect_refusal positions "one per file" "$dir/rec.flac" "$dir/rec2.flac" --positions 2mm
+
+# An output that is an input is refused and the input stays as it was.
+cp "$dir/textcell.csv" "$dir/keep.csv"
+"$pdp" process "$dir/rec.flac" --dx 5mm --csv "$dir/rec.flac" 2>/dev/null && fail "output over an input accepted"
+cmp -s "$dir/rec.flac" "$dir/rec2.flac" && fail "input overwritten"
+"$pdp" process "$dir/rec.flac" --dx 5mm --json "$dir/rec.flac" 2>"$dir/err.txt" && fail "json over input accepted"
+grep -q "is an input recording" "$dir/err.txt" || fail "output-over-input message"
+
+if ((failures)); then
+  echo "$failures failures"
+  exit 1
+fi
+echo "pdp process CLI: all checks passed"
