@@ -74,6 +74,24 @@ void VoltageHistogram::add(std::span<const float> values, std::size_t first, std
   total_ += static_cast<std::int64_t>((values.size() + stride - 1 - first) / stride);
 }
 
+void VoltageHistogram::add_counts(std::span<const std::int64_t> counts, std::int64_t first_index) {
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    if (!counts[i]) continue;
+    const std::int64_t index = first_index + static_cast<std::int64_t>(i);
+    std::int64_t k = index - offset_;
+    if (k < 0 || k >= static_cast<std::int64_t>(counts_.size())) {
+      grow(index);
+      k = index - offset_;
+    }
+    counts_[static_cast<std::size_t>(k)] += counts[i];
+    total_ += counts[i];
+    const auto v = static_cast<float>(static_cast<double>(index) * width_);
+    if (distinct_.size() < 3 && std::find(distinct_.begin(), distinct_.end(), v) == distinct_.end()) {
+      distinct_.push_back(v);
+    }
+  }
+}
+
 std::optional<std::vector<double>> VoltageHistogram::binary_levels() const {
   if (distinct_.size() > 2 || distinct_.empty()) return std::nullopt;
   std::vector<double> levels(distinct_.begin(), distinct_.end());
@@ -224,6 +242,14 @@ void Binariser::feed(std::span<const float> values, std::size_t first, std::size
     }
   }
   position_ = n;
+}
+
+void Binariser::feed_run(float value, std::int64_t length) {
+  if (length <= 0) return;
+  // The first sample may switch the state; the rest repeat its decision.
+  const float one[1] = {value};
+  feed(one, 0, 1);
+  position_ += length - 1;
 }
 
 AirIntervals Binariser::finish() {

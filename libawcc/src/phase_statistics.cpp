@@ -37,7 +37,9 @@ double variance(const std::vector<double>& v, double mean) {
 
 }  // namespace
 
-Summary summarise(std::vector<double> values) {
+Summary summarise(std::vector<double> values) { return summarise_in_place(values); }
+
+Summary summarise_in_place(std::vector<double>& values) {
   Summary s;
   s.count = static_cast<std::int64_t>(values.size());
   if (values.empty()) return s;
@@ -78,16 +80,12 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
   }
   const auto n = static_cast<double>(air.size());
   p.bubble_count_rate = p.duration > 0.0 ? n / p.duration : 0.0;
-  p.air_chord_time = summarise(air);
-  p.water_chord_time = summarise(water);
-  p.interarrival_time = summarise(arrivals);
-  {
-    std::vector<double> sorted_air = air, sorted_water = water;
-    std::sort(sorted_air.begin(), sorted_air.end());
-    std::sort(sorted_water.begin(), sorted_water.end());
-    p.air_chord_histogram = histogram_of(sorted_air, options.histogram_bins);
-    p.water_chord_histogram = histogram_of(sorted_water, options.histogram_bins);
-  }
+  // Sorted in place from here on (the order of chords is not needed again).
+  p.air_chord_time = summarise_in_place(air);
+  p.water_chord_time = summarise_in_place(water);
+  p.interarrival_time = summarise_in_place(arrivals);
+  p.air_chord_histogram = histogram_of(air, options.histogram_bins);
+  p.water_chord_histogram = histogram_of(water, options.histogram_bins);
   // Confidence intervals of c and F (alternating renewal process, see header).
   p.void_fraction_ci95 = {p.void_fraction, p.void_fraction};
   p.bubble_count_rate_ci95 = {p.bubble_count_rate, p.bubble_count_rate};

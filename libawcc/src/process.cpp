@@ -18,6 +18,184 @@ std::string ProcessOptions::validate() const {
   return {};
 }
 
+namespace {
+
+struct ChannelSelection {
+  std::size_t stride, lead, trail;
+};
+
+// Two passes over floating (or non-16-bit) samples: histograms, then thresholds.
+void binarise_two_pass(Recording& recording, const ProcessOptions& options, const BinarisationOptions& bopt,
+                       const ChannelSelection& ch, BinarisedRecording& out) {
+  const auto& path = recording.info().path;
+  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * ch.stride);
+  VoltageHistogram h_lead(recording.info().quantum), h_trail(recording.info().quantum);
+  std::int64_t frames = 0;
+  for (;;) {
+    const std::int64_t n = recording.read(block, options.block_frames);
+    if (n == 0) break;
+    const auto used = std::span<const float>(block.data(), static_cast<std::size_t>(n) * ch.stride);
+    h_lead.add(used, ch.lead, ch.stride);
+    h_trail.add(used, ch.trail, ch.stride);
+    frames += n;
+  }
+  if (frames == 0) throw std::runtime_error(fmt::format("{}: the recording holds no samples", path.string()));
+  out.leading_threshold = choose_threshold(h_lead, bopt);
+  out.trailing_threshold = choose_threshold(h_trail, bopt);
+  recording.rewind();
+  Binariser b_lead(out.leading_threshold, recording.info().fs), b_trail(out.trailing_threshold, recording.info().fs);
+  for (;;) {
+    const std::int64_t n = recording.read(block, options.block_frames);
+    if (n == 0) break;
+    const auto used = std::span<const float>(block.data(), static_cast<std::size_t>(n) * ch.stride);
+    b_lead.feed(used, ch.lead, ch.stride);
+    b_trail.feed(used, ch.trail, ch.stride);
+  }
+  out.leading = b_lead.finish();
+  out.trailing = b_trail.finish();
+  if (out.leading.sample_count != frames) {
+    throw std::runtime_error(fmt::format("{}: the second reading gave {} frames instead of {}; the file changed while "
+                                         "being read",
+                                         path.string(), out.leading.sample_count, frames));
+  }
+}
+
+// One pass over 16-bit samples. The thresholds depend on the histogram of the
+// whole record, which is known only at its end, so the pass keeps what any
+// threshold inside a band [lo, hi] needs: runs of samples below the band, runs
+// above it, and the few samples inside it (interfaces, noise) with their
+// values. If the final thresholds fall outside the band, a
+// second pass binarises exactly. Histograms are per count, two copies
+// alternating so that runs of equal counts do not serialise on one counter.
+// The band comes from the first block's thresholds (see band_from).
+class BandRecorder {
+ public:
+  BandRecorder(std::int16_t lo, std::int16_t hi) : lo_(lo), hi_(hi), h0_(65536, 0), h1_(65536, 0) {}
+
+  void feed(const std::int16_t* data, std::size_t frames, std::size_t stride, std::size_t channel) {
+    std::uint32_t* h0 = h0_.data();
+    std::uint32_t* h1 = h1_.data();
+    std::uint8_t previous = previous_;
+    std::int64_t index = position_;
+    const std::int16_t lo = lo_, hi = hi_;
+    std::size_t i = 0;
+    for (; i + 1 < frames; i += 2) {
+      const std::int16_t a = data[i * stride + channel];
+      const std::int16_t b = data[(i + 1) * stride + channel];
+      ++h0[static_cast<std::uint16_t>(a)];
+      ++h1[static_cast<std::uint16_t>(b)];
+      const std::uint8_t ka = a < lo ? 0 : (a > hi ? 1 : 2);
+      const std::uint8_t kb = b < lo ? 0 : (b > hi ? 1 : 2);
+      if (ka != previous || ka == 2) [[unlikely]] events_.push_back({index, a, ka});
+      if (kb != ka || kb == 2) [[unlikely]] events_.push_back({index + 1, b, kb});
+      previous = kb;
+      index += 2;
+    }
+    for (; i < frames; ++i) {
+      const std::int16_t a = data[i * stride + channel];
+      ++h0[static_cast<std::uint16_t>(a)];
+      const std::uint8_t ka = a < lo ? 0 : (a > hi ? 1 : 2);
+      if (ka != previous || ka == 2) events_.push_back({index, a, ka});
+      previous = ka;
+      ++index;
+    }
+    previous_ = previous;
+    position_ = index;
+    // Move the 32-bit counters into 64-bit totals long before they can overflow.
+    if (++blocks_ % 1024 == 0) flush();
+  }
+
+  VoltageHistogram histogram(double quantum) {
+    flush();
+    VoltageHistogram h(quantum);
+    // Tables are indexed by the count reinterpreted as uint16; order them by value.
+    std::vector<std::int64_t> ordered(65536);
+    for (std::int32_t c = -32768; c < 32768; ++c) ordered[static_cast<std::size_t>(c + 32768)] = total_[static_cast<std::uint16_t>(c)];
+    h.add_counts(ordered, -32768);
+    return h;
+  }
+
+  /// True when every threshold of t lies strictly inside the band.
+  [[nodiscard]] bool covers(const Threshold& t, double quantum) const {
+    const double lo = static_cast<double>(lo_) * quantum, hi = static_cast<double>(hi_) * quantum;
+    const double a = std::min(t.lower, t.upper) - t.tolerance, b = std::max(t.lower, t.upper) + t.tolerance;
+    return lo < a && b < hi;
+  }
+
+  AirIntervals resolve(const Threshold& t, double quantum, double fs) const {
+    Binariser b(t, fs);
+    const auto below = static_cast<float>((static_cast<double>(lo_) - 0.5) * quantum);
+    const auto above = static_cast<float>((static_cast<double>(hi_) + 0.5) * quantum);
+    for (std::size_t e = 0; e < events_.size(); ++e) {
+      const auto& ev = events_[e];
+      const std::int64_t next = e + 1 < events_.size() ? events_[e + 1].index : position_;
+      if (ev.kind == 2) {
+        const float v[1] = {static_cast<float>(static_cast<double>(ev.count) * quantum)};
+        b.feed(v, 0, 1);
+      } else {
+        b.feed_run(ev.kind == 0 ? below : above, next - ev.index);
+      }
+    }
+    return b.finish();
+  }
+
+  [[nodiscard]] std::int64_t samples() const { return position_; }
+
+ private:
+  struct Event {
+    std::int64_t index;
+    std::int16_t count;
+    std::uint8_t kind;  // 0 below the band, 1 above, 2 inside (value kept)
+  };
+  void flush() {
+    for (std::size_t k = 0; k < 65536; ++k) {
+      total_[k] += h0_[k] + static_cast<std::int64_t>(h1_[k]);
+      h0_[k] = h1_[k] = 0;
+    }
+  }
+
+  std::int16_t lo_, hi_;
+  std::vector<std::uint32_t> h0_, h1_;
+  std::vector<std::int64_t> total_ = std::vector<std::int64_t>(65536, 0);
+  std::vector<Event> events_;
+  std::uint8_t previous_ = 3;  // no sample yet: the first sample opens an event
+  std::int64_t position_ = 0;
+  std::int64_t blocks_ = 0;
+};
+
+// The band for one channel from the first block: its thresholds widened by
+// 8 % of the span between its modes on each side. Narrow, so that only samples
+// near the threshold are kept (memory is costly to touch on a virtual
+// machine); wide enough that the whole record's thresholds, from the same
+// modes in nearly every recording, fall inside it.
+std::optional<std::pair<std::int16_t, std::int16_t>> band_from(const std::int16_t* data, std::size_t frames,
+                                                                std::size_t stride, std::size_t channel,
+                                                                double quantum, const BinarisationOptions& bopt) {
+  if (bopt.rule == ThresholdRule::fixed) {
+    // The threshold is known: a band of one count around it.
+    const double c = bopt.fixed_threshold / quantum;
+    if (!(std::fabs(c) < 32000.0)) return std::nullopt;
+    return std::pair{static_cast<std::int16_t>(std::floor(c) - 1), static_cast<std::int16_t>(std::ceil(c) + 1)};
+  }
+  std::vector<std::int64_t> counts(65536, 0);
+  for (std::size_t i = 0; i < frames; ++i) ++counts[static_cast<std::size_t>(data[i * stride + channel] + 32768)];
+  VoltageHistogram h(quantum);
+  h.add_counts(counts, -32768);
+  try {
+    const Threshold t = choose_threshold(h, bopt);
+    if (t.binary_input || t.constant) return std::nullopt;
+    const double span = std::fabs(t.water_level - t.air_level);
+    const double lo = (std::min(t.lower, t.upper) - 0.08 * span) / quantum;
+    const double hi = (std::max(t.lower, t.upper) + 0.08 * span) / quantum;
+    if (!(hi - lo > 2.0) || !(lo > -32000.0) || !(hi < 32000.0)) return std::nullopt;
+    return std::pair{static_cast<std::int16_t>(std::ceil(lo)), static_cast<std::int16_t>(std::floor(hi))};
+  } catch (const std::runtime_error&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   auto recording = open_recording(path, options.reader);
@@ -31,52 +209,47 @@ BinarisedRecording binarise_recording(const std::filesystem::path& path, const P
           path.string(), c, channels, channels == 1 ? "" : "s"));
     }
   }
-  const auto stride = static_cast<std::size_t>(channels);
-  const auto lead = static_cast<std::size_t>(options.leading_channel);
-  const auto trail = static_cast<std::size_t>(options.trailing_channel);
-  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
-
-  // Pass 1: histograms (only what the rule needs).
+  const ChannelSelection ch{static_cast<std::size_t>(channels), static_cast<std::size_t>(options.leading_channel),
+                            static_cast<std::size_t>(options.trailing_channel)};
   BinarisationOptions bopt = options.binarisation;
   if (!info.volts_known && bopt.bin_width > 0.0 && bopt.rule != ThresholdRule::felder) bopt.bin_width = 0.0;
-  VoltageHistogram h_lead(info.quantum), h_trail(info.quantum);
-  std::int64_t frames = 0;
-  for (;;) {
-    const std::int64_t n = recording->read(block, options.block_frames);
-    if (n == 0) break;
-    const auto used = std::span<const float>(block.data(), static_cast<std::size_t>(n) * stride);
-    h_lead.add(used, lead, stride);
-    h_trail.add(used, trail, stride);
-    frames += n;
-  }
-  if (frames == 0) throw std::runtime_error(fmt::format("{}: the recording holds no samples", path.string()));
+
   BinarisedRecording out;
   out.info = info;
-  out.info.frames = frames;
   try {
-    out.leading_threshold = choose_threshold(h_lead, bopt);
-    out.trailing_threshold = choose_threshold(h_trail, bopt);
+    bool done = false;
+    if (options.single_pass && recording->has_int16() && info.quantum > 0.0) {
+      std::vector<std::int16_t> block(static_cast<std::size_t>(options.block_frames) * ch.stride);
+      std::int64_t n = recording->read_int16(block, options.block_frames);
+      const auto band_lead = band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.lead, info.quantum, bopt);
+      const auto band_trail = band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail, info.quantum, bopt);
+      if (n > 0 && band_lead && band_trail) {
+        BandRecorder lead(band_lead->first, band_lead->second), trail(band_trail->first, band_trail->second);
+        while (n > 0) {
+          lead.feed(block.data(), static_cast<std::size_t>(n), ch.stride, ch.lead);
+          trail.feed(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail);
+          n = recording->read_int16(block, options.block_frames);
+        }
+        out.leading_threshold = choose_threshold(lead.histogram(info.quantum), bopt);
+        out.trailing_threshold = choose_threshold(trail.histogram(info.quantum), bopt);
+        if (lead.covers(out.leading_threshold, info.quantum) && trail.covers(out.trailing_threshold, info.quantum)) {
+          out.leading = lead.resolve(out.leading_threshold, info.quantum, info.fs);
+          out.trailing = trail.resolve(out.trailing_threshold, info.quantum, info.fs);
+          done = true;
+        }
+      }
+      if (!done) recording->rewind();
+    }
+    if (!done) binarise_two_pass(*recording, options, bopt, ch, out);
   } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("{}: {}", path.string(), e.what()));
+    const std::string what = e.what();
+    if (what.rfind(path.string(), 0) == 0) throw;
+    throw std::runtime_error(fmt::format("{}: {}", path.string(), what));
   }
-
-  // Pass 2: binarise.
-  recording->rewind();
-  Binariser b_lead(out.leading_threshold, info.fs), b_trail(out.trailing_threshold, info.fs);
-  for (;;) {
-    const std::int64_t n = recording->read(block, options.block_frames);
-    if (n == 0) break;
-    const auto used = std::span<const float>(block.data(), static_cast<std::size_t>(n) * stride);
-    b_lead.feed(used, lead, stride);
-    b_trail.feed(used, trail, stride);
+  if (out.leading.sample_count == 0) {
+    throw std::runtime_error(fmt::format("{}: the recording holds no samples", path.string()));
   }
-  out.leading = b_lead.finish();
-  out.trailing = b_trail.finish();
-  if (out.leading.sample_count != frames) {
-    throw std::runtime_error(fmt::format("{}: the second reading gave {} frames instead of {}; the file changed while "
-                                         "being read",
-                                         path.string(), out.leading.sample_count, frames));
-  }
+  out.info.frames = out.leading.sample_count;
   return out;
 }
 

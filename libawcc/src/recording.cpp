@@ -35,6 +35,10 @@ std::string_view to_string(SampleType type) {
   return "?";
 }
 
+std::int64_t Recording::read_int16(std::span<std::int16_t>, std::int64_t) {
+  throw std::logic_error("read_int16 on a recording without 16-bit integer samples");
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -91,6 +95,7 @@ class SndfileRecording final : public Recording {
       default: bits = 0;
     }
     floating_ = bits == 0;
+    int16_ = bits == 16;
     // Values as counts for integer data, as stored for floating data.
     sf_command(file_, SFC_SET_NORM_FLOAT, nullptr, SF_FALSE);
     double vpc = options.volts_per_count;
@@ -134,6 +139,19 @@ class SndfileRecording final : public Recording {
     position_ = 0;
   }
 
+  [[nodiscard]] bool has_int16() const override { return int16_; }
+
+  std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
+    const sf_count_t got = sf_readf_short(file_, out.data(), max_frames);
+    if (got < 0) fail(info_.path, "read error");
+    position_ += got;
+    if (got == 0 && info_.frames >= 0 && position_ < info_.frames) {
+      fail(info_.path, fmt::format("the header announces {} frames but the data ends after {}: the file is truncated",
+                                   info_.frames, position_));
+    }
+    return got;
+  }
+
  private:
   static double sidecar_volts_per_count(const fs::path& path) {
     fs::path side = path;
@@ -152,6 +170,7 @@ class SndfileRecording final : public Recording {
 
   SNDFILE* file_ = nullptr;
   bool floating_ = false;
+  bool int16_ = false;
   double scale_ = 1.0;
   std::int64_t position_ = 0;
 };
@@ -243,6 +262,27 @@ class BinaryRecording final : public Recording {
     in_.clear();
     in_.seekg(layout_.header_bytes);
     position_ = 0;
+  }
+
+  [[nodiscard]] bool has_int16() const override { return layout_.sample_type == SampleType::int16; }
+
+  std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
+    const std::int64_t n = std::min(max_frames, info_.frames - position_);
+    if (n <= 0) return 0;
+    const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(layout_.channels);
+    in_.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(count * 2));
+    if (in_.gcount() != static_cast<std::streamsize>(count * 2)) {
+      fail(info_.path, fmt::format("the data ends early, after frame {} of {}: the file is truncated", position_,
+                                   info_.frames));
+    }
+    if (swap_) {
+      for (std::size_t i = 0; i < count; ++i) {
+        const auto u = static_cast<std::uint16_t>(out[i]);
+        out[i] = static_cast<std::int16_t>(static_cast<std::uint16_t>((u >> 8) | (u << 8)));
+      }
+    }
+    position_ += n;
+    return n;
   }
 
  private:

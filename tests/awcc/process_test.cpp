@@ -210,6 +210,50 @@ TEST_F(Spillway, FelderRuleSitsHalfABinAboveAndRaisesCAndFByAFewPercent) {
   }
 }
 
+TEST_F(Spillway, OnePassAndTwoPassBinarisationAgreeExactly) {
+  for (int i : {1, 5, 10}) {
+    auto o = options();
+    const auto one = awcc::binarise_recording(file(i), o);
+    o.single_pass = false;
+    const auto two = awcc::binarise_recording(file(i), o);
+    EXPECT_EQ(one.leading.intervals, two.leading.intervals) << i;
+    EXPECT_EQ(one.trailing.intervals, two.trailing.intervals) << i;
+    EXPECT_EQ(one.leading_threshold.threshold, two.leading_threshold.threshold) << i;
+  }
+}
+
+TEST(ProcessSynthetic, OnePassFallsBackWhenTheFirstBlockMisleads) {
+  // The first block holds no bubble at all (a long water stretch), so no band
+  // can be set from it; and a second recording whose first block has other
+  // modes than the whole. Both must equal the two-pass result.
+  std::vector<std::int16_t> data;
+  for (int i = 0; i < 300000; ++i) {
+    const bool air = i > 100000 && (i / 23) % 7 == 0;
+    const auto noise = static_cast<int>((static_cast<unsigned>(i) * 7919u) % 61u) - 30;
+    data.push_back(static_cast<std::int16_t>((air ? 2000 : 27000) + noise));
+    // Trailing: the first block sits at a different water level.
+    const bool air2 = (i / 31) % 5 == 0;
+    data.push_back(static_cast<std::int16_t>((air2 ? 3000 : (i < 60000 ? 20000 : 27000)) + noise));
+  }
+  const auto p = pdp_test::temp_dir() / "misleading.dat";
+  {
+    std::ofstream f(p, std::ios::binary);
+    const std::int32_t rows = 300000, channels = 2;
+    f.write(reinterpret_cast<const char*>(&rows), 4);
+    f.write(reinterpret_cast<const char*>(&channels), 4);
+    f.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size() * 2));
+  }
+  awcc::ProcessOptions o;
+  o.reader.fs = 20e3;
+  o.block_frames = 50000;
+  const auto one = awcc::binarise_recording(p, o);
+  o.single_pass = false;
+  const auto two = awcc::binarise_recording(p, o);
+  EXPECT_EQ(one.leading.intervals, two.leading.intervals);
+  EXPECT_EQ(one.trailing.intervals, two.trailing.intervals);
+  EXPECT_GT(one.leading.intervals.size(), 100u);
+}
+
 // --- Bad input and edge cases -----------------------------------------------
 
 std::string process_error(const fs::path& p, const awcc::ProcessOptions& o) {

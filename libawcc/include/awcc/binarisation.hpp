@@ -59,6 +59,9 @@ class VoltageHistogram {
   explicit VoltageHistogram(double quantum);
   /// Adds every `stride`-th value starting at `first`.
   void add(std::span<const float> values, std::size_t first, std::size_t stride);
+  /// Adds counts[i] samples of value (first_index + i) * quantum, for
+  /// histograms of integer data gathered elsewhere (same quantum).
+  void add_counts(std::span<const std::int64_t> counts, std::int64_t first_index);
   [[nodiscard]] std::int64_t total() const { return total_; }
   /// Distinct values seen, when there were at most two (binary input).
   [[nodiscard]] std::optional<std::vector<double>> binary_levels() const;
@@ -101,6 +104,9 @@ class Binariser {
   Binariser(const Threshold& threshold, double fs);
   /// Feeds every `stride`-th value from `first` (consecutive samples).
   void feed(std::span<const float> values, std::size_t first, std::size_t stride);
+  /// Feeds `length` consecutive samples that all take the same decision as
+  /// `value` would (a run known to lie on one side of every threshold).
+  void feed_run(float value, std::int64_t length);
   /// The air intervals of everything fed.
   AirIntervals finish();
 

@@ -65,6 +65,8 @@ struct PhaseStatistics {
 };
 
 Summary summarise(std::vector<double> values);
+/// Same, sorting `values` in place.
+Summary summarise_in_place(std::vector<double>& values);
 PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisticsOptions& options = {});
 
 }  // namespace awcc

@@ -28,6 +28,7 @@ struct ProcessOptions {
   FsccOptions fscc_options;
   int histogram_bins = 50;            ///< chord-time histogram bins
   std::int64_t block_frames = 1 << 16;  ///< frames read at a time
+  bool single_pass = true;            ///< allow the one-pass path for 16-bit data (same result, faster)
 
   [[nodiscard]] std::string validate() const;
 };

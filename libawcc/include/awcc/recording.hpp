@@ -74,6 +74,11 @@ class Recording {
   virtual std::int64_t read(std::span<float> out, std::int64_t max_frames) = 0;
   /// Back to the first frame.
   virtual void rewind() = 0;
+  /// True when the samples are 16-bit integers that read_int16() hands out
+  /// as stored (volts = count * info().quantum): the fast path of binarisation.
+  [[nodiscard]] virtual bool has_int16() const { return false; }
+  /// Like read(), but the raw int16 counts. Only when has_int16().
+  virtual std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames);
 
  protected:
   RecordingInfo info_;
