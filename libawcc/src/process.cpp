@@ -253,30 +253,120 @@ BinarisedRecording binarise_recording(const std::filesystem::path& path, const P
   return out;
 }
 
+std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOptions& options,
+                                   std::optional<double> velocity);
+
+std::optional<double> ProcessResult::velocity() const {
+  if (awcc && awcc->defined) return awcc->velocity;
+  if (fscc && fscc->defined) return fscc->velocity;
+  return std::nullopt;
+}
+
 ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOptions& options) {
   ProcessResult out;
   out.info = r.info;
   out.dx = options.dx;
   out.dy = options.dy;
+  const std::string no_dx = "no tip separation given (--dx): the velocity cannot be computed";
   if (options.fscc) {
     out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options);
     if (!(options.dx > 0.0) && out.fscc->defined) {
       out.fscc->defined = false;
-      out.fscc->reason = "no tip separation given (--dx): the velocity cannot be computed";
+      out.fscc->reason = no_dx;
       out.fscc->velocity = 0.0;
     }
   }
+  if (options.awcc && !options.correlate_raw) {
+    out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);
+    if (!(options.dx > 0.0)) {
+      out.awcc->defined = false;
+      out.awcc->reason = no_dx;
+    }
+  }
+  out.tips = tip_results(r, options, out.velocity());
+  return out;
+}
+
+std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOptions& options,
+                                   std::optional<double> velocity) {
   PhaseStatisticsOptions po;
   po.histogram_bins = options.histogram_bins;
-  if (out.fscc && out.fscc->defined) po.velocity = out.fscc->velocity;
-  out.tips.push_back({options.leading_channel, r.leading_threshold, phase_statistics(r.leading, po)});
-  out.tips.push_back({options.trailing_channel, r.trailing_threshold, phase_statistics(r.trailing, po)});
+  po.velocity = velocity;
+  return {{options.leading_channel, r.leading_threshold, phase_statistics(r.leading, po)},
+          {options.trailing_channel, r.trailing_threshold, phase_statistics(r.trailing, po)}};
+}
+
+AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
+  const AwccOptions& ao = options.awcc_options;
+  if (auto why = ao.validate(); !why.empty()) throw std::invalid_argument(why);
+  AwccResult result;
+  result.windows = awcc_windows(b.leading, ao.np);
+  auto recording = open_recording(path, options.reader);
+  const auto stride = static_cast<std::size_t>(recording->info().channels);
+  const auto lead = static_cast<std::size_t>(options.leading_channel);
+  const auto trail = static_cast<std::size_t>(options.trailing_channel);
+  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
+  std::vector<double> xs, ys;
+  FftPlanCache plans;
+  const double fs = b.info.fs;
+  std::int64_t position = 0, in_block = 0, block_start = 0;
+  std::size_t w = 0;
+  // Windows are contiguous: fill each from the blocks as they come.
+  while (w < result.windows.size()) {
+    AwccWindow& window = result.windows[w];
+    if (position >= block_start + in_block) {
+      block_start += in_block;
+      in_block = recording->read(block, options.block_frames);
+      if (in_block == 0) {
+        throw std::runtime_error(fmt::format("{}: the recording ended at frame {} while reading it again for AWCC",
+                                             path.string(), position));
+      }
+      continue;
+    }
+    const std::int64_t end = window.start + window.length;
+    const std::int64_t take = std::min(end, block_start + in_block) - position;
+    for (std::int64_t i = 0; i < take; ++i) {
+      const auto f = static_cast<std::size_t>(position - block_start + i);
+      xs.push_back(block[f * stride + lead]);
+      ys.push_back(block[f * stride + trail]);
+    }
+    position += take;
+    if (position == end) {
+      const auto [k_min, k_max] = awcc_lag_range(window.length, options.dx, fs, ao);
+      std::vector<double> r;
+      if (k_max >= k_min) r = window_correlation_fft(xs, ys, k_min, k_max, plans);
+      analyse_window(window, r, k_min, options.dx, fs, ao);
+      xs.clear();
+      ys.clear();
+      ++w;
+    }
+  }
+  awcc_summarise(result, ao);
+  return result;
+}
+
+std::string awcc_windows_csv(const AwccResult& result) {
+  std::string out = "start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate\n";
+  for (const auto& w : result.windows) {
+    out += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.9g},{:.6f},{:.6f},{:.6f},{:.6g},{}\n", w.start_time, w.duration,
+                       w.particles, w.lag, w.velocity, w.r12_max, w.spr, w.void_fraction, w.count_rate,
+                       to_string(w.fate));
+  }
   return out;
 }
 
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  ProcessResult out = process_binarised(binarise_recording(path, options), options);
+  const auto binarised = binarise_recording(path, options);
+  ProcessResult out = process_binarised(binarised, options);
+  if (options.awcc && options.correlate_raw) {
+    out.awcc = awcc_raw(path, binarised, options);
+    if (!(options.dx > 0.0)) {
+      out.awcc->defined = false;
+      out.awcc->reason = "no tip separation given (--dx): the velocity cannot be computed";
+    }
+    out.tips = tip_results(binarised, options, out.velocity());
+  }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -358,6 +448,29 @@ json to_json(const ProcessResult& r) {
         {"note", f.note.empty() ? json(nullptr) : json(f.note)},
     };
   }
+  if (r.awcc) {
+    const auto& a = *r.awcc;
+    auto value = [&](double v) { return a.defined ? json(v) : json(nullptr); };
+    auto interval = [&](const Interval95& i) { return a.defined ? ci(i) : json(nullptr); };
+    out["awcc"] = json{
+        {"defined", a.defined},
+        {"reason", a.defined ? json(nullptr) : json(a.reason)},
+        {"velocity", value(a.velocity)},
+        {"velocity_ci95", interval(a.velocity_ci95)},
+        {"velocity_rms", value(a.velocity_rms)},
+        {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
+        {"turbulence_intensity", value(a.turbulence_intensity)},
+        {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
+        {"windows_total", a.windows_total},
+        {"windows_accepted", a.windows_accepted},
+        {"windows_rejected_correlation", a.rejected_correlation},
+        {"windows_rejected_lag", a.rejected_lag},
+        {"windows_rejected_roc", a.rejected_roc},
+        {"windows_rejected_constant", a.rejected_constant},
+        {"windows_lag_zero", a.lag_zero_windows},
+        {"roc_iterations", a.roc_iterations},
+    };
+  }
   return out;
 }
 
@@ -403,6 +516,21 @@ std::string ProcessResult::report() const {
                      f.turbulence_intensity_chanson ? fmt::format("{:.4f}", *f.turbulence_intensity_chanson)
                                                     : std::string("n/a")));
     if (!f.note.empty()) line("        note: " + f.note);
+  }
+  if (awcc) {
+    const auto& a = *awcc;
+    if (a.defined) {
+      line(fmt::format("  AWCC: velocity {:.4f} m/s (95 % CI {:.4f} - {:.4f}), u_rms {:.4f} m/s, Tu {:.4f} (95 % CI "
+                       "{:.4f} - {:.4f})",
+                       a.velocity, a.velocity_ci95.lower, a.velocity_ci95.upper, a.velocity_rms,
+                       a.turbulence_intensity, a.turbulence_intensity_ci95.lower, a.turbulence_intensity_ci95.upper));
+    } else {
+      line(fmt::format("  AWCC: undefined: {}", a.reason));
+    }
+    line(fmt::format("        windows {} accepted of {} (rejected: {} correlation, {} lag, {} outlier cutoff, {} "
+                     "constant)",
+                     a.windows_accepted, a.windows_total, a.rejected_correlation, a.rejected_lag, a.rejected_roc,
+                     a.rejected_constant));
   }
   return out;
 }

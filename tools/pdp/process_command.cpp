@@ -57,7 +57,20 @@ CLI::App* setup_process(CLI::App& app, ProcessCommandOptions& o) {
   cmd->add_option("--bin-width", o.bin_width, "histogram bin width, V; 0 = 100 bins over the range")
       ->capture_default_str()->group(bin);
   auto corr = "Correlation";
-  cmd->add_option("--method", o.method, "fscc (awcc follows)")->check(CLI::IsMember({"fscc"}))->capture_default_str()
+  cmd->add_option("--method", o.method, "awcc | fscc | both")->check(CLI::IsMember({"awcc", "fscc", "both"}))
+      ->capture_default_str()->group(corr);
+  cmd->add_option("--np", o.np, "AWCC particles (air chords) per window")->check(CLI::Range(1, 1000))
+      ->capture_default_str()->group(corr);
+  cmd->add_option("--filter-a", o.filter_a, "AWCC correlation filter threshold A: reject R12max/(SPR^2+1) < A")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str()->group(corr);
+  cmd->add_option("--roc", o.roc, "AWCC robust outlier cutoff: on | off")->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str()->group(corr);
+  cmd->add_option("--weighting", o.weighting, "AWCC moments: duration (window duration weights) | none")
+      ->check(CLI::IsMember({"duration", "none"}))->capture_default_str()->group(corr);
+  cmd->add_option("--correlate", o.correlate, "AWCC correlates the binary signals or the raw voltages: binary | raw")
+      ->check(CLI::IsMember({"binary", "raw"}))->capture_default_str()->group(corr);
+  cmd->add_option("--velocity-range", o.velocity_range,
+                  "AWCC lags searched from a velocity range 'min,max' (e.g. 0.5m/s,20m/s) [default: all lags]")
       ->group(corr);
   cmd->add_option("--segments", o.segments, "FSCC segments: 1 = full record; Felder used 15")
       ->check(CLI::Range(1, 1000))->capture_default_str()->group(corr);
@@ -70,6 +83,7 @@ CLI::App* setup_process(CLI::App& app, ProcessCommandOptions& o) {
   auto out = "Output";
   cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)")->group(out);
   cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)")->group(out);
+  cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)")->group(out);
   cmd->add_option("--positions", o.positions, "profile positions, one per file: '2mm,8mm,...'")->group(out);
   cmd->add_option("--manifest", o.manifest, "profile manifest CSV with columns file,position")
       ->check(CLI::ExistingFile)->group(out);
@@ -151,7 +165,29 @@ awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
   p.fscc_options.felder_lags = o.felder_lags;
   p.fscc_options.subsample = o.subsample == "parabolic" ? awcc::Subsample::parabolic : awcc::Subsample::none;
   p.histogram_bins = o.histogram_bins;
+  p.fscc = o.method != "awcc";
+  p.awcc = o.method != "fscc";
+  auto& a = p.awcc_options;
+  a.np = o.np;
+  a.filter_a = o.filter_a;
+  a.roc = o.roc == "on";
+  a.weighting = o.weighting == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
+  a.subsample = p.fscc_options.subsample;
+  p.correlate_raw = o.correlate == "raw";
+  if (!o.velocity_range.empty()) {
+    const auto comma = o.velocity_range.find(',');
+    if (comma == std::string::npos) {
+      throw std::invalid_argument("--velocity-range needs 'min,max', e.g. 0.5m/s,20m/s");
+    }
+    a.velocity_min = quantity(o.velocity_range.substr(0, comma), Dimension::velocity, "velocity-range");
+    a.velocity_max = quantity(o.velocity_range.substr(comma + 1), Dimension::velocity, "velocity-range");
+  }
+  if (auto why = a.validate(); !why.empty()) throw std::invalid_argument(why);
   if (auto why = p.validate(); !why.empty()) throw std::invalid_argument(why);
+  if (!o.windows.empty() && o.files.size() != 1) {
+    throw std::invalid_argument("--windows writes the window table of one recording; give one file");
+  }
+  if (!o.windows.empty() && !p.awcc) throw std::invalid_argument("--windows needs --method awcc or both");
   return p;
 }
 
@@ -209,16 +245,22 @@ std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const s
   std::string out =
       "file,position,void_fraction,bubble_count_rate,chord_time_mean,chord_time_median,threshold,"
       "void_fraction_trailing,bubble_count_rate_trailing,fscc_velocity,fscc_lag,fscc_r12_max,fscc_t05,fscc_tau05,"
-      "fscc_turbulence_intensity_chanson,sauter_diameter,fscc_reason\n";
+      "fscc_turbulence_intensity_chanson,sauter_diameter,fscc_reason,awcc_velocity,awcc_velocity_rms,"
+      "awcc_turbulence_intensity,awcc_windows_accepted,awcc_windows_total,awcc_reason\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
     const auto& lead = r.tips[0].phase;
     const auto& trail = r.tips[1].phase;
     const auto& f = r.fscc;
-    std::string reason = f && !f->defined ? f->reason : std::string();
-    for (auto& ch : reason)
-      if (ch == ',' || ch == '"') ch = ';';
-    out += fmt::format("{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{},{},{},{},{},{},{}\n",
+    auto clean = [](std::string text) {
+      for (auto& ch : text)
+        if (ch == ',' || ch == '"' || ch == '\n') ch = ';';
+      return text;
+    };
+    const std::string reason = clean(f && !f->defined ? f->reason : std::string());
+    const auto& a = r.awcc;
+    const bool awcc_ok = a && a->defined;
+    out += fmt::format("{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
                        r.info.path.filename().string(), csv_number(pos[i]), lead.void_fraction, lead.bubble_count_rate,
                        lead.air_chord_time.mean, lead.air_chord_time.median, r.tips[0].threshold.threshold,
                        trail.void_fraction, trail.bubble_count_rate,
@@ -227,7 +269,13 @@ std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const s
                        csv_number(f ? std::optional(f->r12_max) : std::nullopt), csv_number(f ? f->t05 : std::nullopt),
                        csv_number(f ? f->tau05 : std::nullopt),
                        csv_number(f ? f->turbulence_intensity_chanson : std::nullopt),
-                       csv_number(lead.sauter_diameter), reason);
+                       csv_number(lead.sauter_diameter), reason,
+                       csv_number(awcc_ok ? std::optional(a->velocity) : std::nullopt),
+                       csv_number(awcc_ok ? std::optional(a->velocity_rms) : std::nullopt),
+                       csv_number(awcc_ok ? std::optional(a->turbulence_intensity) : std::nullopt),
+                       a ? std::to_string(a->windows_accepted) : std::string(),
+                       a ? std::to_string(a->windows_total) : std::string(),
+                       clean(a && !a->defined ? a->reason : std::string()));
   }
   return out;
 }
@@ -241,7 +289,7 @@ int run_process(const ProcessCommandOptions& o) {
     options = build_options(o);
     positions = positions_for(o);
     // Inputs are never modified: refuse an output that is one of them.
-    for (const auto& output : {o.json, o.csv}) {
+    for (const auto& output : {o.json, o.csv, o.windows}) {
       if (output.empty() || !std::filesystem::exists(output)) continue;
       for (const auto& input : o.files) {
         if (std::filesystem::equivalent(output, input)) {
@@ -279,6 +327,9 @@ int run_process(const ProcessCommandOptions& o) {
         }
       }
       awcc::write_text_atomically(o.json, j.dump(2) + "\n");
+    }
+    if (!o.windows.empty() && results[0].awcc) {
+      awcc::write_text_atomically(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
     }
     if (results.size() == 1 && o.csv.empty()) {
       fmt::print("{}", results[0].report());

@@ -18,7 +18,14 @@ struct ProcessCommandOptions {
   std::string csv_header = "auto";                   // auto | yes | no
   std::string time_column = "auto";                  // auto | none | column index
   int leading_channel = 0, trailing_channel = 1;
-  std::string method = "fscc";
+  std::string method = "both";                       // awcc | fscc | both
+  int np = 10;
+  double filter_a = 0.4;
+  std::string roc = "on";                            // on | off
+  std::string weighting = "duration";                // duration | none
+  std::string correlate = "binary";                  // binary | raw
+  std::string velocity_range;                        // "min,max" velocities
+  std::string windows;                               // per-window CSV
   std::string threshold_rule = "histogram";
   std::string threshold;                             // fraction, voltage or "low,high"
   std::string probe = "conductivity";

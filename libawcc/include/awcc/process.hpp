@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
@@ -26,6 +27,9 @@ struct ProcessOptions {
   double dy = 0.0;                    ///< lateral tip separation, m (reported)
   bool fscc = true;                   ///< run FSCC
   FsccOptions fscc_options;
+  bool awcc = false;                  ///< run AWCC
+  AwccOptions awcc_options;
+  bool correlate_raw = false;         ///< AWCC correlates the raw voltages (a third pass over the file)
   int histogram_bins = 50;            ///< chord-time histogram bins
   std::int64_t block_frames = 1 << 16;  ///< frames read at a time
   bool single_pass = true;            ///< allow the one-pass path for 16-bit data (same result, faster)
@@ -51,7 +55,11 @@ struct ProcessResult {
   double dx = 0.0, dy = 0.0;
   std::vector<TipResult> tips;        ///< leading tip first
   std::optional<FsccResult> fscc;
+  std::optional<AwccResult> awcc;
   double seconds = 0.0;               ///< wall time of the processing
+
+  /// The velocity used for chord lengths and d32: AWCC's when defined, else FSCC's.
+  [[nodiscard]] std::optional<double> velocity() const;
 
   [[nodiscard]] std::string report() const;
 };
@@ -60,8 +68,16 @@ struct ProcessResult {
 /// naming the file and the problem.
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options);
 
-/// Phase statistics (and FSCC) from binarised signals.
+/// Phase statistics (and FSCC, and AWCC on the binary signals) from binarised signals.
 ProcessResult process_binarised(const BinarisedRecording& recording, const ProcessOptions& options);
+
+/// AWCC correlating the raw voltages of the recording, windows from its
+/// binarised leading tip (reads the file once more, block by block).
+AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
+                    const ProcessOptions& options);
+
+/// The per-window table as CSV (docs/output.md).
+std::string awcc_windows_csv(const AwccResult& result);
 
 /// Both of the above.
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options);
