@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fmt/format.h>
 #include <limits>
 #include <stdexcept>
@@ -79,91 +80,154 @@ void clip(const AirIntervals& s, std::int64_t start, std::int64_t length, std::v
   }
 }
 
-// prefix[m] = air samples in [0, m), m = 0..length.
-void air_prefix(const std::vector<AirInterval>& iv, std::int64_t length, std::vector<double>& prefix) {
-  prefix.assign(static_cast<std::size_t>(length + 1), 0.0);
-  std::int64_t m = 0;
-  double acc = 0.0;
-  for (const auto& a : iv) {
-    for (; m <= a.start; ++m) prefix[static_cast<std::size_t>(m)] = acc;
-    for (; m <= a.stop; ++m) prefix[static_cast<std::size_t>(m)] = acc + static_cast<double>(m - a.start);
-    acc += static_cast<double>(a.stop - a.start);
-  }
-  for (; m <= length; ++m) prefix[static_cast<std::size_t>(m)] = acc;
+}  // namespace
+
+namespace {
+
+// Air samples of intervals `iv` (sorted, relative) in [0, m).
+double air_below(const std::vector<AirInterval>& iv, const std::vector<double>& cumulative, std::int64_t m) {
+  const auto it = std::partition_point(iv.begin(), iv.end(), [m](const AirInterval& a) { return a.stop <= m; });
+  const auto i = static_cast<std::size_t>(it - iv.begin());
+  double total = cumulative[i];
+  if (it != iv.end() && it->start < m) total += static_cast<double>(m - it->start);
+  return total;
 }
 
 }  // namespace
 
-std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
-                                                 std::int64_t length, std::int64_t k_min, std::int64_t k_max) {
+double PiecewiseCorrelation::at(std::int64_t lag) const {
+  const auto it = std::lower_bound(lags.begin(), lags.end(), lag);
+  if (it == lags.end()) return values.back();
+  const auto j = static_cast<std::size_t>(it - lags.begin());
+  if (*it == lag || j == 0) return values[j];
+  const double f = static_cast<double>(lag - lags[j - 1]) / static_cast<double>(lags[j] - lags[j - 1]);
+  return values[j - 1] + f * (values[j] - values[j - 1]);
+}
+
+std::vector<double> PiecewiseCorrelation::expand() const {
+  std::vector<double> out;
+  if (lags.empty()) return out;
+  out.reserve(static_cast<std::size_t>(lags.back() - lags.front() + 1));
+  out.push_back(values[0]);
+  for (std::size_t j = 1; j < lags.size(); ++j) {
+    const std::int64_t gap = lags[j] - lags[j - 1];
+    for (std::int64_t m = 1; m <= gap; ++m) {
+      out.push_back(m == gap ? values[j] : values[j - 1] + static_cast<double>(m) / static_cast<double>(gap) * (values[j] - values[j - 1]));
+    }
+  }
+  return out;
+}
+
+PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max) {
   thread_local std::vector<AirInterval> a, b;
-  thread_local std::vector<double> px, py;
-  thread_local std::vector<std::int64_t> impulses;
+  thread_local std::vector<double> ca, cb;
+  PiecewiseCorrelation out;
   clip(x, start, length, a);
   clip(y, start, length, b);
   const double L = static_cast<double>(length);
-  double ax = 0, ay = 0;
-  for (const auto& iv : a) ax += static_cast<double>(iv.stop - iv.start);
-  for (const auto& iv : b) ay += static_cast<double>(iv.stop - iv.start);
+  ca.assign(a.size() + 1, 0.0);
+  cb.assign(b.size() + 1, 0.0);
+  for (std::size_t i = 0; i < a.size(); ++i) ca[i + 1] = ca[i] + static_cast<double>(a[i].stop - a[i].start);
+  for (std::size_t i = 0; i < b.size(); ++i) cb[i + 1] = cb[i] + static_cast<double>(b[i].stop - b[i].start);
+  const double ax = ca.back(), ay = cb.back();
   const double mx = ax / L, my = ay / L;
   const double qx = L * mx * (1 - mx), qy = L * my * (1 - my);
-  if (!(qx > 0.0) || !(qy > 0.0)) return {};
-  // Sum of overlaps of every pair of air intervals, as a function of the lag:
-  // each pair's overlap is a trapezoid in k whose second difference is +1 at
-  // b0 - a1, -1 at b0 - a0 and at b1 - a1, +1 at b1 - a0. Impulses live on
-  // [k_min - 1, k_max]; earlier ones are folded into the starting slope and value.
-  const std::int64_t origin = k_min - 1;
-  const auto size = static_cast<std::size_t>(k_max - origin + 1);
-  impulses.assign(size, 0);
-  std::int64_t slope0 = 0;   // slope s(origin - 1) contribution from impulses before origin
-  std::int64_t value0 = 0;   // f(origin) from impulses before origin
-  auto add = [&](std::int64_t k, std::int64_t w) {
+  if (!(qx > 0.0) || !(qy > 0.0) || k_max < k_min) return out;
+
+  // Overlap sums: each pair of air intervals adds a trapezoid in k whose
+  // second difference is +1 at b0 - a1, -1 at b0 - a0 and at b1 - a1, +1 at
+  // b1 - a0. Trapezoids ending at or before k_min or starting after k_max
+  // add nothing in range; impulses before k_min are folded into the starting
+  // value and slope. Impulses and every other kink (the mean terms' kinks at
+  // the edges of intervals entering or leaving the overlapping ranges, and
+  // lag 0 where n = L - |k| turns) are marked on a byte per lag: cheaper than
+  // sorting them.
+  const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
+  thread_local std::vector<std::int32_t> impulse;
+  thread_local std::vector<std::uint8_t> mark;
+  impulse.assign(lags, 0);
+  mark.assign(lags + 8, 0);  // padding for the word-wise scan
+  std::int64_t slope = 0, value = 0;
+  auto add_impulse = [&](std::int64_t k, std::int32_t w) {
     if (k > k_max) return;
-    if (k < origin) {
-      // An impulse at k < origin adds w to every slope s(j), j >= k, so to
-      // f(origin) it adds w (origin - k) and to the starting slope w.
-      slope0 += w;
-      value0 += w * (origin - k);
+    if (k < k_min) {
+      slope += w;
+      value += w * (k_min - k);
       return;
     }
-    impulses[static_cast<std::size_t>(k - origin)] += w;
+    impulse[static_cast<std::size_t>(k - k_min)] += w;
+    mark[static_cast<std::size_t>(k - k_min)] = 1;
+  };
+  auto add_break = [&](std::int64_t k) {
+    if (k >= k_min && k <= k_max) mark[static_cast<std::size_t>(k - k_min)] = 1;
   };
   for (const auto& ia : a) {
     for (const auto& ib : b) {
-      // Trapezoids that end at or before the first lag add nothing there
-      // (their impulses cancel in slope and value), nor do those starting
-      // after the last lag.
-      if (ib.stop - ia.start <= origin) continue;
+      if (ib.stop - ia.start <= k_min) continue;
       if (ib.start - ia.stop > k_max) continue;
-      add(ib.start - ia.stop, +1);
-      add(ib.start - ia.start, -1);
-      add(ib.stop - ia.stop, -1);
-      add(ib.stop - ia.start, +1);
+      add_impulse(ib.start - ia.stop, +1);
+      add_impulse(ib.start - ia.start, -1);
+      add_impulse(ib.stop - ia.stop, -1);
+      add_impulse(ib.stop - ia.start, +1);
     }
   }
-  air_prefix(a, length, px);
-  air_prefix(b, length, py);
-  std::vector<double> r(static_cast<std::size_t>(k_max - k_min + 1));
+  add_break(k_min);
+  add_break(k_max);
+  add_break(0);
+  for (const auto& iv : a) {
+    for (std::int64_t e : {iv.start, iv.stop}) {
+      add_break(length - e);
+      add_break(-e);
+    }
+  }
+  for (const auto& iv : b) {
+    for (std::int64_t e : {iv.start, iv.stop}) {
+      add_break(e);
+      add_break(e - length);
+    }
+  }
+
+  // Sweep the breaks in lag order: f(k) from the slope, which is constant
+  // between breaks; the mean terms from the prefix sums,
+  //   k >= 0: sx = air of x in [0, L - k), sy = air of y in [k, L);
+  //   k <  0: sx = air of x in [-k, L),    sy = air of y in [0, L + k).
   const double norm = 1.0 / std::sqrt(qx * qy);
-  std::int64_t slope = slope0, value = value0;  // f(origin)
-  // Walk k from origin: f(k + 1) = f(k) + s(k), s(k) = s(k - 1) + impulse(k).
-  for (std::int64_t k = origin; k < k_max; ++k) {
-    slope += impulses[static_cast<std::size_t>(k - origin)];
-    value += slope;
-    const std::int64_t lag = k + 1;  // value is now f(lag)
-    const std::int64_t t0 = std::max<std::int64_t>(0, -lag), t1 = std::min(length, length - lag);
-    double sxy = static_cast<double>(value);
-    double sx = 0, sy = 0, n = 0;
-    if (t1 > t0) {
-      sx = px[static_cast<std::size_t>(t1)] - px[static_cast<std::size_t>(t0)];
-      sy = py[static_cast<std::size_t>(t1 + lag)] - py[static_cast<std::size_t>(t0 + lag)];
-      n = static_cast<double>(t1 - t0);
-    } else {
-      sxy = 0;
+  std::int64_t at = k_min;
+  for (std::size_t i = 0; i < lags;) {
+    std::uint64_t word;
+    std::memcpy(&word, mark.data() + i, 8);
+    if (word == 0) {
+      i += 8;
+      continue;
     }
-    r[static_cast<std::size_t>(lag - k_min)] = (sxy - mx * sy - my * sx + n * mx * my) * norm;
+    if (!mark[i]) {
+      ++i;
+      continue;
+    }
+    const std::int64_t k = k_min + static_cast<std::int64_t>(i);
+    value += slope * (k - at);  // slope is constant on [at, k)
+    at = k;
+    double sx, sy;
+    if (k >= 0) {
+      sx = air_below(a, ca, length - k);
+      sy = ay - air_below(b, cb, k);
+    } else {
+      sx = ax - air_below(a, ca, -k);
+      sy = air_below(b, cb, length + k);
+    }
+    const double n = static_cast<double>(length - (k >= 0 ? k : -k));
+    out.lags.push_back(k);
+    out.values.push_back((static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm);
+    slope += impulse[i];
+    ++i;
   }
-  return r;
+  return out;
+}
+
+std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                                 std::int64_t length, std::int64_t k_min, std::int64_t k_max) {
+  return window_correlation_piecewise(x, y, start, length, k_min, k_max).expand();
 }
 
 std::vector<double> window_correlation_fft(std::span<const double> x, std::span<const double> y, std::int64_t k_min,
@@ -209,31 +273,42 @@ std::vector<double> window_correlation_fft(std::span<const double> x, std::span<
   return out;
 }
 
-std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r) {
+namespace {
+
+// Local maxima (flat tops at the middle of their positions, as findpeaks /
+// scipy) and their prominences, for samples at increasing positions.
+template <class Position>
+std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double> r, Position position) {
   const std::size_t n = r.size();
-  std::vector<std::pair<std::size_t, double>> peaks;
+  std::vector<std::pair<std::int64_t, double>> peaks;
   if (n < 3) return peaks;
-  // Local maxima, flat tops at their middle (as findpeaks / scipy).
-  std::vector<std::size_t> at;
+  struct Top {
+    std::size_t first, last;  // a flat top spans [first, last]
+  };
+  thread_local std::vector<Top> tops;
+  tops.clear();
   for (std::size_t i = 1; i + 1 < n; ++i) {
     if (!(r[i - 1] < r[i])) continue;
     std::size_t j = i;
     while (j + 1 < n && r[j + 1] == r[i]) ++j;
-    if (j + 1 < n && r[j + 1] < r[i]) at.push_back((i + j) / 2);
+    if (j + 1 < n && r[j + 1] < r[i]) tops.push_back({i, j});
     i = j;
   }
-  if (at.empty()) return peaks;
+  if (tops.empty()) return peaks;
   // Bases in O(n): for each sample, the minimum of r between it and the
-  // nearest strictly higher sample on one side (or the end), with a stack of
+  // nearest strictly higher sample on one side (or the end), from a stack of
   // strictly decreasing values whose entries carry the minimum of the samples
-  // they covered.
-  auto bases = [&](bool from_left) {
-    std::vector<double> base(n);
+  // they covered. On a piecewise-linear function these minima sit at the
+  // breakpoints, so its sampled form at the breakpoints gives the same bases.
+  thread_local std::vector<double> left, right;
+  auto bases = [&](bool from_left, std::vector<double>& base) {
+    base.resize(n);
     struct Entry {
       double value;
       double gap_min;  // minimum over the samples between this entry and the next one up
     };
-    std::vector<Entry> stack;
+    thread_local std::vector<Entry> stack;
+    stack.clear();
     double bottom_min = std::numeric_limits<double>::infinity();
     for (std::size_t step = 0; step < n; ++step) {
       const std::size_t i = from_left ? step : n - 1 - step;
@@ -251,11 +326,81 @@ std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const dou
       }
       stack.push_back({r[i], std::numeric_limits<double>::infinity()});
     }
-    return base;
   };
-  const auto left = bases(true), right = bases(false);
-  for (std::size_t i : at) peaks.emplace_back(i, r[i] - std::max(left[i], right[i]));
+  bases(true, left);
+  bases(false, right);
+  for (const auto& t : tops) {
+    // A flat top's bases are those of its outer ends.
+    const double prominence = r[t.first] - std::max(left[t.first], right[t.last]);
+    peaks.emplace_back((position(t.first) + position(t.last)) / 2, prominence);
+  }
   return peaks;
+}
+
+// Second-tallest prominent peak over the tallest (0 with one).
+double secondary_peak_ratio(const std::vector<std::pair<std::int64_t, double>>& peaks,
+                            const std::vector<double>& heights, double prominence_fraction) {
+  if (peaks.size() < 2) return 0.0;
+  std::size_t tallest = 0;
+  for (std::size_t i = 1; i < peaks.size(); ++i)
+    if (heights[i] > heights[tallest]) tallest = i;
+  const double min_prominence = prominence_fraction * peaks[tallest].second;
+  double second = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < peaks.size(); ++i) {
+    if (i == tallest || peaks[i].second < min_prominence) continue;
+    second = std::max(second, heights[i]);
+  }
+  const double top = heights[tallest];
+  return std::isfinite(second) && top > 0.0 ? std::max(0.0, second / top) : 0.0;
+}
+
+// Peaks and prominences depend only on the turning points (where the sign
+// of the slope changes, plateau ends included, and the two ends): the minimum
+// between a peak and the first higher sample is a turning point, and the scan
+// for a higher sample stops at the turning point that follows it. Keeping
+// only those makes the prominence scan a few hundred points long. Positions
+// empty: the samples sit at 0, 1, 2, ...
+std::vector<std::pair<std::int64_t, double>> turning_point_prominences(std::span<const double> r,
+                                                                      std::span<const std::int64_t> positions) {
+  thread_local std::vector<double> turns;
+  thread_local std::vector<std::int64_t> where;
+  turns.clear();
+  where.clear();
+  auto position = [&](std::size_t i) { return positions.empty() ? static_cast<std::int64_t>(i) : positions[i]; };
+  auto sign = [](double d) { return (d > 0.0) - (d < 0.0); };
+  if (r.empty()) return {};
+  turns.push_back(r[0]);
+  where.push_back(position(0));
+  for (std::size_t i = 1; i + 1 < r.size(); ++i) {
+    if (sign(r[i] - r[i - 1]) != sign(r[i + 1] - r[i])) {
+      turns.push_back(r[i]);
+      where.push_back(position(i));
+    }
+  }
+  if (r.size() > 1) {
+    turns.push_back(r.back());
+    where.push_back(position(r.size() - 1));
+  }
+  return prominences(std::span<const double>(turns), [&](std::size_t i) { return where[i]; });
+}
+
+double parabolic(double a, double b, double c) {
+  const double denom = a - 2 * b + c;
+  return denom < 0.0 ? 0.5 * (a - c) / denom : 0.0;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r) {
+  std::vector<std::pair<std::size_t, double>> out;
+  for (const auto& [p, prominence] : prominences(r, [](std::size_t i) { return static_cast<std::int64_t>(i); }))
+    out.emplace_back(static_cast<std::size_t>(p), prominence);
+  return out;
+}
+
+std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const double> values,
+                                                              std::span<const std::int64_t> positions) {
+  return prominences(values, [&](std::size_t i) { return positions[i]; });
 }
 
 CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsample, double prominence_fraction) {
@@ -265,25 +410,32 @@ CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsamp
   p.height = r[p.index];
   p.refined_index = static_cast<double>(p.index);
   if (subsample == Subsample::parabolic && p.index > 0 && p.index + 1 < r.size()) {
-    const double a = r[p.index - 1], b = r[p.index], c = r[p.index + 1];
-    const double denom = a - 2 * b + c;
-    if (denom < 0.0) p.refined_index += 0.5 * (a - c) / denom;
+    p.refined_index += parabolic(r[p.index - 1], r[p.index], r[p.index + 1]);
   }
-  const auto peaks = peak_prominences(r);
-  if (peaks.size() < 2) return p;
-  // The tallest peak and its prominence; keep peaks prominent enough; the
-  // second tallest kept one over the tallest.
-  std::size_t tallest = 0;
-  for (std::size_t i = 1; i < peaks.size(); ++i)
-    if (r[peaks[i].first] > r[peaks[tallest].first]) tallest = i;
-  const double min_prominence = prominence_fraction * peaks[tallest].second;
-  double second = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < peaks.size(); ++i) {
-    if (i == tallest || peaks[i].second < min_prominence) continue;
-    second = std::max(second, r[peaks[i].first]);
+  const auto peaks = turning_point_prominences(r, {});
+  std::vector<double> heights;
+  heights.reserve(peaks.size());
+  for (const auto& [i, prominence] : peaks) heights.push_back(r[static_cast<std::size_t>(i)]);
+  p.spr = secondary_peak_ratio(peaks, heights, prominence_fraction);
+  return p;
+}
+
+CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample subsample, double prominence_fraction) {
+  CorrelationPeak p;
+  if (r.empty()) return p;
+  const auto j = static_cast<std::size_t>(std::max_element(r.values.begin(), r.values.end()) - r.values.begin());
+  const std::int64_t k_min = r.lags.front(), k = r.lags[j];
+  p.index = static_cast<std::size_t>(k - k_min);
+  p.height = r.values[j];
+  p.refined_index = static_cast<double>(p.index);
+  if (subsample == Subsample::parabolic && k > k_min && k < r.lags.back()) {
+    p.refined_index += parabolic(r.at(k - 1), p.height, r.at(k + 1));
   }
-  const double top = r[peaks[tallest].first];
-  if (std::isfinite(second) && top > 0.0) p.spr = std::max(0.0, second / top);
+  const auto peaks = turning_point_prominences(r.values, r.lags);
+  std::vector<double> heights;
+  heights.reserve(peaks.size());
+  for (const auto& [lag, prominence] : peaks) heights.push_back(r.at(lag));
+  p.spr = secondary_peak_ratio(peaks, heights, prominence_fraction);
   return p;
 }
 
@@ -330,13 +482,12 @@ std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double
   return {-(length - 1), length - 1};
 }
 
-void analyse_window(AwccWindow& w, std::span<const double> r, std::int64_t first_lag, double dx, double fs,
-                    const AwccOptions& options) {
-  if (r.empty()) {
+void analyse_window(AwccWindow& w, const CorrelationPeak& p, bool constant, std::int64_t first_lag, double dx,
+                    double fs, const AwccOptions& options) {
+  if (constant) {
     w.fate = WindowFate::constant;
     return;
   }
-  const CorrelationPeak p = analyse_correlation(r, options.subsample, options.prominence_fraction);
   w.r12_max = p.height;
   w.spr = p.spr;
   w.lag_samples = first_lag + static_cast<std::int64_t>(p.index);
@@ -348,6 +499,13 @@ void analyse_window(AwccWindow& w, std::span<const double> r, std::int64_t first
   }
   w.velocity = dx / w.lag;
   w.fate = w.r12_max / (w.spr * w.spr + 1.0) < options.filter_a ? WindowFate::correlation : WindowFate::accepted;
+}
+
+void analyse_window(AwccWindow& w, std::span<const double> r, std::int64_t first_lag, double dx, double fs,
+                    const AwccOptions& options) {
+  const CorrelationPeak p =
+      r.empty() ? CorrelationPeak{} : analyse_correlation(r, options.subsample, options.prominence_fraction);
+  analyse_window(w, p, r.empty(), first_lag, dx, fs, options);
 }
 
 void awcc_summarise(AwccResult& result, const AwccOptions& options) {
@@ -438,22 +596,25 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   std::vector<double> xs, ys;
   for (auto& w : result.windows) {
     const auto [k_min, k_max] = awcc_lag_range(w.length, dx, fs, options);
-    std::vector<double> r;
-    if (k_max >= k_min) {
-      if (use_fft) {
-        const auto n = static_cast<std::size_t>(w.length);
-        dense_x.resize(n);
-        dense_y.resize(n);
-        leading.render(w.start, dense_x);
-        trailing.render(w.start, dense_y);
-        xs.assign(dense_x.begin(), dense_x.end());
-        ys.assign(dense_y.begin(), dense_y.end());
-        r = window_correlation_fft(xs, ys, k_min, k_max, plans);
-      } else {
-        r = window_correlation_intervals(leading, trailing, w.start, w.length, k_min, k_max);
-      }
+    if (k_max < k_min) {
+      analyse_window(w, std::span<const double>{}, k_min, dx, fs, options);
+      continue;
     }
-    analyse_window(w, r, k_min, dx, fs, options);
+    if (use_fft) {
+      const auto n = static_cast<std::size_t>(w.length);
+      dense_x.resize(n);
+      dense_y.resize(n);
+      leading.render(w.start, dense_x);
+      trailing.render(w.start, dense_y);
+      xs.assign(dense_x.begin(), dense_x.end());
+      ys.assign(dense_y.begin(), dense_y.end());
+      analyse_window(w, window_correlation_fft(xs, ys, k_min, k_max, plans), k_min, dx, fs, options);
+    } else {
+      const auto r = window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max);
+      const CorrelationPeak p =
+          r.empty() ? CorrelationPeak{} : analyse_correlation(r, options.subsample, options.prominence_fraction);
+      analyse_window(w, p, r.empty(), k_min, dx, fs, options);
+    }
   }
   awcc_summarise(result, options);
   return result;

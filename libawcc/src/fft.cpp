@@ -1,6 +1,7 @@
 #include "awcc/fft.hpp"
 
 #include <fftw3.h>
+#include <algorithm>
 #include <mutex>
 #include <new>
 
@@ -13,15 +14,15 @@ std::mutex& planner_mutex() {
 }  // namespace
 
 std::size_t fast_fft_size(std::size_t minimum) {
+  // 2^k, 3 2^k or 5 2^k: fast transforms, and few distinct sizes, so that
+  // the plans of a cache are reused across windows of similar lengths.
   std::size_t best = 1;
   while (best < minimum) best *= 2;
-  for (std::size_t p7 = 1; p7 <= best; p7 *= 7)
-    for (std::size_t p5 = p7; p5 <= best; p5 *= 5)
-      for (std::size_t p3 = p5; p3 <= best; p3 *= 3) {
-        std::size_t n = p3;
-        while (n < minimum) n *= 2;
-        if (n < best) best = n;
-      }
+  for (std::size_t odd : {3u, 5u}) {
+    std::size_t n = odd;
+    while (n < minimum) n *= 2;
+    best = std::min(best, n);
+  }
   return best;
 }
 

@@ -210,6 +210,32 @@ TEST_F(Spillway, FelderRuleSitsHalfABinAboveAndRaisesCAndFByAFewPercent) {
   }
 }
 
+TEST_F(Spillway, AwccIntervalAndFftPathsAgreeOnEveryWindow) {
+  // Thousands of windows of real data (Np = 5 on the three most aerated
+  // files): the two exact paths agree to rounding on every lag.
+  std::size_t windows = 0;
+  for (int i : {8, 9, 10}) {
+    const auto b = awcc::binarise_recording(file(i), options());
+    const auto w = awcc::awcc_windows(b.leading, 5);
+    awcc::FftPlanCache plans;
+    for (const auto& win : w) {
+      const auto a = awcc::window_correlation_intervals(b.leading, b.trailing, win.start, win.length, -(win.length - 1),
+                                                        win.length - 1);
+      std::vector<double> xs(static_cast<std::size_t>(win.length)), ys(xs.size());
+      std::vector<std::uint8_t> d(xs.size());
+      b.leading.render(win.start, d);
+      std::copy(d.begin(), d.end(), xs.begin());
+      b.trailing.render(win.start, d);
+      std::copy(d.begin(), d.end(), ys.begin());
+      const auto f = awcc::window_correlation_fft(xs, ys, -(win.length - 1), win.length - 1, plans);
+      ASSERT_EQ(a.size(), f.size());
+      for (std::size_t k = 0; k < a.size(); ++k) ASSERT_NEAR(a[k], f[k], 1e-10) << "file " << i << " lag " << k;
+      ++windows;
+    }
+  }
+  EXPECT_GT(windows, 2000u);
+}
+
 TEST_F(Spillway, OnePassAndTwoPassBinarisationAgreeExactly) {
   for (int i : {1, 5, 10}) {
     auto o = options();

@@ -100,8 +100,27 @@ struct AwccResult {
 /// Windows of Np particles on the leading tip (start and length only).
 std::vector<AwccWindow> awcc_windows(const AirIntervals& leading, int np);
 
+/// A window correlation of binary signals held at its breakpoints: R12 is
+/// linear in the lag between consecutive entries of `lags` (every kink of the
+/// overlap sums and of the mean terms is one of them), so peaks, prominences
+/// and the SPR follow from these few hundred points exactly instead of from
+/// every lag.
+struct PiecewiseCorrelation {
+  std::vector<std::int64_t> lags;   ///< increasing, first = k_min, last = k_max
+  std::vector<double> values;       ///< R12 at those lags
+  [[nodiscard]] bool empty() const { return lags.empty(); }
+  /// R12 at any lag in [k_min, k_max] (linear between breakpoints).
+  [[nodiscard]] double at(std::int64_t lag) const;
+  /// R12 at every lag k_min..k_max.
+  [[nodiscard]] std::vector<double> expand() const;
+};
+
+/// Interval path (exact, binary signals): empty when a segment is constant.
+PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max);
+
 /// The normalised cross-correlation of a window, lags [k_min, k_max].
-/// Binary signals, interval path (exact).
+/// Binary signals, interval path (exact): the piecewise form expanded.
 std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max);
 /// Any signals given as the window's samples (binary 0/1 or voltages), FFT path.
@@ -117,9 +136,15 @@ struct CorrelationPeak {
   double spr = 0.0;
 };
 CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsample, double prominence_fraction);
+/// The same on the piecewise form; indices count lags from k_min.
+CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample subsample, double prominence_fraction);
 
 /// Prominences of the local maxima of r (scipy's definition): (index, prominence).
 std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r);
+/// Same for samples at increasing integer positions, linear in between;
+/// returns (position, prominence), a flat top at the middle of its positions.
+std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const double> values,
+                                                              std::span<const std::int64_t> positions);
 
 /// Robust outlier cutoff over the velocities whose flag is true; clears the
 /// flag of the rejected ones. Returns the number of iterations.
@@ -135,6 +160,9 @@ std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double
 /// [first_lag, first_lag + r.size()); an empty r means a constant segment.
 void analyse_window(AwccWindow& window, std::span<const double> r, std::int64_t first_lag, double dx, double fs,
                     const AwccOptions& options);
+/// Same from a peak already found (piecewise path); `constant` for a constant segment.
+void analyse_window(AwccWindow& window, const CorrelationPeak& peak, bool constant, std::int64_t first_lag, double dx,
+                    double fs, const AwccOptions& options);
 
 /// Applies the robust outlier cutoff to the accepted windows, then fills the
 /// moments, intervals, counts and the reason when undefined.

@@ -1,8 +1,8 @@
 #pragma once
 // FFT plans for correlation: a plan object owns its FFTW plans and scratch
 // buffers and is reused for every transform of its size; a cache hands out one
-// plan per size. Sizes are rounded up to products of 2, 3, 5 and 7, which
-// FFTW transforms fastest.
+// plan per size. Sizes are rounded up to 2^k, 3 2^k or 5 2^k: fast for FFTW,
+// and few enough that windows of similar lengths share plans.
 
 #include <complex>
 #include <cstddef>
@@ -12,7 +12,7 @@
 
 namespace awcc {
 
-/// Smallest n >= minimum whose prime factors are all 2, 3, 5 or 7.
+/// Smallest n >= minimum of the form 2^k, 3 2^k or 5 2^k.
 std::size_t fast_fft_size(std::size_t minimum);
 
 /// Real-to-complex forward and complex-to-real inverse transforms of size n.
