@@ -24,6 +24,25 @@ for key in tips threshold void_fraction bubble_count_rate chord_time_mean chord_
   grep -q "\"$key\"" "$dir/one.json" || fail "JSON lacks $key"
 done
 
+# AWCC: JSON keys, the window table, and every option.
+"$pdp" process "$dir/rec.flac" --dx 5mm --method awcc --json "$dir/awcc.json" --windows "$dir/windows.csv" >/dev/null ||
+  fail "awcc run"
+for key in awcc velocity velocity_rms turbulence_intensity velocity_ci95 turbulence_intensity_ci95 windows_total \
+  windows_accepted windows_rejected_correlation windows_rejected_lag windows_rejected_roc; do
+  grep -q "\"$key\"" "$dir/awcc.json" || fail "AWCC JSON lacks $key"
+done
+grep -q '"fscc"' "$dir/awcc.json" && fail "--method awcc also ran FSCC"
+head -1 "$dir/windows.csv" | grep -q "^start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate$" ||
+  fail "window table header"
+[[ $(wc -l <"$dir/windows.csv") -gt 10 ]] || fail "window table rows"
+out=$("$pdp" process "$dir/rec.flac" --dx 5mm --np 15 --filter-a 0.3 --roc off --weighting none --subsample parabolic \
+  --velocity-range 2m/s,40m/s) || fail "awcc options"
+grep -q "AWCC: velocity" <<<"$out" || fail "AWCC summary: $out"
+grep -q "0 outlier cutoff" <<<"$out" || fail "--roc off still rejected windows"
+"$pdp" --log-level warn synth -q --duration 0.5s --fs 100kHz --signal voltage -o "$dir/volt.wav" || fail "voltage synth"
+out=$("$pdp" process "$dir/volt.wav" --dx 5mm --correlate raw) || fail "raw correlation"
+grep -q "AWCC" <<<"$out" || fail "raw correlation summary"
+
 # A profile: CSV rows on stdout, positions from the command line and a manifest.
 "$pdp" --log-level warn synth -q --duration 0.5s --fs 100kHz --seed 2 -o "$dir/rec2.flac"
 csv=$("$pdp" process "$dir/rec.flac" "$dir/rec2.flac" --dx 5mm --positions 2mm,8mm --json "$dir/profile.json") ||
@@ -79,6 +98,8 @@ expect_refusal single "has 1 channel" "$dir/single.dat" --fs 20kHz
 expect_refusal channel "channel 7" "$dir/rec.flac" --trailing-channel 7
 expect_refusal missing_fs "--fs" "$dir/single.dat"
 expect_refusal bad_unit "--dx" "$dir/rec.flac" --dx 5kg
+expect_refusal windows_many "one recording" "$dir/rec.flac" "$dir/rec2.flac" --windows "$dir/w.csv"
+expect_refusal bad_range "velocity-range" "$dir/rec.flac" --velocity-range 5m/s
 expect_refusal positions "one per file" "$dir/rec.flac" "$dir/rec2.flac" --positions 2mm
 
 # An output that is an input is refused and the input stays as it was.
