@@ -4,8 +4,10 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/version.hpp"
+#include "compare_command.hpp"
 #include "process_command.hpp"
 #include "synth_command.hpp"
+#include "validate_command.hpp"
 
 int main(int argc, char** argv) {
   // Logs go to stderr; results to files or stdout.
@@ -25,6 +27,10 @@ int main(int argc, char** argv) {
   auto* synth_command = pdp::setup_synth(app, synth_options);
   pdp::ProcessCommandOptions process_options;
   auto* process_command = pdp::setup_process(app, process_options);
+  pdp::ValidateOptions validate_options;
+  auto* validate_command = pdp::setup_validate(app, validate_options);
+  pdp::CompareOptions compare_options;
+  auto* compare_command = pdp::setup_compare(app, compare_options);
 
   try {
     app.parse(argc, argv);
@@ -33,5 +39,7 @@ int main(int argc, char** argv) {
   }
   if (synth_command->parsed()) return pdp::run_synth(synth_options);
   if (process_command->parsed()) return pdp::run_process(process_options);
+  if (validate_command->parsed()) return pdp::run_validate(validate_options);
+  if (compare_command->parsed()) return pdp::run_compare(compare_options);
   return 0;
 }

@@ -14,8 +14,6 @@ namespace pdp {
 
 CLI::App* setup_synth(CLI::App& app, SynthOptions& options) {
   auto* cmd = app.add_subcommand("synth", "Synthesise a scene: write a recording and its <name>.truth.json sidecar");
-  cmd->add_option("--config", options.config, "scene TOML file; command-line fields override it")
-      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", options.output, "recording to write (.flac, .wav, .w64, .rf64)")->required();
   cmd->add_option("--signal", options.signal, "binary (0 water, 1 air) or voltage (raw int16 counts)")
       ->check(CLI::IsMember({"binary", "voltage"}))
@@ -27,45 +25,14 @@ CLI::App* setup_synth(CLI::App& app, SynthOptions& options) {
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", options.quiet, "do not print the truth summary");
 
-  const synth::Scene defaults;
-  const auto fields = synth::scene_fields();
-  options.field_values.resize(fields.size());
-  for (std::size_t i = 0; i < fields.size(); ++i) {
-    const auto& f = fields[i];
-    auto* opt = cmd->add_option(fmt::format("--{}", f.name), options.field_values[i],
-                                fmt::format("{} [default: {}]", f.help, f.format(defaults)));
-    opt->group("Scene (same names in the TOML file; units allowed, e.g. 5mm, 500kHz, 300s)");
-    options.field_options.push_back(opt);
-  }
+  add_scene_options(cmd, options.scene);
   return cmd;
 }
 
 int run_synth(const SynthOptions& options) {
-  synth::Scene scene;
-  if (!options.config.empty()) {
-    try {
-      synth::load_scene_toml(options.config, scene);
-    } catch (const std::exception& e) {
-      spdlog::error("{}", e.what());
-      return 2;
-    }
-  }
-  const auto fields = synth::scene_fields();
-  for (std::size_t i = 0; i < fields.size(); ++i) {
-    if (options.field_options[i]->count() == 0) continue;
-    try {
-      fields[i].parse(scene, options.field_values[i]);
-    } catch (const std::exception& e) {
-      spdlog::error("--{}: {}", fields[i].name, e.what());
-      return 2;
-    }
-  }
-  const std::string source = options.config.empty() ? "the command line" : options.config + " and the command line";
-  if (const auto errors = scene.validate(); !errors.empty()) {
-    spdlog::error("invalid scene (from {}):", source);
-    for (const auto& e : errors) spdlog::error("  {}", e);
-    return 2;
-  }
+  const auto built = build_scene(options.scene);
+  if (!built) return 2;
+  const synth::Scene& scene = *built;
 
   synth::RecordingOptions recording;
   recording.signal = options.signal == "voltage" ? synth::SignalKind::voltage : synth::SignalKind::binary;

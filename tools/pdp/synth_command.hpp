@@ -5,17 +5,17 @@
 #include <string>
 #include <vector>
 
+#include "scene_cli.hpp"
+
 namespace pdp {
 
 struct SynthOptions {
-  std::string config;                    ///< scene TOML file (optional)
+  SceneCli scene;                        ///< scene fields and --config
   std::string output;                    ///< recording path (.flac, .wav, .w64, .rf64)
   std::string signal = "binary";         ///< binary | voltage
   std::string format;                    ///< flac | wav | w64 | rf64; default from the extension
   double flac_compression = 0.0;         ///< 0 (fastest) to 1 (smallest)
   bool quiet = false;                    ///< no truth summary on stdout
-  std::vector<std::string> field_values; ///< one per scene field, as typed
-  std::vector<CLI::Option*> field_options;
 };
 
 CLI::App* setup_synth(CLI::App& app, SynthOptions& options);

@@ -1,0 +1,22 @@
+#pragma once
+// pdp compare: FSCC and AWCC side by side, on a recording or on a scene.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "scene_cli.hpp"
+
+namespace pdp {
+
+struct CompareOptions {
+  std::string file;          ///< a recording; empty: synthesise the scene
+  std::string dx = "0mm";    ///< for a recording
+  std::string fs;            ///< for a recording without its rate
+  SceneCli scene;
+  MethodCli methods;
+};
+
+CLI::App* setup_compare(CLI::App& app, CompareOptions& options);
+int run_compare(const CompareOptions& options);
+
+}  // namespace pdp

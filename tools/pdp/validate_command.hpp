@@ -1,0 +1,21 @@
+#pragma once
+// pdp validate: synthesise a scene in memory, process it with FSCC and AWCC,
+// and compare every estimate with the truth; --repeat N over N seeds.
+
+#include <CLI/CLI.hpp>
+
+#include "scene_cli.hpp"
+
+namespace pdp {
+
+struct ValidateOptions {
+  SceneCli scene;
+  MethodCli methods;
+  int repeat = 1;           ///< seeds (run i uses a seed derived from the scene seed and i)
+  std::string json;         ///< JSON output file
+};
+
+CLI::App* setup_validate(CLI::App& app, ValidateOptions& options);
+int run_validate(const ValidateOptions& options);
+
+}  // namespace pdp
