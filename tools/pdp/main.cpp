@@ -6,6 +6,7 @@
 #include "awcc/version.hpp"
 #include "compare_command.hpp"
 #include "process_command.hpp"
+#include "sweep_command.hpp"
 #include "synth_command.hpp"
 #include "validate_command.hpp"
 
@@ -31,6 +32,8 @@ int main(int argc, char** argv) {
   auto* validate_command = pdp::setup_validate(app, validate_options);
   pdp::CompareOptions compare_options;
   auto* compare_command = pdp::setup_compare(app, compare_options);
+  pdp::SweepOptions sweep_options;
+  auto* sweep_command = pdp::setup_sweep(app, sweep_options);
 
   try {
     app.parse(argc, argv);
@@ -41,5 +44,6 @@ int main(int argc, char** argv) {
   if (process_command->parsed()) return pdp::run_process(process_options);
   if (validate_command->parsed()) return pdp::run_validate(validate_options);
   if (compare_command->parsed()) return pdp::run_compare(compare_options);
+  if (sweep_command->parsed()) return pdp::run_sweep(sweep_options);
   return 0;
 }

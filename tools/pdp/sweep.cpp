@@ -1,0 +1,384 @@
+#include "sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <toml++/toml.h>
+
+#include "awcc/units.hpp"
+#include "synth/random.hpp"
+
+namespace pdp {
+namespace {
+
+std::string text_of(const toml::node& node) {
+  if (const auto* s = node.as_string()) return std::string(s->get());
+  if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
+  if (const auto* d = node.as_floating_point()) return fmt::format("{}", d->get());
+  if (const auto* b = node.as_boolean()) return b->get() ? "1" : "0";
+  throw std::invalid_argument("a number or a string");
+}
+
+bool is_field(const std::string& name) {
+  if (name == "np" || name == "anisotropy") return true;
+  for (const auto& f : synth::scene_fields())
+    if (f.name == name) return true;
+  return false;
+}
+
+// Applies one value (text) of a field or of np/anisotropy to a run.
+void apply(SweepRun& run, const std::string& name, const std::string& text) {
+  if (name == "np") {
+    const double v = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
+    if (v != std::floor(v) || v < 1 || v > 1000) throw std::invalid_argument(fmt::format("np = {} must be a whole number in [1, 1000]", text));
+    run.np = static_cast<int>(v);
+  } else if (name == "anisotropy") {
+    run.anisotropy = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
+  } else {
+    synth::set_scene_field(run.scene, name, text);
+  }
+}
+
+awcc::Dimension dimension_of(const std::string& name) {
+  for (const auto& f : synth::scene_fields())
+    if (f.name == name) return f.dimension;
+  return awcc::Dimension::dimensionless;
+}
+
+}  // namespace
+
+SweepDefinition load_sweep(const std::filesystem::path& path) {
+  SweepDefinition d;
+  toml::table t;
+  const std::string file = path.string();
+  try {
+    t = toml::parse_file(file);
+  } catch (const toml::parse_error& e) {
+    throw std::runtime_error(fmt::format("{}:{}: not valid TOML: {}", file, e.source().begin.line, e.description()));
+  }
+  auto fail = [&](const std::string& where, const std::string& what) -> void {
+    throw std::runtime_error(fmt::format("{}: {}: {}", file, where, what));
+  };
+  for (const auto& [key, node] : t) {
+    const std::string k(key.str());
+    if (k != "sweep" && k != "base" && k != "grid" && k != "ranges") fail(k, "unknown table; use [sweep], [base], [grid] and [ranges]");
+    if (!node.is_table()) fail(k, "must be a table");
+  }
+  if (const auto* s = t["sweep"].as_table()) {
+    for (const auto& [key, node] : *s) {
+      const std::string k(key.str());
+      if (k == "mode") {
+        const auto* v = node.as_string();
+        if (!v || (v->get() != "grid" && v->get() != "monte-carlo")) fail("[sweep] mode", "write \"grid\" or \"monte-carlo\"");
+        d.mode = v->get();
+      } else if (k == "runs" || k == "repeat" || k == "seed") {
+        const auto* v = node.as_integer();
+        if (!v || v->get() < (k == "seed" ? 0 : 1)) fail("[sweep] " + k, "must be a whole number >= " + std::string(k == "seed" ? "0" : "1"));
+        if (k == "runs") d.runs = v->get();
+        if (k == "repeat") d.repeat = v->get();
+        if (k == "seed") d.seed = static_cast<std::uint64_t>(v->get());
+      } else {
+        fail("[sweep] " + k, "unknown key; use mode, runs, repeat, seed");
+      }
+    }
+  } else {
+    fail("[sweep]", "missing: give at least mode = \"grid\" or \"monte-carlo\"");
+  }
+  if (d.mode == "monte-carlo" && d.runs < 1) fail("[sweep] runs", "monte-carlo needs runs >= 1");
+  SweepRun probe;
+  auto check_value = [&](const std::string& where, const std::string& name, const std::string& text) {
+    SweepRun copy = probe;
+    try {
+      apply(copy, name, text);
+    } catch (const std::exception& e) {
+      fail(where, e.what());
+    }
+  };
+  if (const auto* b = t["base"].as_table()) {
+    for (const auto& [key, node] : *b) {
+      const std::string k(key.str());
+      if (!is_field(k)) fail("[base] " + k, "unknown field; use the names of pdp synth --help, np or anisotropy");
+      std::string text;
+      try {
+        text = text_of(node);
+      } catch (const std::exception& e) {
+        fail("[base] " + k, std::string("must be ") + e.what());
+      }
+      check_value("[base] " + k, k, text);
+      d.base[k] = text;
+    }
+  }
+  if (const auto* g = t["grid"].as_table()) {
+    for (const auto& [key, node] : *g) {
+      const std::string k(key.str());
+      if (!is_field(k)) fail("[grid] " + k, "unknown field; use the names of pdp synth --help, np or anisotropy");
+      const auto* list = node.as_array();
+      if (!list || list->empty()) fail("[grid] " + k, "must be a non-empty list of values");
+      for (const auto& v : *list) {
+        std::string text;
+        try {
+          text = text_of(v);
+        } catch (const std::exception& e) {
+          fail("[grid] " + k, std::string("values must be ") + e.what());
+        }
+        check_value("[grid] " + k, k, text);
+        d.grid[k].push_back(text);
+      }
+    }
+  }
+  if (d.mode == "monte-carlo") {
+    using awcc::Dimension;
+    d.ranges = {{"velocity", {1.0, 50.0}},       {"tu", {0.0, 0.35}},       {"time-scale", {1e-3, 1.0}},
+                {"void-fraction", {0.005, 0.4}}, {"bubble-diameter", {0.5e-3, 20e-3}}, {"dx", {0.5e-3, 10e-3}}};
+  }
+  if (const auto* r = t["ranges"].as_table()) {
+    for (const auto& [key, node] : *r) {
+      const std::string k(key.str());
+      if (!is_field(k)) fail("[ranges] " + k, "unknown field; use the names of pdp synth --help, np or anisotropy");
+      const auto* list = node.as_array();
+      if (!list || list->size() != 2) fail("[ranges] " + k, "must be [min, max]");
+      double ends[2];
+      for (std::size_t i = 0; i < 2; ++i) {
+        try {
+          ends[i] = awcc::parse_quantity(text_of(*list->get(i)), dimension_of(k));
+        } catch (const std::exception& e) {
+          fail("[ranges] " + k, e.what());
+        }
+      }
+      if (!(ends[0] <= ends[1])) fail("[ranges] " + k, "min must not exceed max");
+      d.ranges[k] = {ends[0], ends[1]};
+    }
+  }
+  if (d.mode == "grid" && d.grid.empty()) fail("[grid]", "a grid sweep needs at least one list of values");
+  // Canonical text: every setting, sorted.
+  std::string c = fmt::format("mode={};runs={};repeat={};seed={};", d.mode, d.runs, d.repeat, d.seed);
+  for (const auto& [k, v] : d.base) c += fmt::format("base.{}={};", k, v);
+  for (const auto& [k, v] : d.grid) {
+    c += "grid." + k + "=";
+    for (const auto& x : v) c += x + ",";
+    c += ";";
+  }
+  if (d.mode == "monte-carlo") {
+    for (const auto& [k, v] : d.ranges) c += fmt::format("ranges.{}={:.17g},{:.17g};", k, v.first, v.second);
+  }
+  d.canonical = c;
+  return d;
+}
+
+std::vector<SweepRun> SweepDefinition::expand() const {
+  std::vector<SweepRun> out;
+  SweepRun base_run;
+  for (const auto& [k, v] : base) apply(base_run, k, v);
+  auto finish = [&](SweepRun run, bool tu_y_set, bool tu_z_set) {
+    if (!tu_y_set) run.scene.tu_y = run.anisotropy * run.scene.tu;
+    if (!tu_z_set) run.scene.tu_z = run.anisotropy * run.scene.tu;
+    return run;
+  };
+  auto set_in = [&](const std::string& name) { return base.count(name) || grid.count(name) || ranges.count(name); };
+  const bool tu_y_set = set_in("tu-y"), tu_z_set = set_in("tu-z");
+  std::int64_t index = 0;
+  if (mode == "grid") {
+    std::vector<std::pair<std::string, std::vector<std::string>>> axes(grid.begin(), grid.end());
+    std::vector<std::size_t> at(axes.size(), 0);
+    for (;;) {
+      SweepRun run = base_run;
+      for (std::size_t a = 0; a < axes.size(); ++a) apply(run, axes[a].first, axes[a].second[at[a]]);
+      run = finish(run, tu_y_set, tu_z_set);
+      for (std::int64_t r = 0; r < repeat; ++r) {
+        SweepRun copy = run;
+        copy.index = index;
+        copy.scene.seed = run_seed(seed, static_cast<std::uint64_t>(index));
+        out.push_back(copy);
+        ++index;
+      }
+      std::size_t a = 0;
+      while (a < axes.size() && ++at[a] == axes[a].second.size()) at[a++] = 0;
+      if (a == axes.size()) break;
+    }
+  } else {
+    for (std::int64_t set = 0; set < runs; ++set) {
+      // Parameters from their own stream, keyed by the parameter set.
+      synth::Rng rng(run_seed(seed, static_cast<std::uint64_t>(set)), synth::Stream::bubbles);
+      SweepRun run = base_run;
+      for (const auto& [k, range] : ranges) {
+        double v;
+        if (k == "time-scale") {
+          const double lo = std::log(range.first), hi = std::log(range.second);
+          const double mid = 0.5 * (lo + hi), sd = (hi - lo) / 4.0;
+          double z;
+          do z = rng.normal(); while (std::fabs(z) > 2.0);
+          v = std::exp(mid + sd * z);
+        } else {
+          v = range.first + (range.second - range.first) * rng.uniform();
+        }
+        if (k == "np") v = std::round(v);
+        apply(run, k, fmt::format("{:.17g}", v));
+      }
+      run = finish(run, tu_y_set, tu_z_set);
+      for (std::int64_t r = 0; r < repeat; ++r) {
+        SweepRun copy = run;
+        copy.index = index;
+        copy.scene.seed = run_seed(seed ^ 0x5eedull, static_cast<std::uint64_t>(index));
+        out.push_back(copy);
+        ++index;
+      }
+    }
+  }
+  return out;
+}
+
+std::uint64_t study_id(const SweepDefinition& d) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : d.canonical) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h >> 1;
+}
+
+namespace {
+
+const char* const kResultColumns[] = {
+    "np", "anisotropy", "truth_velocity", "truth_turbulence_intensity", "truth_void_fraction", "truth_count_rate",
+    "truth_d32", "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate", "awcc_d32",
+    "awcc_windows_accepted", "awcc_windows_total", "awcc_velocity_error", "awcc_turbulence_intensity_error",
+    "awcc_d32_error", "fscc_velocity", "fscc_turbulence_intensity_chanson", "fscc_r12_max", "fscc_velocity_error",
+    "window_bias", "window_rms", "seconds_synth", "seconds_process", "seconds_fscc", "seconds_awcc", "reason"};
+
+std::string csv_field_name(std::string_view name) {
+  std::string s(name);
+  std::replace(s.begin(), s.end(), '-', '_');
+  return s;
+}
+
+std::string num(const std::optional<double>& v) { return v ? fmt::format("{:.10g}", *v) : std::string(); }
+
+std::string clean(std::string s) {
+  for (auto& c : s)
+    if (c == ',' || c == '\n' || c == '"' || c == '\r') c = ';';
+  return s;
+}
+
+}  // namespace
+
+std::string sweep_header() {
+  std::string h = "study,run,seed";
+  for (const auto& f : synth::scene_fields()) {
+    if (f.name == "seed") continue;
+    h += ',';
+    h += csv_field_name(f.name);
+  }
+  for (const char* c : kResultColumns) {
+    h += ',';
+    h += c;
+  }
+  return h;
+}
+
+std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string& error, std::uint64_t study) {
+  std::string row = fmt::format("{},{},{}", study, run.index, run.scene.seed);
+  for (const auto& f : synth::scene_fields()) {
+    if (f.name == "seed") continue;
+    std::string v = f.format(run.scene);
+    if (f.name == "time-scale-y" || f.name == "time-scale-z") {
+      v = fmt::format("{:.10g}", run.scene.time_scale_of(f.name == "time-scale-y" ? 1 : 2));
+    } else if (f.dimension != awcc::Dimension::dimensionless || f.name == "tu" || f.name.rfind("tu-", 0) == 0 ||
+               f.name.rfind("rho", 0) == 0 || f.name == "void-fraction" || f.name == "diameter-log-sd" ||
+               f.name == "aspect-ratio") {
+      // Numbers in SI without units, so that the CSV reads as numbers.
+      try {
+        v = fmt::format("{:.10g}", awcc::parse_quantity(v, f.dimension));
+      } catch (const std::exception&) {
+      }
+    }
+    row += ',';
+    row += clean(v);
+  }
+  auto opt = [](bool ok, double v) { return ok ? std::optional<double>(v) : std::nullopt; };
+  row += fmt::format(",{},{:.10g}", run.np, run.anisotropy);
+  if (!r) {
+    for (std::size_t i = 2; i + 1 < std::size(kResultColumns); ++i) row += ",";
+    row += "," + clean(error);
+    return row;
+  }
+  const bool a = r->awcc && r->awcc->defined;
+  const bool f = r->fscc && r->fscc->defined;
+  std::string reason = error;
+  if (r->awcc && !r->awcc->defined) reason += "awcc: " + r->awcc->reason;
+  row += "," + num(r->truth_velocity) + "," + num(r->truth_turbulence_intensity) + "," + num(r->truth_void_fraction) +
+         "," + num(r->truth_count_rate) + "," + num(r->truth_d32);
+  row += "," + num(opt(a, a ? r->awcc->velocity : 0)) + "," + num(opt(a, a ? r->awcc->turbulence_intensity : 0)) + "," +
+         num(r->void_fraction) + "," + num(r->count_rate) + "," + num(r->awcc_d32.value);
+  row += "," + (r->awcc ? std::to_string(r->awcc->windows_accepted) : std::string()) + "," +
+         (r->awcc ? std::to_string(r->awcc->windows_total) : std::string());
+  row += "," + num(r->awcc_velocity.error()) + "," + num(r->awcc_turbulence_intensity.error()) + "," +
+         num(r->awcc_d32.error());
+  row += "," + num(opt(f, f ? r->fscc->velocity : 0)) + "," + num(r->fscc ? r->fscc->turbulence_intensity_chanson : std::nullopt) +
+         "," + num(r->fscc ? std::optional(r->fscc->r12_max) : std::nullopt) + "," + num(r->fscc_velocity.error());
+  row += "," + num(r->window_bias) + "," + num(r->window_rms);
+  row += fmt::format(",{:.4f},{:.4f},{:.4f},{:.4f}", r->seconds_synth, r->seconds_process, r->seconds_fscc, r->seconds_awcc);
+  row += "," + clean(reason);
+  return row;
+}
+
+std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint64_t study) {
+  std::set<std::int64_t> done;
+  std::error_code ec;
+  if (!std::filesystem::exists(csv, ec) || std::filesystem::file_size(csv, ec) == 0) return done;
+  std::string content;
+  {
+    std::ifstream in(csv, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    content = ss.str();
+  }
+  const std::string header = sweep_header();
+  const auto first_newline = content.find('\n');
+  if (first_newline == std::string::npos || content.substr(0, first_newline) != header) {
+    throw std::runtime_error(fmt::format(
+        "{}: not a pdp sweep CSV (its header differs); refusing to append to it: choose another -o file or remove it",
+        csv.string()));
+  }
+  // A crash can leave a partial last row: cut it off.
+  const auto last_newline = content.rfind('\n');
+  if (last_newline + 1 != content.size()) {
+    std::filesystem::resize_file(csv, last_newline + 1);
+    content.resize(last_newline + 1);
+  }
+  const auto columns = static_cast<std::size_t>(std::count(header.begin(), header.end(), ',') + 1);
+  std::size_t pos = first_newline + 1;
+  std::int64_t line = 1;
+  while (pos < content.size()) {
+    const auto end = content.find('\n', pos);
+    const std::string_view row(content.data() + pos, end - pos);
+    ++line;
+    const auto cells = static_cast<std::size_t>(std::count(row.begin(), row.end(), ',') + 1);
+    const auto c1 = row.find(','), c2 = row.find(',', c1 + 1);
+    std::uint64_t id = 0;
+    std::int64_t run = -1;
+    try {
+      id = std::stoull(std::string(row.substr(0, c1)));
+      run = std::stoll(std::string(row.substr(c1 + 1, c2 - c1 - 1)));
+    } catch (const std::exception&) {
+      run = -1;
+    }
+    if (cells != columns || run < 0 || c1 == std::string_view::npos) {
+      throw std::runtime_error(fmt::format("{}:{}: malformed row; the file is not a sweep CSV written by pdp; refusing "
+                                           "to append to it",
+                                           csv.string(), line));
+    }
+    if (id != study) {
+      throw std::runtime_error(fmt::format("{}:{}: the row belongs to another study (its sweep definition differs); "
+                                           "write this study to another -o file",
+                                           csv.string(), line));
+    }
+    done.insert(run);
+    pos = end + 1;
+  }
+  return done;
+}
+
+}  // namespace pdp

@@ -1,0 +1,65 @@
+#pragma once
+// Studies over many synthetic scenes: a sweep definition (TOML), its
+// expansion into runs, and the run rows of the append-only CSV.
+//
+// Definition:
+//   [sweep]  mode = "grid" | "monte-carlo", runs (monte-carlo), repeat, seed
+//   [base]   fixed scene fields (the names of pdp synth, numbers in SI or
+//            strings with units), plus np and anisotropy (Tu_y/Tu_x = Tu_z/Tu_x,
+//            applied when tu-y/tu-z are not set; default 0.5)
+//   [grid]   a list of values per field: the runs are their Cartesian product
+//   [ranges] [min, max] per field: Monte Carlo draws uniformly, the integral
+//            time scale log-normally (mean and sd of ln T from the range ends,
+//            ln T = mid +/- 2 sd, truncated). Monte Carlo defaults are METHOD 5's
+//            ranges: velocity 1-50 m/s, tu 0-0.35, time-scale 1 ms-1 s,
+//            void-fraction 0.005-0.4, bubble-diameter 0.5-20 mm, dx 0.5-10 mm.
+// Run i (of `repeat` per parameter set) has seed run_seed(seed, i): results do
+// not depend on thread count, order or sharding.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "study.hpp"
+
+namespace pdp {
+
+struct SweepRun {
+  std::int64_t index = 0;
+  synth::Scene scene;
+  int np = 10;
+  double anisotropy = 0.5;
+};
+
+struct SweepDefinition {
+  std::string mode = "grid";
+  std::int64_t runs = 0;        ///< monte-carlo parameter sets
+  std::int64_t repeat = 1;
+  std::uint64_t seed = 1;
+  std::string canonical;        ///< a canonical text of the definition, for the study id
+  std::vector<SweepRun> expand() const;
+  std::map<std::string, std::string> base, grid_text;
+  std::map<std::string, std::vector<std::string>> grid;
+  std::map<std::string, std::pair<double, double>> ranges;  ///< SI
+};
+
+/// Reads and checks a sweep file; throws std::runtime_error naming the file,
+/// the table and key, and the fix.
+SweepDefinition load_sweep(const std::filesystem::path& path);
+
+/// The CSV header and one row.
+std::string sweep_header();
+std::string sweep_row(const SweepRun& run, const RunResult* result, const std::string& error, std::uint64_t study);
+
+/// Study id of a definition (FNV-1a of its canonical text).
+std::uint64_t study_id(const SweepDefinition& d);
+
+/// Runs already in an existing CSV of this study. A partial last line (a
+/// crash while writing) is cut off. Throws std::runtime_error when the file is
+/// not such a CSV (foreign header, malformed row, rows of another study).
+std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint64_t study);
+
+}  // namespace pdp
