@@ -24,11 +24,56 @@ std::int64_t air_samples_in(const AirIntervals& s, std::int64_t a, std::int64_t 
   return total;
 }
 
-std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y, std::int64_t t0, std::int64_t t1,
-                                    std::int64_t k_min, std::int64_t k_max, FftPlanCache& plans) {
+namespace {
+
+// S(k) from pairs of air intervals: each pair's overlap is a trapezoid in k
+// (second difference +1 at b0 - a1, -1 at b0 - a0 and b1 - a1, +1 at
+// b1 - a0), summed through an impulse array and two prefix sums. Exact
+// integers; the cost grows with the pairs within the lag range.
+std::vector<double> lagged_products_by_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t t0,
+                                                 std::int64_t t1, std::int64_t k_min, std::int64_t k_max) {
+  const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
+  std::vector<std::int64_t> impulse(lags, 0);
+  std::int64_t slope = 0, value = 0;  // contributions of impulses before k_min to s(k_min - 1) and f(k_min)
+  auto add = [&](std::int64_t k, std::int64_t w) {
+    if (k > k_max) return;
+    if (k < k_min) {
+      slope += w;
+      value += w * (k_min - k);
+      return;
+    }
+    impulse[static_cast<std::size_t>(k - k_min)] += w;
+  };
+  const auto& yi = y.intervals;
+  std::size_t first = 0;
+  for (const auto& iv : x.intervals) {
+    const std::int64_t a0 = std::max(iv.start, t0), a1 = std::min(iv.stop, t1);
+    if (a0 >= a1) continue;
+    // y intervals that can overlap a shifted by a lag in range: b1 > a0 + k_min, b0 <= a1 + k_max.
+    while (first < yi.size() && yi[first].stop <= a0 + k_min) ++first;
+    for (std::size_t j = first; j < yi.size() && yi[j].start <= a1 + k_max - 1 + 1; ++j) {
+      const std::int64_t b0 = yi[j].start, b1 = yi[j].stop;
+      if (b1 - a0 <= k_min) continue;
+      add(b0 - a1, +1);
+      add(b0 - a0, -1);
+      add(b1 - a1, -1);
+      add(b1 - a0, +1);
+    }
+  }
+  std::vector<double> out(lags);
+  for (std::size_t i = 0; i < lags; ++i) {
+    out[i] = static_cast<double>(value);  // f(k_min + i)
+    slope += impulse[i];
+    value += slope;
+  }
+  return out;
+}
+
+std::vector<double> lagged_products_by_fft(const AirIntervals& x, const AirIntervals& y, std::int64_t t0,
+                                           std::int64_t t1, std::int64_t k_min, std::int64_t k_max,
+                                           FftPlanCache& plans) {
   const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
   std::vector<double> out(lags, 0.0);
-  if (t1 <= t0) return out;
   // Blocks of x of length B against y over [b + k_min, b + B + k_max): a
   // circular correlation of size M >= B + K - 1 holds lags 0..K-1 unwrapped.
   const std::size_t block = std::max<std::size_t>(4 * lags, 1 << 15);
@@ -38,7 +83,6 @@ std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y
   std::vector<std::uint8_t> dense(block + lags - 1);
   for (std::int64_t b = t0; b < t1; b += static_cast<std::int64_t>(block)) {
     const auto len = static_cast<std::size_t>(std::min<std::int64_t>(static_cast<std::int64_t>(block), t1 - b));
-    // x block
     x.render(b, std::span<std::uint8_t>(dense.data(), len));
     auto r = plan.real();
     std::fill(r.begin(), r.end(), 0.0);
@@ -50,7 +94,6 @@ std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y
     if (!any) continue;
     plan.forward();
     std::copy(plan.spectrum().begin(), plan.spectrum().end(), xs.begin());
-    // y segment, zero outside its record
     const std::int64_t y0 = b + k_min;
     const std::size_t ylen = len + lags - 1;
     std::fill(r.begin(), r.end(), 0.0);
@@ -70,6 +113,24 @@ std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y
   // The products of 0/1 signals are whole numbers: remove FFT rounding.
   for (auto& v : out) v = std::nearbyint(v);
   return out;
+}
+
+}  // namespace
+
+std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y, std::int64_t t0, std::int64_t t1,
+                                    std::int64_t k_min, std::int64_t k_max, FftPlanCache& plans, ProductPath path) {
+  if (t1 <= t0) return std::vector<double>(static_cast<std::size_t>(k_max - k_min + 1), 0.0);
+  if (path == ProductPath::intervals) return lagged_products_by_intervals(x, y, t0, t1, k_min, k_max);
+  if (path == ProductPath::fft) return lagged_products_by_fft(x, y, t0, t1, k_min, k_max, plans);
+  // Both are exact; pick the cheaper. Pairs within the lag range, against
+  // about 15 operations per sample and lag-block of the FFT path.
+  const double span = static_cast<double>(t1 - t0);
+  const double nx = static_cast<double>(x.intervals.size()), ny = static_cast<double>(y.intervals.size());
+  const double lag_span = static_cast<double>(k_max - k_min + 1);
+  const double pairs = nx * ny * std::min(1.0, (lag_span + 2.0 * span / std::max(1.0, ny)) / static_cast<double>(y.sample_count));
+  const double fft_cost = 15.0 * span * std::log2(std::max(2.0, 8.0 * lag_span));
+  if (4.0 * pairs < fft_cost) return lagged_products_by_intervals(x, y, t0, t1, k_min, k_max);
+  return lagged_products_by_fft(x, y, t0, t1, k_min, k_max, plans);
 }
 
 namespace {

@@ -43,8 +43,10 @@ TEST(LaggedProducts, EqualANaiveLongDoubleSum) {
                                     {1234, 40'000, 0, 999},
                                     {0, 50'000, -5, -1},
                                     {49'000, 50'000, 10, 2000}}) {
-    const auto fast = awcc::lagged_products(x, y, t0, t1, kmin, kmax, plans);
+    const auto fast = awcc::lagged_products(x, y, t0, t1, kmin, kmax, plans, awcc::ProductPath::fft);
+    const auto pairs = awcc::lagged_products(x, y, t0, t1, kmin, kmax, plans, awcc::ProductPath::intervals);
     ASSERT_EQ(fast.size(), static_cast<std::size_t>(kmax - kmin + 1));
+    ASSERT_EQ(fast, pairs);
     for (std::int64_t k = kmin; k <= kmax; k += 7) {
       long double naive = 0;
       for (std::int64_t t = t0; t < t1; ++t) {

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/version.hpp"
+#include "bench_command.hpp"
 #include "compare_command.hpp"
 #include "process_command.hpp"
 #include "sweep_command.hpp"
@@ -34,6 +35,8 @@ int main(int argc, char** argv) {
   auto* compare_command = pdp::setup_compare(app, compare_options);
   pdp::SweepOptions sweep_options;
   auto* sweep_command = pdp::setup_sweep(app, sweep_options);
+  pdp::BenchOptions bench_options;
+  auto* bench_command = pdp::setup_bench(app, bench_options);
 
   try {
     app.parse(argc, argv);
@@ -45,5 +48,6 @@ int main(int argc, char** argv) {
   if (validate_command->parsed()) return pdp::run_validate(validate_options);
   if (compare_command->parsed()) return pdp::run_compare(compare_options);
   if (sweep_command->parsed()) return pdp::run_sweep(sweep_options);
+  if (bench_command->parsed()) return pdp::run_bench(bench_options);
   return 0;
 }

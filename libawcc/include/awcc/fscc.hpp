@@ -17,8 +17,10 @@
 // -199..800 samples, and the peak is the first lag within 1e-5 of the maximum,
 // without interpolation.
 //
-// The lagged products are computed from FFTs of blocks (overlap-save), so
-// memory depends on the lag range, not on the record's length.
+// The lagged products are computed from the pairs of air intervals within the
+// lag range, or from FFTs of blocks (overlap-save) when bubbles are so dense
+// that the pairs cost more; memory depends on the lag range, not on the
+// record's length.
 
 #include <cstdint>
 #include <optional>
@@ -55,10 +57,15 @@ struct FsccResult {
   std::vector<double> r11, r12;      ///< the correlation functions over the lags searched
 };
 
+/// How lagged products are computed: both exact; automatic picks the cheaper
+/// (pairs of air intervals within the lag range, or block FFTs).
+enum class ProductPath { automatic, fft, intervals };
+
 /// S(k) = sum over t in [t0, t1) of X(t) Y(t + k), k in [k_min, k_max], for
 /// 0/1 signals given as intervals (Y is 0 outside its record).
 std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y, std::int64_t t0, std::int64_t t1,
-                                    std::int64_t k_min, std::int64_t k_max, FftPlanCache& plans);
+                                    std::int64_t k_min, std::int64_t k_max, FftPlanCache& plans,
+                                    ProductPath path = ProductPath::automatic);
 
 /// Air samples of a signal within [a, b).
 std::int64_t air_samples_in(const AirIntervals& signal, std::int64_t a, std::int64_t b);
