@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""Figures from pdp's study CSVs (Debian's python3 with matplotlib).
+
+  plot_study.py bench BENCH.csv OUT.png
+      error against run time: |velocity error| and |Tu error| of every method
+      and setting, log-log, one colour per method.
+  plot_study.py sweep RUNS.csv PARAMETER OUT.png [--title TEXT]
+      the relative errors of the AWCC and FSCC mean velocity and of the AWCC
+      turbulence intensity against one swept parameter (a CSV column), as
+      means with 95 % intervals (Student t) over the repetitions.
+  plot_study.py windows RUNS.csv OUT.png
+      AWCC windows kept against the parameter-free truth: accepted fraction
+      against the true turbulence intensity.
+
+Every figure carries the command line that made it in its footer.
+"""
+import csv
+import math
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+T975 = [0, 12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145,
+        2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045,
+        2.042]
+
+
+def t975(df):
+    return T975[df] if 0 < df <= 30 else 1.96 + 2.4 / max(df, 1)
+
+
+def number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return None
+
+
+def footer(fig):
+    fig.text(0.01, 0.005, "made by: " + " ".join(["tools/plot_study.py"] + sys.argv[1:]), fontsize=6, color="grey")
+
+
+def bench(path, out):
+    rows = list(csv.DictReader(open(path)))
+    if not rows:
+        raise SystemExit(f"{path}: no rows")
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    methods = sorted({r["method"] for r in rows})
+    colours = dict(zip(methods, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+    for ax, column, label in ((axes[0], "velocity_error", "|mean velocity error|"),
+                              (axes[1], "turbulence_intensity_error", "|turbulence intensity error|")):
+        for m in methods:
+            xs, ys = [], []
+            for r in rows:
+                e, t = number(r[column]), number(r["seconds"])
+                if r["method"] == m and e is not None and t:
+                    xs.append(t)
+                    ys.append(max(abs(e), 1e-4))
+            ax.scatter(xs, ys, label=m, color=colours[m], s=18)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("run time per record (s)")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("Error against run time (pdp bench)")
+    footer(fig)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=120)
+
+
+def sweep(path, parameter, out, title):
+    rows = list(csv.DictReader(open(path)))
+    if not rows or parameter not in rows[0]:
+        raise SystemExit(f"{path}: no column '{parameter}'")
+    series = {"AWCC mean velocity": "awcc_velocity_error", "FSCC mean velocity": "fscc_velocity_error",
+              "AWCC turbulence intensity": "awcc_turbulence_intensity_error"}
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for label, column in series.items():
+        groups = defaultdict(list)
+        for r in rows:
+            x, e = number(r[parameter]), number(r[column])
+            if x is not None and e is not None:
+                groups[x].append(100.0 * e)
+        xs = sorted(groups)
+        means, halves = [], []
+        for x in xs:
+            v = groups[x]
+            m = sum(v) / len(v)
+            sd = math.sqrt(sum((e - m) ** 2 for e in v) / (len(v) - 1)) if len(v) > 1 else 0.0
+            means.append(m)
+            halves.append(t975(len(v) - 1) * sd / math.sqrt(len(v)) if len(v) > 1 else 0.0)
+        ax.errorbar(xs, means, yerr=halves, marker="o", capsize=3, label=label)
+    ax.axhline(0.0, color="black", linewidth=0.8)
+    ax.set_xlabel(parameter)
+    ax.set_ylabel("relative error (%), mean and 95 % interval")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title or f"Error against {parameter}")
+    footer(fig)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=120)
+
+
+def windows(path, out):
+    rows = list(csv.DictReader(open(path)))
+    xs, ys = [], []
+    for r in rows:
+        a, t, tu = number(r["awcc_windows_accepted"]), number(r["awcc_windows_total"]), number(
+            r["truth_turbulence_intensity"])
+        if a is not None and t and tu is not None:
+            xs.append(tu)
+            ys.append(a / t)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.scatter(xs, ys, s=10)
+    ax.set_xlabel("true turbulence intensity")
+    ax.set_ylabel("fraction of AWCC windows accepted")
+    ax.grid(True, alpha=0.3)
+    footer(fig)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=120)
+
+
+def main(argv):
+    if len(argv) >= 4 and argv[1] == "bench":
+        bench(argv[2], argv[3])
+    elif len(argv) >= 5 and argv[1] == "sweep":
+        title = argv[argv.index("--title") + 1] if "--title" in argv else None
+        sweep(argv[2], argv[3], argv[4], title)
+    elif len(argv) >= 4 and argv[1] == "windows":
+        windows(argv[2], argv[3])
+    else:
+        raise SystemExit(__doc__)
+
+
+if __name__ == "__main__":
+    main(sys.argv)
