@@ -88,6 +88,19 @@ err=$("$pdp" sweep "$dir/bad.toml" -o "$dir/bad.csv" 2>&1) && fail "bad study ac
 grep -q "bubble-diameter" <<<"$err" || fail "bad study message: $err"
 [[ ! -e $dir/bad.csv ]] || fail "bad study wrote a file"
 
+# MPI: two ranks (one writer, one worker) give the threaded result.
+if "$pdp" --version | grep -q MPI; then
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_plm_rsh_agent=
+  mpirun --oversubscribe -np 2 "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/mpi.csv" >"$dir/mpi.log" 2>&1 ||
+    fail "mpirun sweep: $(tail -5 "$dir/mpi.log")"
+  [[ "$(canonical "$dir/mpi.csv")" == "$(canonical "$dir/two.csv")" ]] || fail "MPI sweep differs from the threaded one"
+  mpirun --oversubscribe -np 3 "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/mpi3.csv" >"$dir/mpi3.log" 2>&1 ||
+    fail "mpirun -np 3 sweep"
+  [[ "$(canonical "$dir/mpi3.csv")" == "$(canonical "$dir/two.csv")" ]] || fail "3-rank MPI sweep differs"
+else
+  fail "pdp was built without MPI (scripts/setup installs OpenMPI; the sweep under mpirun is part of CI)"
+fi
+
 # Monte Carlo: the drawn scenes lie in the ranges and are reproducible.
 cat >"$dir/mc.toml" <<'TOML'
 [sweep]

@@ -17,7 +17,11 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("%^[%l]%$ %v");
 
   CLI::App app{"pdp: dual-tip phase-detection probe toolkit (AWCC processing, synthetic probe)"};
+#ifdef PDP_WITH_MPI
+  app.set_version_flag("--version", std::string("pdp ") + awcc::version + " (MPI)");
+#else
   app.set_version_flag("--version", std::string("pdp ") + awcc::version);
+#endif
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "trace | debug | info | warn | error | off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))

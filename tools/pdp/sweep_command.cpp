@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fmt/format.h>
 #include <mutex>
@@ -14,6 +15,10 @@
 #include "awcc/atomic_output.hpp"
 #include "sweep.hpp"
 #include "terminal.hpp"
+
+#ifdef PDP_WITH_MPI
+#include <mpi.h>
+#endif
 
 namespace pdp {
 
@@ -44,9 +49,77 @@ void write_all(int fd, const std::string& text, const std::string& path) {
   }
 }
 
+#ifdef PDP_WITH_MPI
+// Under mpirun: rank 0 is the one writer and hands out runs one at a time;
+// the other ranks compute them and send their rows back. Every rank reads
+// the same study, so a run index is all a message needs.
+int mpi_size() {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return size;
+}
+
+template <class Compute>
+int sweep_over_ranks(const std::vector<const SweepRun*>& pending, Compute&& compute_row, int fd,
+                     const std::string& output) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  constexpr int kRow = 1, kTask = 2;
+  if (rank == 0) {
+    std::size_t next = 0, written = 0;
+    int active = size - 1;
+    Progress progress("sweeping");
+    while (active > 0) {
+      MPI_Status status;
+      MPI_Probe(MPI_ANY_SOURCE, kRow, MPI_COMM_WORLD, &status);
+      int length = 0;
+      MPI_Get_count(&status, MPI_CHAR, &length);
+      std::string row(static_cast<std::size_t>(length), '\0');
+      MPI_Recv(row.data(), length, MPI_CHAR, status.MPI_SOURCE, kRow, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      if (!row.empty()) {
+        write_all(fd, row + "\n", output);
+        ::fdatasync(fd);
+        progress(static_cast<double>(++written) / static_cast<double>(pending.size()));
+      }
+      std::int64_t task = next < pending.size() ? static_cast<std::int64_t>(next++) : -1;
+      if (task < 0) --active;
+      MPI_Send(&task, 1, MPI_INT64_T, status.MPI_SOURCE, kTask, MPI_COMM_WORLD);
+    }
+    spdlog::info("{}: {} runs written by {} ranks", output, written, size - 1);
+  } else {
+    std::string row;  // empty: "ready"
+    for (;;) {
+      MPI_Send(row.data(), static_cast<int>(row.size()), MPI_CHAR, 0, kRow, MPI_COMM_WORLD);
+      std::int64_t task = -1;
+      MPI_Recv(&task, 1, MPI_INT64_T, 0, kTask, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      if (task < 0) break;
+      row = compute_row(*pending[static_cast<std::size_t>(task)]);
+    }
+  }
+  return 0;
+}
+#endif
+
 }  // namespace
 
 int run_sweep(const SweepOptions& o) {
+#ifdef PDP_WITH_MPI
+  // MPI only when started by mpirun, so that a plain run needs no MPI daemon.
+  struct MpiSession {
+    bool on = std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr;
+    MpiSession() {
+      if (on) MPI_Init(nullptr, nullptr);
+    }
+    ~MpiSession() {
+      if (on) MPI_Finalize();
+    }
+  } mpi;
+  int rank = 0;
+  if (mpi.on) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+#else
+  const int rank = 0;
+#endif
   SweepDefinition definition;
   std::vector<SweepRun> runs;
   StudyOptions study;
@@ -74,28 +147,63 @@ int run_sweep(const SweepOptions& o) {
   }
   const std::uint64_t id = study_id(definition);
   std::set<std::int64_t> done;
-  try {
-    done = finished_runs(o.output, id);
-    std::error_code ec;
-    if (!std::filesystem::exists(o.output, ec) || std::filesystem::file_size(o.output, ec) == 0) {
-      awcc::write_text_atomically(o.output, sweep_header() + "\n");
+  int refused = 0;
+  if (rank == 0) {
+    try {
+      done = finished_runs(o.output, id);
+      std::error_code ec;
+      if (!std::filesystem::exists(o.output, ec) || std::filesystem::file_size(o.output, ec) == 0) {
+        awcc::write_text_atomically(o.output, sweep_header() + "\n");
+      }
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+      refused = 1;
     }
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 2;
   }
+#ifdef PDP_WITH_MPI
+  if (mpi.on) {
+    // The writer's view of finished runs, to every rank.
+    MPI_Bcast(&refused, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    std::vector<std::int64_t> list(done.begin(), done.end());
+    std::int64_t count = static_cast<std::int64_t>(list.size());
+    MPI_Bcast(&count, 1, MPI_INT64_T, 0, MPI_COMM_WORLD);
+    list.resize(static_cast<std::size_t>(count));
+    MPI_Bcast(list.data(), static_cast<int>(count), MPI_INT64_T, 0, MPI_COMM_WORLD);
+    done = std::set<std::int64_t>(list.begin(), list.end());
+  }
+#endif
+  if (refused) return 2;
   std::vector<const SweepRun*> pending;
   for (const auto& run : runs) {
     if (run.index % shards != shard || done.count(run.index)) continue;
     pending.push_back(&run);
   }
-  spdlog::info("{}: {} runs in the study, {} already in {}, {} to run{}", o.study, runs.size(), done.size(), o.output,
-               pending.size(), shards > 1 ? fmt::format(" (shard {}/{})", shard, shards) : "");
-  const int fd = ::open(o.output.c_str(), O_WRONLY | O_APPEND);
-  if (fd < 0) {
+  if (rank == 0) {
+    spdlog::info("{}: {} runs in the study, {} already in {}, {} to run{}", o.study, runs.size(), done.size(),
+                 o.output, pending.size(), shards > 1 ? fmt::format(" (shard {}/{})", shard, shards) : "");
+  }
+  const int fd = rank == 0 ? ::open(o.output.c_str(), O_WRONLY | O_APPEND) : -1;
+  if (rank == 0 && fd < 0) {
     spdlog::error("{}: cannot open for appending: {}", o.output, std::strerror(errno));
     return 1;
   }
+  auto compute_row = [&](const SweepRun& run) {
+    StudyOptions options = study;
+    options.awcc.np = run.np;
+    try {
+      const RunResult r = run_scene(run.scene, options);
+      return sweep_row(run, &r, "", id);
+    } catch (const std::exception& e) {
+      return sweep_row(run, nullptr, e.what(), id);
+    }
+  };
+#ifdef PDP_WITH_MPI
+  if (mpi.on && mpi_size() > 1) {
+    const int status = sweep_over_ranks(pending, compute_row, fd, o.output);
+    if (fd >= 0) ::close(fd);
+    return status;
+  }
+#endif
   const unsigned threads = o.threads > 0 ? static_cast<unsigned>(o.threads)
                                          : std::max(1u, std::thread::hardware_concurrency());
   std::atomic<std::size_t> next{0};
@@ -107,16 +215,7 @@ int run_sweep(const SweepOptions& o) {
     for (;;) {
       const std::size_t i = next++;
       if (i >= pending.size()) return;
-      const SweepRun& run = *pending[i];
-      StudyOptions options = study;
-      options.awcc.np = run.np;
-      std::string row;
-      try {
-        const RunResult r = run_scene(run.scene, options);
-        row = sweep_row(run, &r, "", id);
-      } catch (const std::exception& e) {
-        row = sweep_row(run, nullptr, e.what(), id);
-      }
+      const std::string row = compute_row(*pending[i]);
       std::lock_guard lock(write_mutex);
       try {
         // One write per row, then to disk: a crash loses no finished row.
