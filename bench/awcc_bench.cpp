@@ -6,8 +6,6 @@
 // from the two binary signals on one thread with the default (interval) path
 // and the FFT path: median of N runs, windows per second, and the growth of
 // the process's peak memory during AWCC.
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,19 +14,11 @@
 #include <vector>
 
 #include "awcc/awcc.hpp"
+#include "bench_util.hpp"
 #include "synth/synthesiser.hpp"
 
-namespace {
-
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
-double peak_mb() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
-
-}  // namespace
+using bench::now;
+using bench::peak_mb;
 
 int main(int argc, char** argv) {
   double duration = 300.0;

@@ -7,8 +7,6 @@
 // phase statistics (two passes over the file: histogram, then thresholds),
 // and optionally (c) FSCC on the binarised signals. Prints the median of N
 // runs, the samples per second and the peak memory of the process.
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -17,23 +15,11 @@
 #include <vector>
 
 #include "awcc/process.hpp"
+#include "bench_util.hpp"
 
-namespace {
-
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
-double peak_mb() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
+using bench::now;
+using bench::peak_mb;
+using bench::median;
 
 int main(int argc, char** argv) {
   if (argc < 2) {

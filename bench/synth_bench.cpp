@@ -7,8 +7,6 @@
 // --brute-force it also times the dense per-sample piercing test of the same
 // scene (bubbles and velocities kept for it), and checks that both give the
 // same samples.
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,21 +14,11 @@
 #include <cstring>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "synth/synthesiser.hpp"
 
-namespace {
-
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-double peak_mb() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
-
-}  // namespace
+using bench::now;
+using bench::peak_mb;
 
 int main(int argc, char** argv) {
   double duration = 300.0;

@@ -1,5 +1,7 @@
 #include "awcc/awcc.hpp"
 
+#include "overlap_impulses.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -135,11 +137,8 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
   const double qx = L * mx * (1 - mx), qy = L * my * (1 - my);
   if (!(qx > 0.0) || !(qy > 0.0) || k_max < k_min) return out;
 
-  // Overlap sums: each pair of air intervals adds a trapezoid in k whose
-  // second difference is +1 at b0 - a1, -1 at b0 - a0 and at b1 - a1, +1 at
-  // b1 - a0. Trapezoids ending at or before k_min or starting after k_max
-  // add nothing in range; impulses before k_min are folded into the starting
-  // value and slope. Impulses and every other kink (the mean terms' kinks at
+  // Overlap sums from the pairs of air intervals (overlap_impulses.hpp).
+  // Impulses and every other kink (the mean terms' kinks at
   // the edges of intervals entering or leaving the overlapping ranges, and
   // lag 0 where n = L - |k| turns) are marked on a byte per lag: cheaper than
   // sorting them.
@@ -148,30 +147,14 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
   thread_local std::vector<std::uint8_t> mark;
   impulse.assign(lags, 0);
   mark.assign(lags + 8, 0);  // padding for the word-wise scan
-  std::int64_t slope = 0, value = 0;
-  auto add_impulse = [&](std::int64_t k, std::int32_t w) {
-    if (k > k_max) return;
-    if (k < k_min) {
-      slope += w;
-      value += w * (k_min - k);
-      return;
-    }
-    impulse[static_cast<std::size_t>(k - k_min)] += w;
-    mark[static_cast<std::size_t>(k - k_min)] = 1;
-  };
+  detail::OverlapImpulses<std::int32_t> sum{k_min, k_max, impulse, mark.data()};
   auto add_break = [&](std::int64_t k) {
     if (k >= k_min && k <= k_max) mark[static_cast<std::size_t>(k - k_min)] = 1;
   };
   for (const auto& ia : a) {
-    for (const auto& ib : b) {
-      if (ib.stop - ia.start <= k_min) continue;
-      if (ib.start - ia.stop > k_max) continue;
-      add_impulse(ib.start - ia.stop, +1);
-      add_impulse(ib.start - ia.start, -1);
-      add_impulse(ib.stop - ia.stop, -1);
-      add_impulse(ib.stop - ia.start, +1);
-    }
+    for (const auto& ib : b) sum.add_pair(ia.start, ia.stop, ib.start, ib.stop);
   }
+  std::int64_t slope = sum.slope, value = sum.value;
   add_break(k_min);
   add_break(k_max);
   add_break(0);

@@ -1,5 +1,7 @@
 #include "awcc/fscc.hpp"
 
+#include "overlap_impulses.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -26,24 +28,13 @@ std::int64_t air_samples_in(const AirIntervals& s, std::int64_t a, std::int64_t 
 
 namespace {
 
-// S(k) from pairs of air intervals: each pair's overlap is a trapezoid in k
-// (second difference +1 at b0 - a1, -1 at b0 - a0 and b1 - a1, +1 at
-// b1 - a0), summed through an impulse array and two prefix sums. Exact
-// integers; the cost grows with the pairs within the lag range.
+// S(k) from the pairs of air intervals within the lag range (see
+// overlap_impulses.hpp). Exact integers; the cost grows with the pairs.
 std::vector<double> lagged_products_by_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t t0,
                                                  std::int64_t t1, std::int64_t k_min, std::int64_t k_max) {
   const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
   std::vector<std::int64_t> impulse(lags, 0);
-  std::int64_t slope = 0, value = 0;  // contributions of impulses before k_min to s(k_min - 1) and f(k_min)
-  auto add = [&](std::int64_t k, std::int64_t w) {
-    if (k > k_max) return;
-    if (k < k_min) {
-      slope += w;
-      value += w * (k_min - k);
-      return;
-    }
-    impulse[static_cast<std::size_t>(k - k_min)] += w;
-  };
+  detail::OverlapImpulses<std::int64_t> sum{k_min, k_max, impulse};
   const auto& yi = y.intervals;
   std::size_t first = 0;
   for (const auto& iv : x.intervals) {
@@ -51,15 +42,11 @@ std::vector<double> lagged_products_by_intervals(const AirIntervals& x, const Ai
     if (a0 >= a1) continue;
     // y intervals that can overlap a shifted by a lag in range: b1 > a0 + k_min, b0 <= a1 + k_max.
     while (first < yi.size() && yi[first].stop <= a0 + k_min) ++first;
-    for (std::size_t j = first; j < yi.size() && yi[j].start <= a1 + k_max - 1 + 1; ++j) {
-      const std::int64_t b0 = yi[j].start, b1 = yi[j].stop;
-      if (b1 - a0 <= k_min) continue;
-      add(b0 - a1, +1);
-      add(b0 - a0, -1);
-      add(b1 - a1, -1);
-      add(b1 - a0, +1);
+    for (std::size_t j = first; j < yi.size() && yi[j].start <= a1 + k_max; ++j) {
+      sum.add_pair(a0, a1, yi[j].start, yi[j].stop);
     }
   }
+  std::int64_t slope = sum.slope, value = sum.value;
   std::vector<double> out(lags);
   for (std::size_t i = 0; i < lags; ++i) {
     out[i] = static_cast<double>(value);  // f(k_min + i)

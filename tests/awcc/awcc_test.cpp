@@ -5,25 +5,14 @@
 #include <cmath>
 #include <random>
 
+#include "random_signals.hpp"
+
 namespace {
 
 using awcc::AirInterval;
 using awcc::AirIntervals;
 
-AirIntervals telegraph(std::int64_t n, unsigned seed, double fs = 1000.0, int max_air = 10, int max_water = 40) {
-  std::mt19937 rng(seed);
-  std::vector<std::uint8_t> dense(static_cast<std::size_t>(n));
-  std::uint8_t state = 0;
-  std::int64_t next = 0;
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (i == next) {
-      state ^= 1;
-      next = i + 1 + static_cast<std::int64_t>(rng() % static_cast<unsigned>(state ? max_air : max_water));
-    }
-    dense[static_cast<std::size_t>(i)] = state;
-  }
-  return awcc::from_dense(dense, fs);
-}
+using pdp_test::telegraph;
 
 // Naive normalised correlation of a window, in long double.
 std::vector<double> naive(const std::vector<std::uint8_t>& dx, const std::vector<std::uint8_t>& dy, std::int64_t start,

@@ -5,24 +5,15 @@
 #include <cmath>
 #include <random>
 
+#include "random_signals.hpp"
+
 namespace {
 
 using awcc::AirIntervals;
 
-// A random telegraph signal of n samples: chords of 2..40 samples.
+// Chords of 2..11 (air) and 2..41 (water) samples.
 AirIntervals telegraph(std::int64_t n, unsigned seed, double fs = 1000.0) {
-  std::mt19937 rng(seed);
-  std::vector<std::uint8_t> dense(static_cast<std::size_t>(n));
-  std::uint8_t state = 0;
-  std::int64_t next = 0;
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (i == next) {
-      state ^= 1;
-      next = i + 2 + static_cast<std::int64_t>(rng() % (state ? 10 : 40));
-    }
-    dense[static_cast<std::size_t>(i)] = state;
-  }
-  return awcc::from_dense(dense, fs);
+  return pdp_test::telegraph(n, seed, fs, 10, 40, 2);
 }
 
 AirIntervals shifted(const AirIntervals& s, std::int64_t delay) {

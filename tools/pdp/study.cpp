@@ -7,6 +7,7 @@
 
 #include "awcc/phase_statistics.hpp"
 #include "synth/random.hpp"
+#include "terminal.hpp"
 #include "synth/synthesiser.hpp"
 
 namespace pdp {
@@ -23,32 +24,6 @@ std::uint64_t run_seed(std::uint64_t seed, std::uint64_t index) {
 }
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-Spread spread(std::vector<double> v) {
-  Spread s;
-  s.count = static_cast<std::int64_t>(v.size());
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  double sum = 0;
-  for (double x : v) sum += x;
-  s.mean = sum / static_cast<double>(v.size());
-  double ss = 0;
-  for (double x : v) ss += (x - s.mean) * (x - s.mean);
-  s.sd = v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : 0.0;
-  auto q = [&](double p) {
-    const double pos = p * static_cast<double>(v.size() - 1);
-    const auto k = static_cast<std::size_t>(pos);
-    return k + 1 < v.size() ? v[k] + (pos - static_cast<double>(k)) * (v[k + 1] - v[k]) : v.back();
-  };
-  s.q25 = q(0.25);
-  s.median = q(0.5);
-  s.q75 = q(0.75);
-  return s;
-}
 
 // Student t 0.975 quantile for df degrees of freedom.
 double t975(std::int64_t df) {
@@ -160,8 +135,8 @@ RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
       r.window_bias = sum / static_cast<double>(diff.size());
       r.window_rms = std::sqrt(ss / static_cast<double>(diff.size()));
     }
-    r.accepted_truth = spread(accepted);
-    r.rejected_truth = spread(rejected);
+    r.accepted_truth = awcc::summarise(std::move(accepted));
+    r.rejected_truth = awcc::summarise(std::move(rejected));
   }
   return r;
 }
@@ -172,8 +147,10 @@ using nlohmann::json;
 
 json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
-json spread_json(const Spread& s) {
-  return json{{"count", s.count}, {"mean", s.mean}, {"sd", s.sd}, {"q25", s.q25}, {"median", s.median}, {"q75", s.q75}};
+// Summary::percentiles holds the 5, 10, 25, 50, 75, 90 and 95th.
+json spread_json(const awcc::Summary& s) {
+  return json{{"count", s.count},           {"mean", s.mean},   {"sd", s.std},
+              {"q25", s.percentiles[2]},    {"median", s.median}, {"q75", s.percentiles[4]}};
 }
 
 }  // namespace
@@ -258,12 +235,10 @@ std::string run_report(const RunResult& r) {
       out += fmt::format("window level: AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms {:.4f} m/s\n",
                          *r.window_bias, *r.window_rms);
     }
-    out += fmt::format("true window velocity, accepted: mean {:.4f}, sd {:.4f}, quartiles {:.4f} {:.4f} {:.4f} m/s ({})\n",
-                       r.accepted_truth.mean, r.accepted_truth.sd, r.accepted_truth.q25, r.accepted_truth.median,
-                       r.accepted_truth.q75, r.accepted_truth.count);
-    out += fmt::format("true window velocity, rejected: mean {:.4f}, sd {:.4f}, quartiles {:.4f} {:.4f} {:.4f} m/s ({})\n",
-                       r.rejected_truth.mean, r.rejected_truth.sd, r.rejected_truth.q25, r.rejected_truth.median,
-                       r.rejected_truth.q75, r.rejected_truth.count);
+    for (const auto& [label, s] : {std::pair{"accepted", &r.accepted_truth}, std::pair{"rejected", &r.rejected_truth}}) {
+      out += fmt::format("true window velocity, {}: mean {:.4f}, sd {:.4f}, quartiles {:.4f} {:.4f} {:.4f} m/s ({})\n",
+                         label, s->mean, s->std, s->percentiles[2], s->median, s->percentiles[4], s->count);
+    }
   }
   out += fmt::format("run time: synthesis {:.3f} s, processing {:.3f} s (FSCC {:.3f} s, AWCC {:.3f} s)\n",
                      r.seconds_synth, r.seconds_process, r.seconds_fscc, r.seconds_awcc);

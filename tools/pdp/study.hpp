@@ -13,6 +13,7 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/fscc.hpp"
+#include "awcc/phase_statistics.hpp"
 #include "synth/scene.hpp"
 
 namespace pdp {
@@ -32,12 +33,6 @@ struct Score {
   [[nodiscard]] std::optional<double> error() const;
 };
 
-/// Quartiles of a sample (empty sample: all 0, count 0).
-struct Spread {
-  std::int64_t count = 0;
-  double mean = 0.0, sd = 0.0, q25 = 0.0, median = 0.0, q75 = 0.0;
-};
-
 struct RunResult {
   synth::Scene scene;
   // Truth (realised, of the generated series and bubbles).
@@ -55,7 +50,7 @@ struct RunResult {
   Score void_fraction_score, count_rate_score;
   // Window level (AWCC): accepted window velocity minus window-averaged truth.
   std::optional<double> window_bias, window_rms;   ///< m/s
-  Spread accepted_truth, rejected_truth;           ///< true window velocities, m/s
+  awcc::Summary accepted_truth, rejected_truth;    ///< true window velocities, m/s
   double seconds_synth = 0.0, seconds_process = 0.0, seconds_fscc = 0.0, seconds_awcc = 0.0;
 };
 
