@@ -115,7 +115,9 @@ int run_bench(const BenchOptions& o) {
         for (double f : rates)
           if (f != 500e3) records.emplace_back(base_duration, f);
       }
-      for (const auto& [duration, fs] : records) {
+      for (const auto& record : records) {
+        // Plain copies: lambdas below capture them (clang 14 cannot capture bindings).
+        const double duration = record.first, fs = record.second;
         synth::Scene s = named_scene(name);
         s.duration = duration;
         s.fs = fs;

@@ -1,0 +1,35 @@
+// Every reader and the whole processing chain (binarisation, phase
+// statistics, FSCC, AWCC) on arbitrary bytes. The first byte picks the
+// container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV),
+// the rest is the file.
+#include <stdexcept>
+
+#include "awcc/process.hpp"
+#include "fuzz_util.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  static const char* extensions[] = {".wav", ".flac", ".dat", ".raw", ".csv", ".tsv", ".w64", ".aiff"};
+  const std::uint8_t selector = data[0];
+  const auto path = fuzz::scratch(std::string("input") + extensions[selector % 8]);
+  fuzz::write(path, data + 1, size - 1);
+  awcc::ProcessOptions o;
+  o.reader.fs = 10000.0;
+  o.reader.raw.sample_type = static_cast<awcc::SampleType>((selector >> 3) % 4);
+  o.reader.raw.byte_order = (selector >> 5) & 1 ? awcc::ByteOrder::big : awcc::ByteOrder::little;
+  o.reader.raw.channels = 1 + ((selector >> 6) & 1) + 1;  // 2 or 3
+  o.dx = 5e-3;
+  o.awcc = true;
+  o.fscc_options.max_lag = 0.01;
+  o.binarisation.rule = static_cast<awcc::ThresholdRule>((selector >> 2) % 4 == 2 ? 0 : (selector >> 2) % 4);
+  o.block_frames = 1 + (selector % 7) * 1000;
+  try {
+    const auto r = awcc::process_recording(path, o);
+    (void)awcc::to_json(r).dump();
+    (void)r.report();
+  } catch (const std::runtime_error&) {
+  } catch (const std::invalid_argument&) {
+  }
+  std::filesystem::remove(path);
+  return 0;
+}

@@ -1,0 +1,23 @@
+// The sweep definition parser and its expansion on arbitrary text.
+#include <stdexcept>
+
+#include "fuzz_util.hpp"
+#include "sweep.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const auto path = fuzz::scratch("sweep.toml");
+  fuzz::write(path, data, size);
+  try {
+    const auto d = pdp::load_sweep(path);
+    std::size_t combinations = 1;
+    for (const auto& [k, v] : d.grid) combinations *= v.size();
+    if (d.repeat * static_cast<std::int64_t>(combinations) < 10000 && d.runs * d.repeat < 10000) {
+      const auto runs = d.expand();
+      for (const auto& r : runs) (void)pdp::sweep_row(r, nullptr, "x", pdp::study_id(d));
+    }
+  } catch (const std::runtime_error&) {
+  } catch (const std::invalid_argument&) {
+  }
+  std::filesystem::remove(path);
+  return 0;
+}
