@@ -28,6 +28,7 @@ std::string AwccOptions::validate() const {
   if (!(prominence_fraction >= 0.0 && prominence_fraction <= 1.0))
     return fmt::format("prominence fraction {} must lie in [0, 1]", prominence_fraction);
   if (velocity_min.has_value() != velocity_max.has_value()) return "give both ends of the velocity range";
+  if (max_lag_samples < 1) return fmt::format("max lag {} samples must be >= 1", max_lag_samples);
   if (velocity_min && !(*velocity_min > 0.0 && *velocity_max > *velocity_min))
     return fmt::format("velocity range {} to {} m/s must satisfy 0 < min < max", *velocity_min, *velocity_max);
   return {};
@@ -460,9 +461,11 @@ std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double
   if (options.velocity_min && options.velocity_max && dx > 0.0) {
     const auto lo = static_cast<std::int64_t>(std::floor(dx * fs / *options.velocity_max));
     const auto hi = static_cast<std::int64_t>(std::ceil(dx * fs / *options.velocity_min));
-    return {std::max<std::int64_t>(lo, -(length - 1)), std::min<std::int64_t>(hi, length - 1)};
+    const std::int64_t reach = std::min(length - 1, options.max_lag_samples);
+    return {std::max<std::int64_t>(lo, -reach), std::min<std::int64_t>(hi, reach)};
   }
-  return {-(length - 1), length - 1};
+  const std::int64_t reach = std::min(length - 1, options.max_lag_samples);
+  return {-reach, reach};
 }
 
 void analyse_window(AwccWindow& w, const CorrelationPeak& p, bool constant, std::int64_t first_lag, double dx,

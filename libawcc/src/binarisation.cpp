@@ -161,6 +161,15 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
     throw std::runtime_error("the signal has no spread: no threshold can be found");
   }
   const auto bins = h.regroup(width);
+  if (bins.size() == 1) {
+    // Every sample in one bin: a channel without interfaces (a tip in water,
+    // or a dead channel). Not an error: all water, and said so.
+    t.constant = true;
+    t.air_level = t.water_level = (static_cast<double>(bins[0].first) + 0.5) * width;
+    t.threshold = t.lower = t.upper = air_low ? lo - 1.0 : hi + 1.0;
+    t.note = "every sample in one histogram bin: no interface, taken as water";
+    return t;
+  }
   // Search each side for its most populated bin; ties go to the first bin.
   struct Mode {
     std::int64_t bin = 0, count = -1;

@@ -199,7 +199,14 @@ std::optional<std::pair<std::int16_t, std::int16_t>> band_from(const std::int16_
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   auto recording = open_recording(path, options.reader);
+  return binarise_recording(*recording, options);
+}
+
+BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& options) {
+  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  Recording* recording = &opened;
   const RecordingInfo& info = recording->info();
+  const std::filesystem::path& path = info.path;
   const int channels = info.channels;
   for (int c : {options.leading_channel, options.trailing_channel}) {
     if (c >= channels) {

@@ -408,6 +408,25 @@ bool parse_number(std::string_view cell, double& value) {
   return ec == std::errc{} && ptr == cell.data() + cell.size();
 }
 
+// Lines longer than this are not rows of a column file; refusing them keeps
+// memory bounded whatever the file holds.
+constexpr std::size_t kMaxCsvLine = 1 << 20;
+
+// std::getline, but refusing lines longer than kMaxCsvLine.
+bool bounded_getline(std::istream& in, std::string& line, const fs::path& path, std::int64_t number) {
+  line.clear();
+  for (;;) {
+    const int c = in.get();
+    if (c == std::char_traits<char>::eof()) return !line.empty();  // a last line without newline counts
+    if (c == '\n') return true;
+    line.push_back(static_cast<char>(c));
+    if (line.size() > kMaxCsvLine) {
+      fail(path, fmt::format("line {} is longer than {} bytes: not a column file (or a damaged one)", number,
+                             kMaxCsvLine));
+    }
+  }
+}
+
 class CsvRecording final : public Recording {
  public:
   CsvRecording(const fs::path& path, const ReaderOptions& options) : in_(path, std::ios::binary) {
@@ -417,9 +436,10 @@ class CsvRecording final : public Recording {
     std::string first;
     std::streampos data_start = 0;
     // Skip blank lines at the top.
+    std::int64_t number = 0;
     do {
       data_start = in_.tellg();
-      if (!std::getline(in_, first)) fail(path, "the CSV file holds no rows");
+      if (!bounded_getline(in_, first, path, ++number)) fail(path, "the CSV file holds no rows");
     } while (trim(first).empty());
     delimiter_ = options.csv.delimiter;
     if (!delimiter_) {
@@ -478,7 +498,7 @@ class CsvRecording final : public Recording {
   std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
     std::int64_t n = 0;
     std::string line;
-    while (n < max_frames && std::getline(in_, line)) {
+    while (n < max_frames && bounded_getline(in_, line, info_.path, line_ + 1)) {
       ++line_;
       if (trim(line).empty()) continue;
       const auto cells = split(line, delimiter_);
@@ -515,7 +535,8 @@ class CsvRecording final : public Recording {
     // The sampling interval from the first rows' time stamps (median step).
     std::vector<double> times;
     std::string line;
-    while (times.size() < 2001 && std::getline(in_, line)) {
+    std::int64_t number = line_;
+    while (times.size() < 2001 && bounded_getline(in_, line, info_.path, ++number)) {
       if (trim(line).empty()) continue;
       const auto cells = split(line, delimiter_);
       double t;

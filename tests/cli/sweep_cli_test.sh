@@ -65,6 +65,20 @@ for delay in 0.2 0.5 0.9; do
   [[ "$(canonical "$dir/killed.csv")" == "$(canonical "$dir/two.csv")" ]] || fail "resume after kill at $delay s differs"
 done
 
+# Many kills of one sweep at random points, resuming each time into the same
+# file, then a final resume: still exactly the uninterrupted rows.
+rm -f "$dir/many.csv"
+RANDOM=17
+for attempt in $(seq 1 10); do
+  "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/many.csv" --threads 2 &
+  pid=$!
+  sleep "0.$((RANDOM % 30 + 3))"
+  kill -9 "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+done
+"$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/many.csv" || fail "final resume after 10 kills"
+[[ "$(canonical "$dir/many.csv")" == "$(canonical "$dir/two.csv")" ]] || fail "10 kills and resumes differ"
+
 # A partial last row (a crash while writing) is cut off and redone.
 head -n 5 "$dir/two.csv" >"$dir/partial.csv"
 printf '%s' "$(sed -n 6p "$dir/two.csv" | cut -c1-40)" >>"$dir/partial.csv"

@@ -84,7 +84,7 @@ TEST_P(ExactUpdate, StationaryStatisticsMatchTheImposedOnes) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(DtOverT, ExactUpdate, ::testing::Values(0.01, 1.0, 10.0, 100.0));
+INSTANTIATE_TEST_SUITE_P(DtOverT, ExactUpdate, ::testing::Values(0.001, 0.01, 1.0, 10.0, 100.0, 1000.0));
 
 TEST(EulerUpdate, IsBiasedAsPredictedWhileExactIsNot) {
   // Euler at dt/T = 1 is the AR(1) x' = 0 * x + sigma sqrt(2) eta: variance

@@ -62,6 +62,10 @@ struct AwccOptions {
   double prominence_fraction = 0.3;       ///< peaks kept for the SPR, fraction of the tallest's prominence
   std::optional<double> velocity_min;     ///< m/s: with velocity_max, lags searched from dx / u
   std::optional<double> velocity_max;     ///< m/s
+  /// Largest |lag| searched, samples: bounds the work and memory of
+  /// pathological windows (a record of a few enormous bubbles); 2^20 is far
+  /// beyond any physical transit (2 s at 500 kHz).
+  std::int64_t max_lag_samples = std::int64_t{1} << 20;
 
   [[nodiscard]] std::string validate() const;
 };

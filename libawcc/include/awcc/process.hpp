@@ -67,6 +67,8 @@ struct ProcessResult {
 /// Reads and binarises the two tips' channels. Throws std::runtime_error
 /// naming the file and the problem.
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options);
+/// The same from an open recording (read from its start; options.reader is not used).
+BinarisedRecording binarise_recording(Recording& recording, const ProcessOptions& options);
 
 /// Phase statistics (and FSCC, and AWCC on the binary signals) from binarised signals.
 ProcessResult process_binarised(const BinarisedRecording& recording, const ProcessOptions& options);
