@@ -23,12 +23,7 @@ CLI::App* setup_compare(CLI::App& app, CompareOptions& o) {
 
 int run_compare(const CompareOptions& o) {
   StudyOptions study;
-  try {
-    apply_method_options(o.methods, study);
-  } catch (const std::invalid_argument& e) {
-    spdlog::error("{}", e.what());
-    return 2;
-  }
+  if (!apply_method_options_or_log(o.methods, study)) return 2;
   try {
     std::optional<awcc::FsccResult> f;
     std::optional<awcc::AwccResult> a;

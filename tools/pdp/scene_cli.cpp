@@ -86,4 +86,14 @@ void apply_method_options(const MethodCli& m, StudyOptions& o) {
   if (auto why = o.fscc.validate(); !why.empty()) throw std::invalid_argument(why);
 }
 
+bool apply_method_options_or_log(const MethodCli& cli, StudyOptions& options) {
+  try {
+    apply_method_options(cli, options);
+    return true;
+  } catch (const std::invalid_argument& e) {
+    spdlog::error("{}", e.what());
+    return false;
+  }
+}
+
 }  // namespace pdp

@@ -41,5 +41,8 @@ void add_method_options(CLI::App* cmd, MethodCli& cli);
 struct StudyOptions;
 /// Throws std::invalid_argument naming the option.
 void apply_method_options(const MethodCli& cli, StudyOptions& options);
+/// The same, logging the problem and returning false instead of throwing
+/// (as build_scene does for the scene).
+bool apply_method_options_or_log(const MethodCli& cli, StudyOptions& options);
 
 }  // namespace pdp

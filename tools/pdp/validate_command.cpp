@@ -32,12 +32,7 @@ int run_validate(const ValidateOptions& o) {
   const auto scene = build_scene(o.scene);
   if (!scene) return 2;
   StudyOptions study;
-  try {
-    apply_method_options(o.methods, study);
-  } catch (const std::invalid_argument& e) {
-    spdlog::error("{}", e.what());
-    return 2;
-  }
+  if (!apply_method_options_or_log(o.methods, study)) return 2;
   std::vector<RunResult> runs;
   try {
     Progress progress("validating");
