@@ -574,6 +574,7 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     throw std::invalid_argument("AWCC needs two signals of the same length and sampling rate");
   }
   AwccResult result;
+  result.np = options.np;
   result.windows = awcc_windows(leading, options.np);
   const double fs = leading.fs;
   const bool use_fft = options.path == CorrelationPath::fft;

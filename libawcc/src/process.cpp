@@ -307,6 +307,7 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
   const AwccOptions& ao = options.awcc_options;
   if (auto why = ao.validate(); !why.empty()) throw std::invalid_argument(why);
   AwccResult result;
+  result.np = ao.np;
   result.windows = awcc_windows(b.leading, ao.np);
   auto recording = open_recording(path, options.reader);
   const auto stride = static_cast<std::size_t>(recording->info().channels);
@@ -462,6 +463,7 @@ json to_json(const ProcessResult& r) {
     out["awcc"] = json{
         {"defined", a.defined},
         {"reason", a.defined ? json(nullptr) : json(a.reason)},
+        {"np", a.np},
         {"velocity", value(a.velocity)},
         {"velocity_ci95", interval(a.velocity_ci95)},
         {"velocity_rms", value(a.velocity_rms)},

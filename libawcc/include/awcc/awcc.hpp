@@ -90,6 +90,7 @@ struct AwccWindow {
 struct AwccResult {
   bool defined = false;         ///< false: see reason; the figures below are 0
   std::string reason;
+  int np = 0;                   ///< particles per window used
   double velocity = 0.0;        ///< m/s
   double velocity_rms = 0.0;    ///< m/s
   double turbulence_intensity = 0.0;

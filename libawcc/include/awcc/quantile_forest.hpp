@@ -1,0 +1,113 @@
+#pragma once
+// Quantile regression forest (Meinshausen 2006), METHOD.md 7.
+//
+// Training: every tree grows on a bootstrap sample (m = round(f n) draws with
+// replacement of the n training rows). A node splits on the feature and
+// threshold, among `features_per_split` features drawn at random, that most
+// reduce the squared error of the targets (variance reduction), subject to
+// each child holding at least `min_leaf` draws; it becomes a leaf at
+// `max_depth`, below 2 min_leaf draws, on constant targets, or when no split
+// reduces the error. A leaf keeps the training rows it holds (a row drawn twice
+// is held twice).
+//
+// Prediction at x: with L_t(x) the leaf of tree t reached by x, c_ti(x) the
+// number of times row i is held by it and |L_t(x)| its size, the weight of
+// training target Y_i is
+//   w_i(x) = (1/T) sum_t c_ti(x) / |L_t(x)|,        sum_i w_i(x) = 1,
+// the conditional distribution F(y | x) = sum_i w_i(x) 1{Y_i <= y}, and the
+// alpha-quantile
+//   Q_alpha(x) = inf { y : F(y | x) >= alpha }
+// (no interpolation: with one tree it is the leaf's empirical quantile, the
+// order statistic Y_(ceil(alpha |L|))). Quantiles of one x never cross.
+//
+// Determinism: tree t draws its bootstrap and features from its own stream,
+// seeded by (seed, t), so a seed gives the same forest whatever the thread
+// count.
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace awcc {
+
+struct ForestOptions {
+  int trees = 100;                  ///< trees in the forest
+  int min_leaf = 5;                 ///< least bootstrap draws per leaf
+  int max_depth = 0;                ///< deepest split level; 0 = unlimited (min_leaf bounds the tree)
+  int features_per_split = 0;       ///< features tried per split; 0 = ceil(p / 3)
+  double sample_fraction = 1.0;     ///< bootstrap draws per tree / training rows
+  std::uint64_t seed = 1;           ///< a seed gives the same forest
+  int threads = 0;                  ///< training threads; 0 = all cores
+
+  [[nodiscard]] std::string validate() const;
+};
+
+/// Training rows: features row-major (rows x features), one target per row.
+struct TrainingData {
+  int features = 0;
+  std::vector<double> x;            ///< row i, feature j at x[i * features + j]
+  std::vector<double> y;
+  [[nodiscard]] std::size_t rows() const { return y.size(); }
+  [[nodiscard]] std::span<const double> row(std::size_t i) const {
+    return {x.data() + i * static_cast<std::size_t>(features), static_cast<std::size_t>(features)};
+  }
+};
+
+/// One regression tree held flat: node 0 is the root.
+struct RegressionTree {
+  struct Node {
+    std::int32_t feature = -1;      ///< -1: leaf
+    double threshold = 0.0;         ///< x[feature] <= threshold goes to `left`
+    std::uint32_t left = 0, right = 0;  ///< child nodes; for a leaf: first and count in `leaf_rows`
+  };
+  std::vector<Node> nodes;
+  std::vector<std::uint32_t> leaf_rows;  ///< training rows held by the leaves, leaf by leaf
+
+  /// The leaf reached by x (its node index).
+  [[nodiscard]] std::uint32_t leaf(std::span<const double> x) const;
+  /// The training rows that leaf holds.
+  [[nodiscard]] std::span<const std::uint32_t> rows(std::uint32_t leaf) const;
+};
+
+/// A weighted sample: values ascending, weights summing to 1.
+struct WeightedDistribution {
+  std::vector<double> values, weights;
+  /// inf { y : F(y) >= alpha } (F within 1e-12 of alpha counts as reaching it).
+  [[nodiscard]] double quantile(double alpha) const;
+};
+
+class QuantileForest {
+ public:
+  QuantileForest() = default;
+  /// Grows the forest; throws std::invalid_argument on bad options or data
+  /// (non-finite values, no rows, more rows than 2^32 - 1).
+  static QuantileForest train(const TrainingData& data, const ForestOptions& options);
+  /// A forest from its parts (model files); throws std::invalid_argument when
+  /// a tree refers to a node, feature or row that does not exist.
+  static QuantileForest assemble(int features, std::vector<double> targets, std::vector<RegressionTree> trees);
+
+  [[nodiscard]] int features() const { return features_; }
+  [[nodiscard]] const std::vector<double>& targets() const { return targets_; }
+  [[nodiscard]] const std::vector<RegressionTree>& trees() const { return trees_; }
+
+  /// w_i(x) for every training row i (the definition above, dense).
+  [[nodiscard]] std::vector<double> weights(std::span<const double> x) const;
+  /// F(. | x) as a weighted sample (only the rows with weight).
+  [[nodiscard]] WeightedDistribution distribution(std::span<const double> x) const;
+  /// Q_alpha(x) for each level alpha in (0, 1].
+  [[nodiscard]] std::vector<double> quantiles(std::span<const double> x, std::span<const double> levels) const;
+
+ private:
+  int features_ = 0;
+  std::vector<double> targets_;
+  std::vector<RegressionTree> trees_;
+};
+
+/// Mean pinball (quantile) loss of predicted quantiles q at levels alpha for
+/// the truth y: (1/K) sum_k max(alpha_k (y - q_k), (alpha_k - 1)(y - q_k)).
+/// A proper score: its expectation is least at the true quantiles.
+double pinball_loss(std::span<const double> q, std::span<const double> levels, double y);
+
+}  // namespace awcc

@@ -1,0 +1,349 @@
+#include "awcc/correction.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
+#include "awcc/atomic_output.hpp"
+
+namespace awcc {
+
+namespace {
+
+constexpr char magic[8] = {'p', 'd', 'p', '-', 'q', 'r', 'f', '\n'};
+
+// Little-endian writer and a bounds-checked reader: the file's byte order
+// does not depend on the machine's.
+class Writer {
+ public:
+  void u8(std::uint8_t v) { raw(&v, 1); }
+  void u32(std::uint32_t v) {
+    std::uint8_t b[4];
+    for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(v >> (8 * i));
+    raw(b, 4);
+  }
+  void u64(std::uint64_t v) {
+    std::uint8_t b[8];
+    for (int i = 0; i < 8; ++i) b[i] = static_cast<std::uint8_t>(v >> (8 * i));
+    raw(b, 8);
+  }
+  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
+  void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
+  void text(const std::string& s) {
+    u32(static_cast<std::uint32_t>(s.size()));
+    raw(s.data(), s.size());
+  }
+  void raw(const void* data, std::size_t n) {
+    if (n == 0) return;
+    const auto at = bytes.size();
+    bytes.resize(at + n);
+    std::memcpy(bytes.data() + at, data, n);
+  }
+  std::vector<std::uint8_t> bytes;
+};
+
+class Reader {
+ public:
+  Reader(const std::uint8_t* data, std::size_t size, const std::string& name) : p_(data), end_(data + size), name_(name) {}
+  std::uint8_t u8() { return *take(1); }
+  std::uint32_t u32() {
+    const auto* b = take(4);
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(b[i]) << (8 * i);
+    return v;
+  }
+  std::uint64_t u64() {
+    const auto* b = take(8);
+    std::uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(b[i]) << (8 * i);
+    return v;
+  }
+  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
+  std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
+  double f64() { return std::bit_cast<double>(u64()); }
+  std::string text() {
+    const auto n = u32();
+    const auto* b = take(n);
+    return {reinterpret_cast<const char*>(b), n};
+  }
+  /// A count of items of `item_bytes` each that must fit in what is left.
+  std::size_t count(std::uint64_t n, std::size_t item_bytes) {
+    if (n > static_cast<std::uint64_t>(end_ - p_) / std::max<std::size_t>(item_bytes, 1)) damaged("a count exceeds the file");
+    return static_cast<std::size_t>(n);
+  }
+  [[nodiscard]] bool done() const { return p_ == end_; }
+  [[noreturn]] void damaged(const std::string& what) const {
+    throw std::runtime_error(fmt::format("{}: damaged model file ({}); retrain it with pdp train or fetch it again", name_, what));
+  }
+
+ private:
+  const std::uint8_t* take(std::size_t n) {
+    if (static_cast<std::size_t>(end_ - p_) < n) damaged("it ends early");
+    const auto* b = p_;
+    p_ += n;
+    return b;
+  }
+  const std::uint8_t* p_;
+  const std::uint8_t* end_;
+  const std::string& name_;
+};
+
+void write_forest(Writer& w, const std::string& name, TargetForm form, const QuantileForest& f) {
+  w.text(name);
+  w.u8(static_cast<std::uint8_t>(form));
+  w.u32(static_cast<std::uint32_t>(f.features()));
+  w.u64(f.targets().size());
+  for (double y : f.targets()) w.f64(y);
+  w.u32(static_cast<std::uint32_t>(f.trees().size()));
+  for (const auto& t : f.trees()) {
+    w.u32(static_cast<std::uint32_t>(t.nodes.size()));
+    for (const auto& n : t.nodes) {
+      w.i32(n.feature);
+      w.f64(n.threshold);
+      w.u32(n.left);
+      w.u32(n.right);
+    }
+    w.u64(t.leaf_rows.size());
+    for (auto r : t.leaf_rows) w.u32(r);
+  }
+}
+
+QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& form) {
+  if (const auto name = r.text(); name != expected) r.damaged(fmt::format("forest '{}' where '{}' belongs", name, expected));
+  const auto f = r.u8();
+  if (f > 2) r.damaged(fmt::format("unknown target form {}", f));
+  form = static_cast<TargetForm>(f);
+  const auto features = r.u32();
+  if (features != CorrectionFeatures::count) r.damaged(fmt::format("{} features, expected {}", features, CorrectionFeatures::count));
+  std::vector<double> targets(r.count(r.u64(), 8));
+  for (auto& y : targets) y = r.f64();
+  std::vector<RegressionTree> trees(r.count(r.u32(), 12));
+  for (auto& t : trees) {
+    t.nodes.resize(r.count(r.u32(), 20));
+    for (auto& n : t.nodes) {
+      n.feature = r.i32();
+      n.threshold = r.f64();
+      n.left = r.u32();
+      n.right = r.u32();
+    }
+    t.leaf_rows.resize(r.count(r.u64(), 4));
+    for (auto& row : t.leaf_rows) row = r.u32();
+  }
+  try {
+    return QuantileForest::assemble(static_cast<int>(features), std::move(targets), std::move(trees));
+  } catch (const std::invalid_argument& e) {
+    r.damaged(e.what());
+  }
+}
+
+}  // namespace
+
+std::uint32_t crc32(const std::uint8_t* data, std::size_t size) {
+  static const auto table = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xedb88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  std::uint32_t c = 0xffffffffu;
+  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xffu] ^ (c >> 8);
+  return c ^ 0xffffffffu;
+}
+
+std::string_view to_string(TargetForm f) {
+  switch (f) {
+    case TargetForm::value: return "value";
+    case TargetForm::ratio: return "ratio";
+    case TargetForm::difference: return "difference";
+  }
+  return "unknown";
+}
+
+double to_target(TargetForm form, double truth, double measured) {
+  switch (form) {
+    case TargetForm::value: return truth;
+    case TargetForm::ratio: return truth / measured;
+    case TargetForm::difference: return truth - measured;
+  }
+  return truth;
+}
+
+double from_target(TargetForm form, double target, double measured) {
+  switch (form) {
+    case TargetForm::value: return target;
+    case TargetForm::ratio: return target * measured;
+    case TargetForm::difference: return target + measured;
+  }
+  return target;
+}
+
+std::string CorrectionModel::out_of_range(const CorrectionFeatures& f) const {
+  if (f.windows_accepted < min_windows) {
+    return fmt::format("{} accepted windows; the model was trained on runs with at least {}", f.windows_accepted,
+                       min_windows);
+  }
+  const auto x = f.vector();
+  for (std::size_t j = 0; j < ranges.size() && j < x.size(); ++j) {
+    const auto& r = ranges[j];
+    const double pad = range_margin * (r.max - r.min);
+    if (!(x[j] >= r.min - pad && x[j] <= r.max + pad)) {
+      return fmt::format("{} = {:.6g} is outside the training range [{:.6g}, {:.6g}]", r.name, x[j], r.min, r.max);
+    }
+  }
+  return {};
+}
+
+Correction CorrectionModel::correct(const CorrectionFeatures& f) const {
+  Correction c;
+  c.reason = out_of_range(f);
+  c.in_range = c.reason.empty();
+  if (!c.in_range) return c;
+  const auto x = f.vector();
+  auto one = [&](const QuantileForest& forest, TargetForm form, double measured, bool nonnegative) {
+    CorrectedQuantity q;
+    q.measured = measured;
+    const auto t = forest.quantiles(x, correction_levels);
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      q.quantiles[k] = from_target(form, t[k], measured);
+      if (nonnegative) q.quantiles[k] = std::max(0.0, q.quantiles[k]);
+    }
+    return q;
+  };
+  c.velocity = one(velocity, velocity_form, f.velocity, false);
+  c.turbulence_intensity = one(turbulence_intensity, turbulence_form, f.turbulence_intensity, true);
+  return c;
+}
+
+std::vector<std::uint8_t> CorrectionModel::serialise() const {
+  Writer payload;
+  payload.text(provenance);
+  payload.u32(static_cast<std::uint32_t>(ranges.size()));
+  for (const auto& r : ranges) {
+    payload.text(r.name);
+    payload.f64(r.min);
+    payload.f64(r.max);
+  }
+  payload.f64(range_margin);
+  payload.i64(min_windows);
+  payload.u32(2);
+  write_forest(payload, "velocity", velocity_form, velocity);
+  write_forest(payload, "turbulence_intensity", turbulence_form, turbulence_intensity);
+  Writer w;
+  w.raw(magic, sizeof magic);
+  w.u32(format_version);
+  w.u64(payload.bytes.size());
+  w.raw(payload.bytes.data(), payload.bytes.size());
+  w.u32(crc32(w.bytes.data(), w.bytes.size()));
+  return std::move(w.bytes);
+}
+
+CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+  if (bytes.size() < sizeof magic || std::memcmp(bytes.data(), magic, sizeof magic) != 0) {
+    throw std::runtime_error(fmt::format("{}: not a pdp model file (it does not start with \"pdp-qrf\"); give a file "
+                                         "written by pdp train",
+                                         name));
+  }
+  Reader head(bytes.data() + sizeof magic, bytes.size() - sizeof magic, name);
+  const auto version = head.u32();
+  if (version != format_version) {
+    throw std::runtime_error(fmt::format("{}: model file format version {}; this pdp reads version {}; retrain the "
+                                         "model with this pdp train",
+                                         name, version, format_version));
+  }
+  const auto length = head.u64();
+  const std::size_t header = sizeof magic + 4 + 8;
+  if (length > bytes.size() || bytes.size() - header - 4 != length) {
+    head.damaged(fmt::format("{} bytes where the header announces {}", bytes.size(), header + length + 4));
+  }
+  Reader tail(bytes.data() + header + length, 4, name);
+  if (tail.u32() != crc32(bytes.data(), header + length)) head.damaged("checksum mismatch");
+  Reader r(bytes.data() + header, length, name);
+  CorrectionModel m;
+  m.provenance = r.text();
+  m.ranges.resize(r.count(r.u32(), 20));
+  if (m.ranges.size() != CorrectionFeatures::count) r.damaged(fmt::format("{} feature ranges", m.ranges.size()));
+  for (std::size_t j = 0; j < m.ranges.size(); ++j) {
+    auto& fr = m.ranges[j];
+    fr.name = r.text();
+    fr.min = r.f64();
+    fr.max = r.f64();
+    if (fr.name != CorrectionFeatures::names[j]) {
+      r.damaged(fmt::format("feature {} is '{}', expected '{}'", j, fr.name, CorrectionFeatures::names[j]));
+    }
+    if (!(std::isfinite(fr.min) && std::isfinite(fr.max) && fr.min <= fr.max)) r.damaged("a feature range is not finite");
+  }
+  m.range_margin = r.f64();
+  if (!(m.range_margin >= 0.0 && m.range_margin <= 1.0)) r.damaged("range margin outside [0, 1]");
+  m.min_windows = r.i64();
+  if (r.u32() != 2) r.damaged("the model holds other than two forests");
+  m.velocity = read_forest(r, "velocity", m.velocity_form);
+  m.turbulence_intensity = read_forest(r, "turbulence_intensity", m.turbulence_form);
+  if (!r.done()) r.damaged("bytes after the last forest");
+  return m;
+}
+
+void CorrectionModel::save(const std::filesystem::path& path) const {
+  const auto bytes = serialise();
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot write the model", path.string()));
+  });
+}
+
+CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open the model file; check the path", path.string()));
+  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return parse(bytes, path.string());
+}
+
+std::optional<CorrectionFeatures> correction_features(const ProcessResult& r, std::string* why) {
+  auto fail = [&](std::string text) -> std::optional<CorrectionFeatures> {
+    if (why) *why = std::move(text);
+    return std::nullopt;
+  };
+  if (!r.awcc) return fail("AWCC was not run (use --method awcc or both)");
+  if (!r.awcc->defined) return fail("AWCC gave no velocity: " + r.awcc->reason);
+  if (r.tips.empty()) return fail("no tip statistics");
+  const auto& lead = r.tips[0].phase;
+  if (!(lead.bubble_count_rate > 0.0)) return fail("no bubbles on the leading tip");
+  CorrectionFeatures f;
+  f.velocity = r.awcc->velocity;
+  f.turbulence_intensity = r.awcc->turbulence_intensity;
+  f.void_fraction = lead.void_fraction;
+  // The same d32 as the training data: 1.5 u c / F with AWCC's velocity.
+  f.d32 = 1.5 * f.velocity * f.void_fraction / lead.bubble_count_rate;
+  f.dx = r.dx;
+  f.dy = r.dy;
+  f.np = r.awcc->np;
+  f.windows_accepted = r.awcc->windows_accepted;
+  return f;
+}
+
+nlohmann::json to_json(const Correction& c) {
+  using nlohmann::json;
+  auto quantity = [](const std::optional<CorrectedQuantity>& q) {
+    if (!q) return json(nullptr);
+    json levels = json::object();
+    for (std::size_t k = 0; k < correction_levels.size(); ++k) levels[correction_level_names[k]] = q->quantiles[k];
+    return json{{"measured", q->measured}, {"median", q->median()}, {"quantiles", levels}};
+  };
+  return json{{"in_range", c.in_range},
+              {"reason", c.in_range ? json(nullptr) : json(c.reason)},
+              {"velocity", quantity(c.velocity)},
+              {"turbulence_intensity", quantity(c.turbulence_intensity)}};
+}
+
+}  // namespace awcc
