@@ -332,6 +332,37 @@ std::optional<CorrectionFeatures> correction_features(const ProcessResult& r, st
   return f;
 }
 
+Correction not_corrected(std::string reason) {
+  Correction c;
+  c.reason = std::move(reason);
+  return c;
+}
+
+std::string correction_csv_header() {
+  std::string out = "correction_in_range,correction_reason";
+  for (const char* q : {"velocity", "turbulence_intensity"}) {
+    out += fmt::format(",corrected_{}", q);
+    for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
+  }
+  return out;
+}
+
+std::string correction_csv_cells(const Correction& c) {
+  std::string reason = c.in_range ? std::string() : c.reason;
+  for (auto& ch : reason)
+    if (ch == ',' || ch == '"' || ch == '\n' || ch == '\r') ch = ';';
+  std::string out = fmt::format("{},{}", c.in_range ? 1 : 0, reason);
+  for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
+    if (*q) {
+      out += fmt::format(",{:.10g}", (*q)->median());
+      for (double v : (*q)->quantiles) out += fmt::format(",{:.10g}", v);
+    } else {
+      out += std::string(1 + correction_levels.size(), ',');
+    }
+  }
+  return out;
+}
+
 nlohmann::json to_json(const Correction& c) {
   using nlohmann::json;
   auto quantity = [](const std::optional<CorrectedQuantity>& q) {

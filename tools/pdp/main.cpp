@@ -6,9 +6,11 @@
 #include "awcc/version.hpp"
 #include "bench_command.hpp"
 #include "compare_command.hpp"
+#include "correct_command.hpp"
 #include "process_command.hpp"
 #include "sweep_command.hpp"
 #include "synth_command.hpp"
+#include "train_command.hpp"
 #include "validate_command.hpp"
 
 int main(int argc, char** argv) {
@@ -41,6 +43,10 @@ int main(int argc, char** argv) {
   auto* sweep_command = pdp::setup_sweep(app, sweep_options);
   pdp::BenchOptions bench_options;
   auto* bench_command = pdp::setup_bench(app, bench_options);
+  pdp::TrainCommandOptions train_options;
+  auto* train_command = pdp::setup_train(app, train_options);
+  pdp::CorrectOptions correct_options;
+  auto* correct_command = pdp::setup_correct(app, correct_options);
 
   try {
     app.parse(argc, argv);
@@ -53,5 +59,7 @@ int main(int argc, char** argv) {
   if (compare_command->parsed()) return pdp::run_compare(compare_options);
   if (sweep_command->parsed()) return pdp::run_sweep(sweep_options);
   if (bench_command->parsed()) return pdp::run_bench(bench_options);
+  if (train_command->parsed()) return pdp::run_train(train_options);
+  if (correct_command->parsed()) return pdp::run_correct(correct_options);
   return 0;
 }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/correction.hpp"
 #include "awcc/process.hpp"
 #include "awcc/units.hpp"
 #include "terminal.hpp"
@@ -89,6 +90,10 @@ CLI::App* setup_process(CLI::App& app, ProcessCommandOptions& o) {
       ->check(CLI::ExistingFile)->group(out);
   cmd->add_option("--histogram-bins", o.histogram_bins, "bins of the chord-time histograms")
       ->check(CLI::Range(1, 100000))->capture_default_str()->group(out);
+  cmd->add_option("--correct", o.correct,
+                  "bias-correct AWCC's velocity and Tu with this model (.qrf from pdp train; samples/model/awcc.qrf "
+                  "ships): adds quantiles to the JSON, CSV and report")
+      ->check(CLI::ExistingFile)->group(corr);
   return cmd;
 }
 
@@ -241,12 +246,14 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
 
 std::string csv_number(const std::optional<double>& v) { return v ? fmt::format("{:.10g}", *v) : std::string(); }
 
-std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const std::vector<std::optional<double>>& pos) {
+std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const std::vector<std::optional<double>>& pos,
+                        const std::vector<awcc::Correction>& corrections) {
   std::string out =
       "file,position,void_fraction,bubble_count_rate,chord_time_mean,chord_time_median,threshold,"
       "void_fraction_trailing,bubble_count_rate_trailing,fscc_velocity,fscc_lag,fscc_r12_max,fscc_t05,fscc_tau05,"
       "fscc_turbulence_intensity_chanson,sauter_diameter,fscc_reason,awcc_velocity,awcc_velocity_rms,"
-      "awcc_turbulence_intensity,awcc_windows_accepted,awcc_windows_total,awcc_reason\n";
+      "awcc_turbulence_intensity,awcc_windows_accepted,awcc_windows_total,awcc_reason";
+  out += corrections.empty() ? "\n" : "," + awcc::correction_csv_header() + "\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
     const auto& lead = r.tips[0].phase;
@@ -260,7 +267,7 @@ std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const s
     const std::string reason = clean(f && !f->defined ? f->reason : std::string());
     const auto& a = r.awcc;
     const bool awcc_ok = a && a->defined;
-    out += fmt::format("{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+    out += fmt::format("{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                        r.info.path.filename().string(), csv_number(pos[i]), lead.void_fraction, lead.bubble_count_rate,
                        lead.air_chord_time.mean, lead.air_chord_time.median, r.tips[0].threshold.threshold,
                        trail.void_fraction, trail.bubble_count_rate,
@@ -276,8 +283,21 @@ std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const s
                        a ? std::to_string(a->windows_accepted) : std::string(),
                        a ? std::to_string(a->windows_total) : std::string(),
                        clean(a && !a->defined ? a->reason : std::string()));
+    out += corrections.empty() ? "\n" : "," + awcc::correction_csv_cells(corrections[i]) + "\n";
   }
   return out;
+}
+
+std::string correction_report(const awcc::Correction& c) {
+  if (!c.in_range) return fmt::format("  correction: not corrected: {}\n", c.reason);
+  const auto& u = *c.velocity;
+  const auto& t = *c.turbulence_intensity;
+  return fmt::format(
+      "  correction (quantile regression forest):\n"
+      "    velocity             {:.4f} m/s median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n"
+      "    turbulence intensity {:.4f} median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
+      u.median(), u.quantiles[1], u.quantiles[5], u.quantiles[0], u.quantiles[6], u.measured, t.median(),
+      t.quantiles[1], t.quantiles[5], t.quantiles[0], t.quantiles[6], t.measured);
 }
 
 }  // namespace
@@ -285,9 +305,13 @@ std::string profile_csv(const std::vector<awcc::ProcessResult>& results, const s
 int run_process(const ProcessCommandOptions& o) {
   awcc::ProcessOptions options;
   std::vector<std::optional<double>> positions;
+  std::optional<awcc::CorrectionModel> model;
   try {
     options = build_options(o);
     positions = positions_for(o);
+    if (!o.correct.empty() && !options.awcc) {
+      throw std::invalid_argument("--correct corrects AWCC's estimates; use --method awcc or both");
+    }
     // Inputs are never modified: refuse an output that is one of them.
     for (const auto& output : {o.json, o.csv, o.windows}) {
       if (output.empty() || !std::filesystem::exists(output)) continue;
@@ -301,6 +325,15 @@ int run_process(const ProcessCommandOptions& o) {
     spdlog::error("{}", e.what());
     return 2;
   }
+  // The model is read before any processing: a damaged one fails fast.
+  if (!o.correct.empty()) {
+    try {
+      model = awcc::CorrectionModel::load(o.correct);
+    } catch (const std::exception& e) {
+      spdlog::error("--correct: {}", e.what());
+      return 2;
+    }
+  }
   std::vector<awcc::ProcessResult> results;
   try {
     Progress progress("processing");
@@ -313,16 +346,34 @@ int run_process(const ProcessCommandOptions& o) {
     spdlog::error("{}", e.what());
     return 1;
   }
+  std::vector<awcc::Correction> corrections;
+  if (model) {
+    for (const auto& r : results) {
+      std::string why;
+      const auto f = awcc::correction_features(r, &why);
+      corrections.push_back(f ? model->correct(*f) : awcc::not_corrected(why));
+      if (!corrections.back().in_range) {
+        spdlog::warn("{}: not corrected: {}", r.info.path.string(), corrections.back().reason);
+      }
+    }
+  }
+  auto correction_json = [&](std::size_t i) {
+    auto c = awcc::to_json(corrections[i]);
+    c["model"] = std::filesystem::path(o.correct).filename().string();
+    return c;
+  };
   try {
     if (!o.json.empty()) {
       nlohmann::json j;
       if (results.size() == 1) {
         j = awcc::to_json(results[0]);
+        if (model) j["correction"] = correction_json(0);
       } else {
         j["profile"] = nlohmann::json::array();
         for (std::size_t i = 0; i < results.size(); ++i) {
           auto row = awcc::to_json(results[i]);
           row["position"] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
+          if (model) row["correction"] = correction_json(i);
           j["profile"].push_back(row);
         }
       }
@@ -333,8 +384,9 @@ int run_process(const ProcessCommandOptions& o) {
     }
     if (results.size() == 1 && o.csv.empty()) {
       fmt::print("{}", results[0].report());
+      if (model) fmt::print("{}", correction_report(corrections[0]));
     } else {
-      const std::string table = profile_csv(results, positions);
+      const std::string table = profile_csv(results, positions, corrections);
       if (o.csv.empty()) fmt::print("{}", table);
       else awcc::write_text_atomically(o.csv, table);
     }

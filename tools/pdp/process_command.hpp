@@ -37,6 +37,7 @@ struct ProcessCommandOptions {
   std::string json, csv;                             // output files
   std::string positions, manifest;                   // profile positions
   int histogram_bins = 50;
+  std::string correct;                                // correction model (.qrf); empty = no correction
 };
 
 CLI::App* setup_process(CLI::App& app, ProcessCommandOptions& options);

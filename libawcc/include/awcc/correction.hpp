@@ -111,6 +111,15 @@ double from_target(TargetForm form, double target, double measured);
 /// not run or gave no value, or the count rate is zero.
 std::optional<CorrectionFeatures> correction_features(const ProcessResult& r, std::string* why = nullptr);
 
+/// A row that is not corrected, with the reason.
+Correction not_corrected(std::string reason);
+
+/// Profile CSV columns of a correction (no leading comma): correction_in_range,
+/// correction_reason, corrected_velocity (median), corrected_velocity_q0.025 ..
+/// _q0.975, and the same for turbulence_intensity.
+std::string correction_csv_header();
+std::string correction_csv_cells(const Correction& c);
+
 /// {"in_range", "reason", "velocity": {"measured", "median", "quantiles": {"0.025": ...}}, "turbulence_intensity": ...}
 nlohmann::json to_json(const Correction& c);
 

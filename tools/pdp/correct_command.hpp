@@ -1,0 +1,23 @@
+#pragma once
+// pdp correct: adds the bias correction (median and quantiles of the true
+// velocity and turbulence intensity, METHOD.md 7) to a pdp process JSON or a
+// profile CSV. Rows outside the model's training ranges are flagged and left
+// uncorrected.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace pdp {
+
+struct CorrectOptions {
+  std::string input;    ///< pdp process JSON or profile CSV
+  std::string model;    ///< .qrf model file
+  std::string output;   ///< output file; empty = stdout
+  std::string dx, dy;   ///< tip separations where the input lacks them (units allowed)
+  int np = 0;           ///< AWCC particles per window where the input lacks it; 0 = not given
+};
+
+CLI::App* setup_correct(CLI::App& app, CorrectOptions& options);
+int run_correct(const CorrectOptions& options);
+
+}  // namespace pdp

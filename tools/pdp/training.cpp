@@ -1,0 +1,461 @@
+#include "training.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+#include "awcc/version.hpp"
+#include "terminal.hpp"
+
+namespace pdp {
+
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (;;) {
+    const auto comma = line.find(',', start);
+    out.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+std::uint64_t mix(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+std::vector<double> levels() { return {awcc::correction_levels.begin(), awcc::correction_levels.end()}; }
+
+/// Runs fn(i) for i in [0, n) on `threads` threads (results land by index).
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& fn) {
+  unsigned t = threads > 0 ? static_cast<unsigned>(threads) : std::max(1u, std::thread::hardware_concurrency());
+  t = static_cast<unsigned>(std::min<std::size_t>(t, std::max<std::size_t>(n, 1)));
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i; (i = next.fetch_add(1)) < n;) fn(i);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < t; ++i) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
+}
+
+awcc::TrainingData data_of(const std::vector<TrainingRow>& rows, bool velocity, awcc::TargetForm form) {
+  awcc::TrainingData d;
+  d.features = awcc::CorrectionFeatures::count;
+  d.x.reserve(rows.size() * 7);
+  d.y.reserve(rows.size());
+  for (const auto& r : rows) {
+    const auto x = r.features.vector();
+    d.x.insert(d.x.end(), x.begin(), x.end());
+    d.y.push_back(velocity ? awcc::to_target(form, r.true_velocity, r.features.velocity)
+                           : awcc::to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity));
+  }
+  return d;
+}
+
+// Pinball loss of one target's quantiles in the units of the scores
+// (velocity relative to the truth, Tu absolute).
+double target_pinball(const std::vector<double>& q, const TrainingRow& r, bool velocity) {
+  const auto lv = levels();
+  if (velocity) {
+    std::vector<double> rel(q.size());
+    for (std::size_t k = 0; k < q.size(); ++k) rel[k] = q[k] / r.true_velocity;
+    return awcc::pinball_loss(rel, lv, 1.0);
+  }
+  return awcc::pinball_loss(q, lv, r.true_turbulence_intensity);
+}
+
+std::vector<double> predict(const awcc::QuantileForest& f, awcc::TargetForm form, const TrainingRow& r, bool velocity) {
+  const auto x = r.features.vector();
+  auto q = f.quantiles(x, levels());
+  const double measured = velocity ? r.features.velocity : r.features.turbulence_intensity;
+  for (auto& v : q) {
+    v = awcc::from_target(form, v, measured);
+    if (!velocity) v = std::max(0.0, v);
+  }
+  return q;
+}
+
+}  // namespace
+
+std::string TrainOptions::validate() const {
+  if (trees < 1) return fmt::format("--trees {}: give at least 1", trees);
+  if (min_windows < 1) return fmt::format("--min-windows {}: give at least 1", min_windows);
+  if (!(held_out > 0.0 && held_out < 1.0)) return fmt::format("--held-out {}: give a fraction in (0, 1)", held_out);
+  if (folds == 1 || folds < 0) return fmt::format("--folds {}: give 0 (no cross-validation) or at least 2", folds);
+  if (cv_trees < 1) return fmt::format("--cv-trees {}: give at least 1", cv_trees);
+  if (min_leaf < 1) return fmt::format("--min-leaf {}: give at least 1", min_leaf);
+  if (features_per_split < 1 || features_per_split > awcc::CorrectionFeatures::count) {
+    return fmt::format("--features-per-split {}: give 1 to {}", features_per_split, awcc::CorrectionFeatures::count);
+  }
+  return {};
+}
+
+TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows) {
+  TrainingSet set;
+  std::set<std::pair<std::string, std::int64_t>> seen;
+  for (const auto& path : csvs) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error(fmt::format("{}: cannot open the sweep CSV; check the path", path.string()));
+    std::string line;
+    if (!std::getline(in, line)) throw std::runtime_error(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
+    const auto header = split(line);
+    std::map<std::string, std::size_t> col;
+    for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+    const char* needed[] = {"study", "run", "dx", "dy", "np", "truth_velocity", "truth_turbulence_intensity",
+                            "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_d32",
+                            "awcc_windows_accepted", "reason"};
+    for (const char* name : needed) {
+      if (!col.count(name)) {
+        throw std::runtime_error(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
+      }
+    }
+    std::set<std::string> studies;
+    std::int64_t number = 1;
+    while (std::getline(in, line)) {
+      ++number;
+      if (line.empty()) continue;
+      const auto cells = split(line);
+      if (cells.size() != header.size()) {
+        throw std::runtime_error(fmt::format("{}:{}: {} cells where the header has {}; a sweep CSV cut short? pdp sweep "
+                                             "resumes and repairs it",
+                                             path.string(), number, cells.size(), header.size()));
+      }
+      auto cell = [&](const char* name) -> const std::string& { return cells[col.at(name)]; };
+      auto number_of = [&](const char* name) {
+        const auto& text = cell(name);
+        std::size_t used = 0;
+        double v = 0.0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != text.size() || text.empty() || !std::isfinite(v)) {
+          throw std::runtime_error(fmt::format("{}:{}: column {} = '{}' is not a number", path.string(), number, name, text));
+        }
+        return v;
+      };
+      ++set.total;
+      studies.insert(cell("study"));
+      const auto run = static_cast<std::int64_t>(number_of("run"));
+      if (!seen.insert({cell("study"), run}).second) {
+        throw std::runtime_error(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
+                                             path.string(), number, run, cell("study")));
+      }
+      if (!cell("reason").empty()) {
+        // "awcc: ..." is AWCC giving no value (e.g. no window accepted), not a failed run.
+        ++(cell("reason").starts_with("awcc:") ? set.excluded_undefined : set.excluded_error);
+        continue;
+      }
+      if (cell("awcc_velocity").empty() || cell("awcc_turbulence_intensity").empty() || cell("awcc_d32").empty()) {
+        ++set.excluded_undefined;
+        continue;
+      }
+      TrainingRow r;
+      r.run = run;
+      auto& f = r.features;
+      f.windows_accepted = static_cast<std::int64_t>(number_of("awcc_windows_accepted"));
+      if (f.windows_accepted < min_windows) {
+        ++set.excluded_windows;
+        continue;
+      }
+      f.velocity = number_of("awcc_velocity");
+      f.turbulence_intensity = number_of("awcc_turbulence_intensity");
+      f.void_fraction = number_of("awcc_void_fraction");
+      f.d32 = number_of("awcc_d32");
+      f.dx = number_of("dx");
+      f.dy = number_of("dy");
+      f.np = number_of("np");
+      r.true_velocity = number_of("truth_velocity");
+      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
+      if (!(f.velocity > 0.0)) {  // the ratio target needs u > 0; such runs are not corrected either
+        ++set.excluded_undefined;
+        continue;
+      }
+      set.rows.push_back(r);
+    }
+    for (const auto& s : studies) set.sources.push_back(fmt::format("{} (study {})", path.filename().string(), s));
+  }
+  if (set.rows.empty()) {
+    throw std::runtime_error(fmt::format("no usable runs in the sweep CSVs ({} read: {} failed, {} without an AWCC "
+                                         "velocity, {} with fewer than {} accepted windows)",
+                                         set.total, set.excluded_error, set.excluded_undefined, set.excluded_windows,
+                                         min_windows));
+  }
+  return set;
+}
+
+awcc::CorrectionModel fit_model(const std::vector<TrainingRow>& rows, awcc::TargetForm velocity_form,
+                                awcc::TargetForm turbulence_form, const awcc::ForestOptions& velocity_options,
+                                const awcc::ForestOptions& turbulence_options, std::int64_t min_windows) {
+  awcc::CorrectionModel m;
+  m.min_windows = min_windows;
+  m.velocity_form = velocity_form;
+  m.turbulence_form = turbulence_form;
+  for (int j = 0; j < awcc::CorrectionFeatures::count; ++j) {
+    awcc::FeatureRange r{awcc::CorrectionFeatures::names[static_cast<std::size_t>(j)], 1e300, -1e300};
+    for (const auto& row : rows) {
+      const double v = row.features.vector()[static_cast<std::size_t>(j)];
+      r.min = std::min(r.min, v);
+      r.max = std::max(r.max, v);
+    }
+    m.ranges.push_back(r);
+  }
+  m.velocity = awcc::QuantileForest::train(data_of(rows, true, velocity_form), velocity_options);
+  m.turbulence_intensity = awcc::QuantileForest::train(data_of(rows, false, turbulence_form), turbulence_options);
+  return m;
+}
+
+HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<TrainingRow>& rows,
+                    std::vector<HeldOutPrediction>* predictions, int threads) {
+  std::vector<awcc::Correction> c(rows.size());
+  parallel_for(rows.size(), threads, [&](std::size_t i) { c[i] = model.correct(rows[i].features); });
+  HeldOutScores s;
+  double n = 0.0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    if (predictions) predictions->push_back({r, c[i]});
+    if (!c[i].in_range) {
+      ++s.out_of_range;
+      continue;
+    }
+    ++s.rows;
+    n += 1.0;
+    const auto& u = *c[i].velocity;
+    const auto& t = *c[i].turbulence_intensity;
+    const double raw_u = r.features.velocity / r.true_velocity - 1.0;
+    const double cor_u = u.median() / r.true_velocity - 1.0;
+    s.velocity_rmse_raw += raw_u * raw_u;
+    s.velocity_rmse_corrected += cor_u * cor_u;
+    s.velocity_bias_raw += raw_u;
+    s.velocity_bias_corrected += cor_u;
+    const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
+    s.velocity_pinball += target_pinball(uq, r, true);
+    s.velocity_coverage80 += (r.true_velocity >= uq[1] && r.true_velocity <= uq[5]) ? 1.0 : 0.0;
+    s.velocity_coverage95 += (r.true_velocity >= uq[0] && r.true_velocity <= uq[6]) ? 1.0 : 0.0;
+    const double raw_t = r.features.turbulence_intensity - r.true_turbulence_intensity;
+    const double cor_t = t.median() - r.true_turbulence_intensity;
+    s.tu_rmse_raw += raw_t * raw_t;
+    s.tu_rmse_corrected += cor_t * cor_t;
+    s.tu_bias_raw += raw_t;
+    s.tu_bias_corrected += cor_t;
+    s.tu_pinball += target_pinball(tq, r, false);
+    const double tt = r.true_turbulence_intensity;
+    s.tu_coverage80 += (tt >= tq[1] && tt <= tq[5]) ? 1.0 : 0.0;
+    s.tu_coverage95 += (tt >= tq[0] && tt <= tq[6]) ? 1.0 : 0.0;
+  }
+  if (n > 0) {
+    s.velocity_rmse_raw = std::sqrt(s.velocity_rmse_raw / n);
+    s.velocity_rmse_corrected = std::sqrt(s.velocity_rmse_corrected / n);
+    s.tu_rmse_raw = std::sqrt(s.tu_rmse_raw / n);
+    s.tu_rmse_corrected = std::sqrt(s.tu_rmse_corrected / n);
+    for (double* v : {&s.velocity_bias_raw, &s.velocity_bias_corrected, &s.velocity_pinball, &s.velocity_coverage80,
+                      &s.velocity_coverage95, &s.tu_bias_raw, &s.tu_bias_corrected, &s.tu_pinball, &s.tu_coverage80,
+                      &s.tu_coverage95})
+      *v /= n;
+  }
+  return s;
+}
+
+TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
+  if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
+  // Held-out split by a hash of the run index: independent of file order.
+  std::vector<TrainingRow> rows = set.rows;
+  std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
+    const auto ha = mix(o.seed ^ mix(static_cast<std::uint64_t>(a.run))), hb = mix(o.seed ^ mix(static_cast<std::uint64_t>(b.run)));
+    return ha != hb ? ha < hb : a.run < b.run;
+  });
+  const auto held = static_cast<std::size_t>(std::llround(o.held_out * static_cast<double>(rows.size())));
+  if (held == 0 || held >= rows.size()) {
+    throw std::invalid_argument(fmt::format("{} usable runs cannot be split {:.0f}/{:.0f}; run a larger sweep", rows.size(),
+                                            100 * (1 - o.held_out), 100 * o.held_out));
+  }
+  const std::vector<TrainingRow> held_out(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(held));
+  const std::vector<TrainingRow> training(rows.begin() + static_cast<std::ptrdiff_t>(held), rows.end());
+
+  TrainResult result;
+  result.training_rows = static_cast<std::int64_t>(training.size());
+  awcc::ForestOptions vopt, topt;
+  vopt.trees = topt.trees = o.trees;
+  vopt.threads = topt.threads = o.threads;
+  vopt.seed = o.seed;
+  topt.seed = o.seed + 1;
+  vopt.min_leaf = topt.min_leaf = o.min_leaf;
+  vopt.features_per_split = topt.features_per_split = o.features_per_split;
+  awcc::TargetForm vform = o.velocity_form, tform = o.turbulence_form;
+
+  const auto cv_start = std::chrono::steady_clock::now();
+  const std::size_t grid = o.min_leaf_grid.size() * o.features_per_split_grid.size() * 2;
+  const double cv_share = o.folds >= 2 ? 0.7 : 0.0;
+  if (o.folds >= 2) {
+    const auto k = static_cast<std::size_t>(o.folds);
+    std::size_t done = 0;
+    for (int target = 0; target < 2; ++target) {
+      const bool velocity = target == 0;
+      const std::array<awcc::TargetForm, 2> forms{awcc::TargetForm::value,
+                                                  velocity ? awcc::TargetForm::ratio : awcc::TargetForm::difference};
+      CvEntry best;
+      best.pinball = std::numeric_limits<double>::infinity();
+      for (auto form : forms) {
+        for (int leaf : o.min_leaf_grid) {
+          for (int mtry : o.features_per_split_grid) {
+            double loss = 0.0;
+            for (std::size_t fold = 0; fold < k; ++fold) {
+              std::vector<TrainingRow> fit, test;
+              for (std::size_t i = 0; i < training.size(); ++i) (i % k == fold ? test : fit).push_back(training[i]);
+              awcc::ForestOptions fo;
+              fo.trees = o.cv_trees;
+              fo.min_leaf = leaf;
+              fo.features_per_split = mtry;
+              fo.seed = o.seed + 17 * fold + static_cast<std::uint64_t>(target);
+              fo.threads = o.threads;
+              const auto forest = awcc::QuantileForest::train(data_of(fit, velocity, form), fo);
+              std::vector<double> losses(test.size());
+              parallel_for(test.size(), o.threads, [&](std::size_t i) {
+                losses[i] = target_pinball(predict(forest, form, test[i], velocity), test[i], velocity);
+              });
+              for (double l : losses) loss += l;
+            }
+            loss /= static_cast<double>(training.size());
+            result.cv.push_back({velocity ? "velocity" : "turbulence_intensity", form, leaf, mtry, loss});
+            if (loss < best.pinball) best = result.cv.back();
+            if (progress) progress(cv_share * static_cast<double>(++done) / static_cast<double>(grid));
+          }
+        }
+      }
+      auto& opt = velocity ? vopt : topt;
+      opt.min_leaf = best.min_leaf;
+      opt.features_per_split = best.features_per_split;
+      (velocity ? vform : tform) = best.form;
+    }
+  }
+  result.seconds_cv = seconds_since(cv_start);
+  result.velocity_min_leaf = vopt.min_leaf;
+  result.velocity_features_per_split = vopt.features_per_split;
+  result.turbulence_min_leaf = topt.min_leaf;
+  result.turbulence_features_per_split = topt.features_per_split;
+
+  const auto train_start = std::chrono::steady_clock::now();
+  result.model = fit_model(training, vform, tform, vopt, topt, o.min_windows);
+  result.seconds_train = seconds_since(train_start);
+  result.held_out = score(result.model, held_out, &result.predictions, o.threads);
+  if (progress) progress(cv_share + 0.1);
+
+  // Learning curve: the same hyperparameters on nested subsets of the training rows.
+  for (std::size_t parts : {16, 8, 4, 2, 1}) {
+    const std::size_t n = training.size() / parts;
+    if (n < 50) continue;
+    const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
+    auto m = parts == 1 ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows);
+    // Every point scores the same held-out rows: those inside the full
+    // model's ranges (a small subset's own ranges would drop the hard rows).
+    m.ranges = result.model.ranges;
+    result.learning_curve.push_back({static_cast<std::int64_t>(n), score(m, held_out, nullptr, o.threads)});
+  }
+  if (progress) progress(1.0);
+
+  const auto& h = result.held_out;
+  std::string sources;
+  for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
+  result.model.provenance = fmt::format(
+      "pdp train {}: {}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
+      "windows); trained on {}, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
+      "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
+      "{:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; Tu RMSE {:.4f} raw, {:.4f} corrected, 80/95 % coverage "
+      "{:.1f}/{:.1f} %.",
+      awcc::version, sources, set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
+      set.excluded_windows, o.min_windows, training.size(), held_out.size(), o.seed, awcc::to_string(vform), vopt.trees,
+      vopt.min_leaf, vopt.features_per_split, awcc::to_string(tform), topt.trees, topt.min_leaf,
+      topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected, 100 * h.velocity_coverage80,
+      100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected, 100 * h.tu_coverage80, 100 * h.tu_coverage95);
+  return result;
+}
+
+std::string TrainResult::report() const {
+  std::string out = model.provenance + "\n\n";
+  auto line = [&out](const std::string& s) { out += s + "\n"; };
+  if (!cv.empty()) {
+    line("Cross-validation (mean pinball loss over the correction levels; velocity relative to the truth):");
+    line("  target                form        min_leaf  features/split  pinball");
+    for (const auto& e : cv) {
+      line(fmt::format("  {:<21} {:<11} {:>8}  {:>14}  {:.6f}", e.target, awcc::to_string(e.form), e.min_leaf,
+                       e.features_per_split, e.pinball));
+    }
+    line(fmt::format("  ({:.1f} s)", seconds_cv));
+  }
+  const auto& h = held_out;
+  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored); training {} runs in {:.2f} s", h.rows,
+                   h.out_of_range, training_rows, seconds_train));
+  line("                         raw AWCC    corrected median");
+  line(fmt::format("  velocity RMSE          {:7.3f} %   {:7.3f} %", 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected));
+  line(fmt::format("  velocity mean error    {:7.3f} %   {:7.3f} %", 100 * h.velocity_bias_raw, 100 * h.velocity_bias_corrected));
+  line(fmt::format("  Tu RMSE                {:7.4f}     {:7.4f}", h.tu_rmse_raw, h.tu_rmse_corrected));
+  line(fmt::format("  Tu mean error          {:7.4f}     {:7.4f}", h.tu_bias_raw, h.tu_bias_corrected));
+  line(fmt::format("  coverage 80 % / 95 %   velocity {:.1f} / {:.1f} %, Tu {:.1f} / {:.1f} %", 100 * h.velocity_coverage80,
+                   100 * h.velocity_coverage95, 100 * h.tu_coverage80, 100 * h.tu_coverage95));
+  if (!learning_curve.empty()) {
+    line("Learning curve (held-out scores against training runs):");
+    line("  runs    velocity RMSE   velocity pinball   Tu RMSE   Tu pinball");
+    for (const auto& p : learning_curve) {
+      line(fmt::format("  {:>6}  {:9.3f} %   {:14.6f}   {:8.4f}   {:.6f}", p.training_rows,
+                       100 * p.scores.velocity_rmse_corrected, p.scores.velocity_pinball, p.scores.tu_rmse_corrected,
+                       p.scores.tu_pinball));
+    }
+  }
+  return out;
+}
+
+std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
+  std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,true_velocity,"
+                    "true_turbulence_intensity,in_range";
+  for (const char* q : {"velocity", "turbulence_intensity"}) {
+    for (const char* l : awcc::correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
+  }
+  out += "\n";
+  for (const auto& p : predictions) {
+    const auto& f = p.row.features;
+    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{}", p.row.run,
+                       f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np, f.windows_accepted,
+                       p.row.true_velocity, p.row.true_turbulence_intensity, p.correction.in_range ? 1 : 0);
+    for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
+      for (std::size_t k = 0; k < awcc::correction_levels.size(); ++k) {
+        out += *q ? fmt::format(",{:.10g}", (*q)->quantiles[k]) : std::string(",");
+      }
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string learning_curve_csv(const std::vector<LearningPoint>& curve) {
+  std::string out = "training_runs,held_out_runs,velocity_rmse_raw,velocity_rmse_corrected,velocity_pinball,"
+                    "velocity_coverage80,velocity_coverage95,tu_rmse_raw,tu_rmse_corrected,tu_pinball,tu_coverage80,"
+                    "tu_coverage95\n";
+  for (const auto& p : curve) {
+    const auto& s = p.scores;
+    out += fmt::format("{},{},{:.8g},{:.8g},{:.8g},{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.6g},{:.6g}\n", p.training_rows,
+                       s.rows, s.velocity_rmse_raw, s.velocity_rmse_corrected, s.velocity_pinball, s.velocity_coverage80,
+                       s.velocity_coverage95, s.tu_rmse_raw, s.tu_rmse_corrected, s.tu_pinball, s.tu_coverage80,
+                       s.tu_coverage95);
+  }
+  return out;
+}
+
+}  // namespace pdp

@@ -1,0 +1,134 @@
+#pragma once
+// Training the bias-correction model (METHOD.md 7) from pdp sweep CSVs:
+// the training set, the held-out split, k-fold cross-validation of the
+// hyperparameters, the held-out scores and the learning curve.
+//
+// Rows used: runs with no error whose AWCC gave a value from at least
+// `min_windows` accepted windows; the others are counted by cause.
+// Held-out split: the rows ordered by a hash of (seed, run index); the first
+// `held_out` fraction is held out. The model is trained on the rest only, so
+// the held-out scores are those of the shipped model.
+//
+// Scores. Velocity: relative errors (a 1 m/s error at 2 m/s is not one at
+// 40 m/s): RMSE of (u / u_true - 1) for raw AWCC and for the corrected
+// median, and the pinball loss of the quantiles of u / u_true at the
+// correction levels. Turbulence intensity: absolute (Tu is already relative):
+// RMSE of Tu - Tu_true and the pinball loss of the quantiles. Coverage: the
+// fraction of rows whose truth lies in [q0.1, q0.9] (nominal 80 %) and in
+// [q0.025, q0.975] (nominal 95 %).
+//
+// Cross-validation: for each target, every (target form, min leaf, features
+// per split) of the grid is scored by the mean pinball loss over k folds of
+// the training rows; the least wins. Max depth stays unlimited: min leaf
+// already bounds the trees, and leaves must hold enough rows for quantiles.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "awcc/correction.hpp"
+
+namespace pdp {
+
+struct TrainingRow {
+  std::int64_t run = 0;
+  awcc::CorrectionFeatures features;
+  double true_velocity = 0.0, true_turbulence_intensity = 0.0;
+};
+
+struct TrainingSet {
+  std::vector<TrainingRow> rows;
+  std::int64_t total = 0;               ///< rows read
+  std::int64_t excluded_error = 0;      ///< the run failed (reason column)
+  std::int64_t excluded_undefined = 0;  ///< AWCC gave no velocity
+  std::int64_t excluded_windows = 0;    ///< fewer than min_windows accepted windows
+  std::vector<std::string> sources;     ///< file names and study ids
+};
+
+/// Reads sweep CSVs (pdp sweep's columns); throws std::runtime_error naming
+/// the file, line and column when one is not such a CSV. A run index seen twice
+/// (e.g. the same shard given twice) is refused.
+TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows);
+
+struct TrainOptions {
+  int trees = 100;                      ///< trees per forest
+  std::int64_t min_windows = 100;       ///< least accepted windows of a training run
+  double held_out = 0.2;                ///< fraction of runs held out for the report
+  int folds = 5;                        ///< cross-validation folds; 0 = no CV (use the values below)
+  int cv_trees = 50;                    ///< trees per forest during cross-validation
+  std::vector<int> min_leaf_grid{3, 5, 10, 20, 40};
+  std::vector<int> features_per_split_grid{2, 3, 5, 7};
+  int min_leaf = 10;                    ///< without CV
+  int features_per_split = 3;           ///< without CV
+  awcc::TargetForm velocity_form = awcc::TargetForm::ratio;        ///< without CV
+  awcc::TargetForm turbulence_form = awcc::TargetForm::difference; ///< without CV
+  std::uint64_t seed = 1;
+  int threads = 0;
+  [[nodiscard]] std::string validate() const;
+};
+
+struct CvEntry {
+  std::string target;                   ///< "velocity" | "turbulence_intensity"
+  awcc::TargetForm form = awcc::TargetForm::value;
+  int min_leaf = 0, features_per_split = 0;
+  double pinball = 0.0;                 ///< mean over folds and rows
+};
+
+/// Scores of predictions against truth on some rows.
+struct HeldOutScores {
+  std::int64_t rows = 0, out_of_range = 0;
+  double velocity_rmse_raw = 0.0, velocity_rmse_corrected = 0.0;  ///< relative (u/u_true - 1)
+  double velocity_bias_raw = 0.0, velocity_bias_corrected = 0.0;  ///< mean relative error
+  double velocity_pinball = 0.0;        ///< relative
+  double velocity_coverage80 = 0.0, velocity_coverage95 = 0.0;
+  double tu_rmse_raw = 0.0, tu_rmse_corrected = 0.0;               ///< absolute
+  double tu_bias_raw = 0.0, tu_bias_corrected = 0.0;
+  double tu_pinball = 0.0;
+  double tu_coverage80 = 0.0, tu_coverage95 = 0.0;
+};
+
+struct LearningPoint {
+  std::int64_t training_rows = 0;
+  HeldOutScores scores;
+};
+
+struct HeldOutPrediction {
+  TrainingRow row;
+  awcc::Correction correction;
+};
+
+struct TrainResult {
+  awcc::CorrectionModel model;
+  std::int64_t training_rows = 0;
+  std::vector<CvEntry> cv;              ///< every grid point scored
+  int velocity_min_leaf = 0, velocity_features_per_split = 0;
+  int turbulence_min_leaf = 0, turbulence_features_per_split = 0;
+  HeldOutScores held_out;
+  std::vector<HeldOutPrediction> predictions;
+  std::vector<LearningPoint> learning_curve;  ///< training subsets 1/16 .. 1 of the training rows
+  double seconds_cv = 0.0, seconds_train = 0.0;
+  [[nodiscard]] std::string report() const;
+};
+
+/// Splits, cross-validates, trains and scores. `progress` gets a fraction done.
+TrainResult train_model(const TrainingSet& set, const TrainOptions& options,
+                        const std::function<void(double)>& progress = {});
+
+/// Scores a model on rows.
+HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<TrainingRow>& rows,
+                    std::vector<HeldOutPrediction>* predictions = nullptr, int threads = 0);
+
+/// The two forests and the ranges from training rows.
+awcc::CorrectionModel fit_model(const std::vector<TrainingRow>& rows, awcc::TargetForm velocity_form,
+                                awcc::TargetForm turbulence_form, const awcc::ForestOptions& velocity_options,
+                                const awcc::ForestOptions& turbulence_options, std::int64_t min_windows);
+
+/// Held-out predictions as CSV: run, features, truth, raw, quantiles.
+std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
+/// The learning curve as CSV.
+std::string learning_curve_csv(const std::vector<LearningPoint>& curve);
+
+}  // namespace pdp
