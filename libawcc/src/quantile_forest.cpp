@@ -276,6 +276,9 @@ QuantileForest QuantileForest::assemble(int features, std::vector<double> target
       if (r >= targets.size()) throw std::invalid_argument(fmt::format("forest: tree {} holds row {} of {}", t, r, targets.size()));
     }
   }
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    if (!std::isfinite(targets[i])) throw std::invalid_argument(fmt::format("forest: target {} is not finite", i));
+  }
   QuantileForest forest;
   forest.features_ = features;
   forest.targets_ = std::move(targets);
