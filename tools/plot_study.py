@@ -11,6 +11,12 @@
   plot_study.py windows RUNS.csv OUT.png
       AWCC windows kept against the parameter-free truth: accepted fraction
       against the true turbulence intensity.
+  plot_study.py correction PREDICTIONS.csv OUT.png
+      held-out runs of pdp train --predictions: measured (raw AWCC) and
+      corrected median against the truth, velocity and turbulence intensity,
+      with the corrected 80 % intervals.
+  plot_study.py learning LEARNING.csv OUT.png
+      held-out scores of pdp train --learning-curve against training runs.
 
 Every figure carries the command line that made it in its footer.
 """
@@ -125,6 +131,69 @@ def windows(path, out):
     fig.savefig(out, dpi=120)
 
 
+def correction(path, out):
+    rows = [r for r in csv.DictReader(open(path)) if r["in_range"] == "1"]
+    if not rows:
+        raise SystemExit(f"{path}: no corrected rows")
+    fig, axes = plt.subplots(2, 2, figsize=(11, 9))
+    for col, (q, label) in enumerate((("velocity", "velocity"), ("turbulence_intensity", "turbulence intensity"))):
+        truth = [float(r["true_" + q]) for r in rows]
+        raw = [float(r[q]) for r in rows]
+        med = [float(r[f"corrected_{q}_q0.5"]) for r in rows]
+        lo = [float(r[f"corrected_{q}_q0.1"]) for r in rows]
+        hi = [float(r[f"corrected_{q}_q0.9"]) for r in rows]
+        if q == "velocity":
+            # Relative to the truth: velocities span 1-50 m/s.
+            raw = [a / t for a, t in zip(raw, truth)]
+            med = [a / t for a, t in zip(med, truth)]
+            lo = [a / t for a, t in zip(lo, truth)]
+            hi = [a / t for a, t in zip(hi, truth)]
+            ylabel = "estimate / true velocity"
+            ref = [1.0] * len(truth)
+        else:
+            ylabel = "estimated turbulence intensity"
+            ref = truth
+        for row, (values, name) in enumerate(((raw, "raw AWCC"), (med, "corrected median"))):
+            ax = axes[row][col]
+            if row == 1:
+                ax.vlines(truth, lo, hi, color="tab:orange", alpha=0.25, lw=0.8, label="80 % interval")
+            ax.scatter(truth, values, s=6, color="tab:blue" if row == 0 else "tab:green", label=name)
+            order = sorted(range(len(truth)), key=lambda i: truth[i])
+            ax.plot([truth[i] for i in order], [ref[i] for i in order], color="k", lw=0.8)
+            if q == "velocity":
+                ax.set_xscale("log")
+                ax.set_ylim(0.5, 1.5)
+            err = [(v - r) for v, r in zip(values, ref)]
+            rmse = math.sqrt(sum(e * e for e in err) / len(err))
+            ax.set_title(f"{label}: {name} (RMSE {rmse:.3g}{' relative' if q == 'velocity' else ''})", fontsize=10)
+            ax.set_xlabel(f"true {label}" + (" (m/s)" if q == "velocity" else ""))
+            ax.set_ylabel(ylabel)
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=8, loc="upper right")
+    footer(fig)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=110)
+
+
+def learning(path, out):
+    rows = list(csv.DictReader(open(path)))
+    n = [int(r["training_runs"]) for r in rows]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, (key, label) in zip(axes, (("velocity", "velocity (relative)"), ("tu", "turbulence intensity"))):
+        ax.plot(n, [float(r[f"{key}_pinball"]) for r in rows], "o-", label="pinball loss (quantiles)")
+        ax.plot(n, [float(r[f"{key}_rmse_corrected"]) for r in rows], "s-", label="RMSE of the median")
+        ax.plot(n, [float(r[f"{key}_rmse_raw"]) for r in rows], "k--", lw=0.8, label="RMSE of raw AWCC")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("training runs")
+        ax.set_title(f"held-out score: {label}", fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    footer(fig)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=110)
+
+
 def main(argv):
     if len(argv) >= 4 and argv[1] == "bench":
         bench(argv[2], argv[3])
@@ -133,6 +202,10 @@ def main(argv):
         sweep(argv[2], argv[3], argv[4], title)
     elif len(argv) >= 4 and argv[1] == "windows":
         windows(argv[2], argv[3])
+    elif len(argv) >= 4 and argv[1] == "correction":
+        correction(argv[2], argv[3])
+    elif len(argv) >= 4 and argv[1] == "learning":
+        learning(argv[2], argv[3])
     else:
         raise SystemExit(__doc__)
 

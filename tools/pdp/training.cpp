@@ -247,7 +247,8 @@ HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<Traini
     s.velocity_bias_raw += raw_u;
     s.velocity_bias_corrected += cor_u;
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
-    s.velocity_pinball += target_pinball(uq, r, true);
+    s.velocity_losses.push_back(target_pinball(uq, r, true));
+    s.velocity_pinball += s.velocity_losses.back();
     s.velocity_coverage80 += (r.true_velocity >= uq[1] && r.true_velocity <= uq[5]) ? 1.0 : 0.0;
     s.velocity_coverage95 += (r.true_velocity >= uq[0] && r.true_velocity <= uq[6]) ? 1.0 : 0.0;
     const double raw_t = r.features.turbulence_intensity - r.true_turbulence_intensity;
@@ -256,7 +257,8 @@ HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<Traini
     s.tu_rmse_corrected += cor_t * cor_t;
     s.tu_bias_raw += raw_t;
     s.tu_bias_corrected += cor_t;
-    s.tu_pinball += target_pinball(tq, r, false);
+    s.tu_losses.push_back(target_pinball(tq, r, false));
+    s.tu_pinball += s.tu_losses.back();
     const double tt = r.true_turbulence_intensity;
     s.tu_coverage80 += (tt >= tq[1] && tt <= tq[5]) ? 1.0 : 0.0;
     s.tu_coverage95 += (tt >= tq[0] && tt <= tq[6]) ? 1.0 : 0.0;
@@ -359,15 +361,31 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   if (progress) progress(cv_share + 0.1);
 
   // Learning curve: the same hyperparameters on nested subsets of the training rows.
-  for (std::size_t parts : {16, 8, 4, 2, 1}) {
-    const std::size_t n = training.size() / parts;
+  auto gain = [](const std::vector<double>& before, const std::vector<double>& after, double& mean, double& se) {
+    const std::size_t n = std::min(before.size(), after.size());
+    if (n < 2) return;
+    double m = 0.0, q = 0.0;
+    for (std::size_t i = 0; i < n; ++i) m += before[i] - after[i];
+    m /= static_cast<double>(n);
+    for (std::size_t i = 0; i < n; ++i) q += (before[i] - after[i] - m) * (before[i] - after[i] - m);
+    mean = m;
+    se = std::sqrt(q / static_cast<double>(n - 1) / static_cast<double>(n));
+  };
+  for (const auto& [num, den] : std::vector<std::pair<std::size_t, std::size_t>>{{1, 16}, {1, 8}, {1, 4}, {1, 2}, {3, 4}, {1, 1}}) {
+    const std::size_t n = training.size() * num / den;
     if (n < 50) continue;
     const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
-    auto m = parts == 1 ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows);
+    auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows);
     // Every point scores the same held-out rows: those inside the full
     // model's ranges (a small subset's own ranges would drop the hard rows).
     m.ranges = result.model.ranges;
-    result.learning_curve.push_back({static_cast<std::int64_t>(n), score(m, held_out, nullptr, o.threads)});
+    LearningPoint point{static_cast<std::int64_t>(n), score(m, held_out, nullptr, o.threads)};
+    if (!result.learning_curve.empty()) {
+      const auto& before = result.learning_curve.back().scores;
+      gain(before.velocity_losses, point.scores.velocity_losses, point.velocity_gain, point.velocity_gain_se);
+      gain(before.tu_losses, point.scores.tu_losses, point.tu_gain, point.tu_gain_se);
+    }
+    result.learning_curve.push_back(std::move(point));
   }
   if (progress) progress(1.0);
 
@@ -412,11 +430,13 @@ std::string TrainResult::report() const {
                    100 * h.velocity_coverage95, 100 * h.tu_coverage80, 100 * h.tu_coverage95));
   if (!learning_curve.empty()) {
     line("Learning curve (held-out scores against training runs):");
-    line("  runs    velocity RMSE   velocity pinball   Tu RMSE   Tu pinball");
+    line("  (gain: paired decrease of the pinball loss from the previous point, +/- its standard error)");
+    line("  runs    velocity RMSE   velocity pinball (gain)              Tu RMSE   Tu pinball (gain)");
     for (const auto& p : learning_curve) {
-      line(fmt::format("  {:>6}  {:9.3f} %   {:14.6f}   {:8.4f}   {:.6f}", p.training_rows,
-                       100 * p.scores.velocity_rmse_corrected, p.scores.velocity_pinball, p.scores.tu_rmse_corrected,
-                       p.scores.tu_pinball));
+      line(fmt::format("  {:>6}  {:9.3f} %   {:.6f} ({:+.6f} +/- {:.6f})   {:8.4f}   {:.6f} ({:+.6f} +/- {:.6f})",
+                       p.training_rows, 100 * p.scores.velocity_rmse_corrected, p.scores.velocity_pinball,
+                       p.velocity_gain, p.velocity_gain_se, p.scores.tu_rmse_corrected, p.scores.tu_pinball, p.tu_gain,
+                       p.tu_gain_se));
     }
   }
   return out;
@@ -447,13 +467,13 @@ std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
 std::string learning_curve_csv(const std::vector<LearningPoint>& curve) {
   std::string out = "training_runs,held_out_runs,velocity_rmse_raw,velocity_rmse_corrected,velocity_pinball,"
                     "velocity_coverage80,velocity_coverage95,tu_rmse_raw,tu_rmse_corrected,tu_pinball,tu_coverage80,"
-                    "tu_coverage95\n";
+                    "tu_coverage95,velocity_gain,velocity_gain_se,tu_gain,tu_gain_se\n";
   for (const auto& p : curve) {
     const auto& s = p.scores;
-    out += fmt::format("{},{},{:.8g},{:.8g},{:.8g},{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.6g},{:.6g}\n", p.training_rows,
-                       s.rows, s.velocity_rmse_raw, s.velocity_rmse_corrected, s.velocity_pinball, s.velocity_coverage80,
-                       s.velocity_coverage95, s.tu_rmse_raw, s.tu_rmse_corrected, s.tu_pinball, s.tu_coverage80,
-                       s.tu_coverage95);
+    out += fmt::format("{},{},{:.8g},{:.8g},{:.8g},{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n",
+                       p.training_rows, s.rows, s.velocity_rmse_raw, s.velocity_rmse_corrected, s.velocity_pinball,
+                       s.velocity_coverage80, s.velocity_coverage95, s.tu_rmse_raw, s.tu_rmse_corrected, s.tu_pinball,
+                       s.tu_coverage80, s.tu_coverage95, p.velocity_gain, p.velocity_gain_se, p.tu_gain, p.tu_gain_se);
   }
   return out;
 }

@@ -88,11 +88,16 @@ struct HeldOutScores {
   double tu_bias_raw = 0.0, tu_bias_corrected = 0.0;
   double tu_pinball = 0.0;
   double tu_coverage80 = 0.0, tu_coverage95 = 0.0;
+  std::vector<double> velocity_losses, tu_losses;  ///< pinball loss of each scored row, in row order
 };
 
 struct LearningPoint {
   std::int64_t training_rows = 0;
   HeldOutScores scores;
+  /// Paired improvement of the mean pinball loss over the previous (smaller)
+  /// point, on the same held-out rows, and its standard error (sd of the
+  /// row differences / sqrt(rows)); 0 for the first point.
+  double velocity_gain = 0.0, velocity_gain_se = 0.0, tu_gain = 0.0, tu_gain_se = 0.0;
 };
 
 struct HeldOutPrediction {
@@ -108,7 +113,7 @@ struct TrainResult {
   int turbulence_min_leaf = 0, turbulence_features_per_split = 0;
   HeldOutScores held_out;
   std::vector<HeldOutPrediction> predictions;
-  std::vector<LearningPoint> learning_curve;  ///< training subsets 1/16 .. 1 of the training rows
+  std::vector<LearningPoint> learning_curve;  ///< nested training subsets 1/16, 1/8, 1/4, 1/2, 3/4, 1 of the training rows
   double seconds_cv = 0.0, seconds_train = 0.0;
   [[nodiscard]] std::string report() const;
 };

@@ -1,0 +1,160 @@
+#include "training.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "sweep.hpp"
+#include "test_paths.hpp"
+
+namespace {
+
+// A sweep CSV row with the columns pdp train reads set, the rest empty.
+std::string row(std::int64_t run, const std::map<std::string, std::string>& values) {
+  std::string header = pdp::sweep_header();
+  std::vector<std::string> names;
+  std::size_t start = 0;
+  for (;;) {
+    const auto comma = header.find(',', start);
+    names.push_back(header.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::string v;
+    if (names[i] == "study") v = "42";
+    else if (names[i] == "run") v = std::to_string(run);
+    else if (auto it = values.find(names[i]); it != values.end()) v = it->second;
+    out += (i ? "," : "") + v;
+  }
+  return out + "\n";
+}
+
+std::map<std::string, std::string> good(double u, double true_u, double windows = 500) {
+  return {{"dx", "0.005"}, {"dy", "0.001"}, {"np", "10"}, {"truth_velocity", std::to_string(true_u)},
+          {"truth_turbulence_intensity", "0.2"}, {"awcc_velocity", std::to_string(u)},
+          {"awcc_turbulence_intensity", "0.18"}, {"awcc_void_fraction", "0.2"}, {"awcc_d32", "0.003"},
+          {"awcc_windows_accepted", std::to_string(static_cast<long>(windows))}};
+}
+
+std::filesystem::path write(const std::string& name, const std::string& text) {
+  const auto p = pdp_test::temp_dir() / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+TEST(Training, LoadCountsEveryExcludedRunByCause) {
+  std::string csv = pdp::sweep_header() + "\n";
+  csv += row(0, good(10, 9.5));
+  csv += row(1, {{"reason", "synthesis failed: boom"}});
+  auto undefined = good(10, 9.5);
+  undefined["reason"] = "awcc: 0 of 12 windows accepted";
+  undefined["awcc_velocity"] = "";
+  csv += row(2, undefined);
+  csv += row(3, good(10, 9.5, 99));
+  csv += row(4, good(20, 19, 100));
+  const auto set = pdp::load_training_set({write("training_counts.csv", csv)}, 100);
+  EXPECT_EQ(set.total, 5);
+  EXPECT_EQ(set.excluded_error, 1);
+  EXPECT_EQ(set.excluded_undefined, 1);
+  EXPECT_EQ(set.excluded_windows, 1);
+  ASSERT_EQ(set.rows.size(), 2u);
+  EXPECT_EQ(set.rows[1].run, 4);
+  EXPECT_DOUBLE_EQ(set.rows[1].features.velocity, 20.0);
+  EXPECT_DOUBLE_EQ(set.rows[1].true_velocity, 19.0);
+  EXPECT_DOUBLE_EQ(set.rows[1].features.dy, 0.001);
+  EXPECT_DOUBLE_EQ(set.rows[1].features.np, 10.0);
+}
+
+TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
+  std::string csv = pdp::sweep_header() + "\n" + row(0, good(10, 9.5)) + row(0, good(10, 9.5));
+  try {
+    (void)pdp::load_training_set({write("training_dup.csv", csv)}, 100);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("training_dup.csv:3: run 0"), std::string::npos) << e.what();
+  }
+  auto bad = good(10, 9.5);
+  bad["awcc_d32"] = "3mm";
+  csv = pdp::sweep_header() + "\n" + row(0, bad);
+  try {
+    (void)pdp::load_training_set({write("training_bad.csv", csv)}, 100);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("training_bad.csv:2: column awcc_d32 = '3mm'"), std::string::npos) << e.what();
+  }
+  try {
+    (void)pdp::load_training_set({write("training_foreign.csv", "a,b\n1,2\n")}, 100);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no column 'study'"), std::string::npos) << e.what();
+  }
+}
+
+// Every training target is the ratio 1.1, so every quantile is 1.1 u: the
+// scores follow by hand. Row A: truth 1.1 u (corrected error 0, covered; raw
+// 1/1.1 - 1); row B: truth u (corrected 0.1, not covered; raw 0).
+TEST(Training, ScoresAreTheDefinedStatistics) {
+  std::vector<pdp::TrainingRow> train;
+  for (int i = 0; i < 50; ++i) {
+    pdp::TrainingRow r;
+    r.run = i;
+    r.features = {10.0 + i, 0.1, 0.2, 0.003, 0.005, 0.001, 10, 500};
+    r.true_velocity = 1.1 * r.features.velocity;
+    r.true_turbulence_intensity = 0.15;  // difference +0.05
+    train.push_back(r);
+  }
+  awcc::ForestOptions o;
+  o.trees = 5;
+  const auto model = pdp::fit_model(train, awcc::TargetForm::ratio, awcc::TargetForm::difference, o, o, 100);
+  auto a = train[10], b = train[20];
+  b.true_velocity = b.features.velocity;
+  b.true_turbulence_intensity = 0.1;
+  const auto s = pdp::score(model, {a, b});
+  EXPECT_EQ(s.rows, 2);
+  EXPECT_NEAR(s.velocity_rmse_corrected, std::sqrt(0.01 / 2), 1e-12);
+  EXPECT_NEAR(s.velocity_rmse_raw, std::sqrt(std::pow(1 / 1.1 - 1, 2) / 2), 1e-12);
+  EXPECT_NEAR(s.velocity_bias_corrected, 0.05, 1e-12);
+  EXPECT_DOUBLE_EQ(s.velocity_coverage80, 0.5);
+  EXPECT_DOUBLE_EQ(s.velocity_coverage95, 0.5);
+  EXPECT_NEAR(s.tu_rmse_corrected, std::sqrt(0.05 * 0.05 / 2), 1e-12);
+  EXPECT_NEAR(s.tu_rmse_raw, std::sqrt((0.05 * 0.05 + 0.0) / 2), 1e-12);
+  // A row outside the ranges is counted, not scored.
+  auto c = a;
+  c.features.dx = 1.0;
+  EXPECT_EQ(pdp::score(model, {a, c}).out_of_range, 1);
+}
+
+// The held-out split hashes run indices: the order of the rows in the files
+// does not change the model.
+TEST(Training, ModelDoesNotDependOnRowOrder) {
+  std::mt19937_64 g(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  pdp::TrainingSet set;
+  for (int i = 0; i < 200; ++i) {
+    pdp::TrainingRow r;
+    r.run = i;
+    r.features = {1 + 49 * u(g), 0.35 * u(g), 0.4 * u(g), 0.01 * u(g), 0.01 * u(g), 0.002 * u(g), 10, 500};
+    r.true_velocity = r.features.velocity * (1 - 0.1 * u(g));
+    r.true_turbulence_intensity = r.features.turbulence_intensity + 0.05 * u(g);
+    set.rows.push_back(r);
+  }
+  set.total = 200;
+  pdp::TrainOptions o;
+  o.trees = 10;
+  o.folds = 2;
+  o.cv_trees = 3;
+  o.min_leaf_grid = {3, 8};
+  o.features_per_split_grid = {2, 7};
+  const auto first = pdp::train_model(set, o);
+  std::reverse(set.rows.begin(), set.rows.end());
+  const auto second = pdp::train_model(set, o);
+  EXPECT_EQ(first.model.serialise(), second.model.serialise());
+  EXPECT_EQ(first.predictions.size(), 40u);
+  EXPECT_EQ(first.cv.size(), 2u * 2u * 2u * 2u);
+}
+
+}  // namespace
