@@ -177,6 +177,8 @@ def correction(path, out):
 
 def learning(path, out):
     rows = list(csv.DictReader(open(path)))
+    if not rows:
+        raise SystemExit(f"{path}: no points (too few training runs)")
     n = [int(r["training_runs"]) for r in rows]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     for ax, (key, label) in zip(axes, (("velocity", "velocity (relative)"), ("tu", "turbulence intensity"))):
@@ -184,7 +186,8 @@ def learning(path, out):
         ax.plot(n, [float(r[f"{key}_rmse_corrected"]) for r in rows], "s-", label="RMSE of the median")
         ax.plot(n, [float(r[f"{key}_rmse_raw"]) for r in rows], "k--", lw=0.8, label="RMSE of raw AWCC")
         ax.set_xscale("log")
-        ax.set_yscale("log")
+        if all(float(r[f"{key}_{c}"]) > 0 for r in rows for c in ("pinball", "rmse_corrected", "rmse_raw")):
+            ax.set_yscale("log")
         ax.set_xlabel("training runs")
         ax.set_title(f"held-out score: {label}", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)

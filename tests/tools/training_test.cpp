@@ -6,6 +6,7 @@
 #include <fstream>
 #include <random>
 
+#include "cells.hpp"
 #include "sweep.hpp"
 #include "test_paths.hpp"
 
@@ -13,15 +14,7 @@ namespace {
 
 // A sweep CSV row with the columns pdp train reads set, the rest empty.
 std::string row(std::int64_t run, const std::map<std::string, std::string>& values) {
-  std::string header = pdp::sweep_header();
-  std::vector<std::string> names;
-  std::size_t start = 0;
-  for (;;) {
-    const auto comma = header.find(',', start);
-    names.push_back(header.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
+  const auto names = pdp::split_cells(pdp::sweep_header());
   std::string out;
   for (std::size_t i = 0; i < names.size(); ++i) {
     std::string v;

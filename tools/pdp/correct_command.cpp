@@ -11,6 +11,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/correction.hpp"
 #include "awcc/units.hpp"
+#include "cells.hpp"
 
 namespace pdp {
 
@@ -101,22 +102,13 @@ std::string correct_json(const awcc::CorrectionModel& model, const std::string& 
   return j.dump(2) + "\n";
 }
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream in(line);
-  std::string cell;
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
 std::string correct_csv(const awcc::CorrectionModel& model, const std::string& text, const Fallbacks& fb,
                         const std::string& file) {
   std::stringstream in(text);
   std::string line;
   if (!std::getline(in, line)) throw std::invalid_argument(fmt::format("{}: empty file", file));
   if (!line.empty() && line.back() == '\r') line.pop_back();
-  const auto header = split(line);
+  const auto header = split_cells(line);
   std::map<std::string, std::size_t> col;
   for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
   for (const char* name : {"void_fraction", "bubble_count_rate", "awcc_velocity", "awcc_turbulence_intensity", "awcc_windows_accepted"}) {
@@ -132,22 +124,15 @@ std::string correct_csv(const awcc::CorrectionModel& model, const std::string& t
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
-    const auto cells = split(line);
+    const auto cells = split_cells(line);
     if (cells.size() != header.size()) {
       throw std::invalid_argument(fmt::format("{}:{}: {} cells where the header has {}", file, number, cells.size(), header.size()));
     }
     auto value = [&](const char* name) -> std::optional<double> {
       const auto it = col.find(name);
       if (it == col.end() || cells[it->second].empty()) return std::nullopt;
-      const auto& t = cells[it->second];
-      std::size_t used = 0;
-      double v = 0.0;
-      try {
-        v = std::stod(t, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != t.size()) throw std::invalid_argument(fmt::format("{}:{}: column {} = '{}' is not a number", file, number, name, t));
+      const auto v = cell_number(cells[it->second]);
+      if (!v) throw std::invalid_argument(fmt::format("{}:{}: column {} = '{}' is not a number", file, number, name, cells[it->second]));
       return v;
     };
     awcc::Correction c;

@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <sstream>
+#include <cmath>
+
 
 #include "awcc/atomic_output.hpp"
+#include "cells.hpp"
 #include "terminal.hpp"
 #include "training.hpp"
 
@@ -41,23 +43,14 @@ namespace {
 
 std::vector<int> int_list(const std::string& text, const char* option) {
   std::vector<int> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    std::size_t used = 0;
-    int v = 0;
-    try {
-      v = std::stoi(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size() || item.empty() || v < 1) {
+  for (const auto& item : split_cells(text)) {
+    const auto v = cell_number(item);
+    if (!v || *v < 1 || *v != std::floor(*v) || *v > 1e6) {
       throw std::invalid_argument(fmt::format("{} '{}': give positive whole numbers separated by commas, e.g. 5,10,20",
                                               option, text));
     }
-    out.push_back(v);
+    out.push_back(static_cast<int>(*v));
   }
-  if (out.empty()) throw std::invalid_argument(fmt::format("{}: give at least one value", option));
   return out;
 }
 

@@ -14,23 +14,12 @@
 #include <thread>
 
 #include "awcc/version.hpp"
+#include "cells.hpp"
 #include "terminal.hpp"
 
 namespace pdp {
 
 namespace {
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  for (;;) {
-    const auto comma = line.find(',', start);
-    out.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
 
 std::uint64_t mix(std::uint64_t z) {
   z += 0x9e3779b97f4a7c15ull;
@@ -115,7 +104,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     if (!in) throw std::runtime_error(fmt::format("{}: cannot open the sweep CSV; check the path", path.string()));
     std::string line;
     if (!std::getline(in, line)) throw std::runtime_error(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
-    const auto header = split(line);
+    const auto header = split_cells(line);
     std::map<std::string, std::size_t> col;
     for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
     const char* needed[] = {"study", "run", "dx", "dy", "np", "truth_velocity", "truth_turbulence_intensity",
@@ -131,7 +120,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     while (std::getline(in, line)) {
       ++number;
       if (line.empty()) continue;
-      const auto cells = split(line);
+      const auto cells = split_cells(line);
       if (cells.size() != header.size()) {
         throw std::runtime_error(fmt::format("{}:{}: {} cells where the header has {}; a sweep CSV cut short? pdp sweep "
                                              "resumes and repairs it",
@@ -139,18 +128,11 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       }
       auto cell = [&](const char* name) -> const std::string& { return cells[col.at(name)]; };
       auto number_of = [&](const char* name) {
-        const auto& text = cell(name);
-        std::size_t used = 0;
-        double v = 0.0;
-        try {
-          v = std::stod(text, &used);
-        } catch (const std::exception&) {
-          used = 0;
+        const auto v = cell_number(cell(name));
+        if (!v) {
+          throw std::runtime_error(fmt::format("{}:{}: column {} = '{}' is not a number", path.string(), number, name, cell(name)));
         }
-        if (used != text.size() || text.empty() || !std::isfinite(v)) {
-          throw std::runtime_error(fmt::format("{}:{}: column {} = '{}' is not a number", path.string(), number, name, text));
-        }
-        return v;
+        return *v;
       };
       ++set.total;
       studies.insert(cell("study"));
@@ -373,7 +355,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   };
   for (const auto& [num, den] : std::vector<std::pair<std::size_t, std::size_t>>{{1, 16}, {1, 8}, {1, 4}, {1, 2}, {3, 4}, {1, 1}}) {
     const std::size_t n = training.size() * num / den;
-    if (n < 50) continue;
+    if (n < 10) continue;
     const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
     auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows);
     // Every point scores the same held-out rows: those inside the full
