@@ -99,13 +99,18 @@ class TreeBuilder {
     const auto min_leaf = static_cast<std::size_t>(o_.min_leaf);
     Split best;
     if (count < 2 * min_leaf) return best;
-    // Targets centred on the node mean keep the sums small (no cancellation).
-    double mean = 0.0;
-    for (std::size_t i = begin; i < end; ++i) mean += data_.y[rows_[i]];
-    mean /= static_cast<double>(count);
     bool constant = true;
     for (std::size_t i = begin; i < end && constant; ++i) constant = data_.y[rows_[i]] == data_.y[rows_[begin]];
     if (constant) return best;
+    // Targets centred on the node mean (a running mean: no overflow) and
+    // divided by their largest deviation: the sums then stay within +/- n
+    // whatever the targets' magnitude, and the best split is unchanged.
+    double mean = 0.0;
+    std::size_t seen = 0;
+    for (std::size_t i = begin; i < end; ++i) mean += (data_.y[rows_[i]] - mean) / static_cast<double>(++seen);
+    double scale = 0.0;
+    for (std::size_t i = begin; i < end; ++i) scale = std::max(scale, std::fabs(data_.y[rows_[i]] - mean));
+    if (!(scale > 0.0) || !std::isfinite(scale)) return best;
     // Draw mtry distinct features (partial Fisher-Yates).
     const int p = data_.features;
     order_.resize(static_cast<std::size_t>(p));
@@ -116,7 +121,7 @@ class TreeBuilder {
     }
     const double total = [&] {
       double s = 0.0;
-      for (std::size_t i = begin; i < end; ++i) s += data_.y[rows_[i]] - mean;
+      for (std::size_t i = begin; i < end; ++i) s += (data_.y[rows_[i]] - mean) / scale;
       return s;
     }();
     const double base = total * total / static_cast<double>(count);
@@ -125,7 +130,7 @@ class TreeBuilder {
       pairs_.clear();
       for (std::size_t i = begin; i < end; ++i) {
         const auto r = rows_[i];
-        pairs_.emplace_back(data_.x[r * static_cast<std::size_t>(p) + static_cast<std::size_t>(f)], data_.y[r] - mean);
+        pairs_.emplace_back(data_.x[r * static_cast<std::size_t>(p) + static_cast<std::size_t>(f)], (data_.y[r] - mean) / scale);
       }
       std::sort(pairs_.begin(), pairs_.end());
       if (pairs_.front().first == pairs_.back().first) continue;
@@ -147,8 +152,9 @@ class TreeBuilder {
         }
       }
     }
-    // A gain lost in rounding is no split.
-    if (best.gain <= 1e-14 * (base + 1e-300)) best.feature = -1;
+    // A gain lost in rounding is no split (scaled deviations: the total sum of
+    // squares is at least 1, so an absolute floor is a relative one).
+    if (best.gain <= 1e-12) best.feature = -1;
     return best;
   }
 

@@ -255,6 +255,45 @@ TEST(QuantileForest, QuantilesDoNotCrossAndStayWithinTheTargets) {
   }
 }
 
+// Degenerate data: one row, identical features, constant targets, extreme
+// magnitudes. Each must give a valid forest whose quantiles are the only
+// values there are, without dividing by zero or splitting on nothing.
+TEST(QuantileForest, DegenerateDataGivesSingleLeaves) {
+  const std::vector<double> alphas{0.025, 0.5, 0.975};
+  TrainingData one;
+  one.features = 3;
+  one.x = {1, 2, 3};
+  one.y = {4.5};
+  auto f = QuantileForest::train(one, {});
+  EXPECT_EQ(f.quantiles(one.row(0), alphas), (std::vector<double>{4.5, 4.5, 4.5}));
+  EXPECT_EQ(f.trees()[0].nodes.size(), 1u);
+
+  TrainingData same;
+  same.features = 2;
+  for (int i = 0; i < 50; ++i) {
+    same.x.insert(same.x.end(), {0.5, 0.5});
+    same.y.push_back(i);  // no feature separates them
+  }
+  f = QuantileForest::train(same, {});
+  for (const auto& t : f.trees()) EXPECT_EQ(t.nodes.size(), 1u);
+  const auto q = f.quantiles(same.row(0), alphas);
+  EXPECT_GE(q[0], 0.0);
+  EXPECT_LE(q[2], 49.0);
+
+  TrainingData flat = random_data(100, 2, 8);
+  for (auto& y : flat.y) y = 1e-300;  // constant and tiny
+  f = QuantileForest::train(flat, {});
+  for (const auto& t : f.trees()) EXPECT_EQ(t.nodes.size(), 1u);
+  EXPECT_EQ(f.quantiles(flat.row(3), alphas)[1], 1e-300);
+
+  TrainingData huge = random_data(200, 2, 9);
+  for (auto& y : huge.y) y *= 1e300;  // sums of squares would overflow uncentred
+  f = QuantileForest::train(huge, {});
+  const auto qh = f.quantiles(huge.row(5), alphas);
+  for (double v : qh) EXPECT_TRUE(std::isfinite(v));
+  EXPECT_GT(f.trees()[0].nodes.size(), 1u);
+}
+
 TEST(QuantileForest, RefusesBadOptionsAndData) {
   ForestOptions o;
   o.trees = 0;
