@@ -102,16 +102,33 @@ void write_forest(Writer& w, const std::string& name, TargetForm form, const Qua
   w.u64(f.targets().size());
   for (double y : f.targets()) w.f64(y);
   w.u32(static_cast<std::uint32_t>(f.trees().size()));
+  // Held rows in 2 bytes when the rows are few enough, else 4.
+  const bool narrow = f.targets().size() <= 65536;
+  w.u8(narrow ? 2 : 4);
   for (const auto& t : f.trees()) {
     w.u32(static_cast<std::uint32_t>(t.nodes.size()));
     for (const auto& n : t.nodes) {
-      w.i32(n.feature);
-      w.f64(n.threshold);
-      w.u32(n.left);
-      w.u32(n.right);
+      if (n.feature < 0) {
+        w.u8(0xff);
+        w.u32(n.left);
+        w.u32(n.right);
+      } else {
+        // Children are allocated in pairs: right = left + 1.
+        if (n.right != n.left + 1) throw std::logic_error("forest node children are not adjacent");
+        w.u8(static_cast<std::uint8_t>(n.feature));
+        w.f64(n.threshold);
+        w.u32(n.left);
+      }
     }
     w.u64(t.leaf_rows.size());
-    for (auto r : t.leaf_rows) w.u32(r);
+    for (auto r : t.leaf_rows) {
+      if (narrow) {
+        w.u8(static_cast<std::uint8_t>(r));
+        w.u8(static_cast<std::uint8_t>(r >> 8));
+      } else {
+        w.u32(r);
+      }
+    }
   }
 }
 
@@ -125,16 +142,32 @@ QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& f
   std::vector<double> targets(r.count(r.u64(), 8));
   for (auto& y : targets) y = r.f64();
   std::vector<RegressionTree> trees(r.count(r.u32(), 12));
+  const auto row_bytes = r.u8();
+  if (row_bytes != 2 && row_bytes != 4) r.damaged(fmt::format("held rows of {} bytes", row_bytes));
   for (auto& t : trees) {
-    t.nodes.resize(r.count(r.u32(), 20));
+    t.nodes.resize(r.count(r.u32(), 9));
     for (auto& n : t.nodes) {
-      n.feature = r.i32();
-      n.threshold = r.f64();
-      n.left = r.u32();
-      n.right = r.u32();
+      const auto feature = r.u8();
+      if (feature == 0xff) {
+        n.feature = -1;
+        n.left = r.u32();
+        n.right = r.u32();
+      } else {
+        n.feature = feature;
+        n.threshold = r.f64();
+        n.left = r.u32();
+        n.right = n.left + 1;
+      }
     }
-    t.leaf_rows.resize(r.count(r.u64(), 4));
-    for (auto& row : t.leaf_rows) row = r.u32();
+    t.leaf_rows.resize(r.count(r.u64(), row_bytes));
+    for (auto& row : t.leaf_rows) {
+      if (row_bytes == 2) {
+        row = r.u8();
+        row |= static_cast<std::uint32_t>(r.u8()) << 8;
+      } else {
+        row = r.u32();
+      }
+    }
   }
   try {
     return QuantileForest::assemble(static_cast<int>(features), std::move(targets), std::move(trees));

@@ -85,6 +85,30 @@ TEST(Correction, RoundTripGivesTheSameBytesAndPredictions) {
   EXPECT_NEAR(a.turbulence_intensity->median(), 0.22, 1e-12);
 }
 
+// More than 65,536 training rows: held rows take 4 bytes on file.
+TEST(Correction, LargeTrainingSetsRoundTrip) {
+  auto m = small_model();
+  awcc::TrainingData big;
+  big.features = CorrectionFeatures::count;
+  std::mt19937_64 g(2);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 70000; ++i) {
+    for (int j = 0; j < big.features; ++j) big.x.push_back(u(g));
+    big.y.push_back(u(g));
+  }
+  awcc::ForestOptions o;
+  o.trees = 2;
+  o.min_leaf = 50;
+  m.velocity = awcc::QuantileForest::train(big, o);
+  const auto bytes = m.serialise();
+  const auto back = CorrectionModel::parse(bytes, "big");
+  EXPECT_EQ(back.velocity.trees()[1].leaf_rows, m.velocity.trees()[1].leaf_rows);
+  EXPECT_EQ(back.serialise(), bytes);
+  std::uint32_t largest = 0;
+  for (auto r : back.velocity.trees()[0].leaf_rows) largest = std::max(largest, r);
+  EXPECT_GT(largest, 65535u);
+}
+
 TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
@@ -137,22 +161,19 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   // ...and a file carrying it is refused as damaged. Build the file bytes by
   // patching the serialised root (same size) and recomputing the checksum.
   const auto good = m.serialise();
-  std::vector<std::uint8_t> node(20);
+  // A split node on file: u8 feature, f64 threshold, u32 left child.
+  std::vector<std::uint8_t> node(13);
   const auto& root = m.velocity.trees()[0].nodes[0];
-  auto put32 = [&](std::size_t at, std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) node[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
-  };
-  put32(0, static_cast<std::uint32_t>(root.feature));
+  node[0] = static_cast<std::uint8_t>(root.feature);
   std::uint64_t bits;
   std::memcpy(&bits, &root.threshold, 8);
-  for (int i = 0; i < 8; ++i) node[4 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(bits >> (8 * i));
-  put32(12, root.left);
-  put32(16, root.right);
+  for (int i = 0; i < 8; ++i) node[1 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(bits >> (8 * i));
+  for (int i = 0; i < 4; ++i) node[9 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(root.left >> (8 * i));
   const auto at = std::search(good.begin(), good.end(), node.begin(), node.end());
   ASSERT_NE(at, good.end());
   forged = good;
   const auto offset = static_cast<std::size_t>(at - good.begin());
-  for (int i = 0; i < 4; ++i) forged[offset + 12 + static_cast<std::size_t>(i)] = 0;
+  for (int i = 0; i < 4; ++i) forged[offset + 9 + static_cast<std::size_t>(i)] = 0;
   const auto crc = awcc::crc32(forged.data(), forged.size() - 4);
   for (int i = 0; i < 4; ++i) forged[forged.size() - 4 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
   EXPECT_NE(message(forged).find("malformed"), std::string::npos) << message(forged);

@@ -111,6 +111,8 @@ TEST(Training, ScoresAreTheDefinedStatistics) {
   EXPECT_NEAR(s.velocity_rmse_corrected, std::sqrt(0.01 / 2), 1e-12);
   EXPECT_NEAR(s.velocity_rmse_raw, std::sqrt(std::pow(1 / 1.1 - 1, 2) / 2), 1e-12);
   EXPECT_NEAR(s.velocity_bias_corrected, 0.05, 1e-12);
+  EXPECT_NEAR(s.velocity_median_abs_corrected, 0.05, 1e-12);  // median of {0, 0.1}
+  EXPECT_NEAR(s.velocity_median_abs_raw, 0.5 * (1 - 1 / 1.1), 1e-12);
   EXPECT_DOUBLE_EQ(s.velocity_coverage80, 0.5);
   EXPECT_DOUBLE_EQ(s.velocity_coverage95, 0.5);
   EXPECT_NEAR(s.tu_rmse_corrected, std::sqrt(0.05 * 0.05 / 2), 1e-12);

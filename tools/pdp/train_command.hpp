@@ -17,7 +17,7 @@ struct TrainCommandOptions {
   double held_out = 0.2;
   int folds = 5;
   int cv_trees = 50;
-  std::string min_leaf_grid = "3,5,10,20,40";
+  std::string min_leaf_grid = "1,2,3,5,10,20";
   std::string features_per_split_grid = "2,3,5,7";
   std::uint64_t seed = 1;
   int threads = 0;

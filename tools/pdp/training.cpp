@@ -211,6 +211,12 @@ HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<Traini
   parallel_for(rows.size(), threads, [&](std::size_t i) { c[i] = model.correct(rows[i].features); });
   HeldOutScores s;
   double n = 0.0;
+  std::vector<double> abs_u_raw, abs_u_cor, abs_t_raw, abs_t_cor;
+  auto median = [](std::vector<double>& v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
     if (predictions) predictions->push_back({r, c[i]});
@@ -228,6 +234,8 @@ HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<Traini
     s.velocity_rmse_corrected += cor_u * cor_u;
     s.velocity_bias_raw += raw_u;
     s.velocity_bias_corrected += cor_u;
+    abs_u_raw.push_back(std::fabs(raw_u));
+    abs_u_cor.push_back(std::fabs(cor_u));
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
     s.velocity_losses.push_back(target_pinball(uq, r, true));
     s.velocity_pinball += s.velocity_losses.back();
@@ -239,12 +247,18 @@ HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<Traini
     s.tu_rmse_corrected += cor_t * cor_t;
     s.tu_bias_raw += raw_t;
     s.tu_bias_corrected += cor_t;
+    abs_t_raw.push_back(std::fabs(raw_t));
+    abs_t_cor.push_back(std::fabs(cor_t));
     s.tu_losses.push_back(target_pinball(tq, r, false));
     s.tu_pinball += s.tu_losses.back();
     const double tt = r.true_turbulence_intensity;
     s.tu_coverage80 += (tt >= tq[1] && tt <= tq[5]) ? 1.0 : 0.0;
     s.tu_coverage95 += (tt >= tq[0] && tt <= tq[6]) ? 1.0 : 0.0;
   }
+  s.velocity_median_abs_raw = median(abs_u_raw);
+  s.velocity_median_abs_corrected = median(abs_u_cor);
+  s.tu_median_abs_raw = median(abs_t_raw);
+  s.tu_median_abs_corrected = median(abs_t_cor);
   if (n > 0) {
     s.velocity_rmse_raw = std::sqrt(s.velocity_rmse_raw / n);
     s.velocity_rmse_corrected = std::sqrt(s.velocity_rmse_corrected / n);
@@ -405,8 +419,11 @@ std::string TrainResult::report() const {
                    h.out_of_range, training_rows, seconds_train));
   line("                         raw AWCC    corrected median");
   line(fmt::format("  velocity RMSE          {:7.3f} %   {:7.3f} %", 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected));
+  line(fmt::format("  velocity median |err|  {:7.3f} %   {:7.3f} %", 100 * h.velocity_median_abs_raw,
+                   100 * h.velocity_median_abs_corrected));
   line(fmt::format("  velocity mean error    {:7.3f} %   {:7.3f} %", 100 * h.velocity_bias_raw, 100 * h.velocity_bias_corrected));
   line(fmt::format("  Tu RMSE                {:7.4f}     {:7.4f}", h.tu_rmse_raw, h.tu_rmse_corrected));
+  line(fmt::format("  Tu median |err|        {:7.4f}     {:7.4f}", h.tu_median_abs_raw, h.tu_median_abs_corrected));
   line(fmt::format("  Tu mean error          {:7.4f}     {:7.4f}", h.tu_bias_raw, h.tu_bias_corrected));
   line(fmt::format("  coverage 80 % / 95 %   velocity {:.1f} / {:.1f} %, Tu {:.1f} / {:.1f} %", 100 * h.velocity_coverage80,
                    100 * h.velocity_coverage95, 100 * h.tu_coverage80, 100 * h.tu_coverage95));

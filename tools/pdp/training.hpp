@@ -59,7 +59,7 @@ struct TrainOptions {
   double held_out = 0.2;                ///< fraction of runs held out for the report
   int folds = 5;                        ///< cross-validation folds; 0 = no CV (use the values below)
   int cv_trees = 50;                    ///< trees per forest during cross-validation
-  std::vector<int> min_leaf_grid{3, 5, 10, 20, 40};
+  std::vector<int> min_leaf_grid{1, 2, 3, 5, 10, 20};
   std::vector<int> features_per_split_grid{2, 3, 5, 7};
   int min_leaf = 10;                    ///< without CV
   int features_per_split = 3;           ///< without CV
@@ -82,10 +82,12 @@ struct HeldOutScores {
   std::int64_t rows = 0, out_of_range = 0;
   double velocity_rmse_raw = 0.0, velocity_rmse_corrected = 0.0;  ///< relative (u/u_true - 1)
   double velocity_bias_raw = 0.0, velocity_bias_corrected = 0.0;  ///< mean relative error
+  double velocity_median_abs_raw = 0.0, velocity_median_abs_corrected = 0.0;  ///< median |relative error|
   double velocity_pinball = 0.0;        ///< relative
   double velocity_coverage80 = 0.0, velocity_coverage95 = 0.0;
   double tu_rmse_raw = 0.0, tu_rmse_corrected = 0.0;               ///< absolute
   double tu_bias_raw = 0.0, tu_bias_corrected = 0.0;
+  double tu_median_abs_raw = 0.0, tu_median_abs_corrected = 0.0;  ///< median |error|
   double tu_pinball = 0.0;
   double tu_coverage80 = 0.0, tu_coverage95 = 0.0;
   std::vector<double> velocity_losses, tu_losses;  ///< pinball loss of each scored row, in row order

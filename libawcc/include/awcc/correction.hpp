@@ -26,8 +26,12 @@
 //   "pdp-qrf\n" (8 bytes), u32 format version, u64 payload bytes, payload,
 //   u32 CRC-32 (IEEE 802.3) of everything before it.
 // Payload: provenance text; features (name, min, max); range margin; minimum
-// windows; per forest its name, target form, training targets and trees
-// (nodes: i32 feature, f64 threshold, u32 left, u32 right; held rows: u32).
+// windows; per forest its name, target form, feature count, training targets
+// (f64), tree count, the width of a held row (u8: 2 or 4 bytes; 2 when there
+// are at most 65,536 targets) and the trees: node count, nodes (a split: u8
+// feature, f64 threshold, u32 left child, the right child being left + 1; a
+// leaf: u8 0xff, u32 first held row, u32 count), held-row count (u64), held
+// rows.
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
 

@@ -1,0 +1,127 @@
+#!/usr/bin/env bash
+# pdp train, pdp correct and pdp process --correct on a small sweep: the
+# model is the same for a seed whatever the threads; corrections reach the
+# JSON and the CSV with the documented keys; rows outside the training ranges
+# are flagged; damaged, foreign and missing inputs give a clear error, a
+# non-zero exit and no output file. The shipped model loads and corrects.
+# Usage: correct_cli_test.sh PDP SCRATCH_DIR SOURCE_DIR
+set -u
+pdp=$1
+dir=$2/correct_cli
+src=$3
+rm -rf "$dir" && mkdir -p "$dir"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+cat >"$dir/mc.toml" <<'TOML'
+[sweep]
+mode = "monte-carlo"
+runs = 48
+seed = 5
+[base]
+duration = "4s"
+fs = "100kHz"
+[ranges]
+velocity = ["2m/s", "8m/s"]
+void-fraction = [0.1, 0.3]
+bubble-diameter = ["1mm", "3mm"]
+dx = ["3mm", "6mm"]
+dy = ["0mm", "1mm"]
+np = [4.5, 10.5]
+TOML
+"$pdp" --log-level warn sweep "$dir/mc.toml" -o "$dir/mc.csv" || fail "sweep"
+
+# Training: a report, a model, and the same bytes for 1 and 2 threads.
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/a.qrf" --trees 20 --folds 2 --cv-trees 5 --min-leaf 3,5 \
+  --features-per-split 3,7 --min-windows 20 --threads 1 --predictions "$dir/pred.csv" --learning-curve "$dir/lc.csv" \
+  >"$dir/report.txt" || fail "train"
+grep -q "Held out:" "$dir/report.txt" || fail "no held-out report"
+grep -q "coverage 80 % / 95 %" "$dir/report.txt" || fail "no coverage in the report"
+grep -q "^  velocity  *ratio" "$dir/report.txt" || fail "no CV table"
+head -1 "$dir/pred.csv" | grep -q "corrected_velocity_q0.975" || fail "predictions CSV header"
+head -1 "$dir/lc.csv" | grep -q "^training_runs," || fail "learning curve header"
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/b.qrf" --trees 20 --folds 2 --cv-trees 5 --min-leaf 3,5 \
+  --features-per-split 3,7 --min-windows 20 --threads 2 >/dev/null || fail "train, 2 threads"
+cmp -s "$dir/a.qrf" "$dir/b.qrf" || fail "models differ between 1 and 2 threads"
+
+# A recording inside the training ranges.
+"$pdp" --log-level warn synth -q --duration 4s --fs 100kHz --velocity 5 --void-fraction 0.2 --bubble-diameter 2mm \
+  --dx 4.5mm --dy 0.5mm --seed 9 -o "$dir/rec.flac" || fail "synth"
+out=$("$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc --correct "$dir/a.qrf" \
+  --json "$dir/rec.json") || fail "process --correct"
+grep -q "correction (quantile regression forest)" <<<"$out" || fail "no correction in the summary: $out"
+python3 - "$dir/rec.json" <<'PY' || fail "process --correct JSON"
+import json, sys
+j = json.load(open(sys.argv[1]))
+c = j["correction"]
+assert c["in_range"] is True and c["reason"] is None, c
+for q in ("velocity", "turbulence_intensity"):
+    qs = c[q]["quantiles"]
+    assert list(qs) == ["0.025", "0.1", "0.25", "0.5", "0.75", "0.9", "0.975"], list(qs)
+    v = list(qs.values())
+    assert v == sorted(v), v
+    assert c[q]["median"] == qs["0.5"]
+assert abs(c["velocity"]["median"] / j["awcc"]["velocity"] - 1) < 0.3
+PY
+
+# pdp correct on that JSON gives the same correction object.
+"$pdp" correct "$dir/rec.json" -m "$dir/a.qrf" -o "$dir/again.json" || fail "correct JSON"
+python3 -c "
+import json,sys
+a=json.load(open('$dir/rec.json'))['correction']; b=json.load(open('$dir/again.json'))['correction']
+sys.exit(0 if a==b else 1)" || fail "pdp correct and process --correct disagree"
+
+# A profile CSV lacks Np: refused with the fix, no output; with --np, corrected.
+"$pdp" --log-level error process "$dir/rec.flac" "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc \
+  --csv "$dir/profile.csv" || fail "profile"
+err=$("$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" -o "$dir/corrected.csv" 2>&1) && fail "CSV without np accepted"
+grep -q "no dx column in the file; give it with --dx" <<<"$err" || fail "message without the fix: $err"
+[[ -e "$dir/corrected.csv" ]] && fail "output written on error"
+"$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" --dx 4.5mm --dy 0.5mm --np 6 -o "$dir/corrected.csv" ||
+  fail "correct CSV"
+head -1 "$dir/corrected.csv" | grep -q ",correction_in_range,correction_reason,corrected_velocity,corrected_velocity_q0.025," ||
+  fail "CSV correction columns"
+[[ $(cut -d, -f24 "$dir/corrected.csv" | tail -n +2 | sort -u) == "1" ]] || fail "profile rows not corrected"
+
+# Outside the training ranges (dx 20 mm): flagged, not corrected.
+"$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" --dx 20mm --dy 0.5mm --np 6 -o "$dir/outside.csv" || fail "correct outside"
+tail -1 "$dir/outside.csv" | grep -q ",0,dx = 0.02 is outside the training range" || fail "out-of-range row not flagged"
+
+# Damaged, foreign and version-bumped models: clear error, no output.
+head -c 5000 "$dir/a.qrf" >"$dir/cut.qrf"
+err=$("$pdp" process "$dir/rec.flac" --dx 4.5mm --method awcc --correct "$dir/cut.qrf" --json "$dir/x.json" 2>&1) &&
+  fail "truncated model accepted"
+grep -q "cut.qrf: damaged model file" <<<"$err" || fail "truncated model message: $err"
+[[ -e "$dir/x.json" ]] && fail "JSON written with a damaged model"
+cp "$dir/a.qrf" "$dir/flip.qrf"
+printf '\x55' | dd of="$dir/flip.qrf" bs=1 seek=3000 conv=notrunc status=none
+err=$("$pdp" correct "$dir/rec.json" -m "$dir/flip.qrf" 2>&1) && fail "damaged model accepted"
+grep -q "checksum mismatch" <<<"$err" || fail "damaged model message: $err"
+err=$("$pdp" correct "$dir/rec.json" -m "$dir/mc.csv" 2>&1) && fail "foreign model accepted"
+grep -q "not a pdp model file" <<<"$err" || fail "foreign model message: $err"
+err=$("$pdp" correct "$dir/mc.csv" -m "$dir/a.qrf" 2>&1) && fail "a sweep CSV corrected as a profile"
+grep -q "mc.csv: no column 'bubble_count_rate'" <<<"$err" || fail "wrong input message: $err"
+
+# The shipped model loads and corrects (it was trained on 60 s records; this
+# row is inside its ranges).
+shipped=$src/samples/model/awcc.qrf
+if [[ -f "$shipped" ]]; then
+  "$pdp" correct "$dir/rec.json" -m "$shipped" -o "$dir/shipped.json" || fail "shipped model"
+  python3 -c "
+import json,sys
+c=json.load(open('$dir/shipped.json'))['correction']
+sys.exit(0 if c['in_range'] and c['velocity']['quantiles']['0.025'] <= c['velocity']['quantiles']['0.975'] else 1)" ||
+    fail "shipped model did not correct"
+else
+  fail "samples/model/awcc.qrf is missing"
+fi
+
+# The figures of docs/validation.md from the training outputs.
+png() { [[ -s $1 && $(head -c 8 "$1" | od -An -c | tr -d ' ') == '211PNG\r\n032\n' ]]; }
+/usr/bin/python3 "$src/tools/plot_study.py" correction "$dir/pred.csv" "$dir/pred.png" || fail "correction figure"
+png "$dir/pred.png" || fail "correction figure is not a PNG"
+/usr/bin/python3 "$src/tools/plot_study.py" learning "$dir/lc.csv" "$dir/lc.png" || fail "learning-curve figure"
+png "$dir/lc.png" || fail "learning-curve figure is not a PNG"
+
+[[ $failures -eq 0 ]] && echo "correct CLI: all checks passed"
+exit $((failures > 0))
