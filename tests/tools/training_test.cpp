@@ -56,6 +56,7 @@ TEST(Training, LoadCountsEveryExcludedRunByCause) {
   EXPECT_EQ(set.excluded_windows, 1);
   ASSERT_EQ(set.rows.size(), 2u);
   EXPECT_EQ(set.rows[1].run, 4);
+  EXPECT_EQ(set.rows[1].study, 42u);
   EXPECT_DOUBLE_EQ(set.rows[1].features.velocity, 20.0);
   EXPECT_DOUBLE_EQ(set.rows[1].true_velocity, 19.0);
   EXPECT_DOUBLE_EQ(set.rows[1].features.dy, 0.001);
@@ -144,6 +145,9 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
   o.cv_trees = 3;
   o.min_leaf_grid = {3, 8};
   o.features_per_split_grid = {2, 7};
+  // Two studies with the same run indices (two sweeps combined).
+  for (int i = 0; i < 100; ++i) set.rows[static_cast<std::size_t>(i)].study = 7;
+  for (int i = 100; i < 200; ++i) set.rows[static_cast<std::size_t>(i)].run -= 100;
   const auto first = pdp::train_model(set, o);
   std::reverse(set.rows.begin(), set.rows.end());
   const auto second = pdp::train_model(set, o);

@@ -152,6 +152,13 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       }
       TrainingRow r;
       r.run = run;
+      try {
+        std::size_t used = 0;
+        r.study = std::stoull(cell("study"), &used);
+        if (used != cell("study").size()) throw std::invalid_argument("trailing text");
+      } catch (const std::exception&) {
+        throw std::runtime_error(fmt::format("{}:{}: study = '{}' is not a sweep study id", path.string(), number, cell("study")));
+      }
       auto& f = r.features;
       f.windows_accepted = static_cast<std::int64_t>(number_of("awcc_windows_accepted"));
       if (f.windows_accepted < min_windows) {
@@ -276,9 +283,11 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
   // Held-out split by a hash of the run index: independent of file order.
   std::vector<TrainingRow> rows = set.rows;
+  auto key = [&](const TrainingRow& r) { return mix(o.seed ^ mix(static_cast<std::uint64_t>(r.run) ^ mix(r.study))); };
   std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
-    const auto ha = mix(o.seed ^ mix(static_cast<std::uint64_t>(a.run))), hb = mix(o.seed ^ mix(static_cast<std::uint64_t>(b.run)));
-    return ha != hb ? ha < hb : a.run < b.run;
+    const auto ha = key(a), hb = key(b);
+    if (ha != hb) return ha < hb;
+    return a.study != b.study ? a.study < b.study : a.run < b.run;
   });
   const auto held = static_cast<std::size_t>(std::llround(o.held_out * static_cast<double>(rows.size())));
   if (held == 0 || held >= rows.size()) {

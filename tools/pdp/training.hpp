@@ -5,7 +5,7 @@
 //
 // Rows used: runs with no error whose AWCC gave a value from at least
 // `min_windows` accepted windows; the others are counted by cause.
-// Held-out split: the rows ordered by a hash of (seed, run index); the first
+// Held-out split: the rows ordered by a hash of (seed, study, run index); the first
 // `held_out` fraction is held out. The model is trained on the rest only, so
 // the held-out scores are those of the shipped model.
 //
@@ -34,6 +34,7 @@
 namespace pdp {
 
 struct TrainingRow {
+  std::uint64_t study = 0;              ///< sweep study id (several sweeps may be combined)
   std::int64_t run = 0;
   awcc::CorrectionFeatures features;
   double true_velocity = 0.0, true_turbulence_intensity = 0.0;
