@@ -49,22 +49,25 @@ class Writer {
   std::vector<std::uint8_t> bytes;
 };
 
+// The file's little-endian bytes as a number on this machine.
+template <typename T>
+T little(const std::uint8_t* b) {
+  T v;
+  std::memcpy(&v, b, sizeof v);
+  if constexpr (std::endian::native == std::endian::big) {  // C++20 has no std::byteswap
+    T r = 0;
+    for (std::size_t i = 0; i < sizeof v; ++i) r |= static_cast<T>(b[i]) << (8 * i);
+    v = r;
+  }
+  return v;
+}
+
 class Reader {
  public:
   Reader(const std::uint8_t* data, std::size_t size, const std::string& name) : p_(data), end_(data + size), name_(name) {}
   std::uint8_t u8() { return *take(1); }
-  std::uint32_t u32() {
-    const auto* b = take(4);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(b[i]) << (8 * i);
-    return v;
-  }
-  std::uint64_t u64() {
-    const auto* b = take(8);
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(b[i]) << (8 * i);
-    return v;
-  }
+  std::uint32_t u32() { return little<std::uint32_t>(take(4)); }
+  std::uint64_t u64() { return little<std::uint64_t>(take(8)); }
   std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
   std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
   double f64() { return std::bit_cast<double>(u64()); }
@@ -336,9 +339,13 @@ void CorrectionModel::save(const std::filesystem::path& path) const {
 }
 
 CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw std::runtime_error(fmt::format("{}: cannot open the model file; check the path", path.string()));
-  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto size = static_cast<std::size_t>(in.tellg());
+  std::vector<std::uint8_t> bytes(size);
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the model file", path.string()));
   return parse(bytes, path.string());
 }
 
