@@ -23,6 +23,7 @@ duration = "4s"
 fs = "100kHz"
 [ranges]
 velocity = ["2m/s", "8m/s"]
+tu = [0.02, 0.3]
 void-fraction = [0.1, 0.3]
 bubble-diameter = ["1mm", "3mm"]
 dx = ["3mm", "6mm"]
@@ -44,8 +45,9 @@ head -1 "$dir/lc.csv" | grep -q "^training_runs," || fail "learning curve header
   --features-per-split 3,7 --min-windows 20 --threads 2 >/dev/null || fail "train, 2 threads"
 cmp -s "$dir/a.qrf" "$dir/b.qrf" || fail "models differ between 1 and 2 threads"
 
-# A recording inside the training ranges.
-"$pdp" --log-level warn synth -q --duration 4s --fs 100kHz --velocity 5 --void-fraction 0.2 --bubble-diameter 2mm \
+# A recording well inside the training ranges (mid-range in every feature:
+# the ranges of 30 training runs are narrow).
+"$pdp" --log-level warn synth -q --duration 4s --fs 100kHz --velocity 5 --tu 0.1 --void-fraction 0.2 --bubble-diameter 2mm \
   --dx 4.5mm --dy 0.5mm --seed 9 -o "$dir/rec.flac" || fail "synth"
 out=$("$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc --correct "$dir/a.qrf" \
   --json "$dir/rec.json") || fail "process --correct"
