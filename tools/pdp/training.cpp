@@ -212,18 +212,59 @@ awcc::CorrectionModel fit_model(const std::vector<TrainingRow>& rows, awcc::Targ
   return m;
 }
 
+namespace {
+
+// The statistics of one quantity (velocity or Tu) over the scored rows.
+struct QuantityScores {
+  double square_raw = 0.0, square_corrected = 0.0, sum_raw = 0.0, sum_corrected = 0.0;
+  double pinball = 0.0, covered80 = 0.0, covered95 = 0.0;
+  std::vector<double> abs_raw, abs_corrected, losses;
+
+  void add(double raw_error, double corrected_error, double truth, const std::array<double, 7>& q, double loss) {
+    square_raw += raw_error * raw_error;
+    square_corrected += corrected_error * corrected_error;
+    sum_raw += raw_error;
+    sum_corrected += corrected_error;
+    abs_raw.push_back(std::fabs(raw_error));
+    abs_corrected.push_back(std::fabs(corrected_error));
+    losses.push_back(loss);
+    pinball += loss;
+    covered80 += (truth >= q[1] && truth <= q[5]) ? 1.0 : 0.0;
+    covered95 += (truth >= q[0] && truth <= q[6]) ? 1.0 : 0.0;
+  }
+
+  /// rmse, median |error|, mean error (raw, corrected), pinball, coverages.
+  void finish(double& rmse_raw, double& rmse_corrected, double& median_raw, double& median_corrected,
+              double& bias_raw, double& bias_corrected, double& mean_pinball, double& coverage80,
+              double& coverage95, std::vector<double>& row_losses) {
+    auto median = [](std::vector<double>& v) {
+      if (v.empty()) return 0.0;
+      std::sort(v.begin(), v.end());
+      return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    };
+    median_raw = median(abs_raw);
+    median_corrected = median(abs_corrected);
+    row_losses = std::move(losses);
+    const auto n = static_cast<double>(abs_raw.size());
+    if (n == 0) return;
+    rmse_raw = std::sqrt(square_raw / n);
+    rmse_corrected = std::sqrt(square_corrected / n);
+    bias_raw = sum_raw / n;
+    bias_corrected = sum_corrected / n;
+    mean_pinball = pinball / n;
+    coverage80 = covered80 / n;
+    coverage95 = covered95 / n;
+  }
+};
+
+}  // namespace
+
 HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions, int threads) {
   std::vector<awcc::Correction> c(rows.size());
   parallel_for(rows.size(), threads, [&](std::size_t i) { c[i] = model.correct(rows[i].features); });
   HeldOutScores s;
-  double n = 0.0;
-  std::vector<double> abs_u_raw, abs_u_cor, abs_t_raw, abs_t_cor;
-  auto median = [](std::vector<double>& v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  };
+  QuantityScores velocity, tu;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
     if (predictions) predictions->push_back({r, c[i]});
@@ -232,50 +273,20 @@ HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<Traini
       continue;
     }
     ++s.rows;
-    n += 1.0;
     const auto& u = *c[i].velocity;
     const auto& t = *c[i].turbulence_intensity;
-    const double raw_u = r.features.velocity / r.true_velocity - 1.0;
-    const double cor_u = u.median() / r.true_velocity - 1.0;
-    s.velocity_rmse_raw += raw_u * raw_u;
-    s.velocity_rmse_corrected += cor_u * cor_u;
-    s.velocity_bias_raw += raw_u;
-    s.velocity_bias_corrected += cor_u;
-    abs_u_raw.push_back(std::fabs(raw_u));
-    abs_u_cor.push_back(std::fabs(cor_u));
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
-    s.velocity_losses.push_back(target_pinball(uq, r, true));
-    s.velocity_pinball += s.velocity_losses.back();
-    s.velocity_coverage80 += (r.true_velocity >= uq[1] && r.true_velocity <= uq[5]) ? 1.0 : 0.0;
-    s.velocity_coverage95 += (r.true_velocity >= uq[0] && r.true_velocity <= uq[6]) ? 1.0 : 0.0;
-    const double raw_t = r.features.turbulence_intensity - r.true_turbulence_intensity;
-    const double cor_t = t.median() - r.true_turbulence_intensity;
-    s.tu_rmse_raw += raw_t * raw_t;
-    s.tu_rmse_corrected += cor_t * cor_t;
-    s.tu_bias_raw += raw_t;
-    s.tu_bias_corrected += cor_t;
-    abs_t_raw.push_back(std::fabs(raw_t));
-    abs_t_cor.push_back(std::fabs(cor_t));
-    s.tu_losses.push_back(target_pinball(tq, r, false));
-    s.tu_pinball += s.tu_losses.back();
-    const double tt = r.true_turbulence_intensity;
-    s.tu_coverage80 += (tt >= tq[1] && tt <= tq[5]) ? 1.0 : 0.0;
-    s.tu_coverage95 += (tt >= tq[0] && tt <= tq[6]) ? 1.0 : 0.0;
+    // Velocity relative to the truth, Tu absolute.
+    velocity.add(r.features.velocity / r.true_velocity - 1.0, u.median() / r.true_velocity - 1.0, r.true_velocity,
+                 u.quantiles, target_pinball(uq, r, true));
+    tu.add(r.features.turbulence_intensity - r.true_turbulence_intensity, t.median() - r.true_turbulence_intensity,
+           r.true_turbulence_intensity, t.quantiles, target_pinball(tq, r, false));
   }
-  s.velocity_median_abs_raw = median(abs_u_raw);
-  s.velocity_median_abs_corrected = median(abs_u_cor);
-  s.tu_median_abs_raw = median(abs_t_raw);
-  s.tu_median_abs_corrected = median(abs_t_cor);
-  if (n > 0) {
-    s.velocity_rmse_raw = std::sqrt(s.velocity_rmse_raw / n);
-    s.velocity_rmse_corrected = std::sqrt(s.velocity_rmse_corrected / n);
-    s.tu_rmse_raw = std::sqrt(s.tu_rmse_raw / n);
-    s.tu_rmse_corrected = std::sqrt(s.tu_rmse_corrected / n);
-    for (double* v : {&s.velocity_bias_raw, &s.velocity_bias_corrected, &s.velocity_pinball, &s.velocity_coverage80,
-                      &s.velocity_coverage95, &s.tu_bias_raw, &s.tu_bias_corrected, &s.tu_pinball, &s.tu_coverage80,
-                      &s.tu_coverage95})
-      *v /= n;
-  }
+  velocity.finish(s.velocity_rmse_raw, s.velocity_rmse_corrected, s.velocity_median_abs_raw,
+                  s.velocity_median_abs_corrected, s.velocity_bias_raw, s.velocity_bias_corrected, s.velocity_pinball,
+                  s.velocity_coverage80, s.velocity_coverage95, s.velocity_losses);
+  tu.finish(s.tu_rmse_raw, s.tu_rmse_corrected, s.tu_median_abs_raw, s.tu_median_abs_corrected, s.tu_bias_raw,
+            s.tu_bias_corrected, s.tu_pinball, s.tu_coverage80, s.tu_coverage95, s.tu_losses);
   return s;
 }
 
