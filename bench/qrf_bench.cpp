@@ -11,9 +11,9 @@
 #include <cstdio>
 #include <random>
 
-#include "awcc/correction.hpp"
+#include "correction/model.hpp"
 #include "bench_util.hpp"
-#include "training.hpp"
+#include "correction/training.hpp"
 
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -21,11 +21,11 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int threads = argc > 3 ? std::atoi(argv[3]) : 0;
-  const auto set = pdp::load_training_set({argv[1]}, 100);
+  const auto set = correction::load_training_set({argv[1]}, 100);
   std::mt19937_64 g(1);
   std::uniform_int_distribution<std::size_t> pick(0, set.rows.size() - 1);
   std::uniform_real_distribution<double> jitter(-1e-6, 1e-6);
-  std::vector<pdp::TrainingRow> rows;
+  std::vector<correction::TrainingRow> rows;
   for (int i = 0; i < 20000; ++i) {
     auto r = set.rows[pick(g)];
     auto& f = r.features;
@@ -33,14 +33,14 @@ int main(int argc, char** argv) {
     r.run = i;
     rows.push_back(r);
   }
-  awcc::ForestOptions o;
+  correction::ForestOptions o;
   o.trees = 100;
   o.min_leaf = 5;
   o.features_per_split = 7;
   o.threads = threads;
   for (int rep = 0; rep < 2; ++rep) {
     const double t0 = bench::now();
-    const auto m = pdp::fit_model(rows, awcc::TargetForm::ratio, awcc::TargetForm::difference, o, o, 100);
+    const auto m = correction::fit_model(rows, correction::TargetForm::ratio, correction::TargetForm::difference, o, o, 100);
     const double t1 = bench::now();
     fmt::print("train: 20,000 runs, 2 forests x 100 trees (min leaf 5, 7 features per split): {:.2f} s, model {:.1f} MB, "
                "peak {:.0f} MB\n", t1 - t0, static_cast<double>(m.serialise().size()) / 1e6, bench::peak_mb());
@@ -49,10 +49,10 @@ int main(int argc, char** argv) {
   std::vector<double> load, correct;
   for (int rep = 0; rep < 20; ++rep) {
     const double t0 = bench::now();
-    const auto model = awcc::CorrectionModel::load(argv[2]);
+    const auto model = correction::CorrectionModel::load(argv[2]);
     const double t1 = bench::now();
     int in_range = 0;
-    for (std::size_t i = 0; i < 30; ++i) in_range += model.correct(set.rows[i * 7 % set.rows.size()].features).in_range;
+    for (std::size_t i = 0; i < 30; ++i) in_range += model.correct(set.rows[i * 7 % set.rows.size()].features).corrected();
     const double t2 = bench::now();
     load.push_back(t1 - t0);
     correct.push_back(t2 - t1);

@@ -1,27 +1,28 @@
-# Installs both libraries, their headers, the pdp tool and one CMake package
-# "pdp": consumers write find_package(pdp CONFIG REQUIRED) and link
-# awcc::awcc and/or synth::synth.
+# Installs the libraries (awcc::core, awcc::awcc, synth::synth,
+# correction::correction), their headers, the pdp tool and one CMake package
+# "pdp": consumers write find_package(pdp CONFIG REQUIRED) and link what they
+# use. Headers under awcc/detail/ are the libraries' own and not installed.
 include(CMakePackageConfigHelpers)
 
 set(PDP_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/pdp")
 
-install(TARGETS awcc EXPORT awccTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
-  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(TARGETS synth EXPORT synthTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
-  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY libawcc/include/awcc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+foreach(target awcc_core awcc synth correction)
+  install(TARGETS ${target} EXPORT ${target}Targets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+    INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endforeach()
+install(DIRECTORY libcore/include/awcc libawcc/include/awcc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  PATTERN detail EXCLUDE)
 install(FILES ${PROJECT_BINARY_DIR}/generated/awcc/version.hpp
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/awcc)
-install(DIRECTORY libsynth/include/synth DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY libsynth/include/synth libcorrection/include/correction DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
+install(EXPORT awcc_coreTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT awccTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT synthTargets NAMESPACE synth:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
+install(EXPORT correctionTargets NAMESPACE correction:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 
 configure_package_config_file(cmake/pdpConfig.cmake.in
   ${PROJECT_BINARY_DIR}/pdpConfig.cmake

@@ -10,27 +10,27 @@
 #include <stdexcept>
 #include <vector>
 
-#include "awcc/correction.hpp"
+#include "correction/model.hpp"
 
 namespace {
 
 std::vector<std::uint8_t> make_seed() {
   std::mt19937_64 g(1);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  awcc::TrainingData v;
-  v.features = awcc::CorrectionFeatures::count;
-  awcc::CorrectionModel m;
+  correction::TrainingData v;
+  v.features = correction::Features::count;
+  correction::CorrectionModel m;
   for (int i = 0; i < 40; ++i) {
     for (int j = 0; j < v.features; ++j) v.x.push_back(u(g));
     v.y.push_back(u(g));
   }
-  for (int j = 0; j < v.features; ++j) m.ranges.push_back({awcc::CorrectionFeatures::names[static_cast<std::size_t>(j)], 0.0, 1.0});
-  awcc::ForestOptions o;
+  for (int j = 0; j < v.features; ++j) m.ranges.push_back({correction::Features::names[static_cast<std::size_t>(j)], 0.0, 1.0});
+  correction::ForestOptions o;
   o.trees = 3;
   o.min_leaf = 3;
   o.threads = 1;
-  m.velocity = awcc::QuantileForest::train(v, o);
-  m.turbulence_intensity = awcc::QuantileForest::train(v, o);
+  m.velocity = correction::QuantileForest::train(v, o);
+  m.turbulence_intensity = correction::QuantileForest::train(v, o);
   m.provenance = "fuzz";
   return m.serialise();
 }
@@ -54,12 +54,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (bytes.size() >= 24) {
     const std::uint64_t length = bytes.size() - 24;
     for (int i = 0; i < 8; ++i) bytes[12 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(length >> (8 * i));
-    const auto crc = awcc::crc32(bytes.data(), bytes.size() - 4);
+    const auto crc = correction::crc32(bytes.data(), bytes.size() - 4);
     for (int i = 0; i < 4; ++i) bytes[bytes.size() - 4 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
   }
   try {
-    const auto m = awcc::CorrectionModel::parse(bytes, "fuzz.qrf");
-    awcc::CorrectionFeatures f;
+    const auto m = correction::CorrectionModel::parse(bytes, "fuzz.qrf");
+    correction::Features f;
     for (double v : {0.0, 0.5, 1.0}) {
       f.velocity = f.turbulence_intensity = f.void_fraction = f.d32 = f.dx = f.dy = f.np = v;
       f.windows_accepted = 1000;

@@ -2,6 +2,7 @@
 // statistics, FSCC, AWCC) on arbitrary bytes. The first byte picks the
 // container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV),
 // the rest is the file.
+#include "awcc/serialise.hpp"
 #include <stdexcept>
 
 #include "awcc/process.hpp"

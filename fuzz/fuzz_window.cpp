@@ -1,6 +1,7 @@
 // The per-window correlation and filter chain on arbitrary sample blocks:
 // voltages through the FFT path, and the bits as binary signals through both
 // exact paths, which must agree (a differential check).
+#include "awcc/detail/awcc_steps.hpp"
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -17,16 +18,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     x[i] = static_cast<std::int8_t>(data[2 + 2 * i]);
     y[i] = static_cast<std::int8_t>(data[3 + 2 * i]);
   }
-  awcc::FftPlanCache plans;
+  awcc::AwccWorkspace plans;
   awcc::AwccOptions o;
   o.subsample = data[0] & 1 ? awcc::Subsample::parabolic : awcc::Subsample::none;
   o.prominence_fraction = (data[1] % 11) / 10.0;
   const auto k = static_cast<std::int64_t>(n) - 1;
-  const auto r = awcc::window_correlation_fft(x, y, -k, k, plans);
+  const auto r = awcc::detail::window_correlation_fft(x, y, -k, k, plans);
   awcc::AwccWindow w;
   w.length = static_cast<std::int64_t>(n);
   w.duration = static_cast<double>(n);
-  awcc::analyse_window(w, r, -k, 1.0, 1.0, o);
+  awcc::detail::analyse_window(w, r, -k, 1.0, 1.0, o, plans);
   if (!r.empty() && !(std::isfinite(w.r12_max) && std::isfinite(w.spr) && std::isfinite(w.velocity))) __builtin_trap();
   // Binary signals from the low bits: both exact paths agree.
   std::vector<std::uint8_t> bx(n), by(n);
@@ -35,9 +36,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     by[i] = data[3 + 2 * i] & 1;
   }
   const auto sx = awcc::from_dense(bx, 1.0), sy = awcc::from_dense(by, 1.0);
-  const auto pieces = awcc::window_correlation_intervals(sx, sy, 0, static_cast<std::int64_t>(n), -k, k);
+  const auto pieces = awcc::detail::window_correlation_intervals(sx, sy, 0, static_cast<std::int64_t>(n), -k, k, plans);
   std::vector<double> fx(bx.begin(), bx.end()), fy(by.begin(), by.end());
-  const auto fft = awcc::window_correlation_fft(fx, fy, -k, k, plans);
+  const auto fft = awcc::detail::window_correlation_fft(fx, fy, -k, k, plans);
   if (pieces.size() != fft.size()) __builtin_trap();
   for (std::size_t i = 0; i < fft.size(); ++i)
     if (std::fabs(pieces[i] - fft[i]) > 1e-8) __builtin_trap();

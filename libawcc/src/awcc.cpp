@@ -1,5 +1,7 @@
 #include "awcc/awcc.hpp"
 
+#include "awcc/detail/awcc_steps.hpp"
+#include "awcc/order_statistics.hpp"
 #include "overlap_impulses.hpp"
 
 #include <algorithm>
@@ -18,9 +20,30 @@ std::string_view to_string(WindowFate fate) {
     case WindowFate::lag: return "lag";
     case WindowFate::roc: return "roc";
     case WindowFate::constant: return "constant";
+    case WindowFate::too_short: return "too_short";
   }
   return "?";
 }
+
+std::string_view to_string(Weighting weighting) { return weighting == Weighting::duration ? "duration" : "none"; }
+
+std::string_view to_string(CorrelationSignal signal) { return signal == CorrelationSignal::raw ? "raw" : "binary"; }
+
+std::string_view to_string(AwccStatus status) {
+  switch (status) {
+    case AwccStatus::ok: return "ok";
+    case AwccStatus::too_few_particles: return "too_few_particles";
+    case AwccStatus::delay_below_one_sample: return "delay_below_one_sample";
+    case AwccStatus::too_few_windows: return "too_few_windows";
+    case AwccStatus::no_tip_separation: return "no_tip_separation";
+  }
+  return "?";
+}
+
+AwccWorkspace::AwccWorkspace() : scratch_(std::make_unique<detail::AwccScratch>()) {}
+AwccWorkspace::~AwccWorkspace() = default;
+AwccWorkspace::AwccWorkspace(AwccWorkspace&&) noexcept = default;
+AwccWorkspace& AwccWorkspace::operator=(AwccWorkspace&&) noexcept = default;
 
 std::string AwccOptions::validate() const {
   if (np < 1 || np > 1000) return fmt::format("np = {}: particles per window must lie in [1, 1000]", np);
@@ -69,6 +92,8 @@ std::vector<AwccWindow> awcc_windows(const AirIntervals& leading, int np) {
   }
   return windows;
 }
+
+namespace detail {
 
 namespace {
 
@@ -122,9 +147,13 @@ std::vector<double> PiecewiseCorrelation::expand() const {
 }
 
 PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
-                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max) {
-  thread_local std::vector<AirInterval> a, b;
-  thread_local std::vector<double> ca, cb;
+                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max,
+                                                  AwccWorkspace& workspace) {
+  auto& scratch = workspace.scratch();
+  auto& a = scratch.clipped_x;
+  auto& b = scratch.clipped_y;
+  auto& ca = scratch.air_x;
+  auto& cb = scratch.air_y;
   PiecewiseCorrelation out;
   clip(x, start, length, a);
   clip(y, start, length, b);
@@ -144,8 +173,8 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
   // lag 0 where n = L - |k| turns) are marked on a byte per lag: cheaper than
   // sorting them.
   const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
-  thread_local std::vector<std::int32_t> impulse;
-  thread_local std::vector<std::uint8_t> mark;
+  auto& impulse = scratch.impulse;
+  auto& mark = scratch.mark;
   impulse.assign(lags, 0);
   mark.assign(lags + 8, 0);  // padding for the word-wise scan
   detail::OverlapImpulses<std::int32_t> sum{k_min, k_max, impulse, mark.data()};
@@ -210,12 +239,13 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
 }
 
 std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
-                                                 std::int64_t length, std::int64_t k_min, std::int64_t k_max) {
-  return window_correlation_piecewise(x, y, start, length, k_min, k_max).expand();
+                                                 std::int64_t length, std::int64_t k_min, std::int64_t k_max,
+                                                 AwccWorkspace& workspace) {
+  return window_correlation_piecewise(x, y, start, length, k_min, k_max, workspace).expand();
 }
 
 std::vector<double> window_correlation_fft(std::span<const double> x, std::span<const double> y, std::int64_t k_min,
-                                           std::int64_t k_max, FftPlanCache& plans) {
+                                           std::int64_t k_max, AwccWorkspace& workspace) {
   const std::size_t n = x.size();
   if (n == 0 || y.size() != n) return {};
   double mx = 0, my = 0;
@@ -234,8 +264,8 @@ std::vector<double> window_correlation_fft(std::span<const double> x, std::span<
   if (!(qx > 1e-20 * static_cast<double>(n) * (1.0 + mx * mx)) || !(qy > 1e-20 * static_cast<double>(n) * (1.0 + my * my)))
     return {};
   const std::size_t m = fast_fft_size(2 * n - 1);
-  FftPlan& plan = plans.get(m);
-  thread_local std::vector<std::complex<double>> xs;
+  FftPlan& plan = workspace.scratch().plans.get(m);
+  auto& xs = workspace.scratch().spectrum;
   auto r = plan.real();
   std::fill(r.begin(), r.end(), 0.0);
   for (std::size_t i = 0; i < n; ++i) r[i] = x[i] - mx;
@@ -262,14 +292,13 @@ namespace {
 // Local maxima (flat tops at the middle of their positions, as findpeaks /
 // scipy) and their prominences, for samples at increasing positions.
 template <class Position>
-std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double> r, Position position) {
+std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double> r, Position position,
+                                                        AwccScratch& scratch) {
   const std::size_t n = r.size();
   std::vector<std::pair<std::int64_t, double>> peaks;
   if (n < 3) return peaks;
-  struct Top {
-    std::size_t first, last;  // a flat top spans [first, last]
-  };
-  thread_local std::vector<Top> tops;
+  // A flat top spans [first, last].
+  auto& tops = scratch.tops;
   tops.clear();
   for (std::size_t i = 1; i + 1 < n; ++i) {
     if (!(r[i - 1] < r[i])) continue;
@@ -284,39 +313,37 @@ std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double>
   // strictly decreasing values whose entries carry the minimum of the samples
   // they covered. On a piecewise-linear function these minima sit at the
   // breakpoints, so its sampled form at the breakpoints gives the same bases.
-  thread_local std::vector<double> left, right;
+  auto& left = scratch.left;
+  auto& right = scratch.right;
   auto bases = [&](bool from_left, std::vector<double>& base) {
     base.resize(n);
-    struct Entry {
-      double value;
-      double gap_min;  // minimum over the samples between this entry and the next one up
-    };
-    thread_local std::vector<Entry> stack;
+    // (value, minimum over the samples between this entry and the next one up)
+    auto& stack = scratch.stack;
     stack.clear();
     double bottom_min = std::numeric_limits<double>::infinity();
     for (std::size_t step = 0; step < n; ++step) {
       const std::size_t i = from_left ? step : n - 1 - step;
       double covered = std::numeric_limits<double>::infinity();
-      while (!stack.empty() && stack.back().value <= r[i]) {
-        covered = std::min({covered, stack.back().value, stack.back().gap_min});
+      while (!stack.empty() && stack.back().first <= r[i]) {
+        covered = std::min({covered, stack.back().first, stack.back().second});
         stack.pop_back();
       }
       if (stack.empty()) {
         bottom_min = std::min(bottom_min, covered);
         base[i] = std::min(bottom_min, r[i]);
       } else {
-        stack.back().gap_min = std::min(stack.back().gap_min, covered);
-        base[i] = std::min(stack.back().gap_min, r[i]);
+        stack.back().second = std::min(stack.back().second, covered);
+        base[i] = std::min(stack.back().second, r[i]);
       }
-      stack.push_back({r[i], std::numeric_limits<double>::infinity()});
+      stack.emplace_back(r[i], std::numeric_limits<double>::infinity());
     }
   };
   bases(true, left);
   bases(false, right);
   for (const auto& t : tops) {
     // A flat top's bases are those of its outer ends.
-    const double prominence = r[t.first] - std::max(left[t.first], right[t.last]);
-    peaks.emplace_back((position(t.first) + position(t.last)) / 2, prominence);
+    const double prominence = r[t.first] - std::max(left[t.first], right[t.second]);
+    peaks.emplace_back((position(t.first) + position(t.second)) / 2, prominence);
   }
   return peaks;
 }
@@ -345,9 +372,10 @@ double secondary_peak_ratio(const std::vector<std::pair<std::int64_t, double>>& 
 // only those makes the prominence scan a few hundred points long. Positions
 // empty: the samples sit at 0, 1, 2, ...
 std::vector<std::pair<std::int64_t, double>> turning_point_prominences(std::span<const double> r,
-                                                                      std::span<const std::int64_t> positions) {
-  thread_local std::vector<double> turns;
-  thread_local std::vector<std::int64_t> where;
+                                                                      std::span<const std::int64_t> positions,
+                                                                      AwccScratch& scratch) {
+  auto& turns = scratch.turns;
+  auto& where = scratch.where;
   turns.clear();
   where.clear();
   auto position = [&](std::size_t i) { return positions.empty() ? static_cast<std::int64_t>(i) : positions[i]; };
@@ -365,7 +393,7 @@ std::vector<std::pair<std::int64_t, double>> turning_point_prominences(std::span
     turns.push_back(r.back());
     where.push_back(position(r.size() - 1));
   }
-  return prominences(std::span<const double>(turns), [&](std::size_t i) { return where[i]; });
+  return prominences(std::span<const double>(turns), [&](std::size_t i) { return where[i]; }, scratch);
 }
 
 double parabolic(double a, double b, double c) {
@@ -377,17 +405,20 @@ double parabolic(double a, double b, double c) {
 
 std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r) {
   std::vector<std::pair<std::size_t, double>> out;
-  for (const auto& [p, prominence] : prominences(r, [](std::size_t i) { return static_cast<std::int64_t>(i); }))
+  AwccScratch scratch;
+  for (const auto& [p, prominence] : prominences(r, [](std::size_t i) { return static_cast<std::int64_t>(i); }, scratch))
     out.emplace_back(static_cast<std::size_t>(p), prominence);
   return out;
 }
 
 std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const double> values,
                                                               std::span<const std::int64_t> positions) {
-  return prominences(values, [&](std::size_t i) { return positions[i]; });
+  AwccScratch scratch;
+  return prominences(values, [&](std::size_t i) { return positions[i]; }, scratch);
 }
 
-CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsample, double prominence_fraction) {
+CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsample, double prominence_fraction,
+                                    AwccWorkspace& workspace) {
   CorrelationPeak p;
   if (r.empty()) return p;
   p.index = static_cast<std::size_t>(std::max_element(r.begin(), r.end()) - r.begin());
@@ -396,7 +427,7 @@ CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsamp
   if (subsample == Subsample::parabolic && p.index > 0 && p.index + 1 < r.size()) {
     p.refined_index += parabolic(r[p.index - 1], r[p.index], r[p.index + 1]);
   }
-  const auto peaks = turning_point_prominences(r, {});
+  const auto peaks = turning_point_prominences(r, {}, workspace.scratch());
   std::vector<double> heights;
   heights.reserve(peaks.size());
   for (const auto& [i, prominence] : peaks) heights.push_back(r[static_cast<std::size_t>(i)]);
@@ -404,7 +435,8 @@ CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsamp
   return p;
 }
 
-CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample subsample, double prominence_fraction) {
+CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample subsample, double prominence_fraction,
+                                    AwccWorkspace& workspace) {
   CorrelationPeak p;
   if (r.empty()) return p;
   const auto j = static_cast<std::size_t>(std::max_element(r.values.begin(), r.values.end()) - r.values.begin());
@@ -415,7 +447,7 @@ CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample sub
   if (subsample == Subsample::parabolic && k > k_min && k < r.lags.back()) {
     p.refined_index += parabolic(r.at(k - 1), p.height, r.at(k + 1));
   }
-  const auto peaks = turning_point_prominences(r.values, r.lags);
+  const auto peaks = turning_point_prominences(r.values, r.lags, workspace.scratch());
   std::vector<double> heights;
   heights.reserve(peaks.size());
   for (const auto& [lag, prominence] : peaks) heights.push_back(r.at(lag));
@@ -432,13 +464,6 @@ int robust_outlier_cutoff(std::span<const double> u, std::vector<bool>& keep) {
       if (keep[i]) values.push_back(u[i]);
     const std::size_t n = values.size();
     if (n < 3) return iterations;
-    auto median = [](std::vector<double>& v) {
-      const std::size_t h = v.size() / 2;
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h), v.end());
-      const double upper = v[h];
-      if (v.size() % 2) return upper;
-      return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
-    };
     const double centre = median(values);
     deviations.clear();
     for (double v : values) deviations.push_back(std::fabs(v - centre));
@@ -488,9 +513,9 @@ void analyse_window(AwccWindow& w, const CorrelationPeak& p, bool constant, std:
 }
 
 void analyse_window(AwccWindow& w, std::span<const double> r, std::int64_t first_lag, double dx, double fs,
-                    const AwccOptions& options) {
+                    const AwccOptions& options, AwccWorkspace& workspace) {
   const CorrelationPeak p =
-      r.empty() ? CorrelationPeak{} : analyse_correlation(r, options.subsample, options.prominence_fraction);
+      r.empty() ? CorrelationPeak{} : analyse_correlation(r, options.subsample, options.prominence_fraction, workspace);
   analyse_window(w, p, r.empty(), first_lag, dx, fs, options);
 }
 
@@ -509,7 +534,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
   }
   result.windows_accepted = result.rejected_correlation = result.rejected_lag = result.rejected_roc =
-      result.rejected_constant = result.lag_zero_windows = 0;
+      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = 0;
   double sw = 0, swu = 0;
   for (const auto& w : windows) {
     switch (w.fate) {
@@ -518,6 +543,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       case WindowFate::lag: ++result.rejected_lag; break;
       case WindowFate::roc: ++result.rejected_roc; break;
       case WindowFate::constant: ++result.rejected_constant; break;
+      case WindowFate::too_short: ++result.rejected_too_short; break;
     }
     if (w.fate == WindowFate::lag && w.lag_samples == 0) ++result.lag_zero_windows;
     if (w.fate != WindowFate::accepted) continue;
@@ -525,23 +551,27 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     sw += weight;
     swu += weight * w.velocity;
   }
-  result.defined = false;
+  result.status = AwccStatus::too_few_windows;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
   if (result.windows_total == 0) {
-    result.reason = fmt::format("fewer than Np = {} particles on the leading tip: no window can be formed", options.np);
+    result.status = AwccStatus::too_few_particles;
+    result.message = fmt::format("fewer than Np = {} particles on the leading tip: no window can be formed", options.np);
     return;
   }
   if (result.windows_accepted < 2) {
     if (result.lag_zero_windows * 2 > result.windows_total) {
-      result.reason = "most windows peak at lag 0: the tip-to-tip delay is shorter than one sample, so the velocity "
-                      "cannot be resolved at this sampling rate (sample faster or use a larger dx)";
+      result.status = AwccStatus::delay_below_one_sample;
+      result.message = "most windows peak at lag 0: the tip-to-tip delay is shorter than one sample, so the velocity "
+                       "cannot be resolved at this sampling rate (sample faster or use a larger dx)";
     } else {
-      result.reason = fmt::format(
+      result.message = fmt::format(
           "{} of {} windows accepted ({} rejected by the correlation filter, {} by a non-positive lag, {} by the "
-          "outlier cutoff, {} constant): too few for statistics",
+          "outlier cutoff, {} constant{}): too few for statistics",
           result.windows_accepted, result.windows_total, result.rejected_correlation, result.rejected_lag,
-          result.rejected_roc, result.rejected_constant);
+          result.rejected_roc, result.rejected_constant,
+          result.rejected_too_short ? fmt::format(", {} too short for the velocity range", result.rejected_too_short)
+                                    : std::string());
     }
     return;
   }
@@ -554,8 +584,8 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   }
   const double rms = std::sqrt(swd / sw);
   const double n = static_cast<double>(result.windows_accepted);
-  result.defined = true;
-  result.reason.clear();
+  result.status = AwccStatus::ok;
+  result.message.clear();
   result.velocity = mean;
   result.velocity_rms = rms;
   result.turbulence_intensity = rms / mean;
@@ -568,23 +598,35 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.turbulence_intensity_ci95 = {tu - ht, tu + ht};
 }
 
+}  // namespace detail
+
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options) {
+  AwccWorkspace workspace;
+  return awcc(leading, trailing, dx, options, workspace);
+}
+
+AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options,
+                AwccWorkspace& workspace) {
+  using namespace detail;
   if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  if (options.signal != CorrelationSignal::binary) {
+    throw std::invalid_argument("AWCC of air intervals correlates binary signals; raw voltages need the recording");
+  }
   if (leading.sample_count != trailing.sample_count || leading.fs != trailing.fs) {
     throw std::invalid_argument("AWCC needs two signals of the same length and sampling rate");
   }
   AwccResult result;
   result.np = options.np;
+  result.options = options;
   result.windows = awcc_windows(leading, options.np);
   const double fs = leading.fs;
   const bool use_fft = options.path == CorrelationPath::fft;
-  FftPlanCache plans;
   std::vector<std::uint8_t> dense_x, dense_y;
   std::vector<double> xs, ys;
   for (auto& w : result.windows) {
     const auto [k_min, k_max] = awcc_lag_range(w.length, dx, fs, options);
     if (k_max < k_min) {
-      analyse_window(w, std::span<const double>{}, k_min, dx, fs, options);
+      w.fate = WindowFate::too_short;
       continue;
     }
     if (use_fft) {
@@ -595,16 +637,25 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
       trailing.render(w.start, dense_y);
       xs.assign(dense_x.begin(), dense_x.end());
       ys.assign(dense_y.begin(), dense_y.end());
-      analyse_window(w, window_correlation_fft(xs, ys, k_min, k_max, plans), k_min, dx, fs, options);
+      analyse_window(w, window_correlation_fft(xs, ys, k_min, k_max, workspace), k_min, dx, fs, options, workspace);
     } else {
-      const auto r = window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max);
-      const CorrelationPeak p =
-          r.empty() ? CorrelationPeak{} : analyse_correlation(r, options.subsample, options.prominence_fraction);
+      const auto r = window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max, workspace);
+      const CorrelationPeak p = r.empty() ? CorrelationPeak{}
+                                          : analyse_correlation(r, options.subsample, options.prominence_fraction,
+                                                                workspace);
       analyse_window(w, p, r.empty(), k_min, dx, fs, options);
     }
   }
   awcc_summarise(result, options);
+  if (!(dx > 0.0) && result.ok()) no_tip_separation(result);
   return result;
+}
+
+void detail::no_tip_separation(AwccResult& result) {
+  result.status = AwccStatus::no_tip_separation;
+  result.message = "no tip separation given: the velocity cannot be computed";
+  result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
+  result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
 }
 
 }  // namespace awcc

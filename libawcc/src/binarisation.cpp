@@ -1,5 +1,7 @@
 #include "awcc/binarisation.hpp"
 
+#include "awcc/errors.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -25,7 +27,9 @@ std::string BinarisationOptions::validate() const {
   if (!(hysteresis_low > 0.0 && hysteresis_low < hysteresis_high && hysteresis_high < 1.0))
     return fmt::format("hysteresis fractions {}, {} must satisfy 0 < low < high < 1", hysteresis_low, hysteresis_high);
   if (!(bin_width >= 0.0 && std::isfinite(bin_width))) return fmt::format("histogram bin width {} V must be >= 0", bin_width);
-  if (!std::isfinite(fixed_threshold)) return "the fixed threshold must be finite";
+  if (rule == ThresholdRule::fixed && !fixed_threshold)
+    return "the fixed threshold rule needs a threshold voltage (e.g. 2.5V)";
+  if (fixed_threshold && !std::isfinite(*fixed_threshold)) return "the fixed threshold must be finite";
   return {};
 }
 
@@ -45,7 +49,7 @@ void VoltageHistogram::grow(std::int64_t index) {
   const std::int64_t new_lo = index < offset_ ? lo - extra : lo;
   const std::int64_t new_size = span + extra;
   if (new_size > (std::int64_t{1} << 26)) {
-    throw std::runtime_error(fmt::format(
+    throw InputError(fmt::format(
         "the signal spans more than {} V at a resolution of {} V: the values are not a probe voltage (wrong scale "
         "or damaged data)",
         static_cast<double>(new_size) * width_, width_));
@@ -148,7 +152,7 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
   }
   const bool air_low = o.probe == ProbeType::conductivity;
   if (o.rule == ThresholdRule::fixed) {
-    t.threshold = t.lower = t.upper = o.fixed_threshold;
+    t.threshold = t.lower = t.upper = o.fixed_threshold.value_or(0.0);
     return t;
   }
   double width = o.bin_width;
@@ -158,7 +162,7 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
     else width = (hi - lo) / 100.0;
   }
   if (!(width > 0.0)) {
-    throw std::runtime_error("the signal has no spread: no threshold can be found");
+    throw InputError("the signal has no spread: no threshold can be found", "threshold");
   }
   const auto bins = h.regroup(width);
   if (bins.size() == 1) {
@@ -187,10 +191,10 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
     }
   }
   if (low_mode.count < 0 || high_mode.count < 0) {
-    throw std::runtime_error(fmt::format(
-        "no {} mode found: the voltage histogram has no populated bin {} {:.3f} V; use --threshold-rule fixed "
-        "with a --threshold voltage",
-        low_mode.count < 0 ? "low" : "high", low_mode.count < 0 ? "below" : "above", split));
+    throw InputError(fmt::format("no {} mode found: the voltage histogram has no populated bin {} {:.3f} V; use a "
+                                 "fixed threshold voltage",
+                                 low_mode.count < 0 ? "low" : "high", low_mode.count < 0 ? "below" : "above", split),
+                     "threshold");
   }
   auto level = [&](std::int64_t bin) {
     return o.rule == ThresholdRule::felder ? static_cast<double>(bin + 1) * width

@@ -1,5 +1,6 @@
 #include "awcc/fscc.hpp"
 
+#include "awcc/detail/fscc_steps.hpp"
 #include "overlap_impulses.hpp"
 
 #include <algorithm>
@@ -14,6 +15,24 @@ std::string FsccOptions::validate() const {
   if (!felder_lags && !(max_lag > 0.0 && std::isfinite(max_lag))) return fmt::format("max lag {} s must be > 0", max_lag);
   return {};
 }
+
+std::string_view to_string(Subsample subsample) { return subsample == Subsample::parabolic ? "parabolic" : "none"; }
+
+std::string_view to_string(FsccStatus status) {
+  switch (status) {
+    case FsccStatus::ok: return "ok";
+    case FsccStatus::constant_leading: return "constant_leading";
+    case FsccStatus::constant_trailing: return "constant_trailing";
+    case FsccStatus::no_common_segment: return "no_common_segment";
+    case FsccStatus::no_positive_peak: return "no_positive_peak";
+    case FsccStatus::non_positive_lag: return "non_positive_lag";
+    case FsccStatus::peak_at_lag_range_end: return "peak_at_lag_range_end";
+    case FsccStatus::no_tip_separation: return "no_tip_separation";
+  }
+  return "?";
+}
+
+namespace detail {
 
 std::int64_t air_samples_in(const AirIntervals& s, std::int64_t a, std::int64_t b) {
   a = std::max<std::int64_t>(a, 0);
@@ -120,7 +139,11 @@ std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y
   return lagged_products_by_fft(x, y, t0, t1, k_min, k_max, plans);
 }
 
+}  // namespace detail
+
 namespace {
+
+using detail::lagged_products;
 
 // Air samples before any sample index in O(log n): cumulative chord lengths.
 class AirPrefix {
@@ -151,8 +174,8 @@ class AirPrefix {
 struct Functions {
   std::vector<double> r11, r12;
   std::int64_t k11_min = 0, k12_min = 0;
-  bool defined = true;
-  std::string reason;
+  FsccStatus status = FsccStatus::ok;  // ok: the functions exist
+  std::string message;
 };
 
 // Full-record normalised correlations (METHOD 3).
@@ -167,8 +190,8 @@ Functions full_record(const AirIntervals& x, const AirIntervals& y, std::int64_t
   // Sum of squares of a mean-removed 0/1 signal: n m (1 - m).
   const double qx = static_cast<double>(n) * mx * (1 - mx), qy = static_cast<double>(n) * my * (1 - my);
   if (!(qx > 0.0) || !(qy > 0.0)) {
-    f.defined = false;
-    f.reason = qx > 0.0 ? "the trailing tip's signal is constant (no bubble)" : "the leading tip's signal is constant (no bubble)";
+    f.status = qx > 0.0 ? FsccStatus::constant_trailing : FsccStatus::constant_leading;
+    f.message = qx > 0.0 ? "the trailing tip's signal is constant (no bubble)" : "the leading tip's signal is constant (no bubble)";
     return f;
   }
   const AirPrefix px(x), py(y);
@@ -233,8 +256,8 @@ Functions segmented(const AirIntervals& x, const AirIntervals& y, int segments, 
     used12 += pearson(x, y, px, py, s0, k12_min, k12_max, f.r12);
   }
   if (used11 == 0 || used12 == 0) {
-    f.defined = false;
-    f.reason = "no segment holds bubbles on both tips";
+    f.status = FsccStatus::no_common_segment;
+    f.message = "no segment holds bubbles on both tips";
     return f;
   }
   for (auto& v : f.r11) v /= used11;
@@ -304,8 +327,9 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   out.r12 = std::move(f.r12);
   out.r11_first_lag = f.k11_min;
   out.r12_first_lag = f.k12_min;
-  if (!f.defined) {
-    out.reason = f.reason;
+  if (f.status != FsccStatus::ok) {
+    out.status = f.status;
+    out.message = f.message;
     return out;
   }
   // Peak: the maximum (first occurrence), or Felder's first lag within 1e-5 of it.
@@ -329,15 +353,21 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   }
   out.lag = lag / fs;
   if (!(out.r12_max > 0.0)) {
-    out.reason = "the cross-correlation has no positive peak: the tips' signals are unrelated";
+    out.status = FsccStatus::no_positive_peak;
+    out.message = "the cross-correlation has no positive peak: the tips' signals are unrelated";
   } else if (out.lag_samples <= 0) {
-    out.reason = fmt::format("the cross-correlation peaks at lag {} samples (not positive): no physical velocity; "
-                             "check the tip order (--leading-channel/--trailing-channel)",
-                             out.lag_samples);
+    out.status = FsccStatus::non_positive_lag;
+    out.message = fmt::format("the cross-correlation peaks at lag {} samples (not positive): no physical velocity; "
+                              "check the tip order",
+                              out.lag_samples);
   } else if (out.lag_samples == f.k12_min + static_cast<std::int64_t>(out.r12.size()) - 1) {
-    out.reason = "the cross-correlation peaks at the end of the lag range; widen --max-lag";
+    out.status = FsccStatus::peak_at_lag_range_end;
+    out.message = "the cross-correlation peaks at the end of the lag range; widen the lag range";
+  } else if (!(dx > 0.0)) {
+    out.status = FsccStatus::no_tip_separation;
+    out.message = "no tip separation given: the velocity cannot be computed";
   } else {
-    out.defined = true;
+    out.status = FsccStatus::ok;
     out.velocity = dx / out.lag;
   }
   // Time scales.
@@ -353,7 +383,7 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     else if (left) out.tau05 = (static_cast<double>(peak) - *left) / fs;
     if (auto i = integral_to_zero(out.r12, peak)) out.txy = *i / fs;
   }
-  if (out.defined && out.t05 && out.tau05) {
+  if (out.ok() && out.t05 && out.tau05) {
     if (*out.tau05 > *out.t05) {
       out.turbulence_intensity_chanson = 0.851 * std::sqrt(*out.tau05 * *out.tau05 - *out.t05 * *out.t05) / out.lag;
     } else {

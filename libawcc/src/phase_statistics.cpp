@@ -3,17 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "awcc/order_statistics.hpp"
+
 namespace awcc {
 namespace {
 
-double quantile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0.0;
-  const double pos = p * static_cast<double>(sorted.size() - 1);
-  const auto k = static_cast<std::size_t>(std::floor(pos));
-  const double frac = pos - static_cast<double>(k);
-  if (k + 1 >= sorted.size()) return sorted.back();
-  return sorted[k] + frac * (sorted[k + 1] - sorted[k]);
-}
+double quantile(const std::vector<double>& sorted, double p) { return quantile_of_sorted(sorted, p); }
 
 Histogram histogram_of(const std::vector<double>& sorted, int bins) {
   Histogram h;

@@ -5,6 +5,9 @@
 #include <fmt/format.h>
 #include <stdexcept>
 
+#include "awcc/detail/awcc_steps.hpp"
+#include "awcc/errors.hpp"
+
 namespace awcc {
 
 std::string ProcessOptions::validate() const {
@@ -39,7 +42,7 @@ void binarise_two_pass(Recording& recording, const ProcessOptions& options, cons
     h_trail.add(used, ch.trail, ch.stride);
     frames += n;
   }
-  if (frames == 0) throw std::runtime_error(fmt::format("{}: the recording holds no samples", path.string()));
+  if (frames == 0) throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
   out.leading_threshold = choose_threshold(h_lead, bopt);
   out.trailing_threshold = choose_threshold(h_trail, bopt);
   recording.rewind();
@@ -54,7 +57,7 @@ void binarise_two_pass(Recording& recording, const ProcessOptions& options, cons
   out.leading = b_lead.finish();
   out.trailing = b_trail.finish();
   if (out.leading.sample_count != frames) {
-    throw std::runtime_error(fmt::format("{}: the second reading gave {} frames instead of {}; the file changed while "
+    throw InputError(fmt::format("{}: the second reading gave {} frames instead of {}; the file changed while "
                                          "being read",
                                          path.string(), out.leading.sample_count, frames));
   }
@@ -173,7 +176,7 @@ std::optional<std::pair<std::int16_t, std::int16_t>> band_from(const std::int16_
                                                                 double quantum, const BinarisationOptions& bopt) {
   if (bopt.rule == ThresholdRule::fixed) {
     // The threshold is known: a band of one count around it.
-    const double c = bopt.fixed_threshold / quantum;
+    const double c = bopt.fixed_threshold.value_or(0.0) / quantum;
     if (!(std::fabs(c) < 32000.0)) return std::nullopt;
     return std::pair{static_cast<std::int16_t>(std::floor(c) - 1), static_cast<std::int16_t>(std::ceil(c) + 1)};
   }
@@ -210,10 +213,10 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
   const int channels = info.channels;
   for (int c : {options.leading_channel, options.trailing_channel}) {
     if (c >= channels) {
-      throw std::runtime_error(fmt::format(
-          "{}: channel {} requested but the recording has {} channel{} (numbered from 0); choose "
-          "--leading-channel/--trailing-channel within range",
-          path.string(), c, channels, channels == 1 ? "" : "s"));
+      throw InputError(fmt::format("{}: channel {} requested but the recording has {} channel{} (numbered from 0); "
+                                   "choose the tips' channels within range",
+                                   path.string(), c, channels, channels == 1 ? "" : "s"),
+                       "channels");
     }
   }
   const ChannelSelection ch{static_cast<std::size_t>(channels), static_cast<std::size_t>(options.leading_channel),
@@ -248,13 +251,13 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
       if (!done) recording->rewind();
     }
     if (!done) binarise_two_pass(*recording, options, bopt, ch, out);
-  } catch (const std::runtime_error& e) {
+  } catch (const InputError& e) {
     const std::string what = e.what();
     if (what.rfind(path.string(), 0) == 0) throw;
-    throw std::runtime_error(fmt::format("{}: {}", path.string(), what));
+    throw InputError(fmt::format("{}: {}", path.string(), what), e.quantity());
   }
   if (out.leading.sample_count == 0) {
-    throw std::runtime_error(fmt::format("{}: the recording holds no samples", path.string()));
+    throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
   }
   out.info.frames = out.leading.sample_count;
   return out;
@@ -264,8 +267,8 @@ std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOpt
                                    std::optional<double> velocity);
 
 std::optional<double> ProcessResult::velocity() const {
-  if (awcc && awcc->defined) return awcc->velocity;
-  if (fscc && fscc->defined) return fscc->velocity;
+  if (awcc && awcc->ok()) return awcc->velocity;
+  if (fscc && fscc->ok()) return fscc->velocity;
   return std::nullopt;
 }
 
@@ -274,21 +277,9 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   out.info = r.info;
   out.dx = options.dx;
   out.dy = options.dy;
-  const std::string no_dx = "no tip separation given (--dx): the velocity cannot be computed";
-  if (options.fscc) {
-    out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options);
-    if (!(options.dx > 0.0) && out.fscc->defined) {
-      out.fscc->defined = false;
-      out.fscc->reason = no_dx;
-      out.fscc->velocity = 0.0;
-    }
-  }
-  if (options.awcc && !options.correlate_raw) {
+  if (options.fscc) out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options);
+  if (options.awcc && options.awcc_options.signal == CorrelationSignal::binary) {
     out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);
-    if (!(options.dx > 0.0)) {
-      out.awcc->defined = false;
-      out.awcc->reason = no_dx;
-    }
   }
   out.tips = tip_results(r, options, out.velocity());
   return out;
@@ -308,6 +299,7 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
   if (auto why = ao.validate(); !why.empty()) throw std::invalid_argument(why);
   AwccResult result;
   result.np = ao.np;
+  result.options = ao;
   result.windows = awcc_windows(b.leading, ao.np);
   auto recording = open_recording(path, options.reader);
   const auto stride = static_cast<std::size_t>(recording->info().channels);
@@ -315,7 +307,7 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
   const auto trail = static_cast<std::size_t>(options.trailing_channel);
   std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
   std::vector<double> xs, ys;
-  FftPlanCache plans;
+  AwccWorkspace workspace;
   const double fs = b.info.fs;
   std::int64_t position = 0, in_block = 0, block_start = 0;
   std::size_t w = 0;
@@ -326,7 +318,7 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
       block_start += in_block;
       in_block = recording->read(block, options.block_frames);
       if (in_block == 0) {
-        throw std::runtime_error(fmt::format("{}: the recording ended at frame {} while reading it again for AWCC",
+        throw InputError(fmt::format("{}: the recording ended at frame {} while reading it again for AWCC",
                                              path.string(), position));
       }
       continue;
@@ -340,207 +332,32 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
     }
     position += take;
     if (position == end) {
-      const auto [k_min, k_max] = awcc_lag_range(window.length, options.dx, fs, ao);
-      std::vector<double> r;
-      if (k_max >= k_min) r = window_correlation_fft(xs, ys, k_min, k_max, plans);
-      analyse_window(window, r, k_min, options.dx, fs, ao);
+      const auto [k_min, k_max] = detail::awcc_lag_range(window.length, options.dx, fs, ao);
+      if (k_max < k_min) {
+        window.fate = WindowFate::too_short;
+      } else {
+        const auto r = detail::window_correlation_fft(xs, ys, k_min, k_max, workspace);
+        detail::analyse_window(window, r, k_min, options.dx, fs, ao, workspace);
+      }
       xs.clear();
       ys.clear();
       ++w;
     }
   }
-  awcc_summarise(result, ao);
+  detail::awcc_summarise(result, ao);
+  if (!(options.dx > 0.0) && result.ok()) detail::no_tip_separation(result);
   return result;
-}
-
-std::string awcc_windows_csv(const AwccResult& result) {
-  std::string out = "start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate\n";
-  for (const auto& w : result.windows) {
-    out += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.9g},{:.6f},{:.6f},{:.6f},{:.6g},{}\n", w.start_time, w.duration,
-                       w.particles, w.lag, w.velocity, w.r12_max, w.spr, w.void_fraction, w.count_rate,
-                       to_string(w.fate));
-  }
-  return out;
 }
 
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const auto binarised = binarise_recording(path, options);
   ProcessResult out = process_binarised(binarised, options);
-  if (options.awcc && options.correlate_raw) {
+  if (options.awcc && options.awcc_options.signal == CorrelationSignal::raw) {
     out.awcc = awcc_raw(path, binarised, options);
-    if (!(options.dx > 0.0)) {
-      out.awcc->defined = false;
-      out.awcc->reason = "no tip separation given (--dx): the velocity cannot be computed";
-    }
     out.tips = tip_results(binarised, options, out.velocity());
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
-}
-
-namespace {
-
-using nlohmann::json;
-
-json optional(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-
-json ci(const Interval95& i) { return json::array({i.lower, i.upper}); }
-
-json summary(const Summary& s) {
-  json pct = json::object();
-  for (std::size_t i = 0; i < s.percentiles.size(); ++i) pct[fmt::format("{:g}", Summary::levels[i])] = s.percentiles[i];
-  return json{{"count", s.count}, {"mean", s.mean},       {"median", s.median},         {"std", s.std},
-              {"min", s.min},     {"max", s.max},         {"percentiles", pct},         {"mean_ci95", ci(s.mean_ci95)},
-              {"median_ci95", ci(s.median_ci95)}};
-}
-
-json histogram(const Histogram& h) { return json{{"bin_width", h.bin_width}, {"counts", h.counts}}; }
-
-}  // namespace
-
-json to_json(const ProcessResult& r) {
-  json tips = json::array();
-  for (const auto& t : r.tips) {
-    const auto& p = t.phase;
-    json tip{
-        {"channel", t.channel},
-        {"threshold", t.threshold.threshold},
-        {"threshold_rule", std::string(to_string(t.threshold.rule))},
-        {"threshold_lower", t.threshold.lower},
-        {"threshold_upper", t.threshold.upper},
-        {"air_level", t.threshold.air_level},
-        {"water_level", t.threshold.water_level},
-        {"binary_input", t.threshold.binary_input},
-        {"void_fraction", p.void_fraction},
-        {"void_fraction_ci95", ci(p.void_fraction_ci95)},
-        {"bubble_count_rate", p.bubble_count_rate},
-        {"bubble_count_rate_ci95", ci(p.bubble_count_rate_ci95)},
-        {"chord_time_mean", p.air_chord_time.mean},
-        {"chord_time_median", p.air_chord_time.median},
-        {"air_chord_time", summary(p.air_chord_time)},
-        {"water_chord_time", summary(p.water_chord_time)},
-        {"interarrival_time", summary(p.interarrival_time)},
-        {"air_chord_time_histogram", histogram(p.air_chord_histogram)},
-        {"water_chord_time_histogram", histogram(p.water_chord_histogram)},
-        {"chord_length", p.air_chord_length ? summary(*p.air_chord_length) : json(nullptr)},
-        {"sauter_diameter", optional(p.sauter_diameter)},
-    };
-    if (!t.threshold.note.empty()) tip["threshold_note"] = t.threshold.note;
-    tips.push_back(tip);
-  }
-  json out{
-      {"file", r.info.path.string()},
-      {"format", r.info.description},
-      {"fs", r.info.fs},
-      {"samples", r.info.frames},
-      {"duration", r.info.fs > 0 ? static_cast<double>(r.info.frames) / r.info.fs : 0.0},
-      {"dx", r.dx},
-      {"dy", r.dy},
-      {"tips", tips},
-  };
-  if (r.fscc) {
-    const auto& f = *r.fscc;
-    out["fscc"] = json{
-        {"defined", f.defined},
-        {"reason", f.defined ? json(nullptr) : json(f.reason)},
-        {"velocity", f.defined ? json(f.velocity) : json(nullptr)},
-        {"lag", f.lag},
-        {"lag_samples", f.lag_samples},
-        {"r12_max", f.r12_max},
-        {"t05", optional(f.t05)},
-        {"tau05", optional(f.tau05)},
-        {"txx", optional(f.txx)},
-        {"txy", optional(f.txy)},
-        {"turbulence_intensity_chanson", optional(f.turbulence_intensity_chanson)},
-        {"note", f.note.empty() ? json(nullptr) : json(f.note)},
-    };
-  }
-  if (r.awcc) {
-    const auto& a = *r.awcc;
-    auto value = [&](double v) { return a.defined ? json(v) : json(nullptr); };
-    auto interval = [&](const Interval95& i) { return a.defined ? ci(i) : json(nullptr); };
-    out["awcc"] = json{
-        {"defined", a.defined},
-        {"reason", a.defined ? json(nullptr) : json(a.reason)},
-        {"np", a.np},
-        {"velocity", value(a.velocity)},
-        {"velocity_ci95", interval(a.velocity_ci95)},
-        {"velocity_rms", value(a.velocity_rms)},
-        {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
-        {"turbulence_intensity", value(a.turbulence_intensity)},
-        {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
-        {"windows_total", a.windows_total},
-        {"windows_accepted", a.windows_accepted},
-        {"windows_rejected_correlation", a.rejected_correlation},
-        {"windows_rejected_lag", a.rejected_lag},
-        {"windows_rejected_roc", a.rejected_roc},
-        {"windows_rejected_constant", a.rejected_constant},
-        {"windows_lag_zero", a.lag_zero_windows},
-        {"roc_iterations", a.roc_iterations},
-    };
-  }
-  return out;
-}
-
-std::string ProcessResult::report() const {
-  std::string out;
-  auto line = [&out](const std::string& s) { out += s + "\n"; };
-  line(fmt::format("{}: {}, {} channels, {:.6g} Hz, {} samples ({:.3f} s)", info.path.string(), info.description,
-                   info.channels, info.fs, info.frames, info.fs > 0 ? static_cast<double>(info.frames) / info.fs : 0.0));
-  const char* names[2] = {"leading", "trailing"};
-  for (std::size_t i = 0; i < tips.size(); ++i) {
-    const auto& t = tips[i];
-    const auto& p = t.phase;
-    line(fmt::format("  {} tip (channel {}): threshold {:.4f} V ({}{}), air {:.4f} V, water {:.4f} V", names[i % 2],
-                     t.channel, t.threshold.threshold, to_string(t.threshold.rule),
-                     t.threshold.binary_input ? ", binary input" : "", t.threshold.air_level, t.threshold.water_level));
-    line(fmt::format("    void fraction        {:.5f}  (95 % CI {:.5f} - {:.5f})", p.void_fraction,
-                     p.void_fraction_ci95.lower, p.void_fraction_ci95.upper));
-    line(fmt::format("    bubble count rate    {:.3f} /s  (95 % CI {:.3f} - {:.3f}), {} complete chords",
-                     p.bubble_count_rate, p.bubble_count_rate_ci95.lower, p.bubble_count_rate_ci95.upper,
-                     p.air_chord_time.count));
-    line(fmt::format("    air chord time       mean {:.4f} ms, median {:.4f} ms, std {:.4f} ms", p.air_chord_time.mean * 1e3,
-                     p.air_chord_time.median * 1e3, p.air_chord_time.std * 1e3));
-    line(fmt::format("    water chord time     mean {:.4f} ms, median {:.4f} ms", p.water_chord_time.mean * 1e3,
-                     p.water_chord_time.median * 1e3));
-    if (p.air_chord_length) {
-      line(fmt::format("    air chord length     mean {:.4f} mm, median {:.4f} mm", p.air_chord_length->mean * 1e3,
-                       p.air_chord_length->median * 1e3));
-    }
-    if (p.sauter_diameter) line(fmt::format("    Sauter diameter d32  {:.4f} mm", *p.sauter_diameter * 1e3));
-    if (!t.threshold.note.empty()) line("    note: " + t.threshold.note);
-  }
-  if (fscc) {
-    const auto& f = *fscc;
-    if (f.defined) {
-      line(fmt::format("  FSCC: velocity {:.4f} m/s (dx {:.3f} mm / lag {:.4f} ms), R12max {:.4f}", f.velocity, dx * 1e3,
-                       f.lag * 1e3, f.r12_max));
-    } else {
-      line(fmt::format("  FSCC: velocity undefined: {}", f.reason));
-    }
-    auto ms = [](const std::optional<double>& v) { return v ? fmt::format("{:.4f} ms", *v * 1e3) : std::string("n/a"); };
-    line(fmt::format("        T05 {}, tau05 {}, Txx {}, Txy {}", ms(f.t05), ms(f.tau05), ms(f.txx), ms(f.txy)));
-    line(fmt::format("        Chanson turbulence intensity {}",
-                     f.turbulence_intensity_chanson ? fmt::format("{:.4f}", *f.turbulence_intensity_chanson)
-                                                    : std::string("n/a")));
-    if (!f.note.empty()) line("        note: " + f.note);
-  }
-  if (awcc) {
-    const auto& a = *awcc;
-    if (a.defined) {
-      line(fmt::format("  AWCC: velocity {:.4f} m/s (95 % CI {:.4f} - {:.4f}), u_rms {:.4f} m/s, Tu {:.4f} (95 % CI "
-                       "{:.4f} - {:.4f})",
-                       a.velocity, a.velocity_ci95.lower, a.velocity_ci95.upper, a.velocity_rms,
-                       a.turbulence_intensity, a.turbulence_intensity_ci95.lower, a.turbulence_intensity_ci95.upper));
-    } else {
-      line(fmt::format("  AWCC: undefined: {}", a.reason));
-    }
-    line(fmt::format("        windows {} accepted of {} (rejected: {} correlation, {} lag, {} outlier cutoff, {} "
-                     "constant)",
-                     a.windows_accepted, a.windows_total, a.rejected_correlation, a.rejected_lag, a.rejected_roc,
-                     a.rejected_constant));
-  }
   return out;
 }
 

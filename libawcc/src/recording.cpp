@@ -7,10 +7,12 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <sndfile.h>
 #include <stdexcept>
 #include <vector>
+
+#include "awcc/errors.hpp"
+#include "awcc/order_statistics.hpp"
 
 namespace awcc {
 
@@ -43,8 +45,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const fs::path& path, std::string_view what) {
-  throw std::runtime_error(fmt::format("{}: {}", path.string(), what));
+// `quantity` names the reader setting that fixes the problem (InputError::quantity).
+[[noreturn]] void fail(const fs::path& path, std::string_view what, std::string quantity = {}) {
+  throw InputError(fmt::format("{}: {}", path.string(), what), std::move(quantity));
 }
 
 std::string lower_extension(const fs::path& p) {
@@ -74,7 +77,7 @@ class SndfileRecording final : public Recording {
     SF_INFO sf{};
     file_ = sf_open(path.c_str(), SFM_READ, &sf);
     if (!file_) {
-      fail(path, fmt::format("not a readable audio file (libsndfile: {}); check the file or give --format", 
+      fail(path, fmt::format("not a readable audio file (libsndfile: {}); check the file or state its format", 
                              sf_strerror(nullptr)));
     }
     if (sf.channels <= 0 || sf.samplerate <= 0) fail(path, "the audio header has no channels or no sampling rate");
@@ -98,8 +101,7 @@ class SndfileRecording final : public Recording {
     int16_ = bits == 16;
     // Values as counts for integer data, as stored for floating data.
     sf_command(file_, SFC_SET_NORM_FLOAT, nullptr, SF_FALSE);
-    double vpc = options.volts_per_count;
-    if (vpc <= 0.0) vpc = sidecar_volts_per_count(path);
+    const double vpc = options.volts_per_count;
     info_.volts_known = vpc > 0.0 || floating_;
     if (floating_) {
       scale_ = vpc > 0.0 ? vpc : 1.0;
@@ -153,21 +155,6 @@ class SndfileRecording final : public Recording {
   }
 
  private:
-  static double sidecar_volts_per_count(const fs::path& path) {
-    fs::path side = path;
-    side.replace_extension();
-    side += ".truth.json";
-    std::ifstream in(side);
-    if (!in) return 0.0;
-    try {
-      const auto j = nlohmann::json::parse(in);
-      const auto& v = j.at("recording").at("volts_per_count");
-      return v.is_number() ? v.get<double>() : 0.0;
-    } catch (const std::exception&) {
-      return 0.0;
-    }
-  }
-
   SNDFILE* file_ = nullptr;
   bool floating_ = false;
   bool int16_ = false;
@@ -303,8 +290,8 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   const auto channels = load<std::int32_t>(header + 4, std::endian::native == std::endian::big);
   if (rows <= 0 || channels <= 0 || channels > 64) {
     fail(path, fmt::format("the .dat header says {} rows and {} channels, which is not a UQ .dat header; if the file "
-                           "is headerless, read it with --format raw and its layout",
-                           rows, channels));
+                           "is headerless, read it as a raw file with its layout",
+                           rows, channels), "format");
   }
   const std::uintmax_t expected = 8 + static_cast<std::uintmax_t>(rows) * static_cast<std::uintmax_t>(channels) * 2;
   if (size < expected) {
@@ -314,8 +301,8 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   }
   if (size > expected) {
     fail(path, fmt::format("the .dat header announces {} rows x {} channels ({} bytes) but the file has {} bytes: the "
-                           "header does not describe the data; check the acquisition or read it with --format raw",
-                           rows, channels, expected, size));
+                           "header does not describe the data; check the acquisition or read it as a raw file with its layout",
+                           rows, channels, expected, size), "format");
   }
   RawLayout layout;
   layout.sample_type = SampleType::int16;
@@ -329,7 +316,7 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   info.channels = channels;
   info.fs = options.fs;
   if (!(info.fs > 0.0)) {
-    fail(path, "a .dat file does not store its sampling rate; give it with --fs (e.g. --fs 20kHz)");
+    fail(path, "a .dat file does not store its sampling rate; state it (e.g. 20 kHz)", "fs");
   }
   info.frames = rows;
   info.quantum = layout.volts_per_count;
@@ -343,13 +330,13 @@ std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& o
   if (layout.header_bytes < 0 || static_cast<std::uintmax_t>(layout.header_bytes) > size) {
     fail(path, fmt::format("raw layout: {} header bytes to skip, but the file has {} bytes", layout.header_bytes, size));
   }
-  if (!(options.fs > 0.0)) fail(path, "a raw file does not store its sampling rate; give it with --fs (e.g. --fs 500kHz)");
+  if (!(options.fs > 0.0)) fail(path, "a raw file does not store its sampling rate; state it (e.g. 500 kHz)", "fs");
   const std::uintmax_t data = size - static_cast<std::uintmax_t>(layout.header_bytes);
   const std::uintmax_t frame = sample_size(layout.sample_type) * static_cast<std::uintmax_t>(layout.channels);
   if (data % frame != 0) {
     fail(path, fmt::format("raw layout: {} data bytes are not a whole number of {}-byte frames ({} channels of {}); "
-                           "check --raw-channels, --raw-type and --raw-header",
-                           data, frame, layout.channels, to_string(layout.sample_type)));
+                           "check the raw layout (channels, sample type, header bytes)",
+                           data, frame, layout.channels, to_string(layout.sample_type)), "raw_layout");
   }
   if (data == 0) fail(path, "the raw file holds no samples");
   RecordingInfo info;
@@ -469,7 +456,7 @@ class CsvRecording final : public Recording {
       }
     }
     if (time_column_ >= columns_) {
-      fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_));
+      fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_), "time_column");
     }
     line_ = header ? 1 : 0;
     if (!header) {
@@ -485,8 +472,7 @@ class CsvRecording final : public Recording {
     } else if (time_column_ >= 0) {
       info_.fs = fs_from_time_column();
     } else {
-      fail(path, "the CSV file has no time column; give the sampling rate with --fs, or name a time column with "
-                 "--time-column");
+      fail(path, "the CSV file has no time column; state the sampling rate, or name the time column", "fs");
     }
     info_.volts_known = true;
     info_.quantum = 0.0;
@@ -543,12 +529,11 @@ class CsvRecording final : public Recording {
       if (static_cast<int>(cells.size()) != columns_ || !parse_number(cells[static_cast<std::size_t>(time_column_)], t)) break;
       times.push_back(t);
     }
-    if (times.size() < 2) fail(info_.path, "too few rows to take the sampling rate from the time column; give --fs");
+    if (times.size() < 2) fail(info_.path, "too few rows to take the sampling rate from the time column; state the sampling rate", "fs");
     std::vector<double> steps;
     for (std::size_t i = 1; i < times.size(); ++i) steps.push_back(times[i] - times[i - 1]);
-    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
-    const double dt = steps[steps.size() / 2];
-    if (!(dt > 0.0)) fail(info_.path, "the time column does not increase; give --fs or fix the column");
+    const double dt = median(steps);
+    if (!(dt > 0.0)) fail(info_.path, "the time column does not increase; state the sampling rate or fix the column", "fs");
     return 1.0 / dt;
   }
 
@@ -601,7 +586,7 @@ std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOpti
       format = InputFormat::sndfile;
     else if (ext == ".raw" || ext == ".bin" || ext == ".pcm") format = InputFormat::raw;
     else if (ext == ".csv" || ext == ".tsv" || ext == ".txt" || looks_like_text(path)) format = InputFormat::csv;
-    else fail(path, "cannot tell the recording's format from its name or content; give --format sndfile|dat|raw|csv");
+    else fail(path, "cannot tell the recording's format from its name or content; state the format (sndfile, dat, raw or csv)", "format");
   }
   switch (format) {
     case InputFormat::sndfile: return std::make_unique<SndfileRecording>(path, options);

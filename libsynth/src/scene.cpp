@@ -5,7 +5,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <stdexcept>
-#include <toml++/toml.h>
+#include "awcc/settings_file.hpp"
 
 namespace synth {
 
@@ -16,6 +16,16 @@ using awcc::parse_quantity;
 std::vector<Vec3> Scene::probe_tips() const {
   if (!tips.empty()) return tips;
   return {Vec3{0.0, 0.0, 0.0}, Vec3{dx, dy, dz}};
+}
+
+double Scene::streamwise_separation() const {
+  const auto p = probe_tips();
+  return p.size() < 2 ? 0.0 : p[1].x - p[0].x;
+}
+
+double Scene::lateral_separation() const {
+  const auto p = probe_tips();
+  return p.size() < 2 ? 0.0 : std::hypot(p[1].y - p[0].y, p[1].z - p[0].z);
 }
 
 double Scene::time_scale_of(int component) const {
@@ -333,66 +343,24 @@ void set_scene_field(Scene& scene, std::string_view name, std::string_view text)
   throw std::invalid_argument(fmt::format("unknown scene field '{}'", name));
 }
 
-namespace {
-
-std::string node_text(const toml::node& node, std::string_view key) {
-  if (const auto* s = node.as_string()) return std::string(s->get());
-  if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
-  if (const auto* d = node.as_floating_point()) return fmt::format("{}", d->get());
-  if (const auto* b = node.as_boolean()) return b->get() ? "1" : "0";
-  if (const auto* a = node.as_array()) {
-    // tips = [[x, y, z], ...] or ["x,y,z", ...]
-    std::string out;
-    for (const auto& element : *a) {
-      if (!out.empty()) out += ";";
-      if (const auto* inner = element.as_array()) {
-        std::string tip;
-        for (const auto& c : *inner) {
-          if (!tip.empty()) tip += ",";
-          tip += node_text(c, key);
-        }
-        out += tip;
-      } else {
-        out += node_text(element, key);
-      }
-    }
-    return out;
-  }
-  throw std::invalid_argument(fmt::format("the value of '{}' must be a number or a string", key));
-}
-
-}  // namespace
-
 void load_scene_toml(const std::filesystem::path& path, Scene& scene) {
-  toml::table table;
-  try {
-    table = toml::parse_file(path.string());
-  } catch (const toml::parse_error& e) {
-    const auto& where = e.source().begin;
-    throw std::runtime_error(fmt::format("{}:{}:{}: not valid TOML: {}", path.string(), where.line, where.column,
-                                         e.description()));
-  }
   // A [scene] table is accepted as well as top-level keys.
-  const toml::table* source = &table;
-  if (const auto* inner = table["scene"].as_table()) source = inner;
-  for (const auto& [key, node] : *source) {
-    const std::string_view name = key.str();
-    if (source == &table && name == "scene") continue;
-    const auto line = node.source().begin.line;
+  for (const auto& setting : awcc::read_settings(path, "scene")) {
     const SceneField* field = nullptr;
     for (const auto& f : kFields) {
-      if (f.name == name) field = &f;
+      if (f.name == setting.key) field = &f;
     }
     if (!field) {
       std::string names;
       for (const auto& f : kFields) names += (names.empty() ? "" : ", ") + std::string(f.name);
-      throw std::runtime_error(fmt::format("{}:{}: unknown scene field '{}'; known fields: {}", path.string(), line,
-                                           name, names));
+      throw std::runtime_error(fmt::format("{}:{}: unknown scene field '{}'; known fields: {}", path.string(),
+                                           setting.line, setting.key, names));
     }
     try {
-      field->parse(scene, node_text(node, name));
+      field->parse(scene, setting.text);
     } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(fmt::format("{}:{}: field '{}': {}", path.string(), line, name, e.what()));
+      throw std::runtime_error(
+          fmt::format("{}:{}: field '{}': {}", path.string(), setting.line, setting.key, e.what()));
     }
   }
 }

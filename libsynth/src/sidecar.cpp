@@ -1,5 +1,7 @@
 #include "synth/sidecar.hpp"
 
+#include <fstream>
+
 #include "awcc/version.hpp"
 
 namespace synth {
@@ -123,6 +125,18 @@ std::filesystem::path sidecar_path(const std::filesystem::path& recording) {
   p.replace_extension();
   p += ".truth.json";
   return p;
+}
+
+std::optional<double> sidecar_volts_per_count(const std::filesystem::path& recording) {
+  std::ifstream in(sidecar_path(recording));
+  if (!in) return std::nullopt;
+  try {
+    const auto j = nlohmann::json::parse(in);
+    const auto& v = j.at("recording").at("volts_per_count");
+    if (v.is_number() && v.get<double>() > 0.0) return v.get<double>();
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
 }
 
 }  // namespace synth

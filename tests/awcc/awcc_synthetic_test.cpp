@@ -25,7 +25,7 @@ TEST(AwccSynthetic, RecoversMeanAndTurbulenceWhereTheErrorMechanismsVanish) {
   so.keep_velocity_history = true;
   const auto syn = synth::synthesise(s, so);
   const auto r = awcc::awcc(syn.signals[0], syn.signals[1], s.dx, {});
-  ASSERT_TRUE(r.defined) << r.reason;
+  ASSERT_TRUE(r.ok()) << r.message;
   const auto& truth = syn.truth.realised;
   EXPECT_NEAR(r.velocity / truth.mean_velocity[0], 1.0, 0.01);
   EXPECT_NEAR(r.turbulence_intensity / truth.turbulence_intensity[0], 1.0, 0.10);
@@ -93,11 +93,11 @@ TEST_P(AwccExtreme, FinishesWithFiniteResultsOrAReason) {
                    r.turbulence_intensity_ci95.lower, r.turbulence_intensity_ci95.upper}) {
     EXPECT_TRUE(std::isfinite(v)) << GetParam().name;
   }
-  if (r.defined) {
+  if (r.ok()) {
     EXPECT_GT(r.velocity, 0.0);
     EXPECT_GE(r.windows_accepted, 2);
   } else {
-    EXPECT_FALSE(r.reason.empty()) << GetParam().name;
+    EXPECT_FALSE(r.message.empty()) << GetParam().name;
   }
   for (const auto& w : r.windows) {
     ASSERT_TRUE(std::isfinite(w.velocity) && std::isfinite(w.r12_max) && std::isfinite(w.spr)) << GetParam().name;

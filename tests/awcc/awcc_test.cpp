@@ -1,3 +1,4 @@
+#include "awcc/detail/awcc_steps.hpp"
 #include "awcc/awcc.hpp"
 
 #include <gtest/gtest.h>
@@ -76,16 +77,16 @@ TEST(WindowCorrelation, IntervalPathEqualsNaiveAndFftPaths) {
   const auto dx = awcc::to_dense(x), dy = awcc::to_dense(y);
   const auto windows = awcc::awcc_windows(x, 5);
   ASSERT_GT(windows.size(), 2000u);
-  awcc::FftPlanCache plans;
+  awcc::AwccWorkspace plans;
   std::size_t compared = 0;
   for (std::size_t i = 0; i < windows.size(); ++i) {
     const auto& w = windows[i];
     const std::int64_t k_min = i % 3 == 0 ? -(w.length - 1) : -3, k_max = i % 3 == 0 ? w.length - 1 : 40;
     if (k_max >= w.length || -k_min >= w.length) continue;
-    const auto fast = awcc::window_correlation_intervals(x, y, w.start, w.length, k_min, k_max);
+    const auto fast = awcc::detail::window_correlation_intervals(x, y, w.start, w.length, k_min, k_max, plans);
     std::vector<double> xs(dx.begin() + w.start, dx.begin() + w.start + w.length);
     std::vector<double> ys(dy.begin() + w.start, dy.begin() + w.start + w.length);
-    const auto fft = awcc::window_correlation_fft(xs, ys, k_min, k_max, plans);
+    const auto fft = awcc::detail::window_correlation_fft(xs, ys, k_min, k_max, plans);
     ASSERT_EQ(fast.size(), fft.size());
     if (i % 10 == 0) {
       const auto ref = naive(dx, dy, w.start, w.length, k_min, k_max);
@@ -102,11 +103,11 @@ TEST(WindowCorrelation, ConstantSegmentGivesNothing) {
   x.fs = 1;
   x.sample_count = 100;
   const auto y = telegraph(100, 1);
-  EXPECT_TRUE(awcc::window_correlation_intervals(x, y, 0, 100, -99, 99).empty());
+  awcc::AwccWorkspace plans;
+  EXPECT_TRUE(awcc::detail::window_correlation_intervals(x, y, 0, 100, -99, 99, plans).empty());
   std::vector<double> flat(100, 2.5), other(100, 0.0);
   other[10] = 1;
-  awcc::FftPlanCache plans;
-  EXPECT_TRUE(awcc::window_correlation_fft(flat, other, -5, 5, plans).empty());
+  EXPECT_TRUE(awcc::detail::window_correlation_fft(flat, other, -5, 5, plans).empty());
 }
 
 // Signals whose windows each carry a known delay: the trailing signal is the
@@ -193,7 +194,8 @@ TEST(SecondaryPeakRatio, ConstructedShapes) {
     r[static_cast<std::size_t>(10 + i)] = 0.1 * std::min(i, 10 - i) * 2;       // peak 1.0 at 15
     r[static_cast<std::size_t>(40 + i)] = 0.06 * std::min(i, 10 - i) * 2;      // peak 0.6 at 45
   }
-  auto p = awcc::analyse_correlation(r, awcc::Subsample::none, 0.3);
+  awcc::AwccWorkspace workspace;
+  auto p = awcc::detail::analyse_correlation(r, awcc::Subsample::none, 0.3, workspace);
   EXPECT_EQ(p.index, 15u);
   EXPECT_NEAR(p.spr, 0.6, 1e-12);
   // A bump of prominence 0.1 (< 0.3 x 1.0) on the flank is not kept.
@@ -201,14 +203,14 @@ TEST(SecondaryPeakRatio, ConstructedShapes) {
   for (int i = 0; i <= 20; ++i) q[static_cast<std::size_t>(i)] = 0.05 * i;   // rises to 1.0 at 20
   for (int i = 21; i <= 40; ++i) q[static_cast<std::size_t>(i)] = 0.05 * (40 - i);
   q[30] = 0.6;  // neighbours 0.5 and 0.45: prominence 0.1
-  p = awcc::analyse_correlation(q, awcc::Subsample::none, 0.3);
+  p = awcc::detail::analyse_correlation(q, awcc::Subsample::none, 0.3, workspace);
   EXPECT_EQ(p.spr, 0.0);
   // The same bump counts when the rule keeps everything.
-  p = awcc::analyse_correlation(q, awcc::Subsample::none, 0.0);
+  p = awcc::detail::analyse_correlation(q, awcc::Subsample::none, 0.0, workspace);
   EXPECT_NEAR(p.spr, 0.6, 1e-12);
   // A flat-topped secondary peak is found at its middle.
   std::vector<double> f{0, 1, 0, 0.5, 0.5, 0.5, 0};
-  const auto peaks = awcc::peak_prominences(f);
+  const auto peaks = awcc::detail::peak_prominences(f);
   ASSERT_EQ(peaks.size(), 2u);
   EXPECT_EQ(peaks[1].first, 4u);
   EXPECT_NEAR(peaks[1].second, 0.5, 1e-15);
@@ -220,7 +222,7 @@ TEST(PeakProminences, MatchABruteForceScan) {
   for (int trial = 0; trial < 200; ++trial) {
     std::vector<double> r(50 + trial);
     for (auto& v : r) v = std::round(u(rng) * 8) / 8;  // ties and plateaus
-    const auto fast = awcc::peak_prominences(r);
+    const auto fast = awcc::detail::peak_prominences(r);
     for (const auto& [i, prominence] : fast) {
       // scipy: extend each side until a strictly higher sample or the end.
       double left = r[i], right = r[i];
@@ -244,7 +246,7 @@ TEST(RobustOutlierCutoff, RemovesPlantedOutliersOnly) {
   u.push_back(30.0);
   u.push_back(-5.0);
   std::vector<bool> keep(u.size(), true);
-  const int iterations = awcc::robust_outlier_cutoff(u, keep);
+  const int iterations = awcc::detail::robust_outlier_cutoff(u, keep);
   EXPECT_FALSE(keep[200]);
   EXPECT_FALSE(keep[201]);
   for (int i = 0; i < 200; ++i) EXPECT_TRUE(keep[static_cast<std::size_t>(i)]) << i;
@@ -265,8 +267,8 @@ TEST(Moments, DurationWeightedAndIntervalsByHand) {
   }
   awcc::AwccOptions o;
   o.roc = false;
-  awcc::awcc_summarise(r, o);
-  ASSERT_TRUE(r.defined) << r.reason;
+  awcc::detail::awcc_summarise(r, o);
+  ASSERT_TRUE(r.ok()) << r.message;
   // Weighted mean (10 + 36 + 16 + 22) / 8 = 10.5; variance
   // (0.25 + 3 * 2.25 + 2 * 6.25 + 2 * 0.25) / 8 = 20 / 8 = 2.5.
   EXPECT_DOUBLE_EQ(r.velocity, 10.5);
@@ -277,7 +279,7 @@ TEST(Moments, DurationWeightedAndIntervalsByHand) {
   EXPECT_NEAR(r.velocity_rms_ci95.upper - std::sqrt(2.5), 1.96 * std::sqrt(2.5) / std::sqrt(8.0), 1e-12);
   EXPECT_NEAR(r.turbulence_intensity_ci95.upper - tu, 1.96 * std::sqrt(tu * tu * (tu * tu / 4 + 1.0 / 8)), 1e-12);
   o.weighting = awcc::Weighting::none;
-  awcc::awcc_summarise(r, o);
+  awcc::detail::awcc_summarise(r, o);
   EXPECT_DOUBLE_EQ(r.velocity, 10.25);
 }
 
@@ -285,20 +287,20 @@ TEST(Awcc, UndefinedCasesCarryReasonsAndNoNaN) {
   // Fewer than Np particles.
   const auto few = telegraph(100, 2);
   auto r = awcc::awcc(few, few, 1.0, {});
-  EXPECT_FALSE(r.defined);
-  EXPECT_NE(r.reason.find("fewer than Np"), std::string::npos);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("fewer than Np"), std::string::npos);
   // Identical signals: every window peaks at lag 0 (delay below one sample).
   const auto x = telegraph(50'000, 8);
   r = awcc::awcc(x, x, 1.0, {});
-  EXPECT_FALSE(r.defined);
-  EXPECT_NE(r.reason.find("shorter than one sample"), std::string::npos) << r.reason;
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("shorter than one sample"), std::string::npos) << r.message;
   EXPECT_EQ(r.rejected_lag, r.windows_total);
   // Constant trailing tip.
   AirIntervals water;
   water.fs = x.fs;
   water.sample_count = x.sample_count;
   r = awcc::awcc(x, water, 1.0, {});
-  EXPECT_FALSE(r.defined);
+  EXPECT_FALSE(r.ok());
   EXPECT_EQ(r.rejected_constant, r.windows_total);
   for (double v : {r.velocity, r.velocity_rms, r.turbulence_intensity}) EXPECT_TRUE(std::isfinite(v));
 }

@@ -1,3 +1,4 @@
+#include "awcc/detail/fscc_steps.hpp"
 #include "awcc/fscc.hpp"
 
 #include <gtest/gtest.h>
@@ -34,8 +35,8 @@ TEST(LaggedProducts, EqualANaiveLongDoubleSum) {
                                     {1234, 40'000, 0, 999},
                                     {0, 50'000, -5, -1},
                                     {49'000, 50'000, 10, 2000}}) {
-    const auto fast = awcc::lagged_products(x, y, t0, t1, kmin, kmax, plans, awcc::ProductPath::fft);
-    const auto pairs = awcc::lagged_products(x, y, t0, t1, kmin, kmax, plans, awcc::ProductPath::intervals);
+    const auto fast = awcc::detail::lagged_products(x, y, t0, t1, kmin, kmax, plans, awcc::detail::ProductPath::fft);
+    const auto pairs = awcc::detail::lagged_products(x, y, t0, t1, kmin, kmax, plans, awcc::detail::ProductPath::intervals);
     ASSERT_EQ(fast.size(), static_cast<std::size_t>(kmax - kmin + 1));
     ASSERT_EQ(fast, pairs);
     for (std::int64_t k = kmin; k <= kmax; k += 7) {
@@ -86,7 +87,7 @@ TEST(Fscc, RecoversAPlantedDelayExactly) {
     awcc::FsccOptions o;
     o.max_lag = 1e-3;  // 500 samples
     const auto r = awcc::fscc(x, y, 5e-3, o);
-    ASSERT_TRUE(r.defined) << r.reason;
+    ASSERT_TRUE(r.ok()) << r.message;
     EXPECT_EQ(r.lag_samples, delay);
     EXPECT_NEAR(r.velocity, 5e-3 / (static_cast<double>(delay) / 500e3), 1e-9);
     EXPECT_GT(r.r12_max, 0.99);
@@ -126,7 +127,7 @@ TEST(Fscc, SegmentedMatchesNaivePearsonAverages) {
   o.segments = 3;
   o.felder_lags = true;
   const auto r = awcc::fscc(x, y, 1.0, o);
-  ASSERT_TRUE(r.defined) << r.reason;
+  ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_EQ(r.lag_samples, 9);
   const auto dx = awcc::to_dense(x), dy = awcc::to_dense(y);
   const std::int64_t length = 10'000;
@@ -152,11 +153,11 @@ TEST(Fscc, UndefinedResultsCarryAReason) {
   empty.fs = x.fs;
   empty.sample_count = x.sample_count;
   const auto none = awcc::fscc(x, empty, 1.0, {});
-  EXPECT_FALSE(none.defined);
-  EXPECT_NE(none.reason.find("constant"), std::string::npos);
+  EXPECT_FALSE(none.ok());
+  EXPECT_NE(none.message.find("constant"), std::string::npos);
   const auto backwards = awcc::fscc(shifted(x, 5), x, 1.0, {});
-  EXPECT_FALSE(backwards.defined);
-  EXPECT_NE(backwards.reason.find("not positive"), std::string::npos);
+  EXPECT_FALSE(backwards.ok());
+  EXPECT_NE(backwards.message.find("not positive"), std::string::npos);
   EXPECT_EQ(backwards.lag_samples, -5);
 }
 

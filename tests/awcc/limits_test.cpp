@@ -90,12 +90,12 @@ TEST(Limits, MoreThan2To31SamplesAreBinarisedInBlocks) {
   awcc::FsccOptions f;
   f.max_lag = 1e-4;
   const auto r = awcc::fscc(b.leading, b.trailing, 50e-6 * 10.0, f);
-  ASSERT_TRUE(r.defined) << r.reason;
+  ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_EQ(r.lag_samples, 50);
   // AWCC: windows of 10 chords, each 10^6 samples long; the lag search is
   // bounded, the delay found in every window.
   const auto a = awcc::awcc(b.leading, b.trailing, 5e-4, {});
-  ASSERT_TRUE(a.defined) << a.reason;
+  ASSERT_TRUE(a.ok()) << a.message;
   EXPECT_EQ(a.windows_total, periods / 10);  // leftover chords join the last window
   for (const auto& w : a.windows) ASSERT_EQ(w.lag_samples, 50);
 }
@@ -112,8 +112,8 @@ TEST(Limits, OneEnormousBubble) {
   EXPECT_NEAR(p.void_fraction, 1.0, 1e-6);
   EXPECT_EQ(p.bubble_count_rate, 0.0);
   const auto a = awcc::awcc(x, y, 5e-3, {});
-  EXPECT_FALSE(a.defined);
-  EXPECT_NE(a.reason.find("fewer than Np"), std::string::npos);
+  EXPECT_FALSE(a.ok());
+  EXPECT_NE(a.message.find("fewer than Np"), std::string::npos);
   awcc::FsccOptions f;
   f.max_lag = 1e-4;
   const auto r = awcc::fscc(x, y, 5e-3, f);
@@ -227,7 +227,7 @@ TEST(Limits, ValuesAtTheInt16LimitsAndDenormalFloats) {
   EXPECT_NEAR(q.tips[0].phase.void_fraction, 0.2, 1e-3);
   // The second channel is all denormals: a constant channel, not an error.
   EXPECT_TRUE(std::isfinite(q.tips[1].phase.void_fraction));
-  EXPECT_FALSE(q.fscc->defined);
+  EXPECT_FALSE(q.fscc->ok());
 }
 
 TEST(Limits, ExtremeVoidFractionsRunToFiniteResults) {
@@ -238,7 +238,7 @@ TEST(Limits, ExtremeVoidFractionsRunToFiniteResults) {
     const auto syn = synth::synthesise(s);
     EXPECT_EQ(syn.truth.reentries_missed, 0);
     const auto a = awcc::awcc(syn.signals[0], syn.signals[1], s.dx, {});
-    EXPECT_TRUE(a.defined || !a.reason.empty()) << c;
+    EXPECT_TRUE(a.ok() || !a.message.empty()) << c;
     EXPECT_TRUE(std::isfinite(a.velocity) && std::isfinite(a.turbulence_intensity)) << c;
     // Above the jamming limit of sequential placement the realised void
     // fraction falls short of c, and says so through overlaps.

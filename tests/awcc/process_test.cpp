@@ -1,6 +1,8 @@
 // End-to-end processing: synthetic recordings with known truth, the real
 // spillway recordings against an independent straightforward computation,
 // and bad input.
+#include "awcc/detail/awcc_steps.hpp"
+#include "awcc/serialise.hpp"
 #include "awcc/process.hpp"
 
 #include <gtest/gtest.h>
@@ -61,7 +63,7 @@ TEST(ProcessSynthetic, BinaryFileGivesTheTruthExactly) {
   // frequent transit time; with Tu = 0.05 the transit times spread by +/- 5 %
   // around 250 samples and the mode of dx/u lies within 2 Tu^2 = 0.5 % of
   // dx/u_mean; one sample of quantisation is 0.4 %. So 2 % is a safe bound.
-  ASSERT_TRUE(r.fscc && r.fscc->defined) << r.fscc->reason;
+  ASSERT_TRUE(r.fscc && r.fscc->ok()) << r.fscc->message;
   EXPECT_NEAR(r.fscc->velocity / w.synthesis.truth.realised.mean_velocity[0], 1.0, 0.02);
   EXPECT_GT(r.fscc->r12_max, 0.5);
 }
@@ -110,10 +112,10 @@ TEST(ProcessSynthetic, RawVoltageCorrelationAgreesWithBinary) {
   o.awcc = true;
   o.reader.volts_per_count = s.voltage_full_scale / 32768.0;
   const auto binary = awcc::process_recording(w.path, o);
-  o.correlate_raw = true;
+  o.awcc_options.signal = awcc::CorrelationSignal::raw;
   const auto raw = awcc::process_recording(w.path, o);
   ASSERT_TRUE(binary.awcc && raw.awcc);
-  ASSERT_TRUE(binary.awcc->defined && raw.awcc->defined) << raw.awcc->reason;
+  ASSERT_TRUE(binary.awcc->ok() && raw.awcc->ok()) << raw.awcc->message;
   ASSERT_EQ(binary.awcc->windows.size(), raw.awcc->windows.size());
   // Windows the binary path accepts have a clear peak; the raw path finds it
   // too (rejected windows peak anywhere, in both).
@@ -216,8 +218,8 @@ TEST_F(Spillway, VelocitiesArePlausibleAndStableBetweenFullAndSegmented) {
     o.fscc_options.segments = 15;
     o.fscc_options.felder_lags = true;
     const auto segmented = awcc::process_recording(file(i), o);
-    ASSERT_TRUE(full.fscc->defined) << i << ": " << full.fscc->reason;
-    ASSERT_TRUE(segmented.fscc->defined) << i << ": " << segmented.fscc->reason;
+    ASSERT_TRUE(full.fscc->ok()) << i << ": " << full.fscc->message;
+    ASSERT_TRUE(segmented.fscc->ok()) << i << ": " << segmented.fscc->message;
     EXPECT_GT(full.fscc->velocity, 1.0) << i;
     EXPECT_LT(full.fscc->velocity, 6.0) << i;
     EXPECT_NEAR(segmented.fscc->velocity / full.fscc->velocity, 1.0, 0.05) << i;
@@ -251,17 +253,17 @@ TEST_F(Spillway, AwccIntervalAndFftPathsAgreeOnEveryWindow) {
   for (int i : {8, 9, 10}) {
     const auto b = awcc::binarise_recording(file(i), options());
     const auto w = awcc::awcc_windows(b.leading, 5);
-    awcc::FftPlanCache plans;
+    awcc::AwccWorkspace plans;
     for (const auto& win : w) {
-      const auto a = awcc::window_correlation_intervals(b.leading, b.trailing, win.start, win.length, -(win.length - 1),
-                                                        win.length - 1);
+      const auto a = awcc::detail::window_correlation_intervals(b.leading, b.trailing, win.start, win.length, -(win.length - 1),
+                                                        win.length - 1, plans);
       std::vector<double> xs(static_cast<std::size_t>(win.length)), ys(xs.size());
       std::vector<std::uint8_t> d(xs.size());
       b.leading.render(win.start, d);
       std::copy(d.begin(), d.end(), xs.begin());
       b.trailing.render(win.start, d);
       std::copy(d.begin(), d.end(), ys.begin());
-      const auto f = awcc::window_correlation_fft(xs, ys, -(win.length - 1), win.length - 1, plans);
+      const auto f = awcc::detail::window_correlation_fft(xs, ys, -(win.length - 1), win.length - 1, plans);
       ASSERT_EQ(a.size(), f.size());
       for (std::size_t k = 0; k < a.size(); ++k) ASSERT_NEAR(a[k], f[k], 1e-10) << "file " << i << " lag " << k;
       ++windows;
@@ -364,8 +366,8 @@ TEST(ProcessInput, AConstantChannelIsNotAnError) {
   EXPECT_EQ(r.tips[1].phase.void_fraction, 0.0);
   EXPECT_EQ(r.tips[1].phase.bubble_count_rate, 0.0);
   ASSERT_TRUE(r.fscc);
-  EXPECT_FALSE(r.fscc->defined);
-  EXPECT_NE(r.fscc->reason.find("constant"), std::string::npos);
+  EXPECT_FALSE(r.fscc->ok());
+  EXPECT_NE(r.fscc->message.find("constant"), std::string::npos);
   const auto j = awcc::to_json(r);
   EXPECT_TRUE(j["fscc"]["velocity"].is_null());
   EXPECT_FALSE(j["fscc"]["reason"].is_null());

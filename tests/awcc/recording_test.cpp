@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "awcc/errors.hpp"
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -43,10 +45,14 @@ std::vector<float> read_all(awcc::Recording& r, std::int64_t block = 7) {
   return all;
 }
 
+// The message, and "[quantity]" when the error names the setting that fixes
+// it (the command line turns that into its flag).
 std::string error_of(const fs::path& p, const ReaderOptions& o = {}) {
   try {
     auto r = open_recording(p, o);
     read_all(*r);
+  } catch (const awcc::InputError& e) {
+    return e.quantity().empty() ? std::string(e.what()) : std::string(e.what()) + " [" + e.quantity() + "]";
   } catch (const std::runtime_error& e) {
     return e.what();
   }
@@ -85,7 +91,7 @@ TEST(UqDat, RefusesHeadersThatDoNotMatchTheData) {
   // No fs: a .dat file does not store it.
   const auto fine = scratch("no_fs.dat");
   write_binary(fine, std::vector<std::int16_t>(20), dat_header(10, 2));
-  EXPECT_NE(error_of(fine, {}).find("--fs"), std::string::npos) << error_of(fine, {});
+  EXPECT_NE(error_of(fine, {}).find("sampling rate; state it (e.g. 20 kHz) [fs]"), std::string::npos) << error_of(fine, {});
 }
 
 TEST(Raw, ReadsEveryLayout) {
@@ -165,7 +171,7 @@ TEST(Csv, TabsWithoutHeaderNeedFs) {
     std::ofstream f(p);
     f << "1.5\t2.5\n3\t4\n";
   }
-  EXPECT_NE(error_of(p).find("--fs"), std::string::npos);
+  EXPECT_NE(error_of(p).find("[fs]"), std::string::npos) << error_of(p);
   ReaderOptions o;
   o.fs = 100;
   auto r = open_recording(p, o);
@@ -236,7 +242,11 @@ TEST(Detection, BadFilesGetClearMessages) {
   EXPECT_NE(error_of(scratch("missing.flac")).find("no such file"), std::string::npos);
   const auto unknown = scratch("blob.xyz");
   write_binary(unknown, std::vector<std::uint8_t>{0, 1, 2, 3, 200});
-  EXPECT_NE(error_of(unknown).find("--format"), std::string::npos);
+  EXPECT_NE(error_of(unknown).find("[format]"), std::string::npos) << error_of(unknown);
+  // Library messages speak of quantities, never of command-line flags.
+  const auto no_fs = scratch("detection_no_fs.dat");
+  write_binary(no_fs, std::vector<std::int16_t>(20), dat_header(10, 2));
+  for (const auto& f : {no_fs, unknown}) EXPECT_EQ(error_of(f).find("--"), std::string::npos) << error_of(f);
 }
 
 }  // namespace

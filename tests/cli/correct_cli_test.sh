@@ -73,21 +73,60 @@ import json,sys
 a=json.load(open('$dir/rec.json'))['correction']; b=json.load(open('$dir/again.json'))['correction']
 sys.exit(0 if a==b else 1)" || fail "pdp correct and process --correct disagree"
 
-# A profile CSV lacks Np: refused with the fix, no output; with --np, corrected.
+# A profile CSV carries dx, dy and Np: corrected as it is.
 "$pdp" --log-level error process "$dir/rec.flac" "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc \
   --csv "$dir/profile.csv" || fail "profile"
-err=$("$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" -o "$dir/corrected.csv" 2>&1) && fail "CSV without np accepted"
-grep -q "no dx column in the file; give it with --dx" <<<"$err" || fail "message without the fix: $err"
-[[ -e "$dir/corrected.csv" ]] && fail "output written on error"
-"$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" --dx 4.5mm --dy 0.5mm --np 6 -o "$dir/corrected.csv" ||
-  fail "correct CSV"
+"$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" -o "$dir/corrected.csv" || fail "correct CSV"
 head -1 "$dir/corrected.csv" | grep -q ",correction_in_range,correction_reason,corrected_velocity,corrected_velocity_q0.025," ||
   fail "CSV correction columns"
-[[ $(cut -d, -f24 "$dir/corrected.csv" | tail -n +2 | sort -u) == "1" ]] || fail "profile rows not corrected"
+column() {  # the cells of a named column, header excluded
+  python3 -c "import csv,sys; [print(r[sys.argv[2]]) for r in csv.DictReader(open(sys.argv[1]))]" "$1" "$2"
+}
+[[ $(column "$dir/corrected.csv" correction_in_range | sort -u) == "1" ]] || fail "profile rows not corrected"
+[[ $(column "$dir/corrected.csv" correction_status | sort -u) == "corrected" ]] || fail "profile rows' status"
+
+# A CSV without them (another tool's, an older pdp's) is refused with the
+# fix, and no output; with the options, corrected.
+python3 - "$dir/profile.csv" "$dir/bare.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+drop = {"dx", "dy", "np"}
+with open(sys.argv[2], "w", newline="") as f:
+    w = csv.DictWriter(f, [k for k in rows[0] if k not in drop])
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: v for k, v in r.items() if k not in drop})
+PY
+err=$("$pdp" correct "$dir/bare.csv" -m "$dir/a.qrf" -o "$dir/bare-corrected.csv" 2>&1)
+code=$?
+[[ $code -eq 2 ]] || fail "CSV without dx: exit $code, expected 2"
+grep -q "no dx in the file; state the streamwise tip separation (--dx)" <<<"$err" || fail "message without the fix: $err"
+[[ -e "$dir/bare-corrected.csv" ]] && fail "output written on error"
+"$pdp" correct "$dir/bare.csv" -m "$dir/a.qrf" --dx 4.5mm --dy 0.5mm --np 6 -o "$dir/bare-corrected.csv" ||
+  fail "correct CSV with the options"
 
 # Outside the training ranges (dx 20 mm): flagged, not corrected.
-"$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" --dx 20mm --dy 0.5mm --np 6 -o "$dir/outside.csv" || fail "correct outside"
-tail -1 "$dir/outside.csv" | grep -q ",0,dx = 0.02 is outside the training range" || fail "out-of-range row not flagged"
+"$pdp" correct "$dir/bare.csv" -m "$dir/a.qrf" --dx 20mm --dy 0.5mm --np 6 -o "$dir/outside.csv" || fail "correct outside"
+[[ $(column "$dir/outside.csv" correction_reason | tail -1) == "dx = 0.02 is outside the training range"* ]] ||
+  fail "out-of-range row not flagged"
+[[ $(column "$dir/outside.csv" correction_status | tail -1) == "outside_training_range" ]] || fail "out-of-range status"
+
+# Results processed otherwise than the model's training data are refused,
+# naming the difference: on the command line before processing (exit 2) and
+# in a file (exit 1).
+err=$("$pdp" process "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --filter-a 0.3 --correct "$dir/a.qrf" \
+  --json "$dir/other.json" 2>&1)
+code=$?
+[[ $code -eq 2 ]] || fail "process --correct with another filter: exit $code, expected 2"
+grep -q "filter A: model 0.4, results 0.3" <<<"$err" || fail "processing mismatch message: $err"
+[[ -e "$dir/other.json" ]] && fail "JSON written with a mismatched model"
+"$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --weighting none --json "$dir/other.json" ||
+  fail "process with no weighting"
+err=$("$pdp" correct "$dir/other.json" -m "$dir/a.qrf" -o "$dir/other-corrected.json" 2>&1)
+code=$?
+[[ $code -eq 1 ]] || fail "correct of results processed otherwise: exit $code, expected 1"
+grep -q "weighting: model duration, results none" <<<"$err" || fail "file processing mismatch message: $err"
+[[ -e "$dir/other-corrected.json" ]] && fail "output written for a mismatched file"
 
 # Damaged, foreign and version-bumped models: clear error, no output.
 head -c 5000 "$dir/a.qrf" >"$dir/cut.qrf"

@@ -1,32 +1,68 @@
-// Synthesises a short scene through the installed libraries and checks a
-// property of the result, so that linking alone is not mistaken for success.
-#include <awcc/quantile_forest.hpp>
+// A downstream program built against the installed package: it synthesises a
+// short scene (synth::synth), processes it (awcc::awcc), trains a small
+// correction model on synthetic runs, saves it, loads it back and corrects a
+// measurement (correction::correction), and checks a property of each step so
+// that linking alone is not mistaken for success.
+#include <awcc/awcc.hpp>
 #include <awcc/units.hpp>
 #include <awcc/version.hpp>
+#include <correction/model.hpp>
+#include <correction/training.hpp>
 #include <cstdio>
-#include <vector>
+#include <filesystem>
 #include <synth/synthesiser.hpp>
+#include <vector>
 
-int main() {
+int main(int argc, char** argv) {
+  const std::filesystem::path scratch = argc > 1 ? argv[1] : ".";
   synth::Scene scene;
-  scene.duration = awcc::parse_quantity("0.1s", awcc::Dimension::time);
+  scene.duration = awcc::parse_quantity("2s", awcc::Dimension::time);
   scene.fs = awcc::parse_quantity("100kHz", awcc::Dimension::frequency);
   const auto result = synth::synthesise(scene);
   const double c = result.signals.at(0).void_fraction();
-  // A one-tree forest on a step: the quantiles at each side are that side's.
-  awcc::TrainingData d;
-  d.features = 1;
-  for (int i = 0; i < 20; ++i) {
-    d.x.push_back(i);
-    d.y.push_back(i < 10 ? 1.0 : 2.0);
+  const auto a = awcc::awcc(result.signals[0], result.signals[1], scene.streamwise_separation());
+  const bool awcc_ok = a.ok() && a.velocity > 5.0 && a.velocity < 15.0;
+
+  // Training rows: truth = 0.9 x measured, Tu truth = measured + 0.05.
+  std::vector<correction::TrainingRow> rows;
+  for (int i = 0; i < 60; ++i) {
+    correction::Measurement m;
+    m.velocity = 2.0 + 0.1 * i;
+    m.turbulence_intensity = 0.1 + 0.002 * i;
+    m.void_fraction = 0.1 + 0.001 * i;
+    m.bubble_count_rate = 500.0;
+    m.dx = 5e-3;
+    m.dy = 1e-3;
+    m.np = 10;
+    m.windows_accepted = 200;
+    correction::TrainingRow r;
+    r.run = i;
+    r.features = correction::make_features(m).features;
+    r.true_velocity = 0.9 * *m.velocity;
+    r.true_turbulence_intensity = *m.turbulence_intensity + 0.05;
+    rows.push_back(r);
   }
-  awcc::ForestOptions o;
-  o.trees = 1;
-  o.sample_fraction = 5.0;  // every row drawn, with near certainty
-  const auto forest = awcc::QuantileForest::train(d, o);
-  const std::vector<double> x0{2.0}, x1{17.0}, median{0.5};
-  const bool forest_ok = forest.quantiles(x0, median)[0] == 1.0 && forest.quantiles(x1, median)[0] == 2.0;
-  std::printf("awcc %s: %zu tips, void fraction %.3f, forest %s\n", awcc::version, result.signals.size(), c,
-              forest_ok ? "ok" : "wrong");
-  return (result.signals.size() == 2 && c > 0.0 && c < 1.0 && forest_ok) ? 0 : 1;
+  correction::ForestOptions o;
+  o.trees = 5;
+  const auto model = correction::fit_model(rows, correction::TargetForm::ratio, correction::TargetForm::difference, o,
+                                           o, 100);
+  const auto path = scratch / "consumer.qrf";
+  model.save(path);
+  const auto loaded = correction::CorrectionModel::load(path);
+  correction::Measurement m;
+  m.velocity = 4.0;
+  m.turbulence_intensity = 0.15;
+  m.void_fraction = 0.12;
+  m.bubble_count_rate = 500.0;
+  m.dx = 5e-3;
+  m.dy = 1e-3;
+  m.np = 10;
+  m.windows_accepted = 300;
+  const auto corrected = loaded.correct(m);
+  const bool correction_ok = corrected.corrected() && std::abs(corrected.velocity->median() - 3.6) < 1e-9 &&
+                             std::abs(corrected.turbulence_intensity->median() - 0.2) < 1e-9;
+  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s)\n", awcc::version, c,
+              a.velocity, awcc_ok ? "ok" : "wrong", corrected.velocity ? corrected.velocity->median() : 0.0,
+              correction_ok ? "ok" : "wrong");
+  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok) ? 0 : 1;
 }

@@ -9,5 +9,6 @@ test -f "$scratch/prefix/include/awcc/version.hpp"
 "$cmake" -S "$source" -B "$scratch/build" -DCMAKE_PREFIX_PATH="$scratch/prefix" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
 "$cmake" --build "$scratch/build" >/dev/null
-"$scratch/build/consumer"
+"$scratch/build/consumer" "$scratch"
+test ! -e "$scratch/prefix/include/awcc/detail" || { echo "detail headers were installed"; exit 1; }
 "$scratch/prefix/bin/pdp" --version

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/order_statistics.hpp"
 #include "awcc/process.hpp"
 #include "synth/recording.hpp"
 #include "synth/synthesiser.hpp"
@@ -15,16 +16,17 @@
 
 namespace pdp {
 
-CLI::App* setup_bench(CLI::App& app, BenchOptions& o) {
+void setup_bench(CLI::App& app, Command& command, BenchOptions& o) {
   auto* cmd = app.add_subcommand("bench", "Error against run time of every method and setting on fixed scenes");
-  cmd->add_option("-o,--output", o.output, "CSV of timings and errors")->required();
+  command.app = cmd;
+  add_config_option(command);
+  command.required.push_back(cmd->add_option("-o,--output", o.output, "CSV of timings and errors"));
   cmd->add_option("--repeat", o.repeat, "timings per setting; the median is kept")->check(CLI::Range(1, 100))
       ->capture_default_str();
   cmd->add_option("--scenes", o.scenes, "scenes: base, high-tu, small-bubbles, low-c, short-T")->capture_default_str();
   cmd->add_option("--duration", o.duration, "record length of the method settings, s")->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();
   cmd->add_flag("--quick", o.quick, "short records and fewer settings (for tests)");
-  return cmd;
 }
 
 namespace {
@@ -38,8 +40,7 @@ double median_time(int repeat, const std::function<void()>& f) {
     f();
     t.push_back(std::chrono::duration<double>(clock_type::now() - s).count());
   }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
+  return awcc::median(t);
 }
 
 synth::Scene named_scene(const std::string& name) {
@@ -92,8 +93,7 @@ int run_bench(const BenchOptions& o) {
   try {
     for (const auto& name : scenes) named_scene(name);
   } catch (const std::invalid_argument& e) {
-    spdlog::error("{}", e.what());
-    return 2;
+    return report_error(e);
   }
   const double base_duration = o.quick ? std::min(o.duration, 2.0) : o.duration;
   const std::vector<double> durations = o.quick ? std::vector<double>{1.0, 2.0} : std::vector<double>{10, 30, 100, 300};
@@ -145,7 +145,7 @@ int run_bench(const BenchOptions& o) {
           awcc::FsccResult res;
           Row r = base_row("fscc", segments == 1 ? "full" : "segmented-15");
           r.seconds = median_time(o.repeat, [&] { res = awcc::fscc(a, b, s.dx, f); });
-          if (res.defined) r.velocity = res.velocity;
+          if (res.ok()) r.velocity = res.velocity;
           r.tu = res.turbulence_intensity_chanson;
           out += csv_row(r);
         }
@@ -174,7 +174,7 @@ int run_bench(const BenchOptions& o) {
           awcc::AwccResult res;
           Row r = base_row(st.method, st.label);
           r.seconds = median_time(o.repeat, [&] { res = awcc::awcc(a, b, s.dx, st.options); });
-          if (res.defined) {
+          if (res.ok()) {
             r.velocity = res.velocity;
             r.tu = res.turbulence_intensity;
           }
@@ -193,12 +193,12 @@ int run_bench(const BenchOptions& o) {
           p.dx = s.dx;
           p.fscc = false;
           p.awcc = true;
-          p.correlate_raw = true;
+          p.awcc_options.signal = awcc::CorrelationSignal::raw;
           p.reader.volts_per_count = s.voltage_full_scale / 32768.0;
           awcc::ProcessResult res;
           Row r = base_row("awcc-raw", "raw voltage np=10 (incl. reading)");
           r.seconds = median_time(o.repeat, [&] { res = awcc::process_recording(file, p); });
-          if (res.awcc && res.awcc->defined) {
+          if (res.awcc && res.awcc->ok()) {
             r.velocity = res.awcc->velocity;
             r.tu = res.awcc->turbulence_intensity;
           }
@@ -214,10 +214,9 @@ int run_bench(const BenchOptions& o) {
   } catch (const std::exception& e) {
     std::error_code ec;
     std::filesystem::remove_all(scratch, ec);
-    spdlog::error("{}", e.what());
-    return 1;
+    return report_error(e);
   }
-  return 0;
+  return exit_ok;
 }
 
 }  // namespace pdp

@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "command.hpp"
+
 namespace pdp {
 
 struct BenchOptions {
@@ -16,7 +18,7 @@ struct BenchOptions {
   bool quick = false;          ///< short records and fewer settings (tests)
 };
 
-CLI::App* setup_bench(CLI::App& app, BenchOptions& options);
+void setup_bench(CLI::App& app, Command& command, BenchOptions& options);
 int run_bench(const BenchOptions& options);
 
 }  // namespace pdp

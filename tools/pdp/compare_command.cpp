@@ -10,21 +10,22 @@
 
 namespace pdp {
 
-CLI::App* setup_compare(CLI::App& app, CompareOptions& o) {
+void setup_compare(CLI::App& app, Command& command, CompareOptions& o) {
   auto* cmd = app.add_subcommand("compare", "FSCC and AWCC side by side on a recording (or a synthesised scene)");
+  command.app = cmd;
+  add_config_option(command);
   cmd->add_option("file", o.file, "recording (without it, the scene given by the options is synthesised)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--rec-dx", o.dx, "recording: streamwise tip separation, m (units allowed)")->capture_default_str();
   cmd->add_option("--rec-fs", o.fs, "recording: sampling rate when the file lacks it, Hz");
   add_scene_options(cmd, o.scene);
   add_method_options(cmd, o.methods);
-  return cmd;
 }
 
 int run_compare(const CompareOptions& o) {
   StudyOptions study;
-  if (!apply_method_options_or_log(o.methods, study)) return 2;
   try {
+    apply_method_options(o.methods, study);
     std::optional<awcc::FsccResult> f;
     std::optional<awcc::AwccResult> a;
     double tf = 0, ta = 0;
@@ -35,8 +36,7 @@ int run_compare(const CompareOptions& o) {
       p.dx = awcc::parse_quantity(o.dx, awcc::Dimension::length);
       if (!o.fs.empty()) p.reader.fs = awcc::parse_quantity(o.fs, awcc::Dimension::frequency);
       if (!(p.dx > 0.0)) {
-        spdlog::error("--rec-dx: give the tip separation of the recording, e.g. --rec-dx 7.15mm");
-        return 2;
+        throw std::invalid_argument("--rec-dx: give the tip separation of the recording, e.g. --rec-dx 7.15mm");
       }
       const auto b = awcc::binarise_recording(o.file, p);
       auto t = std::chrono::steady_clock::now();
@@ -48,27 +48,26 @@ int run_compare(const CompareOptions& o) {
       what = o.file;
     } else {
       const auto scene = build_scene(o.scene);
-      if (!scene) return 2;
       study.window_truth = false;
-      const auto r = run_scene(*scene, study);
+      const auto r = run_scene(scene, study);
       f = r.fscc;
       a = r.awcc;
       tf = r.seconds_fscc;
       ta = r.seconds_awcc;
       truth_u = r.truth_velocity;
       truth_tu = r.truth_turbulence_intensity;
-      what = fmt::format("synthetic scene (seed {})", scene->seed);
+      what = fmt::format("synthetic scene (seed {})", scene.seed);
     }
     auto num = [](bool ok, double v, const char* format) {
       return ok ? fmt::format(fmt::runtime(format), v) : std::string("n/a");
     };
     fmt::print("{}\n", what);
     fmt::print("{:<26}{:>14}{:>14}{}\n", "", "FSCC", "AWCC", truth_u ? fmt::format("{:>14}", "truth") : "");
-    fmt::print("{:<26}{:>14}{:>14}{}\n", "velocity (m/s)", num(f->defined, f->velocity, "{:.4f}"),
-               num(a->defined, a->velocity, "{:.4f}"), truth_u ? fmt::format("{:>14.4f}", *truth_u) : "");
+    fmt::print("{:<26}{:>14}{:>14}{}\n", "velocity (m/s)", num(f->ok(), f->velocity, "{:.4f}"),
+               num(a->ok(), a->velocity, "{:.4f}"), truth_u ? fmt::format("{:>14.4f}", *truth_u) : "");
     fmt::print("{:<26}{:>14}{:>14}{}\n", "turbulence intensity",
                num(f->turbulence_intensity_chanson.has_value(), f->turbulence_intensity_chanson.value_or(0), "{:.4f}"),
-               num(a->defined, a->turbulence_intensity, "{:.4f}"), truth_tu ? fmt::format("{:>14.4f}", *truth_tu) : "");
+               num(a->ok(), a->turbulence_intensity, "{:.4f}"), truth_tu ? fmt::format("{:>14.4f}", *truth_tu) : "");
     double mean_r12 = 0;
     std::int64_t kept = 0;
     for (const auto& w : a->windows) {
@@ -80,13 +79,12 @@ int run_compare(const CompareOptions& o) {
                num(kept > 0, kept > 0 ? mean_r12 / static_cast<double>(kept) : 0.0, "{:.4f}"));
     fmt::print("{:<26}{:>14}{:>14}\n", "windows kept", "-", fmt::format("{} of {}", a->windows_accepted, a->windows_total));
     fmt::print("{:<26}{:>14.3f}{:>14.3f}\n", "run time (s)", tf, ta);
-    if (!f->defined) fmt::print("FSCC: {}\n", f->reason);
-    if (!a->defined) fmt::print("AWCC: {}\n", a->reason);
+    if (!f->ok()) fmt::print("FSCC: {}\n", f->message);
+    if (!a->ok()) fmt::print("AWCC: {}\n", a->message);
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
+    return report_error(e);
   }
-  return 0;
+  return exit_ok;
 }
 
 }  // namespace pdp

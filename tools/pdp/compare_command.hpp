@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "command.hpp"
 #include "scene_cli.hpp"
 
 namespace pdp {
@@ -13,10 +14,10 @@ struct CompareOptions {
   std::string dx = "0mm";    ///< for a recording
   std::string fs;            ///< for a recording without its rate
   SceneCli scene;
-  MethodCli methods;
+  OptionSet methods;
 };
 
-CLI::App* setup_compare(CLI::App& app, CompareOptions& options);
+void setup_compare(CLI::App& app, Command& command, CompareOptions& options);
 int run_compare(const CompareOptions& options);
 
 }  // namespace pdp

@@ -7,6 +7,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "command.hpp"
+
 namespace pdp {
 
 struct CorrectOptions {
@@ -17,7 +19,7 @@ struct CorrectOptions {
   int np = 0;           ///< AWCC particles per window where the input lacks it; 0 = not given
 };
 
-CLI::App* setup_correct(CLI::App& app, CorrectOptions& options);
+void setup_correct(CLI::App& app, Command& command, CorrectOptions& options);
 int run_correct(const CorrectOptions& options);
 
 }  // namespace pdp

@@ -1,10 +1,15 @@
-// pdp: the dual-tip phase-detection probe toolkit's command line.
+// pdp: the dual-tip phase-detection probe toolkit's command line. Each
+// subcommand is one source file: parse, call the libraries, print. Exit
+// codes: command.hpp (the README's table).
 #include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <functional>
+
 #include "awcc/version.hpp"
 #include "bench_command.hpp"
+#include "command.hpp"
 #include "compare_command.hpp"
 #include "correct_command.hpp"
 #include "process_command.hpp"
@@ -31,35 +36,51 @@ int main(int argc, char** argv) {
   app.parse_complete_callback([&]() { spdlog::set_level(spdlog::level::from_str(log_level)); });
   app.require_subcommand(1);
 
+  struct Entry {
+    pdp::Command command;
+    std::function<int()> run;
+  };
+  std::vector<Entry> commands(8);
   pdp::SynthOptions synth_options;
-  auto* synth_command = pdp::setup_synth(app, synth_options);
+  pdp::setup_synth(app, commands[0].command, synth_options);
+  commands[0].run = [&] { return pdp::run_synth(synth_options); };
   pdp::ProcessCommandOptions process_options;
-  auto* process_command = pdp::setup_process(app, process_options);
+  pdp::setup_process(app, commands[1].command, process_options);
+  commands[1].run = [&] { return pdp::run_process(process_options); };
   pdp::ValidateOptions validate_options;
-  auto* validate_command = pdp::setup_validate(app, validate_options);
+  pdp::setup_validate(app, commands[2].command, validate_options);
+  commands[2].run = [&] { return pdp::run_validate(validate_options); };
   pdp::CompareOptions compare_options;
-  auto* compare_command = pdp::setup_compare(app, compare_options);
+  pdp::setup_compare(app, commands[3].command, compare_options);
+  commands[3].run = [&] { return pdp::run_compare(compare_options); };
   pdp::SweepOptions sweep_options;
-  auto* sweep_command = pdp::setup_sweep(app, sweep_options);
+  pdp::setup_sweep(app, commands[4].command, sweep_options);
+  commands[4].run = [&] { return pdp::run_sweep(sweep_options); };
   pdp::BenchOptions bench_options;
-  auto* bench_command = pdp::setup_bench(app, bench_options);
+  pdp::setup_bench(app, commands[5].command, bench_options);
+  commands[5].run = [&] { return pdp::run_bench(bench_options); };
   pdp::TrainCommandOptions train_options;
-  auto* train_command = pdp::setup_train(app, train_options);
+  pdp::setup_train(app, commands[6].command, train_options);
+  commands[6].run = [&] { return pdp::run_train(train_options); };
   pdp::CorrectOptions correct_options;
-  auto* correct_command = pdp::setup_correct(app, correct_options);
+  pdp::setup_correct(app, commands[7].command, correct_options);
+  commands[7].run = [&] { return pdp::run_correct(correct_options); };
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Help and version are successes; every other parse error is bad usage.
+    const int code = app.exit(e);
+    return code == 0 ? pdp::exit_ok : pdp::exit_bad_usage;
   }
-  if (synth_command->parsed()) return pdp::run_synth(synth_options);
-  if (process_command->parsed()) return pdp::run_process(process_options);
-  if (validate_command->parsed()) return pdp::run_validate(validate_options);
-  if (compare_command->parsed()) return pdp::run_compare(compare_options);
-  if (sweep_command->parsed()) return pdp::run_sweep(sweep_options);
-  if (bench_command->parsed()) return pdp::run_bench(bench_options);
-  if (train_command->parsed()) return pdp::run_train(train_options);
-  if (correct_command->parsed()) return pdp::run_correct(correct_options);
-  return 0;
+  for (auto& entry : commands) {
+    if (!entry.command.app->parsed()) continue;
+    try {
+      pdp::finish_parsing(entry.command);
+    } catch (const std::exception& e) {
+      return pdp::report_error(e);
+    }
+    return entry.run();
+  }
+  return pdp::exit_bad_usage;
 }

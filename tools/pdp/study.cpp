@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "awcc/phase_statistics.hpp"
-#include "synth/random.hpp"
 #include "terminal.hpp"
 #include "synth/synthesiser.hpp"
 
@@ -17,11 +16,6 @@ std::optional<double> Score::error() const {
   return *value / truth - 1.0;
 }
 
-std::uint64_t run_seed(std::uint64_t seed, std::uint64_t index) {
-  std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + index;
-  synth::splitmix64(state);
-  return synth::splitmix64(state) >> 1;  // keep it a non-negative int64 in files
-}
 
 namespace {
 
@@ -78,7 +72,9 @@ RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
   }
   const auto& lead = syn.signals[0];
   const auto& trail = syn.signals[1];
-  const double dx = scene.probe_tips()[1].x - scene.probe_tips()[0].x;
+  r.dx = scene.streamwise_separation();
+  r.dy = scene.lateral_separation();
+  const double dx = r.dx;
 
   start = std::chrono::steady_clock::now();
   const auto phase = awcc::phase_statistics(lead);
@@ -105,12 +101,12 @@ RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
   r.fscc_velocity.truth = r.awcc_velocity.truth = r.truth_velocity;
   r.fscc_turbulence_intensity.truth = r.awcc_turbulence_intensity.truth = r.truth_turbulence_intensity;
   r.fscc_d32.truth = r.awcc_d32.truth = r.truth_d32;
-  if (r.fscc && r.fscc->defined) {
+  if (r.fscc && r.fscc->ok()) {
     r.fscc_velocity.value = r.fscc->velocity;
     r.fscc_turbulence_intensity.value = r.fscc->turbulence_intensity_chanson;
     r.fscc_d32.value = d32(r.fscc->velocity);
   }
-  if (r.awcc && r.awcc->defined) {
+  if (r.awcc && r.awcc->ok()) {
     r.awcc_velocity.value = r.awcc->velocity;
     r.awcc_turbulence_intensity.value = r.awcc->turbulence_intensity;
     r.awcc_d32.value = d32(r.awcc->velocity);
@@ -165,8 +161,9 @@ json run_to_json(const RunResult& r) {
                   {"d32", r.truth_d32}};
   out["phase"] = {{"void_fraction", r.void_fraction}, {"bubble_count_rate", r.count_rate}};
   if (r.fscc) {
-    out["fscc"] = {{"defined", r.fscc->defined},
-                   {"reason", r.fscc->defined ? json(nullptr) : json(r.fscc->reason)},
+    out["fscc"] = {{"status", awcc::to_string(r.fscc->status)},
+                   {"defined", r.fscc->ok()},
+                   {"reason", r.fscc->ok() ? json(nullptr) : json(r.fscc->message)},
                    {"velocity", opt(r.fscc_velocity.value)},
                    {"turbulence_intensity_chanson", opt(r.fscc_turbulence_intensity.value)},
                    {"r12_max", r.fscc->r12_max},
@@ -174,8 +171,9 @@ json run_to_json(const RunResult& r) {
                    {"seconds", r.seconds_fscc}};
   }
   if (r.awcc) {
-    out["awcc"] = {{"defined", r.awcc->defined},
-                   {"reason", r.awcc->defined ? json(nullptr) : json(r.awcc->reason)},
+    out["awcc"] = {{"status", awcc::to_string(r.awcc->status)},
+                   {"defined", r.awcc->ok()},
+                   {"reason", r.awcc->ok() ? json(nullptr) : json(r.awcc->message)},
                    {"velocity", opt(r.awcc_velocity.value)},
                    {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},
                    {"d32", opt(r.awcc_d32.value)},
@@ -225,9 +223,9 @@ std::string run_report(const RunResult& r) {
   out += fmt::format("{:<26}{:>12.2f}{:>12.2f}{:>10}   (phase statistics, both methods)\n", "bubble count rate (1/s)",
                      r.truth_count_rate, r.count_rate, err(r.count_rate_score));
   out += "(FSCC turbulence intensity: Chanson's estimate)\n";
-  if (r.fscc && !r.fscc->defined) out += "FSCC undefined: " + r.fscc->reason + "\n";
+  if (r.fscc && !r.fscc->ok()) out += "FSCC undefined: " + r.fscc->message + "\n";
   if (r.awcc) {
-    if (!r.awcc->defined) out += "AWCC undefined: " + r.awcc->reason + "\n";
+    if (!r.awcc->ok()) out += "AWCC undefined: " + r.awcc->message + "\n";
     out += fmt::format("AWCC windows: {} accepted of {} ({} correlation, {} lag, {} outlier cutoff, {} constant)\n",
                        r.awcc->windows_accepted, r.awcc->windows_total, r.awcc->rejected_correlation,
                        r.awcc->rejected_lag, r.awcc->rejected_roc, r.awcc->rejected_constant);

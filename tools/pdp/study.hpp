@@ -35,6 +35,9 @@ struct Score {
 
 struct RunResult {
   synth::Scene scene;
+  // The probe geometry processed: trailing tip (second) minus leading tip
+  // (first), streamwise, and lateral as the distance across the flow.
+  double dx = 0.0, dy = 0.0;            ///< m
   // Truth (realised, of the generated series and bubbles).
   double truth_velocity = 0.0;          ///< realised mean u_x, m/s
   double truth_turbulence_intensity = 0.0;  ///< realised Tu_x
@@ -69,7 +72,5 @@ nlohmann::json run_to_json(const RunResult& r);
 /// The readable table of one run.
 std::string run_report(const RunResult& r);
 
-/// Seed of run `index` of a study with seed `seed` (independent of order and threads).
-std::uint64_t run_seed(std::uint64_t seed, std::uint64_t index);
 
 }  // namespace pdp

@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "awcc/units.hpp"
+#include "awcc/random.hpp"
 #include "synth/random.hpp"
 
 namespace pdp {
@@ -190,7 +191,7 @@ std::vector<SweepRun> SweepDefinition::expand() const {
       for (std::int64_t r = 0; r < repeat; ++r) {
         SweepRun copy = run;
         copy.index = index;
-        copy.scene.seed = run_seed(seed, static_cast<std::uint64_t>(index));
+        copy.scene.seed = awcc::derive_seed(seed, static_cast<std::uint64_t>(index));
         out.push_back(copy);
         ++index;
       }
@@ -201,7 +202,7 @@ std::vector<SweepRun> SweepDefinition::expand() const {
   } else {
     for (std::int64_t set = 0; set < runs; ++set) {
       // Parameters from their own stream, keyed by the parameter set.
-      synth::Rng rng(run_seed(seed, static_cast<std::uint64_t>(set)), synth::Stream::bubbles);
+      synth::Rng rng(awcc::derive_seed(seed, static_cast<std::uint64_t>(set)), synth::Stream::bubbles);
       SweepRun run = base_run;
       for (const auto& [k, range] : ranges) {
         double v;
@@ -221,7 +222,7 @@ std::vector<SweepRun> SweepDefinition::expand() const {
       for (std::int64_t r = 0; r < repeat; ++r) {
         SweepRun copy = run;
         copy.index = index;
-        copy.scene.seed = run_seed(seed ^ 0x5eedull, static_cast<std::uint64_t>(index));
+        copy.scene.seed = awcc::derive_seed(seed ^ 0x5eedull, static_cast<std::uint64_t>(index));
         out.push_back(copy);
         ++index;
       }
@@ -246,7 +247,10 @@ const char* const kResultColumns[] = {
     "truth_d32", "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate", "awcc_d32",
     "awcc_windows_accepted", "awcc_windows_total", "awcc_velocity_error", "awcc_turbulence_intensity_error",
     "awcc_d32_error", "fscc_velocity", "fscc_turbulence_intensity_chanson", "fscc_r12_max", "fscc_velocity_error",
-    "window_bias", "window_rms", "seconds_synth", "seconds_process", "seconds_fscc", "seconds_awcc", "reason"};
+    "window_bias", "window_rms", "seconds_synth", "seconds_process", "seconds_fscc", "seconds_awcc", "reason",
+    "probe_dx", "probe_dy", "awcc_filter_a", "awcc_roc", "awcc_weighting", "awcc_signal", "awcc_subsample"};
+// Columns after "reason": written for failed runs too.
+constexpr std::size_t kTrailingColumns = 7;
 
 std::string csv_field_name(std::string_view name) {
   std::string s(name);
@@ -278,7 +282,12 @@ std::string sweep_header() {
   return h;
 }
 
-std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string& error, std::uint64_t study) {
+bool sets(const SweepDefinition& d, const std::string& name) {
+  return d.base.count(name) || d.grid.count(name) || d.ranges.count(name);
+}
+
+std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string& error, std::uint64_t study,
+                      const awcc::AwccOptions& processing) {
   std::string row = fmt::format("{},{},{}", study, run.index, run.scene.seed);
   for (const auto& f : synth::scene_fields()) {
     if (f.name == "seed") continue;
@@ -299,15 +308,20 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
   }
   auto opt = [](bool ok, double v) { return ok ? std::optional<double>(v) : std::nullopt; };
   row += fmt::format(",{},{:.10g}", run.np, run.anisotropy);
+  const std::string trailing =
+      fmt::format(",{:.10g},{:.10g},{:.10g},{},{},{},{}", run.scene.streamwise_separation(),
+                  run.scene.lateral_separation(), processing.filter_a,
+                  processing.roc ? "on" : "off", awcc::to_string(processing.weighting), awcc::to_string(processing.signal),
+                  awcc::to_string(processing.subsample));
   if (!r) {
-    for (std::size_t i = 2; i + 1 < std::size(kResultColumns); ++i) row += ",";
+    for (std::size_t i = 2; i + 1 + kTrailingColumns < std::size(kResultColumns); ++i) row += ",";
     row += "," + clean(error);
-    return row;
+    return row + trailing;
   }
-  const bool a = r->awcc && r->awcc->defined;
-  const bool f = r->fscc && r->fscc->defined;
+  const bool a = r->awcc && r->awcc->ok();
+  const bool f = r->fscc && r->fscc->ok();
   std::string reason = error;
-  if (r->awcc && !r->awcc->defined) reason += "awcc: " + r->awcc->reason;
+  if (r->awcc && !r->awcc->ok()) reason += "awcc: " + r->awcc->message;
   row += "," + num(r->truth_velocity) + "," + num(r->truth_turbulence_intensity) + "," + num(r->truth_void_fraction) +
          "," + num(r->truth_count_rate) + "," + num(r->truth_d32);
   row += "," + num(opt(a, a ? r->awcc->velocity : 0)) + "," + num(opt(a, a ? r->awcc->turbulence_intensity : 0)) + "," +
@@ -321,7 +335,7 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
   row += "," + num(r->window_bias) + "," + num(r->window_rms);
   row += fmt::format(",{:.4f},{:.4f},{:.4f},{:.4f}", r->seconds_synth, r->seconds_process, r->seconds_fscc, r->seconds_awcc);
   row += "," + clean(reason);
-  return row;
+  return row + trailing;
 }
 
 std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint64_t study) {

@@ -13,8 +13,8 @@
 //            ln T = mid +/- 2 sd, truncated). Monte Carlo defaults are METHOD 5's
 //            ranges: velocity 1-50 m/s, tu 0-0.35, time-scale 1 ms-1 s,
 //            void-fraction 0.005-0.4, bubble-diameter 0.5-20 mm, dx 0.5-10 mm.
-// Run i (of `repeat` per parameter set) has seed run_seed(seed, i): results do
-// not depend on thread count, order or sharding.
+// Run i (of `repeat` per parameter set) has seed awcc::derive_seed(seed, i):
+// results do not depend on thread count, order or sharding.
 
 #include <cstdint>
 #include <filesystem>
@@ -50,9 +50,15 @@ struct SweepDefinition {
 /// the table and key, and the fix.
 SweepDefinition load_sweep(const std::filesystem::path& path);
 
-/// The CSV header and one row.
+/// True when the definition sets `name` (in [base], [grid] or [ranges]).
+[[nodiscard]] bool sets(const SweepDefinition& d, const std::string& name);
+
+/// The CSV header and one row: the scene, np and anisotropy, the truth, the
+/// estimates, the probe geometry processed (probe_dx, probe_dy), run times,
+/// the reason a run failed, and the AWCC processing (awcc_filter_a ...).
 std::string sweep_header();
-std::string sweep_row(const SweepRun& run, const RunResult* result, const std::string& error, std::uint64_t study);
+std::string sweep_row(const SweepRun& run, const RunResult* result, const std::string& error, std::uint64_t study,
+                      const awcc::AwccOptions& processing);
 
 /// Study id of a definition (FNV-1a of its canonical text).
 std::uint64_t study_id(const SweepDefinition& d);

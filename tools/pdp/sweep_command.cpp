@@ -13,6 +13,8 @@
 #include <thread>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/errors.hpp"
+#include "awcc/parallel.hpp"
 #include "sweep.hpp"
 #include "terminal.hpp"
 
@@ -22,17 +24,19 @@
 
 namespace pdp {
 
-CLI::App* setup_sweep(CLI::App& app, SweepOptions& o) {
+void setup_sweep(CLI::App& app, Command& command, SweepOptions& o) {
   auto* cmd = app.add_subcommand("sweep", "Run a grid or Monte Carlo study of synthetic scenes into a CSV");
-  cmd->add_option("study", o.study, "sweep definition (TOML: [sweep], [base], [grid], [ranges])")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", o.output, "CSV of runs: appended row by row; an interrupted sweep resumes")->required();
+  command.app = cmd;
+  add_config_option(command);
+  command.required.push_back(
+      cmd->add_option("study", o.study, "sweep definition (TOML: [sweep], [base], [grid], [ranges])")
+          ->check(CLI::ExistingFile));
+  command.required.push_back(
+      cmd->add_option("-o,--output", o.output, "CSV of runs: appended row by row; an interrupted sweep resumes"));
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 4096))
       ->capture_default_str();
   cmd->add_option("--shard", o.shard, "i/n: run only the runs whose index is i modulo n (cluster job arrays)");
   add_method_options(cmd, o.methods);
-  return cmd;
 }
 
 namespace {
@@ -43,7 +47,7 @@ void write_all(int fd, const std::string& text, const std::string& path) {
     const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw std::runtime_error(fmt::format("{}: write failed: {}", path, std::strerror(errno)));
+      throw awcc::OutputError(fmt::format("{}: write failed: {}", path, std::strerror(errno)));
     }
     done += static_cast<std::size_t>(n);
   }
@@ -128,6 +132,15 @@ int run_sweep(const SweepOptions& o) {
     definition = load_sweep(o.study);
     runs = definition.expand();
     apply_method_options(o.methods, study);
+    // A method option of the command line applies to every run, unless the
+    // study sets it: then the two conflict.
+    if (o.methods.given("np")) {
+      if (sets(definition, "np")) {
+        throw std::invalid_argument(fmt::format("--np {} conflicts with np set in {}; give it in one place",
+                                                study.awcc.np, o.study));
+      }
+      for (auto& run : runs) run.np = study.awcc.np;
+    }
     if (!o.shard.empty()) {
       const auto slash = o.shard.find('/');
       if (slash == std::string::npos) throw std::invalid_argument("--shard: write i/n, e.g. 3/10");
@@ -136,13 +149,14 @@ int run_sweep(const SweepOptions& o) {
       if (shards < 1 || shard < 0 || shard >= shards) throw std::invalid_argument("--shard i/n needs 0 <= i < n");
     }
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 2;
+    // A sweep file that cannot be used is a usage error, as an option is.
+    const int code = report_error(e);
+    return code == exit_bad_input ? exit_bad_usage : code;
   }
   for (const auto& run : runs) {
     if (const auto errors = run.scene.validate(); !errors.empty()) {
       spdlog::error("{}: run {} has an invalid scene: {}", o.study, run.index, errors.front());
-      return 2;
+      return exit_bad_usage;
     }
   }
   const std::uint64_t id = study_id(definition);
@@ -156,8 +170,7 @@ int run_sweep(const SweepOptions& o) {
         awcc::write_text_atomically(o.output, sweep_header() + "\n");
       }
     } catch (const std::exception& e) {
-      spdlog::error("{}", e.what());
-      refused = 1;
+      refused = report_error(e);
     }
   }
 #ifdef PDP_WITH_MPI
@@ -172,7 +185,7 @@ int run_sweep(const SweepOptions& o) {
     done = std::set<std::int64_t>(list.begin(), list.end());
   }
 #endif
-  if (refused) return 2;
+  if (refused) return refused;
   std::vector<const SweepRun*> pending;
   for (const auto& run : runs) {
     if (run.index % shards != shard || done.count(run.index)) continue;
@@ -185,16 +198,16 @@ int run_sweep(const SweepOptions& o) {
   const int fd = rank == 0 ? ::open(o.output.c_str(), O_WRONLY | O_APPEND) : -1;
   if (rank == 0 && fd < 0) {
     spdlog::error("{}: cannot open for appending: {}", o.output, std::strerror(errno));
-    return 1;
+    return exit_output_failed;
   }
   auto compute_row = [&](const SweepRun& run) {
     StudyOptions options = study;
     options.awcc.np = run.np;
     try {
       const RunResult r = run_scene(run.scene, options);
-      return sweep_row(run, &r, "", id);
+      return sweep_row(run, &r, "", id, options.awcc);
     } catch (const std::exception& e) {
-      return sweep_row(run, nullptr, e.what(), id);
+      return sweep_row(run, nullptr, e.what(), id, options.awcc);
     }
   };
 #ifdef PDP_WITH_MPI
@@ -204,41 +217,26 @@ int run_sweep(const SweepOptions& o) {
     return status;
   }
 #endif
-  const unsigned threads = o.threads > 0 ? static_cast<unsigned>(o.threads)
-                                         : std::max(1u, std::thread::hardware_concurrency());
-  std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> finished{0};
   std::mutex write_mutex;
-  std::string failure;
-  Progress progress("sweeping");
-  auto worker = [&]() {
-    for (;;) {
-      const std::size_t i = next++;
-      if (i >= pending.size()) return;
+  try {
+    Progress progress("sweeping");
+    awcc::parallel_for(pending.size(), o.threads, [&](std::size_t i) {
       const std::string row = compute_row(*pending[i]);
       std::lock_guard lock(write_mutex);
-      try {
-        // One write per row, then to disk: a crash loses no finished row.
-        write_all(fd, row + "\n", o.output);
-        ::fdatasync(fd);
-      } catch (const std::exception& e) {
-        failure = e.what();
-        next = pending.size();
-        return;
-      }
+      // One write per row, then to disk: a crash loses no finished row. A
+      // failed write stops the sweep (the pool hands out no further run).
+      write_all(fd, row + "\n", o.output);
+      ::fdatasync(fd);
       progress(static_cast<double>(++finished) / static_cast<double>(pending.size()));
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < std::min<std::size_t>(threads, pending.size()); ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  ::close(fd);
-  if (!failure.empty()) {
-    spdlog::error("{}", failure);
-    return 1;
+    });
+  } catch (const std::exception& e) {
+    ::close(fd);
+    return report_error(e);
   }
+  ::close(fd);
   spdlog::info("{}: {} runs written", o.output, finished.load());
-  return 0;
+  return exit_ok;
 }
 
 }  // namespace pdp

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "command.hpp"
 #include "scene_cli.hpp"
 
 namespace pdp {
@@ -14,10 +15,10 @@ struct SweepOptions {
   std::string output;         ///< CSV (appended; resumed when it holds rows of this study)
   int threads = 0;            ///< 0 = all cores
   std::string shard;          ///< "i/n": this process runs the runs with index % n == i
-  MethodCli methods;          ///< AWCC/FSCC settings (np comes from the study)
+  OptionSet methods;          ///< AWCC/FSCC settings for every run (np: unless the study sets it)
 };
 
-CLI::App* setup_sweep(CLI::App& app, SweepOptions& options);
+void setup_sweep(CLI::App& app, Command& command, SweepOptions& options);
 int run_sweep(const SweepOptions& options);
 
 }  // namespace pdp

@@ -12,9 +12,12 @@
 
 namespace pdp {
 
-CLI::App* setup_synth(CLI::App& app, SynthOptions& options) {
+void setup_synth(CLI::App& app, Command& command, SynthOptions& options) {
   auto* cmd = app.add_subcommand("synth", "Synthesise a scene: write a recording and its <name>.truth.json sidecar");
-  cmd->add_option("-o,--output", options.output, "recording to write (.flac, .wav, .w64, .rf64)")->required();
+  command.app = cmd;
+  add_config_option(command);
+  command.required.push_back(
+      cmd->add_option("-o,--output", options.output, "recording to write (.flac, .wav, .w64, .rf64)"));
   cmd->add_option("--signal", options.signal, "binary (0 water, 1 air) or voltage (raw int16 counts)")
       ->check(CLI::IsMember({"binary", "voltage"}))
       ->capture_default_str();
@@ -26,13 +29,15 @@ CLI::App* setup_synth(CLI::App& app, SynthOptions& options) {
   cmd->add_flag("-q,--quiet", options.quiet, "do not print the truth summary");
 
   add_scene_options(cmd, options.scene);
-  return cmd;
 }
 
 int run_synth(const SynthOptions& options) {
-  const auto built = build_scene(options.scene);
-  if (!built) return 2;
-  const synth::Scene& scene = *built;
+  synth::Scene scene;
+  try {
+    scene = build_scene(options.scene);
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
 
   synth::RecordingOptions recording;
   recording.signal = options.signal == "voltage" ? synth::SignalKind::voltage : synth::SignalKind::binary;
@@ -44,11 +49,11 @@ int run_synth(const SynthOptions& options) {
   } else {
     spdlog::error("{}: unknown recording extension; use .flac, .wav, .w64 or .rf64, or give --format",
                   options.output);
-    return 2;
+    return exit_bad_usage;
   }
   if (const auto why = synth::check_recordable(scene, scene.probe_tips().size(), recording.format); !why.empty()) {
     spdlog::error("{}: {}", options.output, why);
-    return 2;
+    return exit_bad_usage;
   }
 
   try {
@@ -82,10 +87,9 @@ int run_synth(const SynthOptions& options) {
                  peak_memory_mb());
     if (!options.quiet) fmt::print("{}", synthesis.truth.report());
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
+    return report_error(e);
   }
-  return 0;
+  return exit_ok;
 }
 
 }  // namespace pdp

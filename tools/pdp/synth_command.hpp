@@ -5,12 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "command.hpp"
 #include "scene_cli.hpp"
 
 namespace pdp {
 
 struct SynthOptions {
-  SceneCli scene;                        ///< scene fields and --config
+  SceneCli scene;                        ///< scene fields
   std::string output;                    ///< recording path (.flac, .wav, .w64, .rf64)
   std::string signal = "binary";         ///< binary | voltage
   std::string format;                    ///< flac | wav | w64 | rf64; default from the extension
@@ -18,7 +19,7 @@ struct SynthOptions {
   bool quiet = false;                    ///< no truth summary on stdout
 };
 
-CLI::App* setup_synth(CLI::App& app, SynthOptions& options);
+void setup_synth(CLI::App& app, Command& command, SynthOptions& options);
 int run_synth(const SynthOptions& options);
 
 }  // namespace pdp

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "command.hpp"
+
 namespace pdp {
 
 struct TrainCommandOptions {
@@ -26,7 +28,7 @@ struct TrainCommandOptions {
   std::string report;               ///< the report as a text file (also on stdout)
 };
 
-CLI::App* setup_train(CLI::App& app, TrainCommandOptions& options);
+void setup_train(CLI::App& app, Command& command, TrainCommandOptions& options);
 int run_train(const TrainCommandOptions& options);
 
 }  // namespace pdp

@@ -4,19 +4,21 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/random.hpp"
 #include "study.hpp"
 #include "terminal.hpp"
 
 namespace pdp {
 
-CLI::App* setup_validate(CLI::App& app, ValidateOptions& o) {
+void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
   auto* cmd = app.add_subcommand("validate", "Synthesise a scene in memory, process it, compare with the truth");
+  command.app = cmd;
+  add_config_option(command);
   add_scene_options(cmd, o.scene);
   add_method_options(cmd, o.methods);
   cmd->add_option("--repeat", o.repeat, "runs with different seeds; means and 95 % intervals of every error")
       ->check(CLI::Range(1, 100000))->capture_default_str();
   cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)");
-  return cmd;
 }
 
 namespace {
@@ -29,22 +31,25 @@ struct ErrorSeries {
 }  // namespace
 
 int run_validate(const ValidateOptions& o) {
-  const auto scene = build_scene(o.scene);
-  if (!scene) return 2;
+  std::optional<synth::Scene> scene;
   StudyOptions study;
-  if (!apply_method_options_or_log(o.methods, study)) return 2;
+  try {
+    scene = build_scene(o.scene);
+    apply_method_options(o.methods, study);
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
   std::vector<RunResult> runs;
   try {
     Progress progress("validating");
     for (int i = 0; i < o.repeat; ++i) {
       synth::Scene s = *scene;
-      if (o.repeat > 1) s.seed = run_seed(scene->seed, static_cast<std::uint64_t>(i));
+      if (o.repeat > 1) s.seed = awcc::derive_seed(scene->seed, static_cast<std::uint64_t>(i));
       runs.push_back(run_scene(s, study));
       progress(static_cast<double>(i + 1) / o.repeat);
     }
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
+    return report_error(e);
   }
   nlohmann::json j;
   if (runs.size() == 1) {
@@ -98,11 +103,10 @@ int run_validate(const ValidateOptions& o) {
     try {
       awcc::write_text_atomically(o.json, j.dump(2) + "\n");
     } catch (const std::exception& e) {
-      spdlog::error("{}", e.what());
-      return 1;
+      return report_error(e);
     }
   }
-  return 0;
+  return exit_ok;
 }
 
 }  // namespace pdp

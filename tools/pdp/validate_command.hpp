@@ -4,18 +4,19 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command.hpp"
 #include "scene_cli.hpp"
 
 namespace pdp {
 
 struct ValidateOptions {
   SceneCli scene;
-  MethodCli methods;
+  OptionSet methods;
   int repeat = 1;           ///< seeds (run i uses a seed derived from the scene seed and i)
   std::string json;         ///< JSON output file
 };
 
-CLI::App* setup_validate(CLI::App& app, ValidateOptions& options);
+void setup_validate(CLI::App& app, Command& command, ValidateOptions& options);
 int run_validate(const ValidateOptions& options);
 
 }  // namespace pdp

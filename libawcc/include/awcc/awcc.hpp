@@ -16,7 +16,9 @@
 //    differences; the mean terms come from prefix sums. Raw voltages are
 //    correlated with the FFT path.
 // 3. Peak: R12,i,max at lag k_i; tau_i = k_i / fs, u_i = dx / tau_i; k_i <= 0
-//    gives no velocity (rejected); optional parabolic refinement of k_i.
+//    gives no velocity (rejected); optional parabolic refinement of k_i. A
+//    window shorter than the least lag of a stated velocity range cannot be
+//    correlated over it (rejected as too short).
 // 4. Secondary peak ratio: local maxima of R12,i with their prominences (as
 //    MATLAB findpeaks / scipy peak_prominences); peaks of prominence at least
 //    0.3 x that of the tallest peak are kept; SPR = second-tallest kept peak /
@@ -39,6 +41,8 @@
 #include <string_view>
 #include <vector>
 
+#include <memory>
+
 #include "awcc/air_intervals.hpp"
 #include "awcc/fft.hpp"
 #include "awcc/fscc.hpp"
@@ -48,18 +52,34 @@ namespace awcc {
 
 enum class Weighting { duration, none };
 enum class CorrelationPath { automatic, fft, intervals };
-enum class WindowFate { accepted, correlation, lag, roc, constant };
+/// What the windows correlate: the binarised signals, or the raw voltages
+/// (windows still cut from the binarised leading tip).
+enum class CorrelationSignal { binary, raw };
+enum class WindowFate { accepted, correlation, lag, roc, constant, too_short };
 
 std::string_view to_string(WindowFate fate);
+std::string_view to_string(Weighting weighting);
+std::string_view to_string(CorrelationSignal signal);
 
 struct AwccOptions {
-  int np = 10;                            ///< particles (air chords) per window, 1-1000
-  double filter_a = 0.4;                  ///< correlation filter threshold A, -
-  bool roc = true;                        ///< robust outlier cutoff
+  /// Particles (air chords of the leading tip) per window, 1-1000. Fewer give
+  /// more windows (a finer velocity series) but noisier correlations.
+  int np = 10;
+  /// Correlation filter threshold A, -: windows with R12max / (SPR^2 + 1) < A
+  /// are rejected; 0.4 balances yield against spurious peaks (Kramer 2019).
+  double filter_a = 0.4;
+  /// Robust outlier cutoff (Valero et al. 2020) on the accepted velocities.
+  bool roc = true;
+  /// Moments weighted by window duration (Buchhave 1979: removes the bias
+  /// towards fast windows) or not at all.
   Weighting weighting = Weighting::duration;
+  /// Correlate the binarised signals or the raw voltages.
+  CorrelationSignal signal = CorrelationSignal::binary;
   Subsample subsample = Subsample::none;  ///< parabolic refinement of the peak lag
   CorrelationPath path = CorrelationPath::automatic;  ///< automatic: intervals for binary signals
-  double prominence_fraction = 0.3;       ///< peaks kept for the SPR, fraction of the tallest's prominence
+  /// Peaks kept for the SPR, as a fraction of the tallest peak's prominence:
+  /// lower counts ripples as secondary peaks.
+  double prominence_fraction = 0.3;
   std::optional<double> velocity_min;     ///< m/s: with velocity_max, lags searched from dx / u
   std::optional<double> velocity_max;     ///< m/s
   /// Largest |lag| searched, samples: bounds the work and memory of
@@ -87,93 +107,61 @@ struct AwccWindow {
   WindowFate fate = WindowFate::accepted;
 };
 
+/// Whether AWCC gave a velocity, and if not why; callers branch on this.
+enum class AwccStatus {
+  ok,
+  too_few_particles,       ///< fewer than Np particles: no window
+  delay_below_one_sample,  ///< most windows peak at lag 0: sample faster or separate the tips more
+  too_few_windows,         ///< fewer than 2 windows accepted
+  no_tip_separation,       ///< dx = 0: no velocity can be computed
+};
+std::string_view to_string(AwccStatus status);
+
 struct AwccResult {
-  bool defined = false;         ///< false: see reason; the figures below are 0
-  std::string reason;
+  AwccStatus status = AwccStatus::too_few_particles;
+  std::string message;          ///< why not ok (empty when ok)
+  [[nodiscard]] bool ok() const { return status == AwccStatus::ok; }
   int np = 0;                   ///< particles per window used
-  double velocity = 0.0;        ///< m/s
+  AwccOptions options;          ///< the options that made this result
+  double velocity = 0.0;        ///< m/s (0 unless ok)
   double velocity_rms = 0.0;    ///< m/s
   double turbulence_intensity = 0.0;
   Interval95 velocity_ci95, velocity_rms_ci95, turbulence_intensity_ci95;
   std::int64_t windows_total = 0, windows_accepted = 0;
   std::int64_t rejected_correlation = 0, rejected_lag = 0, rejected_roc = 0, rejected_constant = 0;
+  std::int64_t rejected_too_short = 0;  ///< windows shorter than the velocity range's least lag
   std::int64_t lag_zero_windows = 0;  ///< windows peaking at lag 0 (delay below one sample)
   int roc_iterations = 0;
   std::vector<AwccWindow> windows;
 };
 
+namespace detail {
+struct AwccScratch;
+}
+
+/// The scratch memory and FFT plans of the window correlations, owned by the
+/// caller and reused from window to window and record to record (one per
+/// thread: it is not shared).
+class AwccWorkspace {
+ public:
+  AwccWorkspace();
+  ~AwccWorkspace();
+  AwccWorkspace(AwccWorkspace&&) noexcept;
+  AwccWorkspace& operator=(AwccWorkspace&&) noexcept;
+  [[nodiscard]] detail::AwccScratch& scratch() { return *scratch_; }
+
+ private:
+  std::unique_ptr<detail::AwccScratch> scratch_;
+};
+
 /// Windows of Np particles on the leading tip (start and length only).
 std::vector<AwccWindow> awcc_windows(const AirIntervals& leading, int np);
 
-/// A window correlation of binary signals held at its breakpoints: R12 is
-/// linear in the lag between consecutive entries of `lags` (every kink of the
-/// overlap sums and of the mean terms is one of them), so peaks, prominences
-/// and the SPR follow from these few hundred points exactly instead of from
-/// every lag.
-struct PiecewiseCorrelation {
-  std::vector<std::int64_t> lags;   ///< increasing, first = k_min, last = k_max
-  std::vector<double> values;       ///< R12 at those lags
-  [[nodiscard]] bool empty() const { return lags.empty(); }
-  /// R12 at any lag in [k_min, k_max] (linear between breakpoints).
-  [[nodiscard]] double at(std::int64_t lag) const;
-  /// R12 at every lag k_min..k_max.
-  [[nodiscard]] std::vector<double> expand() const;
-};
-
-/// Interval path (exact, binary signals): empty when a segment is constant.
-PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
-                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max);
-
-/// The normalised cross-correlation of a window, lags [k_min, k_max].
-/// Binary signals, interval path (exact): the piecewise form expanded.
-std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
-                                                 std::int64_t length, std::int64_t k_min, std::int64_t k_max);
-/// Any signals given as the window's samples (binary 0/1 or voltages), FFT path.
-std::vector<double> window_correlation_fft(std::span<const double> x, std::span<const double> y, std::int64_t k_min,
-                                           std::int64_t k_max, FftPlanCache& plans);
-
-/// Peak and secondary peak ratio of a correlation function whose first value
-/// is at lag first_lag.
-struct CorrelationPeak {
-  std::size_t index = 0;        ///< of the maximum
-  double height = 0.0;
-  double refined_index = 0.0;   ///< parabolic refinement when asked, else index
-  double spr = 0.0;
-};
-CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsample, double prominence_fraction);
-/// The same on the piecewise form; indices count lags from k_min.
-CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample subsample, double prominence_fraction);
-
-/// Prominences of the local maxima of r (scipy's definition): (index, prominence).
-std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r);
-/// Same for samples at increasing integer positions, linear in between;
-/// returns (position, prominence), a flat top at the middle of its positions.
-std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const double> values,
-                                                              std::span<const std::int64_t> positions);
-
-/// Robust outlier cutoff over the velocities whose flag is true; clears the
-/// flag of the rejected ones. Returns the number of iterations.
-int robust_outlier_cutoff(std::span<const double> velocities, std::vector<bool>& keep);
-
-/// Lags searched in a window of `length` samples: all, or those of the
-/// stated velocity range.
-std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double dx, double fs,
-                                                      const AwccOptions& options);
-
-/// Fills a window's peak, lag, velocity, SPR and fate (constant, lag or
-/// correlation; accepted otherwise) from its correlation r over lags
-/// [first_lag, first_lag + r.size()); an empty r means a constant segment.
-void analyse_window(AwccWindow& window, std::span<const double> r, std::int64_t first_lag, double dx, double fs,
-                    const AwccOptions& options);
-/// Same from a peak already found (piecewise path); `constant` for a constant segment.
-void analyse_window(AwccWindow& window, const CorrelationPeak& peak, bool constant, std::int64_t first_lag, double dx,
-                    double fs, const AwccOptions& options);
-
-/// Applies the robust outlier cutoff to the accepted windows, then fills the
-/// moments, intervals, counts and the reason when undefined.
-void awcc_summarise(AwccResult& result, const AwccOptions& options);
-
-/// AWCC of two binary signals (correlated as binary).
+/// AWCC of two binary signals (correlated as binary; options.signal must be
+/// binary: raw voltages are correlated by awcc_raw in awcc/process.hpp).
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options = {});
+/// The same with the caller's workspace.
+AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options,
+                AwccWorkspace& workspace);
 
 }  // namespace awcc

@@ -40,7 +40,7 @@ struct BinarisationOptions {
   ThresholdRule rule = ThresholdRule::histogram;
   ProbeType probe = ProbeType::conductivity;
   double theta = 0.5;                ///< histogram/felder: fraction from air mode to water mode, -
-  double fixed_threshold = 0.0;      ///< fixed: threshold, V
+  std::optional<double> fixed_threshold;  ///< fixed: threshold, V (required by the fixed rule)
   double hysteresis_low = 0.4;       ///< hysteresis: fraction of the nearer-to-air threshold, -
   double hysteresis_high = 0.6;      ///< hysteresis: fraction of the nearer-to-water threshold, -
   double bin_width = 0.1;            ///< histogram: bin width, V; 0 = 100 bins over the observed range

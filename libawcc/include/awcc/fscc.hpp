@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "awcc/air_intervals.hpp"
@@ -33,6 +34,7 @@
 namespace awcc {
 
 enum class Subsample { none, parabolic };
+std::string_view to_string(Subsample subsample);
 
 struct FsccOptions {
   int segments = 1;                  ///< 1 = full record; Felder used 15
@@ -43,32 +45,33 @@ struct FsccOptions {
   [[nodiscard]] std::string validate() const;
 };
 
+/// Whether FSCC gave a velocity, and if not why; callers branch on this.
+enum class FsccStatus {
+  ok,
+  constant_leading,       ///< the leading tip's signal is constant (no bubble)
+  constant_trailing,      ///< the trailing tip's signal is constant
+  no_common_segment,      ///< no segment holds bubbles on both tips
+  no_positive_peak,       ///< R12 has no positive maximum: the signals are unrelated
+  non_positive_lag,       ///< the peak is at a lag <= 0: tips swapped, or no delay
+  peak_at_lag_range_end,  ///< the peak sits on the last lag searched: the range is too short
+  no_tip_separation,      ///< dx = 0: no velocity can be computed
+};
+std::string_view to_string(FsccStatus status);
+
 struct FsccResult {
-  bool defined = false;              ///< false: see reason; nothing below is meaningful but r functions
-  std::string reason;                ///< why the velocity is undefined (empty when defined)
+  FsccStatus status = FsccStatus::constant_leading;
+  std::string message;               ///< why not ok (empty when ok)
+  [[nodiscard]] bool ok() const { return status == FsccStatus::ok; }
   double r12_max = 0.0;              ///< -
   std::int64_t lag_samples = 0;      ///< integer lag of the peak
   double lag = 0.0;                  ///< s (refined when requested)
-  double velocity = 0.0;             ///< dx / lag, m/s
+  double velocity = 0.0;             ///< dx / lag, m/s (0 unless ok)
   std::optional<double> t05, tau05, txx, txy;       ///< s
   std::optional<double> turbulence_intensity_chanson;
   std::string note;                  ///< e.g. why a time scale is missing
   std::int64_t r11_first_lag = 0, r12_first_lag = 0;  ///< lag (samples) of r11[0], r12[0]
   std::vector<double> r11, r12;      ///< the correlation functions over the lags searched
 };
-
-/// How lagged products are computed: both exact; automatic picks the cheaper
-/// (pairs of air intervals within the lag range, or block FFTs).
-enum class ProductPath { automatic, fft, intervals };
-
-/// S(k) = sum over t in [t0, t1) of X(t) Y(t + k), k in [k_min, k_max], for
-/// 0/1 signals given as intervals (Y is 0 outside its record).
-std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y, std::int64_t t0, std::int64_t t1,
-                                    std::int64_t k_min, std::int64_t k_max, FftPlanCache& plans,
-                                    ProductPath path = ProductPath::automatic);
-
-/// Air samples of a signal within [a, b).
-std::int64_t air_samples_in(const AirIntervals& signal, std::int64_t a, std::int64_t b);
 
 /// FSCC of two binary signals of equal length and rate; dx in m.
 FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options = {});

@@ -1,11 +1,10 @@
 #pragma once
-// Processing one recording end to end: read (two passes, block by block),
-// binarise the leading and trailing tips, phase statistics per tip, and FSCC.
-// Results are value types with a readable report and a JSON form whose keys
-// are documented in docs/output.md.
+// Processing one recording end to end: read (block by block), binarise the
+// leading and trailing tips, phase statistics per tip, FSCC and AWCC (both by
+// default, as the pdp command line). Results are value types with a readable
+// report; their JSON and CSV forms are in awcc/serialise.hpp.
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,9 +26,9 @@ struct ProcessOptions {
   double dy = 0.0;                    ///< lateral tip separation, m (reported)
   bool fscc = true;                   ///< run FSCC
   FsccOptions fscc_options;
-  bool awcc = false;                  ///< run AWCC
+  bool awcc = true;                   ///< run AWCC
+  /// AWCC settings; signal = raw correlates the voltages (one more pass over the file).
   AwccOptions awcc_options;
-  bool correlate_raw = false;         ///< AWCC correlates the raw voltages (a third pass over the file)
   int histogram_bins = 50;            ///< chord-time histogram bins
   std::int64_t block_frames = 1 << 16;  ///< frames read at a time
   bool single_pass = true;            ///< allow the one-pass path for 16-bit data (same result, faster)
@@ -78,12 +77,7 @@ ProcessResult process_binarised(const BinarisedRecording& recording, const Proce
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
                     const ProcessOptions& options);
 
-/// The per-window table as CSV (docs/output.md).
-std::string awcc_windows_csv(const AwccResult& result);
-
 /// Both of the above.
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options);
-
-nlohmann::json to_json(const ProcessResult& result);
 
 }  // namespace awcc

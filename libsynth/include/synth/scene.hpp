@@ -75,6 +75,11 @@ struct Scene {
 
   /// Tip positions in metres: `tips` when given, else {0, (dx, dy, dz)}.
   [[nodiscard]] std::vector<Vec3> probe_tips() const;
+  /// The separation a dual-tip processing sees: second tip minus first,
+  /// streamwise (x), and laterally as the distance across the flow,
+  /// hypot(y, z); m. The geometry recorded is the one processed.
+  [[nodiscard]] double streamwise_separation() const;
+  [[nodiscard]] double lateral_separation() const;
   [[nodiscard]] double time_scale_of(int component) const;
   [[nodiscard]] double tu_of(int component) const;
   /// Velocity time step actually used: realisation_step, or when 0,

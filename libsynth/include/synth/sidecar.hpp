@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "synth/recording.hpp"
 #include "synth/truth.hpp"
@@ -23,5 +24,9 @@ nlohmann::json sidecar_json(const Truth& truth, const RecordingOptions& options,
 
 /// "dir/rec.flac" -> "dir/rec.truth.json".
 std::filesystem::path sidecar_path(const std::filesystem::path& recording);
+
+/// The volts per count a synthetic recording's sidecar states, if it has one
+/// that does (readers of the recording use it to give voltages).
+std::optional<double> sidecar_volts_per_count(const std::filesystem::path& recording);
 
 }  // namespace synth

@@ -1,4 +1,4 @@
-#include "awcc/correction.hpp"
+#include "correction/model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,22 +10,22 @@
 
 namespace {
 
-using awcc::CorrectionFeatures;
-using awcc::CorrectionModel;
+using correction::Features;
+using correction::CorrectionModel;
 
 // A small model: truth = measured * (1 + 0.1 * dy/2mm) + noise, Tu truth =
 // measured Tu + 0.02.
 CorrectionModel small_model(std::uint64_t seed = 3) {
   std::mt19937_64 g(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  awcc::TrainingData v, t;
-  v.features = t.features = CorrectionFeatures::count;
+  correction::TrainingData v, t;
+  v.features = t.features = Features::count;
   CorrectionModel m;
   std::array<double, 7> lo, hi;
   lo.fill(1e300);
   hi.fill(-1e300);
   for (int i = 0; i < 400; ++i) {
-    CorrectionFeatures f;
+    Features f;
     f.velocity = 1.0 + 49.0 * u(g);
     f.turbulence_intensity = 0.35 * u(g);
     f.void_fraction = 0.005 + 0.395 * u(g);
@@ -38,21 +38,21 @@ CorrectionModel small_model(std::uint64_t seed = 3) {
     v.x.insert(v.x.end(), x.begin(), x.end());
     t.x.insert(t.x.end(), x.begin(), x.end());
     const double true_u = f.velocity * (1.0 + 0.1 * f.dy / 2e-3) * (1.0 + 0.01 * (u(g) - 0.5));
-    v.y.push_back(awcc::to_target(m.velocity_form, true_u, f.velocity));
-    t.y.push_back(awcc::to_target(m.turbulence_form, f.turbulence_intensity + 0.02, f.turbulence_intensity));
+    v.y.push_back(correction::to_target(m.velocity_form, true_u, f.velocity));
+    t.y.push_back(correction::to_target(m.turbulence_form, f.turbulence_intensity + 0.02, f.turbulence_intensity));
   }
-  for (std::size_t j = 0; j < 7; ++j) m.ranges.push_back({CorrectionFeatures::names[j], lo[j], hi[j]});
-  awcc::ForestOptions o;
+  for (std::size_t j = 0; j < 7; ++j) m.ranges.push_back({Features::names[j], lo[j], hi[j]});
+  correction::ForestOptions o;
   o.trees = 10;
   o.seed = seed;
-  m.velocity = awcc::QuantileForest::train(v, o);
-  m.turbulence_intensity = awcc::QuantileForest::train(t, o);
+  m.velocity = correction::QuantileForest::train(v, o);
+  m.turbulence_intensity = correction::QuantileForest::train(t, o);
   m.provenance = "test model";
   return m;
 }
 
-CorrectionFeatures inside() {
-  CorrectionFeatures f;
+Features inside() {
+  Features f;
   f.velocity = 10.0;
   f.turbulence_intensity = 0.2;
   f.void_fraction = 0.2;
@@ -66,7 +66,7 @@ CorrectionFeatures inside() {
 
 TEST(Correction, Crc32MatchesTheStandardCheckValue) {
   const char* text = "123456789";
-  EXPECT_EQ(awcc::crc32(reinterpret_cast<const std::uint8_t*>(text), 9), 0xCBF43926u);
+  EXPECT_EQ(correction::crc32(reinterpret_cast<const std::uint8_t*>(text), 9), 0xCBF43926u);
 }
 
 TEST(Correction, RoundTripGivesTheSameBytesAndPredictions) {
@@ -76,8 +76,8 @@ TEST(Correction, RoundTripGivesTheSameBytesAndPredictions) {
   EXPECT_EQ(back.serialise(), bytes);
   EXPECT_EQ(back.provenance, "test model");
   const auto a = m.correct(inside()), b = back.correct(inside());
-  ASSERT_TRUE(a.in_range);
-  ASSERT_TRUE(b.in_range);
+  ASSERT_TRUE(a.corrected());
+  ASSERT_TRUE(b.corrected());
   EXPECT_EQ(a.velocity->quantiles, b.velocity->quantiles);
   EXPECT_EQ(a.turbulence_intensity->quantiles, b.turbulence_intensity->quantiles);
   // The learnt factor: truth ~ measured * 1.05 at dy = 1 mm (within the leaf's spread).
@@ -88,18 +88,18 @@ TEST(Correction, RoundTripGivesTheSameBytesAndPredictions) {
 // More than 65,536 training rows: held rows take 4 bytes on file.
 TEST(Correction, LargeTrainingSetsRoundTrip) {
   auto m = small_model();
-  awcc::TrainingData big;
-  big.features = CorrectionFeatures::count;
+  correction::TrainingData big;
+  big.features = Features::count;
   std::mt19937_64 g(2);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i < 70000; ++i) {
     for (int j = 0; j < big.features; ++j) big.x.push_back(u(g));
     big.y.push_back(u(g));
   }
-  awcc::ForestOptions o;
+  correction::ForestOptions o;
   o.trees = 2;
   o.min_leaf = 50;
-  m.velocity = awcc::QuantileForest::train(big, o);
+  m.velocity = correction::QuantileForest::train(big, o);
   const auto bytes = m.serialise();
   const auto back = CorrectionModel::parse(bytes, "big");
   EXPECT_EQ(back.velocity.trees()[1].leaf_rows, m.velocity.trees()[1].leaf_rows);
@@ -113,8 +113,8 @@ TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "pdp-qrf\n");
-  // Format version 1 as u32 little-endian.
-  EXPECT_EQ(bytes[8], 1);
+  // Format version 2 as u32 little-endian.
+  EXPECT_EQ(bytes[8], 2);
   EXPECT_EQ(bytes[9], 0);
   EXPECT_EQ(bytes[10], 0);
   EXPECT_EQ(bytes[11], 0);
@@ -146,8 +146,8 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   const std::string text = "velocity,turbulence_intensity\n1,2\n";
   EXPECT_NE(message({text.begin(), text.end()}).find("not a pdp model file"), std::string::npos);
   auto newer = bytes;
-  newer[8] = 2;
-  EXPECT_NE(message(newer).find("version 2"), std::string::npos) << message(newer);
+  newer[8] = 3;
+  EXPECT_NE(message(newer).find("version 3"), std::string::npos) << message(newer);
   // A structural fault with a valid checksum: the reader checks the trees too.
   auto forged = bytes;
   // The first tree's root node follows the velocity targets; find it by
@@ -157,7 +157,7 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   auto trees = m.velocity.trees();
   trees[0].nodes[0].left = 0;
   // assemble refuses it directly...
-  EXPECT_THROW((void)awcc::QuantileForest::assemble(7, m.velocity.targets(), trees), std::invalid_argument);
+  EXPECT_THROW((void)correction::QuantileForest::assemble(7, m.velocity.targets(), trees), std::invalid_argument);
   // ...and a file carrying it is refused as damaged. Build the file bytes by
   // patching the serialised root (same size) and recomputing the checksum.
   const auto good = m.serialise();
@@ -174,7 +174,7 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   forged = good;
   const auto offset = static_cast<std::size_t>(at - good.begin());
   for (int i = 0; i < 4; ++i) forged[offset + 9 + static_cast<std::size_t>(i)] = 0;
-  const auto crc = awcc::crc32(forged.data(), forged.size() - 4);
+  const auto crc = correction::crc32(forged.data(), forged.size() - 4);
   for (int i = 0; i < 4; ++i) forged[forged.size() - 4 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
   EXPECT_NE(message(forged).find("malformed"), std::string::npos) << message(forged);
 }
@@ -199,37 +199,37 @@ TEST(Correction, RowsOutsideTheTrainingDataAreFlaggedNotCorrected) {
   auto f = inside();
   f.void_fraction = 0.9;
   auto c = m.correct(f);
-  EXPECT_FALSE(c.in_range);
-  EXPECT_NE(c.reason.find("void_fraction = 0.9"), std::string::npos) << c.reason;
+  EXPECT_EQ(c.status, correction::CorrectionStatus::outside_training_range);
+  EXPECT_NE(c.message.find("void_fraction = 0.9"), std::string::npos) << c.message;
   EXPECT_FALSE(c.velocity.has_value());
   f = inside();
   f.windows_accepted = 99;
   c = m.correct(f);
-  EXPECT_FALSE(c.in_range);
-  EXPECT_NE(c.reason.find("99 accepted windows"), std::string::npos) << c.reason;
+  EXPECT_EQ(c.status, correction::CorrectionStatus::too_few_windows);
+  EXPECT_NE(c.message.find("99 accepted windows"), std::string::npos) << c.message;
   // Within the margin of 1 % of the span below the smallest dy: in range;
   // beyond it: out.
   f = inside();
   const auto& dy = m.ranges[5];
   f.dy = dy.min - 0.5 * m.range_margin * (dy.max - dy.min);
-  EXPECT_TRUE(m.correct(f).in_range);
+  EXPECT_TRUE(m.correct(f).corrected());
   f.dy = dy.min - 1.5 * m.range_margin * (dy.max - dy.min);
-  EXPECT_FALSE(m.correct(f).in_range);
+  EXPECT_FALSE(m.correct(f).corrected());
   f = inside();
   f.velocity = std::nan("");
-  EXPECT_FALSE(m.correct(f).in_range);
+  EXPECT_FALSE(m.correct(f).corrected());
 }
 
 TEST(Correction, TargetFormsInvert) {
-  for (auto form : {awcc::TargetForm::value, awcc::TargetForm::ratio, awcc::TargetForm::difference}) {
-    const double t = awcc::to_target(form, 7.5, 6.0);
-    EXPECT_DOUBLE_EQ(awcc::from_target(form, t, 6.0), 7.5) << awcc::to_string(form);
+  for (auto form : {correction::TargetForm::value, correction::TargetForm::ratio, correction::TargetForm::difference}) {
+    const double t = correction::to_target(form, 7.5, 6.0);
+    EXPECT_DOUBLE_EQ(correction::from_target(form, t, 6.0), 7.5) << correction::to_string(form);
   }
 }
 
 TEST(Correction, JsonHasTheDocumentedKeys) {
   const auto c = small_model().correct(inside());
-  const auto j = awcc::to_json(c);
+  const auto j = correction::to_json(c);
   EXPECT_TRUE(j["in_range"].get<bool>());
   EXPECT_TRUE(j["reason"].is_null());
   for (const char* q : {"velocity", "turbulence_intensity"}) {
@@ -240,28 +240,78 @@ TEST(Correction, JsonHasTheDocumentedKeys) {
   }
 }
 
-TEST(Correction, FeaturesOfAProcessedRecording) {
+TEST(Correction, MeasurementOfAProcessedRecording) {
   awcc::ProcessResult r;
-  std::string why;
-  EXPECT_FALSE(awcc::correction_features(r, &why));
-  EXPECT_NE(why.find("AWCC was not run"), std::string::npos);
+  auto m = correction::measurement_of(r);
+  EXPECT_EQ(m.status, correction::CorrectionStatus::awcc_not_run);
   r.dx = 5e-3;
   r.dy = 1e-3;
   r.tips.resize(2);
   r.tips[0].phase.void_fraction = 0.2;
   r.tips[0].phase.bubble_count_rate = 600.0;
   r.awcc = awcc::AwccResult{};
-  r.awcc->defined = true;
+  r.awcc->status = awcc::AwccStatus::too_few_windows;
+  r.awcc->message = "1 of 9 windows accepted";
+  m = correction::measurement_of(r);
+  EXPECT_EQ(m.status, correction::CorrectionStatus::no_awcc_velocity);
+  EXPECT_NE(m.message.find("1 of 9 windows"), std::string::npos);
+  r.awcc->status = awcc::AwccStatus::ok;
   r.awcc->velocity = 10.0;
   r.awcc->turbulence_intensity = 0.25;
   r.awcc->np = 12;
   r.awcc->windows_accepted = 321;
-  const auto f = awcc::correction_features(r, &why);
-  ASSERT_TRUE(f);
-  EXPECT_DOUBLE_EQ(f->d32, 1.5 * 10.0 * 0.2 / 600.0);
-  EXPECT_EQ(f->np, 12.0);
-  EXPECT_EQ(f->windows_accepted, 321);
-  EXPECT_EQ(f->dy, 1e-3);
+  m = correction::measurement_of(r);
+  ASSERT_EQ(m.status, correction::CorrectionStatus::corrected);
+  const auto f = correction::make_features(m.measurement);
+  ASSERT_TRUE(f.ok());
+  EXPECT_DOUBLE_EQ(f.features.d32, 1.5 * 10.0 * 0.2 / 600.0);
+  EXPECT_EQ(f.features.np, 12.0);
+  EXPECT_EQ(f.features.windows_accepted, 321);
+  EXPECT_EQ(f.features.dy, 1e-3);
+}
+
+// The feature contract refuses what has no features, each with its status.
+TEST(Correction, FeaturesNeedAPositiveVelocityAndBubbles) {
+  correction::Measurement m;
+  EXPECT_EQ(correction::make_features(m).status, correction::CorrectionStatus::no_awcc_velocity);
+  m.velocity = -0.5;
+  m.turbulence_intensity = 0.1;
+  m.bubble_count_rate = 10.0;
+  EXPECT_EQ(correction::make_features(m).status, correction::CorrectionStatus::no_awcc_velocity);
+  m.velocity = 0.5;
+  m.bubble_count_rate = 0.0;
+  EXPECT_EQ(correction::make_features(m).status, correction::CorrectionStatus::no_bubbles);
+  m.bubble_count_rate = 10.0;
+  EXPECT_TRUE(correction::make_features(m).ok());
+}
+
+// A model applies to results processed as its training data; every
+// difference is named.
+TEST(Correction, ProcessingMismatchNamesEachDifference) {
+  correction::Processing model, results;
+  EXPECT_EQ(correction::processing_mismatch(model, results), "");
+  results.filter_a = 0.3;
+  results.roc = false;
+  const auto why = correction::processing_mismatch(model, results);
+  EXPECT_NE(why.find("filter A: model 0.4, results 0.3"), std::string::npos) << why;
+  EXPECT_NE(why.find("robust outlier cutoff: model on, results off"), std::string::npos) << why;
+  results = model;
+  results.signal = awcc::CorrelationSignal::raw;
+  EXPECT_NE(correction::processing_mismatch(model, results).find("correlated signal"), std::string::npos);
+}
+
+// The processing survives the file; version 1 files read as the default.
+TEST(Correction, ModelFileKeepsTheProcessing) {
+  auto m = small_model();
+  m.processing.filter_a = 0.25;
+  m.processing.weighting = awcc::Weighting::none;
+  m.processing.subsample = awcc::Subsample::parabolic;
+  const auto back = CorrectionModel::parse(m.serialise(), "m.qrf");
+  EXPECT_TRUE(back.processing == m.processing);
+  EXPECT_NE(back.mismatch(correction::Processing{}), "");
+  const auto shipped = std::filesystem::path(PDP_SOURCE_DIR) / "samples" / "model" / "awcc.qrf";
+  const auto v1 = CorrectionModel::load(shipped);
+  EXPECT_TRUE(v1.processing == correction::Processing{});
 }
 
 }  // namespace

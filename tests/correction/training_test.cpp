@@ -1,4 +1,4 @@
-#include "training.hpp"
+#include "correction/training.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,15 +6,19 @@
 #include <fstream>
 #include <random>
 
-#include "cells.hpp"
-#include "sweep.hpp"
+#include "awcc/csv.hpp"
 #include "test_paths.hpp"
 
 namespace {
 
+// The columns of a pdp sweep CSV that training reads (and a scene column).
+const std::string kHeader =
+    "study,run,velocity,dx,dy,np,truth_velocity,truth_turbulence_intensity,awcc_velocity,awcc_turbulence_intensity,"
+    "awcc_void_fraction,awcc_count_rate,awcc_windows_accepted,reason";
+
 // A sweep CSV row with the columns pdp train reads set, the rest empty.
 std::string row(std::int64_t run, const std::map<std::string, std::string>& values) {
-  const auto names = pdp::split_cells(pdp::sweep_header());
+  const auto names = awcc::split_cells(kHeader);
   std::string out;
   for (std::size_t i = 0; i < names.size(); ++i) {
     std::string v;
@@ -29,7 +33,7 @@ std::string row(std::int64_t run, const std::map<std::string, std::string>& valu
 std::map<std::string, std::string> good(double u, double true_u, double windows = 500) {
   return {{"dx", "0.005"}, {"dy", "0.001"}, {"np", "10"}, {"truth_velocity", std::to_string(true_u)},
           {"truth_turbulence_intensity", "0.2"}, {"awcc_velocity", std::to_string(u)},
-          {"awcc_turbulence_intensity", "0.18"}, {"awcc_void_fraction", "0.2"}, {"awcc_d32", "0.003"},
+          {"awcc_turbulence_intensity", "0.18"}, {"awcc_void_fraction", "0.2"}, {"awcc_count_rate", std::to_string(100 * u)},
           {"awcc_windows_accepted", std::to_string(static_cast<long>(windows))}};
 }
 
@@ -40,16 +44,16 @@ std::filesystem::path write(const std::string& name, const std::string& text) {
 }
 
 TEST(Training, LoadCountsEveryExcludedRunByCause) {
-  std::string csv = pdp::sweep_header() + "\n";
+  std::string csv = kHeader + "\n";
   csv += row(0, good(10, 9.5));
-  csv += row(1, {{"reason", "synthesis failed: boom"}});
+  csv += row(1, {{"reason", "synthesis failed: boom"}});  // a failed run has no truth
   auto undefined = good(10, 9.5);
   undefined["reason"] = "awcc: 0 of 12 windows accepted";
   undefined["awcc_velocity"] = "";
   csv += row(2, undefined);
   csv += row(3, good(10, 9.5, 99));
   csv += row(4, good(20, 19, 100));
-  const auto set = pdp::load_training_set({write("training_counts.csv", csv)}, 100);
+  const auto set = correction::load_training_set({write("training_counts.csv", csv)}, 100);
   EXPECT_EQ(set.total, 5);
   EXPECT_EQ(set.excluded_error, 1);
   EXPECT_EQ(set.excluded_undefined, 1);
@@ -61,27 +65,55 @@ TEST(Training, LoadCountsEveryExcludedRunByCause) {
   EXPECT_DOUBLE_EQ(set.rows[1].true_velocity, 19.0);
   EXPECT_DOUBLE_EQ(set.rows[1].features.dy, 0.001);
   EXPECT_DOUBLE_EQ(set.rows[1].features.np, 10.0);
+  // d32 by the feature contract: 1.5 u c / F = 1.5 x 20 x 0.2 / 2000.
+  EXPECT_NEAR(set.rows[1].features.d32, 0.003, 1e-15);
+  EXPECT_TRUE(set.processing_assumed);  // no processing columns: the default, said
+}
+
+// The geometry processed (probe_dx, probe_dy) wins over the scene's dx and
+// dy, which explicit tips override; rows processed differently are refused.
+TEST(Training, LoadReadsTheProcessedGeometryAndOneProcessing) {
+  const std::string header = kHeader + ",probe_dx,probe_dy,awcc_filter_a,awcc_roc,awcc_weighting,awcc_signal,awcc_subsample";
+  auto cells = [&](std::int64_t run, const std::string& filter_a) {
+    auto r = row(run, good(10, 9.5));
+    r.pop_back();
+    return r + ",0.008,0.0005," + filter_a + ",on,duration,binary,none\n";
+  };
+  auto set = correction::load_training_set({write("training_geometry.csv", header + "\n" + cells(0, "0.4"))}, 100);
+  ASSERT_EQ(set.rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(set.rows[0].features.dx, 0.008);
+  EXPECT_DOUBLE_EQ(set.rows[0].features.dy, 0.0005);
+  EXPECT_FALSE(set.processing_assumed);
+  EXPECT_TRUE(set.processing == correction::Processing{});
+  try {
+    (void)correction::load_training_set(
+        {write("training_mixed.csv", header + "\n" + cells(0, "0.4") + cells(1, "0.3"))}, 100);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("training_mixed.csv:3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("filter A: model 0.4, results 0.3"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
-  std::string csv = pdp::sweep_header() + "\n" + row(0, good(10, 9.5)) + row(0, good(10, 9.5));
+  std::string csv = kHeader + "\n" + row(0, good(10, 9.5)) + row(0, good(10, 9.5));
   try {
-    (void)pdp::load_training_set({write("training_dup.csv", csv)}, 100);
+    (void)correction::load_training_set({write("training_dup.csv", csv)}, 100);
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("training_dup.csv:3: run 0"), std::string::npos) << e.what();
   }
   auto bad = good(10, 9.5);
-  bad["awcc_d32"] = "3mm";
-  csv = pdp::sweep_header() + "\n" + row(0, bad);
+  bad["awcc_count_rate"] = "3mm";
+  csv = kHeader + "\n" + row(0, bad);
   try {
-    (void)pdp::load_training_set({write("training_bad.csv", csv)}, 100);
+    (void)correction::load_training_set({write("training_bad.csv", csv)}, 100);
     FAIL();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("training_bad.csv:2: column awcc_d32 = '3mm'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("training_bad.csv:2: column awcc_count_rate = '3mm'"), std::string::npos) << e.what();
   }
   try {
-    (void)pdp::load_training_set({write("training_foreign.csv", "a,b\n1,2\n")}, 100);
+    (void)correction::load_training_set({write("training_foreign.csv", "a,b\n1,2\n")}, 100);
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("no column 'study'"), std::string::npos) << e.what();
@@ -92,22 +124,22 @@ TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
 // scores follow by hand. Row A: truth 1.1 u (corrected error 0, covered; raw
 // 1/1.1 - 1); row B: truth u (corrected 0.1, not covered; raw 0).
 TEST(Training, ScoresAreTheDefinedStatistics) {
-  std::vector<pdp::TrainingRow> train;
+  std::vector<correction::TrainingRow> train;
   for (int i = 0; i < 50; ++i) {
-    pdp::TrainingRow r;
+    correction::TrainingRow r;
     r.run = i;
     r.features = {10.0 + i, 0.1, 0.2, 0.003, 0.005, 0.001, 10, 500};
     r.true_velocity = 1.1 * r.features.velocity;
     r.true_turbulence_intensity = 0.15;  // difference +0.05
     train.push_back(r);
   }
-  awcc::ForestOptions o;
+  correction::ForestOptions o;
   o.trees = 5;
-  const auto model = pdp::fit_model(train, awcc::TargetForm::ratio, awcc::TargetForm::difference, o, o, 100);
+  const auto model = correction::fit_model(train, correction::TargetForm::ratio, correction::TargetForm::difference, o, o, 100);
   auto a = train[10], b = train[20];
   b.true_velocity = b.features.velocity;
   b.true_turbulence_intensity = 0.1;
-  const auto s = pdp::score(model, {a, b});
+  const auto s = correction::score(model, {a, b});
   EXPECT_EQ(s.rows, 2);
   EXPECT_NEAR(s.velocity_rmse_corrected, std::sqrt(0.01 / 2), 1e-12);
   EXPECT_NEAR(s.velocity_rmse_raw, std::sqrt(std::pow(1 / 1.1 - 1, 2) / 2), 1e-12);
@@ -121,7 +153,7 @@ TEST(Training, ScoresAreTheDefinedStatistics) {
   // A row outside the ranges is counted, not scored.
   auto c = a;
   c.features.dx = 1.0;
-  EXPECT_EQ(pdp::score(model, {a, c}).out_of_range, 1);
+  EXPECT_EQ(correction::score(model, {a, c}).out_of_range, 1);
 }
 
 // The held-out split hashes run indices: the order of the rows in the files
@@ -129,9 +161,9 @@ TEST(Training, ScoresAreTheDefinedStatistics) {
 TEST(Training, ModelDoesNotDependOnRowOrder) {
   std::mt19937_64 g(4);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  pdp::TrainingSet set;
+  correction::TrainingSet set;
   for (int i = 0; i < 200; ++i) {
-    pdp::TrainingRow r;
+    correction::TrainingRow r;
     r.run = i;
     r.features = {1 + 49 * u(g), 0.35 * u(g), 0.4 * u(g), 0.01 * u(g), 0.01 * u(g), 0.002 * u(g), 10, 500};
     r.true_velocity = r.features.velocity * (1 - 0.1 * u(g));
@@ -139,7 +171,7 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
     set.rows.push_back(r);
   }
   set.total = 200;
-  pdp::TrainOptions o;
+  correction::TrainOptions o;
   o.trees = 10;
   o.folds = 2;
   o.cv_trees = 3;
@@ -148,9 +180,9 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
   // Two studies with the same run indices (two sweeps combined).
   for (int i = 0; i < 100; ++i) set.rows[static_cast<std::size_t>(i)].study = 7;
   for (int i = 100; i < 200; ++i) set.rows[static_cast<std::size_t>(i)].run -= 100;
-  const auto first = pdp::train_model(set, o);
+  const auto first = correction::train_model(set, o);
   std::reverse(set.rows.begin(), set.rows.end());
-  const auto second = pdp::train_model(set, o);
+  const auto second = correction::train_model(set, o);
   EXPECT_EQ(first.model.serialise(), second.model.serialise());
   EXPECT_EQ(first.predictions.size(), 40u);
   EXPECT_EQ(first.cv.size(), 2u * 2u * 2u * 2u);

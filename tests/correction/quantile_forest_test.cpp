@@ -1,4 +1,4 @@
-#include "awcc/quantile_forest.hpp"
+#include "correction/quantile_forest.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 
 namespace {
 
-using awcc::ForestOptions;
-using awcc::QuantileForest;
-using awcc::TrainingData;
+using correction::ForestOptions;
+using correction::QuantileForest;
+using correction::TrainingData;
 
 // Levels as exact fractions num/den, so that the order statistic index
 // ceil(alpha m) is computed in integers, independently of the forest's
@@ -310,7 +310,7 @@ TEST(QuantileForest, RefusesBadOptionsAndData) {
 }
 
 TEST(QuantileForest, AssembleRefusesTreesThatPointNowhere) {
-  awcc::RegressionTree t;
+  correction::RegressionTree t;
   t.nodes.resize(3);
   t.nodes[0] = {0, 0.5, 1, 2};
   t.nodes[1] = {-1, 0.0, 0, 1};
@@ -331,8 +331,8 @@ TEST(QuantileForest, AssembleRefusesTreesThatPointNowhere) {
 TEST(QuantileForest, PinballLossIsLeastAtTheTrueQuantile) {
   // Exact values: y = 1, q = 0 at alpha 0.9 costs 0.9; q = 2 costs 0.1.
   const std::vector<double> a{0.9};
-  EXPECT_DOUBLE_EQ(awcc::pinball_loss(std::vector<double>{0.0}, a, 1.0), 0.9);
-  EXPECT_DOUBLE_EQ(awcc::pinball_loss(std::vector<double>{2.0}, a, 1.0), 0.1);
+  EXPECT_DOUBLE_EQ(correction::pinball_loss(std::vector<double>{0.0}, a, 1.0), 0.9);
+  EXPECT_DOUBLE_EQ(correction::pinball_loss(std::vector<double>{2.0}, a, 1.0), 0.1);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "training.hpp"
+#include "correction/training.hpp"
 
 #include <fmt/format.h>
 
@@ -13,47 +13,36 @@
 #include <stdexcept>
 #include <thread>
 
+#include "awcc/csv.hpp"
+#include "awcc/parallel.hpp"
+#include "awcc/random.hpp"
 #include "awcc/version.hpp"
-#include "cells.hpp"
-#include "terminal.hpp"
 
-namespace pdp {
+namespace correction {
 
 namespace {
 
-std::uint64_t mix(std::uint64_t z) {
-  z += 0x9e3779b97f4a7c15ull;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
+using awcc::cell_number;
+using awcc::mix64;
+using awcc::parallel_for;
+using awcc::split_cells;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::vector<double> levels() { return {awcc::correction_levels.begin(), awcc::correction_levels.end()}; }
+std::vector<double> levels() { return {correction_levels.begin(), correction_levels.end()}; }
 
-/// Runs fn(i) for i in [0, n) on `threads` threads (results land by index).
-void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& fn) {
-  unsigned t = threads > 0 ? static_cast<unsigned>(threads) : std::max(1u, std::thread::hardware_concurrency());
-  t = static_cast<unsigned>(std::min<std::size_t>(t, std::max<std::size_t>(n, 1)));
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t i; (i = next.fetch_add(1)) < n;) fn(i);
-  };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < t; ++i) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-}
-
-awcc::TrainingData data_of(const std::vector<TrainingRow>& rows, bool velocity, awcc::TargetForm form) {
-  awcc::TrainingData d;
-  d.features = awcc::CorrectionFeatures::count;
+TrainingData data_of(const std::vector<TrainingRow>& rows, bool velocity, TargetForm form) {
+  TrainingData d;
+  d.features = Features::count;
   d.x.reserve(rows.size() * 7);
   d.y.reserve(rows.size());
   for (const auto& r : rows) {
     const auto x = r.features.vector();
     d.x.insert(d.x.end(), x.begin(), x.end());
-    d.y.push_back(velocity ? awcc::to_target(form, r.true_velocity, r.features.velocity)
-                           : awcc::to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity));
+    d.y.push_back(velocity ? to_target(form, r.true_velocity, r.features.velocity)
+                           : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity));
   }
   return d;
 }
@@ -65,17 +54,17 @@ double target_pinball(const std::vector<double>& q, const TrainingRow& r, bool v
   if (velocity) {
     std::vector<double> rel(q.size());
     for (std::size_t k = 0; k < q.size(); ++k) rel[k] = q[k] / r.true_velocity;
-    return awcc::pinball_loss(rel, lv, 1.0);
+    return pinball_loss(rel, lv, 1.0);
   }
-  return awcc::pinball_loss(q, lv, r.true_turbulence_intensity);
+  return pinball_loss(q, lv, r.true_turbulence_intensity);
 }
 
-std::vector<double> predict(const awcc::QuantileForest& f, awcc::TargetForm form, const TrainingRow& r, bool velocity) {
+std::vector<double> predict(const QuantileForest& f, TargetForm form, const TrainingRow& r, bool velocity) {
   const auto x = r.features.vector();
   auto q = f.quantiles(x, levels());
   const double measured = velocity ? r.features.velocity : r.features.turbulence_intensity;
   for (auto& v : q) {
-    v = awcc::from_target(form, v, measured);
+    v = from_target(form, v, measured);
     if (!velocity) v = std::max(0.0, v);
   }
   return q;
@@ -84,14 +73,14 @@ std::vector<double> predict(const awcc::QuantileForest& f, awcc::TargetForm form
 }  // namespace
 
 std::string TrainOptions::validate() const {
-  if (trees < 1) return fmt::format("--trees {}: give at least 1", trees);
-  if (min_windows < 1) return fmt::format("--min-windows {}: give at least 1", min_windows);
-  if (!(held_out > 0.0 && held_out < 1.0)) return fmt::format("--held-out {}: give a fraction in (0, 1)", held_out);
-  if (folds == 1 || folds < 0) return fmt::format("--folds {}: give 0 (no cross-validation) or at least 2", folds);
-  if (cv_trees < 1) return fmt::format("--cv-trees {}: give at least 1", cv_trees);
-  if (min_leaf < 1) return fmt::format("--min-leaf {}: give at least 1", min_leaf);
-  if (features_per_split < 1 || features_per_split > awcc::CorrectionFeatures::count) {
-    return fmt::format("--features-per-split {}: give 1 to {}", features_per_split, awcc::CorrectionFeatures::count);
+  if (trees < 1) return fmt::format("trees {}: give at least 1", trees);
+  if (min_windows < 1) return fmt::format("minimum windows {}: give at least 1", min_windows);
+  if (!(held_out > 0.0 && held_out < 1.0)) return fmt::format("held-out fraction {}: give a fraction in (0, 1)", held_out);
+  if (folds == 1 || folds < 0) return fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds);
+  if (cv_trees < 1) return fmt::format("cross-validation trees {}: give at least 1", cv_trees);
+  if (min_leaf < 1) return fmt::format("min leaf {}: give at least 1", min_leaf);
+  if (features_per_split < 1 || features_per_split > Features::count) {
+    return fmt::format("features per split {}: give 1 to {}", features_per_split, Features::count);
   }
   return {};
 }
@@ -99,6 +88,7 @@ std::string TrainOptions::validate() const {
 TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows) {
   TrainingSet set;
   std::set<std::pair<std::string, std::int64_t>> seen;
+  bool processing_seen = false;
   for (const auto& path : csvs) {
     std::ifstream in(path);
     if (!in) throw std::runtime_error(fmt::format("{}: cannot open the sweep CSV; check the path", path.string()));
@@ -108,13 +98,22 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     std::map<std::string, std::size_t> col;
     for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
     const char* needed[] = {"study", "run", "dx", "dy", "np", "truth_velocity", "truth_turbulence_intensity",
-                            "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_d32",
+                            "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate",
                             "awcc_windows_accepted", "reason"};
     for (const char* name : needed) {
       if (!col.count(name)) {
         throw std::runtime_error(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
       }
     }
+    // The processing of the runs: every row must agree (the model learns one).
+    const char* processing_columns[] = {"awcc_filter_a", "awcc_roc", "awcc_weighting", "awcc_signal", "awcc_subsample"};
+    const bool has_processing = std::all_of(std::begin(processing_columns), std::end(processing_columns),
+                                            [&](const char* c) { return col.count(c) > 0; });
+    if (!has_processing) set.processing_assumed = true;
+    // The geometry processed; older CSVs have only the scene's dx and dy
+    // (the same unless the scene gave explicit tips).
+    const char* dx_column = col.count("probe_dx") ? "probe_dx" : "dx";
+    const char* dy_column = col.count("probe_dy") ? "probe_dy" : "dy";
     std::set<std::string> studies;
     std::int64_t number = 1;
     while (std::getline(in, line)) {
@@ -141,14 +140,26 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         throw std::runtime_error(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
                                              path.string(), number, run, cell("study")));
       }
-      if (!cell("reason").empty()) {
-        // "awcc: ..." is AWCC giving no value (e.g. no window accepted), not a failed run.
-        ++(cell("reason").starts_with("awcc:") ? set.excluded_undefined : set.excluded_error);
+      // A failed run has no result at all (no truth); a run whose AWCC gave
+      // no value has its truth but no AWCC velocity.
+      if (cell("truth_velocity").empty()) {
+        ++set.excluded_error;
         continue;
       }
-      if (cell("awcc_velocity").empty() || cell("awcc_turbulence_intensity").empty() || cell("awcc_d32").empty()) {
-        ++set.excluded_undefined;
-        continue;
+      if (has_processing) {
+        Processing p;
+        p.filter_a = number_of("awcc_filter_a");
+        p.roc = cell("awcc_roc") == "on";
+        p.weighting = cell("awcc_weighting") == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
+        p.signal = cell("awcc_signal") == "raw" ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
+        p.subsample = cell("awcc_subsample") == "parabolic" ? awcc::Subsample::parabolic : awcc::Subsample::none;
+        if (!processing_seen) set.processing = p;
+        processing_seen = true;
+        if (const auto why = processing_mismatch(set.processing, p); !why.empty()) {
+          throw std::runtime_error(fmt::format("{}:{}: this run was processed differently from the first ({}); a model "
+                                               "learns one processing: train on sweeps run with the same method options",
+                                               path.string(), number, why));
+        }
       }
       TrainingRow r;
       r.run = run;
@@ -159,25 +170,30 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       } catch (const std::exception&) {
         throw std::runtime_error(fmt::format("{}:{}: study = '{}' is not a sweep study id", path.string(), number, cell("study")));
       }
-      auto& f = r.features;
-      f.windows_accepted = static_cast<std::int64_t>(number_of("awcc_windows_accepted"));
-      if (f.windows_accepted < min_windows) {
-        ++set.excluded_windows;
-        continue;
-      }
-      f.velocity = number_of("awcc_velocity");
-      f.turbulence_intensity = number_of("awcc_turbulence_intensity");
-      f.void_fraction = number_of("awcc_void_fraction");
-      f.d32 = number_of("awcc_d32");
-      f.dx = number_of("dx");
-      f.dy = number_of("dy");
-      f.np = number_of("np");
-      r.true_velocity = number_of("truth_velocity");
-      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
-      if (!(f.velocity > 0.0)) {  // the ratio target needs u > 0; such runs are not corrected either
+      Measurement m;
+      if (!cell("awcc_velocity").empty()) m.velocity = number_of("awcc_velocity");
+      if (!cell("awcc_turbulence_intensity").empty()) m.turbulence_intensity = number_of("awcc_turbulence_intensity");
+      const auto features = [&] {
+        if (!m.velocity || !m.turbulence_intensity) return make_features(m);
+        m.void_fraction = number_of("awcc_void_fraction");
+        m.bubble_count_rate = number_of("awcc_count_rate");
+        m.dx = number_of(dx_column);
+        m.dy = number_of(dy_column);
+        m.np = static_cast<int>(number_of("np"));
+        m.windows_accepted = static_cast<std::int64_t>(number_of("awcc_windows_accepted"));
+        return make_features(m);
+      }();
+      if (!features.ok()) {  // no (positive) AWCC velocity, or no bubbles: not corrected either
         ++set.excluded_undefined;
         continue;
       }
+      if (features.features.windows_accepted < min_windows) {
+        ++set.excluded_windows;
+        continue;
+      }
+      r.features = features.features;
+      r.true_velocity = number_of("truth_velocity");
+      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
       set.rows.push_back(r);
     }
     for (const auto& s : studies) set.sources.push_back(fmt::format("{} (study {})", path.filename().string(), s));
@@ -191,15 +207,15 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
   return set;
 }
 
-awcc::CorrectionModel fit_model(const std::vector<TrainingRow>& rows, awcc::TargetForm velocity_form,
-                                awcc::TargetForm turbulence_form, const awcc::ForestOptions& velocity_options,
-                                const awcc::ForestOptions& turbulence_options, std::int64_t min_windows) {
-  awcc::CorrectionModel m;
+CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm velocity_form,
+                                TargetForm turbulence_form, const ForestOptions& velocity_options,
+                                const ForestOptions& turbulence_options, std::int64_t min_windows) {
+  CorrectionModel m;
   m.min_windows = min_windows;
   m.velocity_form = velocity_form;
   m.turbulence_form = turbulence_form;
-  for (int j = 0; j < awcc::CorrectionFeatures::count; ++j) {
-    awcc::FeatureRange r{awcc::CorrectionFeatures::names[static_cast<std::size_t>(j)], 1e300, -1e300};
+  for (int j = 0; j < Features::count; ++j) {
+    FeatureRange r{Features::names[static_cast<std::size_t>(j)], 1e300, -1e300};
     for (const auto& row : rows) {
       const double v = row.features.vector()[static_cast<std::size_t>(j)];
       r.min = std::min(r.min, v);
@@ -207,8 +223,8 @@ awcc::CorrectionModel fit_model(const std::vector<TrainingRow>& rows, awcc::Targ
     }
     m.ranges.push_back(r);
   }
-  m.velocity = awcc::QuantileForest::train(data_of(rows, true, velocity_form), velocity_options);
-  m.turbulence_intensity = awcc::QuantileForest::train(data_of(rows, false, turbulence_form), turbulence_options);
+  m.velocity = QuantileForest::train(data_of(rows, true, velocity_form), velocity_options);
+  m.turbulence_intensity = QuantileForest::train(data_of(rows, false, turbulence_form), turbulence_options);
   return m;
 }
 
@@ -259,16 +275,16 @@ struct QuantityScores {
 
 }  // namespace
 
-HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<TrainingRow>& rows,
+HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions, int threads) {
-  std::vector<awcc::Correction> c(rows.size());
+  std::vector<Correction> c(rows.size());
   parallel_for(rows.size(), threads, [&](std::size_t i) { c[i] = model.correct(rows[i].features); });
   HeldOutScores s;
   QuantityScores velocity, tu;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
     if (predictions) predictions->push_back({r, c[i]});
-    if (!c[i].in_range) {
+    if (!c[i].corrected()) {
       ++s.out_of_range;
       continue;
     }
@@ -294,7 +310,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
   // Held-out split by a hash of the run index: independent of file order.
   std::vector<TrainingRow> rows = set.rows;
-  auto key = [&](const TrainingRow& r) { return mix(o.seed ^ mix(static_cast<std::uint64_t>(r.run) ^ mix(r.study))); };
+  auto key = [&](const TrainingRow& r) { return mix64(o.seed ^ mix64(static_cast<std::uint64_t>(r.run) ^ mix64(r.study))); };
   std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
     const auto ha = key(a), hb = key(b);
     if (ha != hb) return ha < hb;
@@ -310,14 +326,14 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
 
   TrainResult result;
   result.training_rows = static_cast<std::int64_t>(training.size());
-  awcc::ForestOptions vopt, topt;
+  ForestOptions vopt, topt;
   vopt.trees = topt.trees = o.trees;
   vopt.threads = topt.threads = o.threads;
   vopt.seed = o.seed;
   topt.seed = o.seed + 1;
   vopt.min_leaf = topt.min_leaf = o.min_leaf;
   vopt.features_per_split = topt.features_per_split = o.features_per_split;
-  awcc::TargetForm vform = o.velocity_form, tform = o.turbulence_form;
+  TargetForm vform = o.velocity_form, tform = o.turbulence_form;
 
   const auto cv_start = std::chrono::steady_clock::now();
   const std::size_t grid = o.min_leaf_grid.size() * o.features_per_split_grid.size() * 2;
@@ -327,8 +343,8 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     std::size_t done = 0;
     for (int target = 0; target < 2; ++target) {
       const bool velocity = target == 0;
-      const std::array<awcc::TargetForm, 2> forms{awcc::TargetForm::value,
-                                                  velocity ? awcc::TargetForm::ratio : awcc::TargetForm::difference};
+      const std::array<TargetForm, 2> forms{TargetForm::value,
+                                                  velocity ? TargetForm::ratio : TargetForm::difference};
       CvEntry best;
       best.pinball = std::numeric_limits<double>::infinity();
       for (auto form : forms) {
@@ -338,13 +354,13 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
             for (std::size_t fold = 0; fold < k; ++fold) {
               std::vector<TrainingRow> fit, test;
               for (std::size_t i = 0; i < training.size(); ++i) (i % k == fold ? test : fit).push_back(training[i]);
-              awcc::ForestOptions fo;
+              ForestOptions fo;
               fo.trees = o.cv_trees;
               fo.min_leaf = leaf;
               fo.features_per_split = mtry;
               fo.seed = o.seed + 17 * fold + static_cast<std::uint64_t>(target);
               fo.threads = o.threads;
-              const auto forest = awcc::QuantileForest::train(data_of(fit, velocity, form), fo);
+              const auto forest = QuantileForest::train(data_of(fit, velocity, form), fo);
               std::vector<double> losses(test.size());
               parallel_for(test.size(), o.threads, [&](std::size_t i) {
                 losses[i] = target_pinball(predict(forest, form, test[i], velocity), test[i], velocity);
@@ -408,15 +424,17 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   const auto& h = result.held_out;
   std::string sources;
   for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
+  result.model.processing = set.processing;
   result.model.provenance = fmt::format(
-      "pdp train {}: {}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
+      "pdp train {}: {}; processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
       "windows); trained on {}, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
       "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
       "{:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; Tu RMSE {:.4f} raw, {:.4f} corrected, 80/95 % coverage "
       "{:.1f}/{:.1f} %.",
-      awcc::version, sources, set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
-      set.excluded_windows, o.min_windows, training.size(), held_out.size(), o.seed, awcc::to_string(vform), vopt.trees,
-      vopt.min_leaf, vopt.features_per_split, awcc::to_string(tform), topt.trees, topt.min_leaf,
+      awcc::version, sources, describe(set.processing),
+      set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
+      set.excluded_windows, o.min_windows, training.size(), held_out.size(), o.seed, to_string(vform), vopt.trees,
+      vopt.min_leaf, vopt.features_per_split, to_string(tform), topt.trees, topt.min_leaf,
       topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected, 100 * h.velocity_coverage80,
       100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected, 100 * h.tu_coverage80, 100 * h.tu_coverage95);
   return result;
@@ -429,7 +447,7 @@ std::string TrainResult::report() const {
     line("Cross-validation (mean pinball loss over the correction levels; velocity relative to the truth):");
     line("  target                form        min_leaf  features/split  pinball");
     for (const auto& e : cv) {
-      line(fmt::format("  {:<21} {:<11} {:>8}  {:>14}  {:.6f}", e.target, awcc::to_string(e.form), e.min_leaf,
+      line(fmt::format("  {:<21} {:<11} {:>8}  {:>14}  {:.6f}", e.target, to_string(e.form), e.min_leaf,
                        e.features_per_split, e.pinball));
     }
     line(fmt::format("  ({:.1f} s)", seconds_cv));
@@ -465,16 +483,16 @@ std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
   std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,true_velocity,"
                     "true_turbulence_intensity,in_range";
   for (const char* q : {"velocity", "turbulence_intensity"}) {
-    for (const char* l : awcc::correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
+    for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
   out += "\n";
   for (const auto& p : predictions) {
     const auto& f = p.row.features;
     out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{}", p.row.run,
                        f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np, f.windows_accepted,
-                       p.row.true_velocity, p.row.true_turbulence_intensity, p.correction.in_range ? 1 : 0);
+                       p.row.true_velocity, p.row.true_turbulence_intensity, p.correction.corrected() ? 1 : 0);
     for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
-      for (std::size_t k = 0; k < awcc::correction_levels.size(); ++k) {
+      for (std::size_t k = 0; k < correction_levels.size(); ++k) {
         out += *q ? fmt::format(",{:.10g}", (*q)->quantiles[k]) : std::string(",");
       }
     }
@@ -497,4 +515,4 @@ std::string learning_curve_csv(const std::vector<LearningPoint>& curve) {
   return out;
 }
 
-}  // namespace pdp
+}  // namespace correction

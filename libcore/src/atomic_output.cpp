@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <unistd.h>
 
+#include "awcc/errors.hpp"
+
 namespace awcc {
 
 void write_atomically(const std::filesystem::path& target,
@@ -12,7 +14,7 @@ void write_atomically(const std::filesystem::path& target,
   namespace fs = std::filesystem;
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::is_directory(parent)) {
-    throw std::runtime_error(fmt::format("{}: the folder {} does not exist; create it or choose another output path",
+    throw OutputError(fmt::format("{}: the folder {} does not exist; create it or choose another output path",
                                          target.string(), parent.string()));
   }
   const fs::path temporary =
@@ -32,7 +34,7 @@ void write_text_atomically(const std::filesystem::path& target, std::string_view
     std::ofstream out(temporary, std::ios::binary);
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
     out.close();
-    if (!out) throw std::runtime_error(fmt::format("{}: could not write the file", temporary.string()));
+    if (!out) throw OutputError(fmt::format("{}: could not write the file", temporary.string()));
   });
 }
 

@@ -1,4 +1,4 @@
-#include "awcc/quantile_forest.hpp"
+#include "correction/quantile_forest.hpp"
 
 #include <fmt/format.h>
 
@@ -11,28 +11,14 @@
 #include <stdexcept>
 #include <thread>
 
-namespace awcc {
+#include "awcc/parallel.hpp"
+#include "awcc/random.hpp"
+
+namespace correction {
 
 namespace {
 
-// splitmix64: a small, well-mixed generator; one stream per tree.
-struct SplitMix {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-  }
-  /// Uniform in [0, n) without modulo bias (reject the short top end).
-  std::uint64_t below(std::uint64_t n) {
-    const std::uint64_t reject_below = (0 - n) % n;
-    for (;;) {
-      const std::uint64_t r = next();
-      if (r >= reject_below) return r % n;
-    }
-  }
-};
+using SplitMix = awcc::SplitMix64;  // one stream per tree
 
 struct Split {
   int feature = -1;
@@ -230,30 +216,12 @@ QuantileForest QuantileForest::train(const TrainingData& data, const ForestOptio
   forest.features_ = data.features;
   forest.targets_ = data.y;
   forest.trees_.resize(static_cast<std::size_t>(options.trees));
-  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
-  threads = std::clamp(threads, 1u, static_cast<unsigned>(options.trees));
-  std::atomic<int> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto work = [&] {
-    try {
-      for (int t; (t = next.fetch_add(1)) < options.trees;) {
-        // The tree's stream depends on (seed, t) only.
-        SplitMix mix{options.seed ^ (0xd1b54a32d192ed03ull * (static_cast<std::uint64_t>(t) + 1))};
-        TreeBuilder builder(data, options, mtry, mix.next());
-        forest.trees_[static_cast<std::size_t>(t)] = builder.build();
-      }
-    } catch (...) {
-      std::lock_guard lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      next = options.trees;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-  if (failure) std::rethrow_exception(failure);
+  awcc::parallel_for(static_cast<std::size_t>(options.trees), options.threads, [&](std::size_t t) {
+    // The tree's stream depends on (seed, t) only.
+    SplitMix mix{options.seed ^ (0xd1b54a32d192ed03ull * (static_cast<std::uint64_t>(t) + 1))};
+    TreeBuilder builder(data, options, mtry, mix.next());
+    forest.trees_[t] = builder.build();
+  });
   return forest;
 }
 
@@ -343,4 +311,4 @@ double pinball_loss(std::span<const double> q, std::span<const double> levels, d
   return sum / static_cast<double>(q.size());
 }
 
-}  // namespace awcc
+}  // namespace correction

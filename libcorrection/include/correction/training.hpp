@@ -4,7 +4,12 @@
 // hyperparameters, the held-out scores and the learning curve.
 //
 // Rows used: runs with no error whose AWCC gave a value from at least
-// `min_windows` accepted windows; the others are counted by cause.
+// `min_windows` accepted windows; the others are counted by cause. A row's
+// features come from its measured u, Tu, c and F, dx, dy and Np through the
+// one feature contract (correction/features.hpp). The processing of the
+// runs (columns awcc_filter_a ... awcc_subsample) must be the same in every
+// row; it is recorded in the model. CSVs without those columns were written
+// with the default processing, which is assumed and said.
 // Held-out split: the rows ordered by a hash of (seed, study, run index); the first
 // `held_out` fraction is held out. The model is trained on the rest only, so
 // the held-out scores are those of the shipped model.
@@ -29,14 +34,14 @@
 #include <string>
 #include <vector>
 
-#include "awcc/correction.hpp"
+#include "correction/model.hpp"
 
-namespace pdp {
+namespace correction {
 
 struct TrainingRow {
   std::uint64_t study = 0;              ///< sweep study id (several sweeps may be combined)
   std::int64_t run = 0;
-  awcc::CorrectionFeatures features;
+  Features features;
   double true_velocity = 0.0, true_turbulence_intensity = 0.0;
 };
 
@@ -47,6 +52,8 @@ struct TrainingSet {
   std::int64_t excluded_undefined = 0;  ///< AWCC gave no velocity
   std::int64_t excluded_windows = 0;    ///< fewer than min_windows accepted windows
   std::vector<std::string> sources;     ///< file names and study ids
+  Processing processing;                ///< how every run was processed
+  bool processing_assumed = false;      ///< the CSVs do not say: the default was assumed
 };
 
 /// Reads sweep CSVs (pdp sweep's columns); throws std::runtime_error naming
@@ -64,8 +71,8 @@ struct TrainOptions {
   std::vector<int> features_per_split_grid{2, 3, 5, 7};
   int min_leaf = 10;                    ///< without CV
   int features_per_split = 3;           ///< without CV
-  awcc::TargetForm velocity_form = awcc::TargetForm::ratio;        ///< without CV
-  awcc::TargetForm turbulence_form = awcc::TargetForm::difference; ///< without CV
+  TargetForm velocity_form = TargetForm::ratio;        ///< without CV
+  TargetForm turbulence_form = TargetForm::difference; ///< without CV
   std::uint64_t seed = 1;
   int threads = 0;
   [[nodiscard]] std::string validate() const;
@@ -73,7 +80,7 @@ struct TrainOptions {
 
 struct CvEntry {
   std::string target;                   ///< "velocity" | "turbulence_intensity"
-  awcc::TargetForm form = awcc::TargetForm::value;
+  TargetForm form = TargetForm::value;
   int min_leaf = 0, features_per_split = 0;
   double pinball = 0.0;                 ///< mean over folds and rows
 };
@@ -105,11 +112,11 @@ struct LearningPoint {
 
 struct HeldOutPrediction {
   TrainingRow row;
-  awcc::Correction correction;
+  Correction correction;
 };
 
 struct TrainResult {
-  awcc::CorrectionModel model;
+  CorrectionModel model;
   std::int64_t training_rows = 0;
   std::vector<CvEntry> cv;              ///< every grid point scored
   int velocity_min_leaf = 0, velocity_features_per_split = 0;
@@ -126,17 +133,17 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& options,
                         const std::function<void(double)>& progress = {});
 
 /// Scores a model on rows.
-HeldOutScores score(const awcc::CorrectionModel& model, const std::vector<TrainingRow>& rows,
+HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions = nullptr, int threads = 0);
 
 /// The two forests and the ranges from training rows.
-awcc::CorrectionModel fit_model(const std::vector<TrainingRow>& rows, awcc::TargetForm velocity_form,
-                                awcc::TargetForm turbulence_form, const awcc::ForestOptions& velocity_options,
-                                const awcc::ForestOptions& turbulence_options, std::int64_t min_windows);
+CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm velocity_form,
+                                TargetForm turbulence_form, const ForestOptions& velocity_options,
+                                const ForestOptions& turbulence_options, std::int64_t min_windows);
 
 /// Held-out predictions as CSV: run, features, truth, raw, quantiles.
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
 /// The learning curve as CSV.
 std::string learning_curve_csv(const std::vector<LearningPoint>& curve);
 
-}  // namespace pdp
+}  // namespace correction

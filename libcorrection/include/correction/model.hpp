@@ -1,12 +1,9 @@
 #pragma once
 // Bias correction with uncertainty, METHOD.md 7: two quantile regression
-// forests (awcc/quantile_forest.hpp) map what AWCC measured to the
-// distribution of the truth.
+// forests (correction/quantile_forest.hpp) map what AWCC measured (the
+// features of correction/features.hpp) to the distribution of the truth.
 //
-// Features (in this order): measured mean velocity u (m/s), measured
-// turbulence intensity Tu, measured void fraction c, measured Sauter diameter
-// d32 = 1.5 u c / F (m), tip separations dx and dy (m), particles per window
-// Np. Targets: the true mean velocity and the true Tu, each learnt in the form
+// Targets: the true mean velocity and the true Tu, each learnt in the form
 // the model names (TargetForm) and mapped back:
 //   value       t = y_true                  y_q = t_q
 //   ratio       t = y_true / y_measured     y_q = y_measured t_q   (y_measured > 0)
@@ -19,19 +16,23 @@
 // training [min, max] widened by `range_margin` of the span on each side
 // (the trees split between training values, so beyond the data they repeat
 // the edge leaf: that is extrapolation), and at least `min_windows` accepted
-// windows (runs with fewer were left out of training). Otherwise the row is
-// flagged with the reason and left uncorrected.
+// windows (runs with fewer were left out of training). Otherwise the row
+// keeps its measurement, with a status and the reason. A model is applied
+// only to results processed as its training data were (`processing`).
 //
 // Model file (".qrf"), all numbers little-endian whatever the machine:
 //   "pdp-qrf\n" (8 bytes), u32 format version, u64 payload bytes, payload,
 //   u32 CRC-32 (IEEE 802.3) of everything before it.
 // Payload: provenance text; features (name, min, max); range margin; minimum
-// windows; per forest its name, target form, feature count, training targets
-// (f64), tree count, the width of a held row (u8: 2 or 4 bytes; 2 when there
-// are at most 65,536 targets) and the trees: node count, nodes (a split: u8
-// feature, f64 threshold, u32 left child, the right child being left + 1; a
-// leaf: u8 0xff, u32 first held row, u32 count), held-row count (u64), held
-// rows.
+// windows; [version 2: the processing: f64 filter A, u8 robust outlier cutoff,
+// u8 weighting (0 duration, 1 none), u8 signal (0 binary, 1 raw), u8 peak
+// refinement (0 none, 1 parabolic)]; per forest its name, target form,
+// feature count, training targets (f64), tree count, the width of a held row
+// (u8: 2 or 4 bytes; 2 when there are at most 65,536 targets) and the trees:
+// node count, nodes (a split: u8 feature, f64 threshold, u32 left child, the
+// right child being left + 1; a leaf: u8 0xff, u32 first held row, u32
+// count), held-row count (u64), held rows. Version 1 files (no processing)
+// were all trained with the default processing, which they are read with.
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
 
@@ -43,10 +44,10 @@
 #include <string>
 #include <vector>
 
-#include "awcc/process.hpp"
-#include "awcc/quantile_forest.hpp"
+#include "correction/features.hpp"
+#include "correction/quantile_forest.hpp"
 
-namespace awcc {
+namespace correction {
 
 /// The quantile levels every correction reports.
 inline constexpr std::array<double, 7> correction_levels{0.025, 0.1, 0.25, 0.5, 0.75, 0.9, 0.975};
@@ -55,17 +56,6 @@ inline constexpr std::array<const char*, 7> correction_level_names{"0.025", "0.1
 
 enum class TargetForm : std::uint8_t { value = 0, ratio = 1, difference = 2 };
 std::string_view to_string(TargetForm f);
-
-/// What the forests see, in feature order.
-struct CorrectionFeatures {
-  static constexpr int count = 7;
-  static constexpr std::array<const char*, 7> names{"velocity", "turbulence_intensity", "void_fraction", "d32", "dx", "dy", "np"};
-  double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
-  std::int64_t windows_accepted = 0;  ///< not a feature: rows below the model's minimum are not corrected
-  [[nodiscard]] std::array<double, 7> vector() const {
-    return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
-  }
-};
 
 struct FeatureRange {
   std::string name;
@@ -78,32 +68,44 @@ struct CorrectedQuantity {
   [[nodiscard]] double median() const { return quantiles[3]; }
 };
 
+/// The correction of one row: a value with a status.
 struct Correction {
-  bool in_range = false;
-  std::string reason;                 ///< why not, when out of range
+  CorrectionStatus status = CorrectionStatus::awcc_not_run;
+  std::string message;                ///< why not corrected (empty when corrected)
   std::optional<CorrectedQuantity> velocity, turbulence_intensity;
+  [[nodiscard]] bool corrected() const { return status == CorrectionStatus::corrected; }
 };
 
+/// A row that is not corrected, with the status and reason.
+Correction not_corrected(CorrectionStatus status, std::string message);
+
 struct CorrectionModel {
-  static constexpr std::uint32_t format_version = 1;
+  static constexpr std::uint32_t format_version = 2;
 
   std::string provenance;             ///< how the model was made (sweep, rows, options, held-out scores)
   std::vector<FeatureRange> ranges;   ///< training data [min, max] per feature, feature order
   double range_margin = 0.01;         ///< fraction of each span added on both sides
   std::int64_t min_windows = 100;     ///< least accepted windows of a corrected row
+  Processing processing;              ///< how the training data were processed
   TargetForm velocity_form = TargetForm::ratio;
   TargetForm turbulence_form = TargetForm::difference;
   QuantileForest velocity, turbulence_intensity;
 
-  /// Empty when the features are inside the training data, else why not.
-  [[nodiscard]] std::string out_of_range(const CorrectionFeatures& f) const;
-  [[nodiscard]] Correction correct(const CorrectionFeatures& f) const;
+  /// Corrected, or too few windows / outside the training range, with the reason.
+  [[nodiscard]] Correction correct(const Features& f) const;
+  /// From a measurement: its features (make_features) or why there are none.
+  [[nodiscard]] Correction correct(const Measurement& m) const;
+
+  /// Empty when results processed this way may be corrected, else the
+  /// differences ("filter A: model 0.4, results 0.3").
+  [[nodiscard]] std::string mismatch(const Processing& results) const;
 
   [[nodiscard]] std::vector<std::uint8_t> serialise() const;
-  /// `name` is used in messages only.
+  /// `name` is used in messages only. Throws awcc::InputError.
   static CorrectionModel parse(const std::vector<std::uint8_t>& bytes, const std::string& name);
   /// Written to a temporary name and renamed when complete.
   void save(const std::filesystem::path& path) const;
+  /// Throws awcc::InputError naming the file, the problem and the fix.
   static CorrectionModel load(const std::filesystem::path& path);
 };
 
@@ -111,23 +113,16 @@ struct CorrectionModel {
 double to_target(TargetForm form, double truth, double measured);
 double from_target(TargetForm form, double target, double measured);
 
-/// Features of a processed recording; empty (with the reason) when AWCC did
-/// not run or gave no value, or the count rate is zero.
-std::optional<CorrectionFeatures> correction_features(const ProcessResult& r, std::string* why = nullptr);
-
-/// A row that is not corrected, with the reason.
-Correction not_corrected(std::string reason);
-
 /// Profile CSV columns of a correction (no leading comma): correction_in_range,
 /// correction_reason, corrected_velocity (median), corrected_velocity_q0.025 ..
-/// _q0.975, and the same for turbulence_intensity.
+/// _q0.975, the same for turbulence_intensity, and correction_status.
 std::string correction_csv_header();
 std::string correction_csv_cells(const Correction& c);
 
-/// {"in_range", "reason", "velocity": {"measured", "median", "quantiles": {"0.025": ...}}, "turbulence_intensity": ...}
+/// {"status", "in_range", "reason", "velocity": {"measured", "median", "quantiles": {"0.025": ...}}, "turbulence_intensity": ...}
 nlohmann::json to_json(const Correction& c);
 
 /// CRC-32 (IEEE 802.3, reflected, as zlib's crc32).
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size);
 
-}  // namespace awcc
+}  // namespace correction

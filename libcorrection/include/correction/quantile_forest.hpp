@@ -30,7 +30,7 @@
 #include <utility>
 #include <vector>
 
-namespace awcc {
+namespace correction {
 
 struct ForestOptions {
   int trees = 100;                  ///< trees in the forest
@@ -110,4 +110,4 @@ class QuantileForest {
 /// A proper score: its expectation is least at the true quantiles.
 double pinball_loss(std::span<const double> q, std::span<const double> levels, double y);
 
-}  // namespace awcc
+}  // namespace correction

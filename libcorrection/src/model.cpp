@@ -1,4 +1,4 @@
-#include "awcc/correction.hpp"
+#include "correction/model.hpp"
 
 #include <fmt/format.h>
 
@@ -11,8 +11,10 @@
 #include <stdexcept>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 
-namespace awcc {
+namespace correction {
 
 namespace {
 
@@ -83,7 +85,7 @@ class Reader {
   }
   [[nodiscard]] bool done() const { return p_ == end_; }
   [[noreturn]] void damaged(const std::string& what) const {
-    throw std::runtime_error(fmt::format("{}: damaged model file ({}); retrain it with pdp train or fetch it again", name_, what));
+    throw awcc::InputError(fmt::format("{}: damaged model file ({}); retrain it with pdp train or fetch it again", name_, what));
   }
 
  private:
@@ -141,7 +143,7 @@ QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& f
   if (f > 2) r.damaged(fmt::format("unknown target form {}", f));
   form = static_cast<TargetForm>(f);
   const auto features = r.u32();
-  if (features != CorrectionFeatures::count) r.damaged(fmt::format("{} features, expected {}", features, CorrectionFeatures::count));
+  if (features != Features::count) r.damaged(fmt::format("{} features, expected {}", features, Features::count));
   std::vector<double> targets(r.count(r.u64(), 8));
   for (auto& y : targets) y = r.f64();
   std::vector<RegressionTree> trees(r.count(r.u32(), 12));
@@ -223,28 +225,31 @@ double from_target(TargetForm form, double target, double measured) {
   return target;
 }
 
-std::string CorrectionModel::out_of_range(const CorrectionFeatures& f) const {
+Correction not_corrected(CorrectionStatus status, std::string message) {
+  Correction c;
+  c.status = status;
+  c.message = std::move(message);
+  return c;
+}
+
+Correction CorrectionModel::correct(const Features& f) const {
   if (f.windows_accepted < min_windows) {
-    return fmt::format("{} accepted windows; the model was trained on runs with at least {}", f.windows_accepted,
-                       min_windows);
+    return not_corrected(CorrectionStatus::too_few_windows,
+                         fmt::format("{} accepted windows; the model was trained on runs with at least {}",
+                                     f.windows_accepted, min_windows));
   }
   const auto x = f.vector();
   for (std::size_t j = 0; j < ranges.size() && j < x.size(); ++j) {
     const auto& r = ranges[j];
     const double pad = range_margin * (r.max - r.min);
     if (!(x[j] >= r.min - pad && x[j] <= r.max + pad)) {
-      return fmt::format("{} = {:.6g} is outside the training range [{:.6g}, {:.6g}]", r.name, x[j], r.min, r.max);
+      return not_corrected(CorrectionStatus::outside_training_range,
+                           fmt::format("{} = {:.6g} is outside the training range [{:.6g}, {:.6g}]", r.name, x[j],
+                                       r.min, r.max));
     }
   }
-  return {};
-}
-
-Correction CorrectionModel::correct(const CorrectionFeatures& f) const {
   Correction c;
-  c.reason = out_of_range(f);
-  c.in_range = c.reason.empty();
-  if (!c.in_range) return c;
-  const auto x = f.vector();
+  c.status = CorrectionStatus::corrected;
   auto one = [&](const QuantileForest& forest, TargetForm form, double measured, bool nonnegative) {
     CorrectedQuantity q;
     q.measured = measured;
@@ -260,6 +265,15 @@ Correction CorrectionModel::correct(const CorrectionFeatures& f) const {
   return c;
 }
 
+Correction CorrectionModel::correct(const Measurement& m) const {
+  const auto f = make_features(m);
+  return f.ok() ? correct(f.features) : not_corrected(f.status, f.message);
+}
+
+std::string CorrectionModel::mismatch(const Processing& results) const {
+  return processing_mismatch(processing, results);
+}
+
 std::vector<std::uint8_t> CorrectionModel::serialise() const {
   Writer payload;
   payload.text(provenance);
@@ -271,6 +285,11 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
   }
   payload.f64(range_margin);
   payload.i64(min_windows);
+  payload.f64(processing.filter_a);
+  payload.u8(processing.roc ? 1 : 0);
+  payload.u8(processing.weighting == awcc::Weighting::none ? 1 : 0);
+  payload.u8(processing.signal == awcc::CorrelationSignal::raw ? 1 : 0);
+  payload.u8(processing.subsample == awcc::Subsample::parabolic ? 1 : 0);
   payload.u32(2);
   write_forest(payload, "velocity", velocity_form, velocity);
   write_forest(payload, "turbulence_intensity", turbulence_form, turbulence_intensity);
@@ -285,16 +304,16 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
 
 CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, const std::string& name) {
   if (bytes.size() < sizeof magic || std::memcmp(bytes.data(), magic, sizeof magic) != 0) {
-    throw std::runtime_error(fmt::format("{}: not a pdp model file (it does not start with \"pdp-qrf\"); give a file "
-                                         "written by pdp train",
-                                         name));
+    throw awcc::InputError(fmt::format("{}: not a pdp model file (it does not start with \"pdp-qrf\"); give a file "
+                                       "written by pdp train",
+                                       name));
   }
   Reader head(bytes.data() + sizeof magic, bytes.size() - sizeof magic, name);
   const auto version = head.u32();
-  if (version != format_version) {
-    throw std::runtime_error(fmt::format("{}: model file format version {}; this pdp reads version {}; retrain the "
-                                         "model with this pdp train",
-                                         name, version, format_version));
+  if (version < 1 || version > format_version) {
+    throw awcc::InputError(fmt::format("{}: model file format version {}; this pdp reads versions 1 to {}; retrain the "
+                                       "model with this pdp train",
+                                       name, version, format_version));
   }
   const auto length = head.u64();
   const std::size_t header = sizeof magic + 4 + 8;
@@ -307,20 +326,33 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
   CorrectionModel m;
   m.provenance = r.text();
   m.ranges.resize(r.count(r.u32(), 20));
-  if (m.ranges.size() != CorrectionFeatures::count) r.damaged(fmt::format("{} feature ranges", m.ranges.size()));
+  if (m.ranges.size() != Features::count) r.damaged(fmt::format("{} feature ranges", m.ranges.size()));
   for (std::size_t j = 0; j < m.ranges.size(); ++j) {
     auto& fr = m.ranges[j];
     fr.name = r.text();
     fr.min = r.f64();
     fr.max = r.f64();
-    if (fr.name != CorrectionFeatures::names[j]) {
-      r.damaged(fmt::format("feature {} is '{}', expected '{}'", j, fr.name, CorrectionFeatures::names[j]));
+    if (fr.name != Features::names[j]) {
+      r.damaged(fmt::format("feature {} is '{}', expected '{}'", j, fr.name, Features::names[j]));
     }
     if (!(std::isfinite(fr.min) && std::isfinite(fr.max) && fr.min <= fr.max)) r.damaged("a feature range is not finite");
   }
   m.range_margin = r.f64();
   if (!(m.range_margin >= 0.0 && m.range_margin <= 1.0)) r.damaged("range margin outside [0, 1]");
   m.min_windows = r.i64();
+  if (version >= 2) {
+    auto flag = [&](const char* what) {
+      const auto v = r.u8();
+      if (v > 1) r.damaged(fmt::format("{} code {}", what, v));
+      return v == 1;
+    };
+    m.processing.filter_a = r.f64();
+    if (!(m.processing.filter_a >= 0.0 && m.processing.filter_a <= 1.0)) r.damaged("filter A outside [0, 1]");
+    m.processing.roc = flag("outlier cutoff");
+    m.processing.weighting = flag("weighting") ? awcc::Weighting::none : awcc::Weighting::duration;
+    m.processing.signal = flag("signal") ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
+    m.processing.subsample = flag("peak refinement") ? awcc::Subsample::parabolic : awcc::Subsample::none;
+  }
   if (r.u32() != 2) r.damaged("the model holds other than two forests");
   m.velocity = read_forest(r, "velocity", m.velocity_form);
   m.turbulence_intensity = read_forest(r, "turbulence_intensity", m.turbulence_form);
@@ -330,52 +362,23 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
 
 void CorrectionModel::save(const std::filesystem::path& path) const {
   const auto bytes = serialise();
-  write_atomically(path, [&](const std::filesystem::path& tmp) {
+  awcc::write_atomically(path, [&](const std::filesystem::path& tmp) {
     std::ofstream out(tmp, std::ios::binary);
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     out.close();
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot write the model", path.string()));
+    if (!out) throw awcc::OutputError(fmt::format("{}: cannot write the model", path.string()));
   });
 }
 
 CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open the model file; check the path", path.string()));
+  if (!in) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
   const auto size = static_cast<std::size_t>(in.tellg());
   std::vector<std::uint8_t> bytes(size);
   in.seekg(0);
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the model file", path.string()));
+  if (!in) throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
   return parse(bytes, path.string());
-}
-
-std::optional<CorrectionFeatures> correction_features(const ProcessResult& r, std::string* why) {
-  auto fail = [&](std::string text) -> std::optional<CorrectionFeatures> {
-    if (why) *why = std::move(text);
-    return std::nullopt;
-  };
-  if (!r.awcc) return fail("AWCC was not run (use --method awcc or both)");
-  if (!r.awcc->defined) return fail("AWCC gave no velocity: " + r.awcc->reason);
-  if (r.tips.empty()) return fail("no tip statistics");
-  const auto& lead = r.tips[0].phase;
-  if (!(lead.bubble_count_rate > 0.0)) return fail("no bubbles on the leading tip");
-  CorrectionFeatures f;
-  f.velocity = r.awcc->velocity;
-  f.turbulence_intensity = r.awcc->turbulence_intensity;
-  f.void_fraction = lead.void_fraction;
-  // The same d32 as the training data: 1.5 u c / F with AWCC's velocity.
-  f.d32 = 1.5 * f.velocity * f.void_fraction / lead.bubble_count_rate;
-  f.dx = r.dx;
-  f.dy = r.dy;
-  f.np = r.awcc->np;
-  f.windows_accepted = r.awcc->windows_accepted;
-  return f;
-}
-
-Correction not_corrected(std::string reason) {
-  Correction c;
-  c.reason = std::move(reason);
-  return c;
 }
 
 std::string correction_csv_header() {
@@ -384,14 +387,11 @@ std::string correction_csv_header() {
     out += fmt::format(",corrected_{}", q);
     for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
-  return out;
+  return out + ",correction_status";
 }
 
 std::string correction_csv_cells(const Correction& c) {
-  std::string reason = c.in_range ? std::string() : c.reason;
-  for (auto& ch : reason)
-    if (ch == ',' || ch == '"' || ch == '\n' || ch == '\r') ch = ';';
-  std::string out = fmt::format("{},{}", c.in_range ? 1 : 0, reason);
+  std::string out = fmt::format("{},{}", c.corrected() ? 1 : 0, awcc::csv_cell(c.corrected() ? std::string() : c.message));
   for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
     if (*q) {
       out += fmt::format(",{:.10g}", (*q)->median());
@@ -400,7 +400,7 @@ std::string correction_csv_cells(const Correction& c) {
       out += std::string(1 + correction_levels.size(), ',');
     }
   }
-  return out;
+  return out + "," + std::string(to_string(c.status));
 }
 
 nlohmann::json to_json(const Correction& c) {
@@ -411,10 +411,11 @@ nlohmann::json to_json(const Correction& c) {
     for (std::size_t k = 0; k < correction_levels.size(); ++k) levels[correction_level_names[k]] = q->quantiles[k];
     return json{{"measured", q->measured}, {"median", q->median()}, {"quantiles", levels}};
   };
-  return json{{"in_range", c.in_range},
-              {"reason", c.in_range ? json(nullptr) : json(c.reason)},
+  return json{{"status", to_string(c.status)},
+              {"in_range", c.corrected()},
+              {"reason", c.corrected() ? json(nullptr) : json(c.message)},
               {"velocity", quantity(c.velocity)},
               {"turbulence_intensity", quantity(c.turbulence_intensity)}};
 }
 
-}  // namespace awcc
+}  // namespace correction

@@ -1,0 +1,103 @@
+#pragma once
+// The steps of AWCC (awcc/awcc.hpp), for the library's own use, its tests,
+// benchmarks and fuzz targets; not installed, not a stable interface.
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "awcc/awcc.hpp"
+
+namespace awcc::detail {
+
+/// A window correlation of binary signals held at its breakpoints: R12 is
+/// linear in the lag between consecutive entries of `lags` (every kink of the
+/// overlap sums and of the mean terms is one of them), so peaks, prominences
+/// and the SPR follow from these few hundred points exactly instead of from
+/// every lag.
+struct PiecewiseCorrelation {
+  std::vector<std::int64_t> lags;   ///< increasing, first = k_min, last = k_max
+  std::vector<double> values;       ///< R12 at those lags
+  [[nodiscard]] bool empty() const { return lags.empty(); }
+  /// R12 at any lag in [k_min, k_max] (linear between breakpoints).
+  [[nodiscard]] double at(std::int64_t lag) const;
+  /// R12 at every lag k_min..k_max.
+  [[nodiscard]] std::vector<double> expand() const;
+};
+
+/// Interval path (exact, binary signals): empty when a segment is constant.
+PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max,
+                                                  AwccWorkspace& workspace);
+
+/// The normalised cross-correlation of a window, lags [k_min, k_max].
+/// Binary signals, interval path (exact): the piecewise form expanded.
+std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                                 std::int64_t length, std::int64_t k_min, std::int64_t k_max,
+                                                 AwccWorkspace& workspace);
+/// Any signals given as the window's samples (binary 0/1 or voltages), FFT path.
+std::vector<double> window_correlation_fft(std::span<const double> x, std::span<const double> y, std::int64_t k_min,
+                                           std::int64_t k_max, AwccWorkspace& workspace);
+
+/// Peak and secondary peak ratio of a correlation function whose first value
+/// is at lag first_lag.
+struct CorrelationPeak {
+  std::size_t index = 0;        ///< of the maximum
+  double height = 0.0;
+  double refined_index = 0.0;   ///< parabolic refinement when asked, else index
+  double spr = 0.0;
+};
+CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsample, double prominence_fraction,
+                                    AwccWorkspace& workspace);
+/// The same on the piecewise form; indices count lags from k_min.
+CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample subsample, double prominence_fraction,
+                                    AwccWorkspace& workspace);
+
+/// Prominences of the local maxima of r (scipy's definition): (index, prominence).
+std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r);
+/// Same for samples at increasing integer positions, linear in between;
+/// returns (position, prominence), a flat top at the middle of its positions.
+std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const double> values,
+                                                              std::span<const std::int64_t> positions);
+
+/// Robust outlier cutoff over the velocities whose flag is true; clears the
+/// flag of the rejected ones. Returns the number of iterations.
+int robust_outlier_cutoff(std::span<const double> velocities, std::vector<bool>& keep);
+
+/// Lags searched in a window of `length` samples: all, or those of the
+/// stated velocity range (k_max < k_min: the window is too short for it).
+std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double dx, double fs,
+                                                      const AwccOptions& options);
+
+/// Fills a window's peak, lag, velocity, SPR and fate (constant, lag or
+/// correlation; accepted otherwise) from its correlation r over lags
+/// [first_lag, first_lag + r.size()); an empty r means a constant segment.
+void analyse_window(AwccWindow& window, std::span<const double> r, std::int64_t first_lag, double dx, double fs,
+                    const AwccOptions& options, AwccWorkspace& workspace);
+/// Same from a peak already found (piecewise path); `constant` for a constant segment.
+void analyse_window(AwccWindow& window, const CorrelationPeak& peak, bool constant, std::int64_t first_lag, double dx,
+                    double fs, const AwccOptions& options);
+
+/// Applies the robust outlier cutoff to the accepted windows, then fills the
+/// moments, intervals, counts, the status and its message.
+void awcc_summarise(AwccResult& result, const AwccOptions& options);
+
+/// Marks an otherwise good result as having no velocity for want of dx.
+void no_tip_separation(AwccResult& result);
+
+/// Scratch of the window correlations (AwccWorkspace owns one).
+struct AwccScratch {
+  FftPlanCache plans;
+  std::vector<AirInterval> clipped_x, clipped_y;
+  std::vector<double> air_x, air_y;             // cumulative air of the clipped intervals
+  std::vector<std::int32_t> impulse;
+  std::vector<std::uint8_t> mark;
+  std::vector<std::complex<double>> spectrum;
+  std::vector<double> turns, left, right;
+  std::vector<std::int64_t> where;
+  std::vector<std::pair<std::size_t, std::size_t>> tops;
+  std::vector<std::pair<double, double>> stack;
+};
+
+}  // namespace awcc::detail

@@ -1,0 +1,29 @@
+#pragma once
+// The declarations of every option of the processing library
+// (awcc/option_field.hpp): name, unit, help, default. The pdp command line,
+// settings files and the Python module register and read options from these
+// lists and restate none of them. Apply fields in list order: a later field
+// may read an earlier one (the threshold's meaning depends on the rule).
+// After applying AWCC's fields, FSCC refines its peak as AWCC does
+// (`subsample` is declared once, with AWCC's options).
+
+#include <span>
+
+#include "awcc/awcc.hpp"
+#include "awcc/binarisation.hpp"
+#include "awcc/fscc.hpp"
+#include "awcc/option_field.hpp"
+#include "awcc/process.hpp"
+#include "awcc/recording.hpp"
+
+namespace awcc {
+
+std::span<const OptionField<ReaderOptions>> reader_option_fields();
+std::span<const OptionField<BinarisationOptions>> binarisation_option_fields();
+std::span<const OptionField<FsccOptions>> fscc_option_fields();
+std::span<const OptionField<AwccOptions>> awcc_option_fields();
+/// The options of a whole processing run that belong to none of the above:
+/// tip separations, channels, methods, histogram bins.
+std::span<const OptionField<ProcessOptions>> process_option_fields();
+
+}  // namespace awcc

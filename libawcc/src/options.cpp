@@ -1,0 +1,248 @@
+#include "awcc/options.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "awcc/units.hpp"
+
+namespace awcc {
+
+namespace {
+
+double quantity(std::string_view text, Dimension d) { return parse_quantity(text, d); }
+
+long long whole(std::string_view text, long long lo, long long hi) {
+  const double v = parse_quantity(text, Dimension::dimensionless);
+  if (v != std::floor(v) || v < static_cast<double>(lo) || v > static_cast<double>(hi)) {
+    throw std::invalid_argument(fmt::format("'{}' must be a whole number in [{}, {}]", text, lo, hi));
+  }
+  return static_cast<long long>(v);
+}
+
+template <class E, std::size_t N>
+E choice(std::string_view text, const std::array<std::pair<const char*, E>, N>& choices) {
+  std::string names;
+  for (const auto& [name, value] : choices) {
+    if (text == name) return value;
+    names += (names.empty() ? "" : " | ") + std::string(name);
+  }
+  throw std::invalid_argument(fmt::format("'{}' is not one of {}", text, names));
+}
+
+template <class E, std::size_t N>
+std::string name_of(E value, const std::array<std::pair<const char*, E>, N>& choices) {
+  for (const auto& [name, v] : choices)
+    if (v == value) return name;
+  return "?";
+}
+
+bool on_off(std::string_view text) {
+  if (text == "on" || text == "true" || text == "yes" || text == "1") return true;
+  if (text == "off" || text == "false" || text == "no" || text == "0") return false;
+  throw std::invalid_argument(fmt::format("'{}' is not on or off", text));
+}
+
+std::pair<std::string_view, std::string_view> pair_of(std::string_view text, const char* example) {
+  const auto comma = text.find(',');
+  if (comma == std::string_view::npos) throw std::invalid_argument(fmt::format("write two values 'a,b', e.g. {}", example));
+  return {text.substr(0, comma), text.substr(comma + 1)};
+}
+
+constexpr std::array<std::pair<const char*, InputFormat>, 5> kFormats{
+    {{"auto", InputFormat::automatic}, {"sndfile", InputFormat::sndfile}, {"dat", InputFormat::uq_dat},
+     {"raw", InputFormat::raw}, {"csv", InputFormat::csv}}};
+constexpr std::array<std::pair<const char*, SampleType>, 4> kTypes{{{"int16", SampleType::int16},
+                                                                    {"int32", SampleType::int32},
+                                                                    {"float32", SampleType::float32},
+                                                                    {"float64", SampleType::float64}}};
+constexpr std::array<std::pair<const char*, ByteOrder>, 2> kOrders{{{"little", ByteOrder::little},
+                                                                    {"big", ByteOrder::big}}};
+constexpr std::array<std::pair<const char*, ThresholdRule>, 4> kRules{{{"histogram", ThresholdRule::histogram},
+                                                                      {"felder", ThresholdRule::felder},
+                                                                      {"fixed", ThresholdRule::fixed},
+                                                                      {"hysteresis", ThresholdRule::hysteresis}}};
+constexpr std::array<std::pair<const char*, ProbeType>, 2> kProbes{{{"conductivity", ProbeType::conductivity},
+                                                                    {"optical", ProbeType::optical}}};
+constexpr std::array<std::pair<const char*, Weighting>, 2> kWeightings{{{"duration", Weighting::duration},
+                                                                        {"none", Weighting::none}}};
+constexpr std::array<std::pair<const char*, CorrelationSignal>, 2> kSignals{
+    {{"binary", CorrelationSignal::binary}, {"raw", CorrelationSignal::raw}}};
+constexpr std::array<std::pair<const char*, Subsample>, 2> kSubsamples{{{"none", Subsample::none},
+                                                                        {"parabolic", Subsample::parabolic}}};
+constexpr std::array<std::pair<const char*, CorrelationPath>, 3> kPaths{{{"auto", CorrelationPath::automatic},
+                                                                        {"intervals", CorrelationPath::intervals},
+                                                                        {"fft", CorrelationPath::fft}}};
+
+using R = ReaderOptions;
+const OptionField<R> kReader[] = {
+    {"format", "", "recording format: auto | sndfile | dat | raw | csv (auto: from content and extension)",
+     [](R& o, std::string_view t) { o.format = choice(t, kFormats); },
+     [](const R& o) { return name_of(o.format, kFormats); }},
+    {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; overrides a file's own)",
+     [](R& o, std::string_view t) { o.fs = quantity(t, Dimension::frequency); },
+     [](const R& o) { return o.fs > 0.0 ? format_quantity(o.fs, Dimension::frequency) : std::string("from the file"); }},
+    {"raw-type", "", "raw files: sample type int16 | int32 | float32 | float64",
+     [](R& o, std::string_view t) { o.raw.sample_type = choice(t, kTypes); },
+     [](const R& o) { return name_of(o.raw.sample_type, kTypes); }},
+    {"raw-order", "", "raw files: byte order little | big",
+     [](R& o, std::string_view t) { o.raw.byte_order = choice(t, kOrders); },
+     [](const R& o) { return name_of(o.raw.byte_order, kOrders); }},
+    {"raw-channels", "-", "raw files: channels per frame",
+     [](R& o, std::string_view t) { o.raw.channels = static_cast<int>(whole(t, 1, 1024)); },
+     [](const R& o) { return std::to_string(o.raw.channels); }},
+    {"raw-header", "bytes", "raw files: header bytes to skip",
+     [](R& o, std::string_view t) { o.raw.header_bytes = whole(t, 0, std::int64_t{1} << 50); },
+     [](const R& o) { return std::to_string(o.raw.header_bytes); }},
+    {"volts-per-count", "V",
+     "volts per integer count (raw default 1; .dat 5/32768; audio: from a synthetic recording's sidecar, else "
+     "normalised)",
+     [](R& o, std::string_view t) { o.volts_per_count = o.raw.volts_per_count = quantity(t, Dimension::voltage); },
+     [](const R& o) {
+       return o.volts_per_count > 0.0 ? format_quantity(o.volts_per_count, Dimension::voltage) : std::string("the file's");
+     }},
+    {"csv-header", "", "CSV header row: auto | yes | no",
+     [](R& o, std::string_view t) {
+       if (t == "auto") o.csv.header.reset();
+       else o.csv.header = on_off(t);
+     },
+     [](const R& o) { return o.csv.header ? std::string(*o.csv.header ? "yes" : "no") : std::string("auto"); }},
+    {"time-column", "", "CSV time column: auto (by name) | none | its index from 0",
+     [](R& o, std::string_view t) {
+       if (t == "auto") o.csv.time_column = -2;
+       else if (t == "none") o.csv.time_column = -1;
+       else o.csv.time_column = static_cast<int>(whole(t, 0, 100000));
+     },
+     [](const R& o) {
+       return o.csv.time_column == -2 ? std::string("auto")
+                                      : (o.csv.time_column == -1 ? std::string("none") : std::to_string(o.csv.time_column));
+     }},
+};
+
+using B = BinarisationOptions;
+const OptionField<B> kBinarisation[] = {
+    {"threshold-rule", "", "histogram | felder (Felder's program) | fixed (a voltage) | hysteresis (two thresholds)",
+     [](B& o, std::string_view t) { o.rule = choice(t, kRules); },
+     [](const B& o) { return name_of(o.rule, kRules); }},
+    {"threshold", "",
+     "histogram/felder: fraction from air to water mode; fixed: a voltage (e.g. 2.5V); hysteresis: two fractions "
+     "'low,high'",
+     [](B& o, std::string_view t) {
+       switch (o.rule) {
+         case ThresholdRule::histogram:
+         case ThresholdRule::felder: o.theta = quantity(t, Dimension::dimensionless); break;
+         case ThresholdRule::fixed: o.fixed_threshold = quantity(t, Dimension::voltage); break;
+         case ThresholdRule::hysteresis: {
+           const auto [lo, hi] = pair_of(t, "0.4,0.6");
+           o.hysteresis_low = quantity(lo, Dimension::dimensionless);
+           o.hysteresis_high = quantity(hi, Dimension::dimensionless);
+           break;
+         }
+       }
+     },
+     [](const B& o) {
+       switch (o.rule) {
+         case ThresholdRule::fixed:
+           return o.fixed_threshold ? format_quantity(*o.fixed_threshold, Dimension::voltage) : std::string("none");
+         case ThresholdRule::hysteresis: return fmt::format("{:g},{:g}", o.hysteresis_low, o.hysteresis_high);
+         default: return fmt::format("{:g}", o.theta);
+       }
+     }},
+    {"probe", "", "conductivity (air is the low level) | optical (air is the high level)",
+     [](B& o, std::string_view t) { o.probe = choice(t, kProbes); },
+     [](const B& o) { return name_of(o.probe, kProbes); }},
+    {"bin-width", "V", "voltage histogram bin width; 0 = 100 bins over the observed range",
+     [](B& o, std::string_view t) { o.bin_width = quantity(t, Dimension::voltage); },
+     [](const B& o) { return format_quantity(o.bin_width, Dimension::voltage); }},
+};
+
+using F = FsccOptions;
+const OptionField<F> kFscc[] = {
+    {"segments", "-", "FSCC segments: 1 = the full record; Felder's program used 15",
+     [](F& o, std::string_view t) { o.segments = static_cast<int>(whole(t, 1, 1000)); },
+     [](const F& o) { return std::to_string(o.segments); }},
+    {"max-lag", "s", "FSCC lags searched: auto-correlation [0, max], cross-correlation [-max, max]",
+     [](F& o, std::string_view t) { o.max_lag = quantity(t, Dimension::time); },
+     [](const F& o) { return format_quantity(o.max_lag, Dimension::time); }},
+    {"felder-lags", "", "Felder's program: auto lags 0..999, cross lags -199..800 samples, first peak within 1e-5",
+     [](F& o, std::string_view t) { o.felder_lags = on_off(t); },
+     [](const F& o) { return std::string(o.felder_lags ? "on" : "off"); }, true},
+};
+
+using A = AwccOptions;
+const OptionField<A> kAwcc[] = {
+    {"np", "-", "AWCC particles (air chords of the leading tip) per window, 1-1000",
+     [](A& o, std::string_view t) { o.np = static_cast<int>(whole(t, 1, 1000)); },
+     [](const A& o) { return std::to_string(o.np); }},
+    {"filter-a", "-", "AWCC correlation filter threshold A: windows with R12max / (SPR^2 + 1) < A are rejected",
+     [](A& o, std::string_view t) {
+       o.filter_a = quantity(t, Dimension::dimensionless);
+       if (!(o.filter_a >= 0.0 && o.filter_a <= 1.0)) throw std::invalid_argument(fmt::format("A = {} must lie in [0, 1]", t));
+     },
+     [](const A& o) { return fmt::format("{:g}", o.filter_a); }},
+    {"roc", "", "AWCC robust outlier cutoff: on | off",
+     [](A& o, std::string_view t) { o.roc = on_off(t); }, [](const A& o) { return std::string(o.roc ? "on" : "off"); }},
+    {"weighting", "", "AWCC moments: duration (window-duration weights, Buchhave 1979) | none",
+     [](A& o, std::string_view t) { o.weighting = choice(t, kWeightings); },
+     [](const A& o) { return name_of(o.weighting, kWeightings); }},
+    {"correlate", "", "AWCC correlates the binarised signals or the raw voltages: binary | raw",
+     [](A& o, std::string_view t) { o.signal = choice(t, kSignals); },
+     [](const A& o) { return name_of(o.signal, kSignals); }},
+    {"velocity-range", "m/s", "AWCC lags searched from a velocity range 'min,max' (e.g. 0.5m/s,20m/s); default all lags",
+     [](A& o, std::string_view t) {
+       const auto [lo, hi] = pair_of(t, "0.5m/s,20m/s");
+       o.velocity_min = quantity(lo, Dimension::velocity);
+       o.velocity_max = quantity(hi, Dimension::velocity);
+     },
+     [](const A& o) {
+       return o.velocity_min ? fmt::format("{},{}", format_quantity(*o.velocity_min, Dimension::velocity),
+                                           format_quantity(*o.velocity_max, Dimension::velocity))
+                             : std::string("all lags");
+     }},
+    {"subsample", "", "peak refinement of FSCC and AWCC: none | parabolic",
+     [](A& o, std::string_view t) { o.subsample = choice(t, kSubsamples); },
+     [](const A& o) { return name_of(o.subsample, kSubsamples); }},
+    {"path", "", "AWCC correlation of binary signals: auto (intervals) | intervals | fft (same result, other cost)",
+     [](A& o, std::string_view t) { o.path = choice(t, kPaths); },
+     [](const A& o) { return name_of(o.path, kPaths); }},
+};
+
+using P = ProcessOptions;
+constexpr std::array<std::pair<const char*, int>, 3> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}}};
+const OptionField<P> kProcess[] = {
+    {"dx", "m", "streamwise tip separation (e.g. 7.15mm); 0 = no velocity",
+     [](P& o, std::string_view t) { o.dx = quantity(t, Dimension::length); },
+     [](const P& o) { return format_quantity(o.dx, Dimension::length); }},
+    {"dy", "m", "lateral tip separation (reported; a feature of the bias correction)",
+     [](P& o, std::string_view t) { o.dy = quantity(t, Dimension::length); },
+     [](const P& o) { return format_quantity(o.dy, Dimension::length); }},
+    {"leading-channel", "-", "channel of the leading tip (from 0)",
+     [](P& o, std::string_view t) { o.leading_channel = static_cast<int>(whole(t, 0, 1023)); },
+     [](const P& o) { return std::to_string(o.leading_channel); }},
+    {"trailing-channel", "-", "channel of the trailing tip (from 0)",
+     [](P& o, std::string_view t) { o.trailing_channel = static_cast<int>(whole(t, 0, 1023)); },
+     [](const P& o) { return std::to_string(o.trailing_channel); }},
+    {"method", "", "velocity methods: both | awcc | fscc",
+     [](P& o, std::string_view t) {
+       const int m = choice(t, kMethods);
+       o.fscc = (m & 1) != 0;
+       o.awcc = (m & 2) != 0;
+     },
+     [](const P& o) { return name_of((o.fscc ? 1 : 0) | (o.awcc ? 2 : 0), kMethods); }},
+    {"histogram-bins", "-", "bins of the chord-time histograms",
+     [](P& o, std::string_view t) { o.histogram_bins = static_cast<int>(whole(t, 1, 100000)); },
+     [](const P& o) { return std::to_string(o.histogram_bins); }},
+};
+
+}  // namespace
+
+std::span<const OptionField<ReaderOptions>> reader_option_fields() { return kReader; }
+std::span<const OptionField<BinarisationOptions>> binarisation_option_fields() { return kBinarisation; }
+std::span<const OptionField<FsccOptions>> fscc_option_fields() { return kFscc; }
+std::span<const OptionField<AwccOptions>> awcc_option_fields() { return kAwcc; }
+std::span<const OptionField<ProcessOptions>> process_option_fields() { return kProcess; }
+
+}  // namespace awcc

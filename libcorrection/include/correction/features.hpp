@@ -1,0 +1,101 @@
+#pragma once
+// The feature contract of the bias correction (METHOD.md 7), owned here and
+// nowhere else: what a model sees of a measurement, how it is computed, and
+// how the measurement was processed.
+//
+// Features, in this order: measured mean velocity u (m/s), measured
+// turbulence intensity Tu, measured void fraction c (leading tip), measured
+// Sauter diameter d32 = 1.5 u c / F (m, F the leading tip's bubble count
+// rate, u AWCC's velocity), streamwise and lateral tip separations dx and dy
+// (m, the geometry that was processed), particles per window Np.
+//
+// A measurement has features only when AWCC gave a positive velocity and the
+// leading tip saw bubbles; otherwise make_features says why, as a status.
+//
+// Processing: the AWCC settings that change what is measured (filter A, the
+// robust outlier cutoff, the weighting of the moments, the correlated signal
+// and the peak refinement). A model learns the bias of one processing; it is
+// applied only to results processed the same way.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "awcc/awcc.hpp"
+#include "awcc/process.hpp"
+
+namespace correction {
+
+/// Why a row is or is not corrected; callers branch on this, never on text.
+enum class CorrectionStatus {
+  corrected,               ///< the quantiles are there
+  awcc_not_run,            ///< the results hold no AWCC
+  no_awcc_velocity,        ///< AWCC gave no (positive) velocity
+  no_bubbles,              ///< the leading tip saw no complete bubble (F = 0)
+  too_few_windows,         ///< fewer accepted windows than the model's training runs had
+  outside_training_range,  ///< a feature outside the model's training data
+};
+std::string_view to_string(CorrectionStatus status);
+
+/// What AWCC and the phase statistics measured on one recording, and the probe.
+struct Measurement {
+  std::optional<double> velocity;              ///< AWCC mean velocity, m/s (empty: none)
+  std::optional<double> turbulence_intensity;  ///< AWCC Tu, -
+  double void_fraction = 0.0;                  ///< leading tip, -
+  double bubble_count_rate = 0.0;              ///< leading tip, 1/s
+  double dx = 0.0, dy = 0.0;                   ///< tip separations processed, m
+  int np = 0;                                  ///< particles per window
+  std::int64_t windows_accepted = 0;
+};
+
+/// The features of one measurement.
+struct Features {
+  static constexpr int count = 7;
+  static constexpr std::array<const char*, 7> names{"velocity", "turbulence_intensity", "void_fraction", "d32",
+                                                    "dx",       "dy",                   "np"};
+  double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
+  std::int64_t windows_accepted = 0;  ///< not a feature: rows below the model's minimum are not corrected
+  [[nodiscard]] std::array<double, 7> vector() const {
+    return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
+  }
+};
+
+/// Features, or the status and message saying why there are none.
+struct FeatureResult {
+  CorrectionStatus status = CorrectionStatus::corrected;  ///< corrected: features are valid
+  std::string message;
+  Features features;
+  [[nodiscard]] bool ok() const { return status == CorrectionStatus::corrected; }
+};
+
+/// The one computation of the features (d32 = 1.5 u c / F).
+FeatureResult make_features(const Measurement& m);
+
+/// The measurement of a processed recording (AWCC's velocity and Tu, the
+/// leading tip's c and F, the processed dx and dy, Np); `status` says when
+/// AWCC did not run or gave no velocity.
+struct MeasurementResult {
+  CorrectionStatus status = CorrectionStatus::corrected;
+  std::string message;
+  Measurement measurement;
+};
+MeasurementResult measurement_of(const awcc::ProcessResult& result);
+
+/// The AWCC settings a model's bias depends on.
+struct Processing {
+  double filter_a = 0.4;
+  bool roc = true;
+  awcc::Weighting weighting = awcc::Weighting::duration;
+  awcc::CorrelationSignal signal = awcc::CorrelationSignal::binary;
+  awcc::Subsample subsample = awcc::Subsample::none;
+  friend bool operator==(const Processing&, const Processing&) = default;
+};
+Processing processing_of(const awcc::AwccOptions& options);
+/// "filter A 0.4, robust outlier cutoff on, duration weighting, binary signals, no peak refinement".
+std::string describe(const Processing& p);
+/// Empty when equal; else each difference, "filter A: model 0.4, results 0.3; ...".
+std::string processing_mismatch(const Processing& model, const Processing& results);
+
+}  // namespace correction

@@ -1,0 +1,40 @@
+#pragma once
+// Correcting results that were written to files: the process JSON (one
+// recording or a profile) and the profile CSV of pdp process. Each row's
+// measurement is read by the names of awcc/serialise.hpp, its features made
+// by the one contract (correction/features.hpp), and its processing checked
+// against the model's: results processed differently are refused.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "correction/model.hpp"
+
+namespace correction {
+
+/// Values a file may lack, stated by the user (m, m, -).
+struct RowDefaults {
+  std::optional<double> dx, dy;
+  std::optional<int> np;
+};
+
+/// What a correction of a file says besides its rows.
+struct FileCorrection {
+  std::string text;                   ///< the corrected file (same format as the input)
+  std::vector<std::string> warnings;  ///< e.g. rows whose processing the file does not record
+};
+
+/// Adds a "correction" object to every result of a process JSON. Throws
+/// awcc::InputError (not such a JSON, processed differently from the model)
+/// or awcc::OptionError (a value the file lacks and `defaults` does not give:
+/// quantity "dx", "dy" or "np").
+FileCorrection correct_process_json(const CorrectionModel& model, const std::string& text, const RowDefaults& defaults,
+                                    const std::string& file, const std::string& model_name);
+
+/// Appends the correction columns to every row of a profile CSV; same errors.
+FileCorrection correct_profile_csv(const CorrectionModel& model, const std::string& text, const RowDefaults& defaults,
+                                   const std::string& file);
+
+}  // namespace correction

@@ -1,0 +1,100 @@
+#include "correction/features.hpp"
+
+#include <fmt/format.h>
+
+namespace correction {
+
+std::string_view to_string(CorrectionStatus status) {
+  switch (status) {
+    case CorrectionStatus::corrected: return "corrected";
+    case CorrectionStatus::awcc_not_run: return "awcc_not_run";
+    case CorrectionStatus::no_awcc_velocity: return "no_awcc_velocity";
+    case CorrectionStatus::no_bubbles: return "no_bubbles";
+    case CorrectionStatus::too_few_windows: return "too_few_windows";
+    case CorrectionStatus::outside_training_range: return "outside_training_range";
+  }
+  return "unknown";
+}
+
+FeatureResult make_features(const Measurement& m) {
+  FeatureResult r;
+  if (!m.velocity || !m.turbulence_intensity) {
+    r.status = CorrectionStatus::no_awcc_velocity;
+    r.message = "AWCC gave no velocity";
+    return r;
+  }
+  if (!(*m.velocity > 0.0)) {
+    // The velocity target is the ratio true / measured: a measured velocity
+    // that is not positive has no correction.
+    r.status = CorrectionStatus::no_awcc_velocity;
+    r.message = fmt::format("AWCC's velocity {:.6g} m/s is not positive", *m.velocity);
+    return r;
+  }
+  if (!(m.bubble_count_rate > 0.0)) {
+    r.status = CorrectionStatus::no_bubbles;
+    r.message = "no bubbles on the leading tip";
+    return r;
+  }
+  auto& f = r.features;
+  f.velocity = *m.velocity;
+  f.turbulence_intensity = *m.turbulence_intensity;
+  f.void_fraction = m.void_fraction;
+  f.d32 = 1.5 * f.velocity * m.void_fraction / m.bubble_count_rate;
+  f.dx = m.dx;
+  f.dy = m.dy;
+  f.np = m.np;
+  f.windows_accepted = m.windows_accepted;
+  return r;
+}
+
+MeasurementResult measurement_of(const awcc::ProcessResult& r) {
+  MeasurementResult out;
+  if (!r.awcc) {
+    out.status = CorrectionStatus::awcc_not_run;
+    out.message = "AWCC was not run";
+    return out;
+  }
+  if (!r.awcc->ok()) {
+    out.status = CorrectionStatus::no_awcc_velocity;
+    out.message = "AWCC gave no velocity: " + r.awcc->message;
+    return out;
+  }
+  auto& m = out.measurement;
+  m.velocity = r.awcc->velocity;
+  m.turbulence_intensity = r.awcc->turbulence_intensity;
+  if (!r.tips.empty()) {
+    m.void_fraction = r.tips[0].phase.void_fraction;
+    m.bubble_count_rate = r.tips[0].phase.bubble_count_rate;
+  }
+  m.dx = r.dx;
+  m.dy = r.dy;
+  m.np = r.awcc->np;
+  m.windows_accepted = r.awcc->windows_accepted;
+  return out;
+}
+
+Processing processing_of(const awcc::AwccOptions& o) {
+  return {o.filter_a, o.roc, o.weighting, o.signal, o.subsample};
+}
+
+std::string describe(const Processing& p) {
+  return fmt::format("filter A {:g}, robust outlier cutoff {}, {} weighting, {} signals, peak refinement {}", p.filter_a,
+                     p.roc ? "on" : "off", awcc::to_string(p.weighting), awcc::to_string(p.signal),
+                     awcc::to_string(p.subsample));
+}
+
+std::string processing_mismatch(const Processing& model, const Processing& results) {
+  std::string out;
+  auto add = [&](const char* what, const std::string& a, const std::string& b) {
+    if (a == b) return;
+    out += fmt::format("{}{}: model {}, results {}", out.empty() ? "" : "; ", what, a, b);
+  };
+  add("filter A", fmt::format("{:g}", model.filter_a), fmt::format("{:g}", results.filter_a));
+  add("robust outlier cutoff", model.roc ? "on" : "off", results.roc ? "on" : "off");
+  add("weighting", std::string(awcc::to_string(model.weighting)), std::string(awcc::to_string(results.weighting)));
+  add("correlated signal", std::string(awcc::to_string(model.signal)), std::string(awcc::to_string(results.signal)));
+  add("peak refinement", std::string(awcc::to_string(model.subsample)), std::string(awcc::to_string(results.subsample)));
+  return out;
+}
+
+}  // namespace correction

@@ -1,0 +1,201 @@
+#include "correction/rows.hpp"
+
+#include <fmt/format.h>
+
+#include <map>
+#include <sstream>
+
+#include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
+
+namespace correction {
+
+namespace {
+
+using nlohmann::json;
+
+// What a row lacks and the defaults do not give is an error naming the file,
+// the quantity and its fix.
+double need(const std::optional<double>& from_file, const std::optional<double>& from_default,
+            const std::string& where, const char* quantity, const char* what) {
+  if (from_file) return *from_file;
+  if (from_default) return *from_default;
+  throw awcc::OptionError(fmt::format("{}: no {} in the file; state the {}", where, quantity, what), quantity);
+}
+
+std::optional<double> default_np(const RowDefaults& d) {
+  return d.np ? std::optional<double>(*d.np) : std::nullopt;
+}
+
+Processing parse_processing(double filter_a, const std::string& roc, const std::string& weighting,
+                            const std::string& signal, const std::string& subsample) {
+  Processing p;
+  p.filter_a = filter_a;
+  p.roc = roc == "on" || roc == "true";
+  p.weighting = weighting == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
+  p.signal = signal == "raw" ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
+  p.subsample = subsample == "parabolic" ? awcc::Subsample::parabolic : awcc::Subsample::none;
+  return p;
+}
+
+void check_processing(const CorrectionModel& model, const std::optional<Processing>& results, const std::string& where,
+                      std::vector<std::string>& warnings) {
+  if (!results) {
+    warnings.push_back(fmt::format("{}: the file does not record how AWCC was processed; assumed as the model's ({})",
+                                   where, describe(model.processing)));
+    return;
+  }
+  if (const auto why = model.mismatch(*results); !why.empty()) {
+    throw awcc::InputError(fmt::format("{}: processed differently from the model's training data ({}); reprocess with "
+                                       "the model's settings or train a model for these",
+                                       where, why));
+  }
+}
+
+Correction correct_json_row(const CorrectionModel& model, const json& r, const RowDefaults& d, const std::string& file,
+                            std::vector<std::string>& warnings) {
+  auto number = [](const json& j, const char* key) -> std::optional<double> {
+    if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
+    return j[key].get<double>();
+  };
+  if (!r.contains("awcc") || !r["awcc"].is_object()) {
+    return not_corrected(CorrectionStatus::awcc_not_run, "AWCC was not run");
+  }
+  const auto& a = r["awcc"];
+  if (!a.value("defined", false)) {
+    return not_corrected(CorrectionStatus::no_awcc_velocity,
+                         "AWCC gave no velocity: " +
+                             (a.contains("reason") && a["reason"].is_string() ? a["reason"].get<std::string>() : std::string()));
+  }
+  if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
+    throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
+  }
+  const auto& lead = r["tips"][0];
+  auto required = [&](const json& j, const char* key, const char* where) {
+    const auto v = number(j, key);
+    if (!v) {
+      throw awcc::InputError(
+          fmt::format("{}: no number '{}' in {}; give a JSON written by pdp process", file, key, where));
+    }
+    return *v;
+  };
+  std::optional<Processing> processing;
+  if (a.contains("options") && a["options"].is_object()) {
+    const auto& o = a["options"];
+    processing = parse_processing(required(o, "filter_a", "awcc.options"), o.value("roc", true) ? "on" : "off",
+                                  o.value("weighting", ""), o.value("signal", ""), o.value("subsample", ""));
+  }
+  check_processing(model, processing, file, warnings);
+  Measurement m;
+  m.velocity = required(a, "velocity", "awcc");
+  m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
+  m.windows_accepted = static_cast<std::int64_t>(required(a, "windows_accepted", "awcc"));
+  m.void_fraction = required(lead, "void_fraction", "tips[0]");
+  m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
+  m.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
+  m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
+  m.np = static_cast<int>(need(number(a, "np"), default_np(d), file, "np", "particles per window"));
+  return model.correct(m);
+}
+
+}  // namespace
+
+FileCorrection correct_process_json(const CorrectionModel& model, const std::string& text, const RowDefaults& d,
+                                    const std::string& file, const std::string& model_name) {
+  FileCorrection out;
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw awcc::InputError(
+        fmt::format("{}: not valid JSON ({}); give a pdp process JSON or profile CSV", file, e.what()));
+  }
+  auto add = [&](json& row) {
+    auto c = to_json(correct_json_row(model, row, d, file, out.warnings));
+    c["model"] = model_name;
+    row["correction"] = c;
+  };
+  if (j.is_object() && j.contains("profile") && j["profile"].is_array()) {
+    for (auto& row : j["profile"]) add(row);
+  } else if (j.is_object() && j.contains("tips")) {
+    add(j);
+  } else {
+    throw awcc::InputError(fmt::format(
+        "{}: neither a recording's result (tips) nor a profile; give a JSON written by pdp process", file));
+  }
+  out.text = j.dump(2) + "\n";
+  return out;
+}
+
+FileCorrection correct_profile_csv(const CorrectionModel& model, const std::string& text, const RowDefaults& d,
+                                   const std::string& file) {
+  FileCorrection out;
+  std::stringstream in(text);
+  std::string line;
+  if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file", file));
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const auto header = awcc::split_cells(line);
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  for (const char* name :
+       {"void_fraction", "bubble_count_rate", "awcc_velocity", "awcc_turbulence_intensity", "awcc_windows_accepted"}) {
+    if (!col.count(name)) {
+      throw awcc::InputError(fmt::format(
+          "{}: no column '{}'; give a profile CSV of pdp process with AWCC (docs/output.md)", file, name));
+    }
+  }
+  if (col.count("correction_in_range")) {
+    throw awcc::InputError(fmt::format("{}: already corrected (correction columns present)", file));
+  }
+  const bool has_processing = col.count("awcc_filter_a") && col.count("awcc_roc") && col.count("awcc_weighting") &&
+                              col.count("awcc_signal") && col.count("awcc_subsample");
+  out.text = line + "," + correction_csv_header() + "\n";
+  int number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = awcc::split_cells(line);
+    const std::string where = fmt::format("{}:{}", file, number);
+    if (cells.size() != header.size()) {
+      throw awcc::InputError(fmt::format("{}: {} cells where the header has {}", where, cells.size(), header.size()));
+    }
+    auto text_of = [&](const char* name) -> std::string {
+      const auto it = col.find(name);
+      return it == col.end() ? std::string() : cells[it->second];
+    };
+    auto value = [&](const char* name) -> std::optional<double> {
+      const std::string t = text_of(name);
+      if (t.empty()) return std::nullopt;
+      const auto v = awcc::cell_number(t);
+      if (!v) throw awcc::InputError(fmt::format("{}: column {} = '{}' is not a number", where, name, t));
+      return v;
+    };
+    Correction c;
+    const auto u = value("awcc_velocity"), tu = value("awcc_turbulence_intensity");
+    if (!u || !tu) {
+      c = not_corrected(CorrectionStatus::no_awcc_velocity, "AWCC gave no velocity");
+    } else {
+      std::optional<Processing> processing;
+      if (has_processing && value("awcc_filter_a")) {
+        processing = parse_processing(*value("awcc_filter_a"), text_of("awcc_roc"), text_of("awcc_weighting"),
+                                      text_of("awcc_signal"), text_of("awcc_subsample"));
+      }
+      check_processing(model, processing, where, out.warnings);
+      Measurement m;
+      m.velocity = u;
+      m.turbulence_intensity = tu;
+      m.void_fraction = value("void_fraction").value_or(0.0);
+      m.bubble_count_rate = value("bubble_count_rate").value_or(0.0);
+      m.dx = need(value("dx"), d.dx, where, "dx", "streamwise tip separation");
+      m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
+      m.np = static_cast<int>(need(value("np"), default_np(d), where, "np", "particles per window"));
+      m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
+      c = model.correct(m);
+    }
+    out.text += line + "," + correction_csv_cells(c) + "\n";
+  }
+  return out;
+}
+
+}  // namespace correction

@@ -1,0 +1,121 @@
+#include "command.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <map>
+
+#include "awcc/errors.hpp"
+#include "awcc/settings_file.hpp"
+
+namespace pdp {
+
+namespace {
+// Where each option given by a config file came from (one process, one command).
+std::map<std::string, std::string, std::less<>>& origins() {
+  static std::map<std::string, std::string, std::less<>> map;
+  return map;
+}
+}  // namespace
+
+std::string origin_of(std::string_view name) {
+  const auto it = origins().find(name);
+  return it == origins().end() ? std::string() : it->second;
+}
+
+void add_config_option(Command& c) {
+  c.app->add_option("--config", c.config,
+                    "settings file (TOML): keys are these options' names without --, at the top level or in a [" +
+                        c.app->get_name() + "] table; the command line overrides it");
+}
+
+void finish_parsing(Command& c) {
+  if (!c.config.empty()) {
+    std::vector<awcc::Setting> settings;
+    try {
+      settings = awcc::read_settings(c.config, c.app->get_name());
+    } catch (const awcc::InputError& e) {
+      throw std::invalid_argument(std::string("--config: ") + e.what());
+    }
+    for (const auto& s : settings) {
+      CLI::Option* option = c.app->get_option_no_throw("--" + s.key);
+      if (!option) option = c.app->get_option_no_throw(s.key);  // a positional argument by name
+      if (!option || s.key == "config" || s.key == "help") {
+        throw std::invalid_argument(fmt::format("{}:{}: unknown setting '{}' for pdp {}; use the names of pdp {} --help",
+                                                c.config, s.line, s.key, c.app->get_name(), c.app->get_name()));
+      }
+      if (option->count() > 0) continue;  // the command line wins
+      try {
+        if (option->get_items_expected_max() > 1) {
+          for (const auto& item : s.items) option->add_result(item);
+        } else {
+          option->add_result(s.text);
+        }
+        option->run_callback();
+        origins()[s.key] = fmt::format("{}:{}: ", c.config, s.line);
+      } catch (const CLI::Error& e) {
+        throw std::invalid_argument(fmt::format("{}:{}: {}: {}", c.config, s.line, s.key, e.what()));
+      }
+    }
+  }
+  for (CLI::Option* option : c.required) {
+    if (option->count() == 0) {
+      throw std::invalid_argument(fmt::format("{} is required (on the command line or in --config); see pdp {} --help",
+                                              option->get_name(), c.app->get_name()));
+    }
+  }
+}
+
+std::string flag_for(const std::string& quantity) {
+  static const std::map<std::string, std::string> flags{
+      {"fs", "--fs"},
+      {"format", "--format"},
+      {"raw_layout", "--raw-channels, --raw-type and --raw-header"},
+      {"time_column", "--time-column"},
+      {"channels", "--leading-channel/--trailing-channel"},
+      {"threshold", "--threshold-rule fixed --threshold VOLTS"},
+      {"dx", "--dx"},
+      {"dy", "--dy"},
+      {"np", "--np"},
+      {"lag_range", "--max-lag"},
+  };
+  const auto it = flags.find(quantity);
+  return it == flags.end() ? std::string() : it->second;
+}
+
+namespace {
+
+std::string with_flag(const std::string& message, const std::string& quantity) {
+  const auto flag = flag_for(quantity);
+  return flag.empty() ? message : fmt::format("{} ({})", message, flag);
+}
+
+}  // namespace
+
+int report_error(const std::exception& error) {
+  if (const auto* e = dynamic_cast<const awcc::OptionError*>(&error)) {
+    spdlog::error("{}", with_flag(e->what(), e->quantity()));
+    return exit_bad_usage;
+  }
+  if (dynamic_cast<const std::invalid_argument*>(&error)) {
+    spdlog::error("{}", error.what());
+    return exit_bad_usage;
+  }
+  if (const auto* e = dynamic_cast<const awcc::InputError*>(&error)) {
+    spdlog::error("{}", with_flag(e->what(), e->quantity()));
+    return exit_bad_input;
+  }
+  if (dynamic_cast<const awcc::OutputError*>(&error) || dynamic_cast<const std::filesystem::filesystem_error*>(&error)) {
+    spdlog::error("{}", error.what());
+    return exit_output_failed;
+  }
+  if (dynamic_cast<const std::runtime_error*>(&error)) {
+    spdlog::error("{}", error.what());
+    return exit_bad_input;
+  }
+  spdlog::error("internal error: {}; please report it with the command line", error.what());
+  return exit_internal;
+}
+
+}  // namespace pdp

@@ -1,0 +1,49 @@
+#pragma once
+// What every pdp subcommand shares: its --config settings file (the same
+// names as its flags; the command line wins; CLI11 2.1 reads no config for
+// subcommands, so it is applied here), its required arguments (checked after
+// the file is applied, so that a file may give them), and the exit codes of
+// the README's table.
+
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pdp {
+
+/// The documented exit codes (README, "Exit status").
+enum ExitCode : int {
+  exit_ok = 0,
+  exit_bad_input = 1,     ///< input data that cannot be used (a recording, model or results file)
+  exit_bad_usage = 2,     ///< bad options or arguments, including a missing or unreadable config file
+  exit_output_failed = 3, ///< an output could not be written
+  exit_internal = 4,      ///< a defect of pdp: please report it
+};
+
+struct Command {
+  CLI::App* app = nullptr;
+  std::string config;                  ///< --config FILE.toml
+  std::vector<CLI::Option*> required;  ///< given on the command line or in the config file
+};
+
+/// Adds --config to the subcommand.
+void add_config_option(Command& command);
+/// Applies the config file's settings to the options not given on the command
+/// line, then checks the required ones. Throws std::invalid_argument naming
+/// the file, the line and the setting.
+void finish_parsing(Command& command);
+
+/// Logs the error (with the flag that fixes it, when the error names one) and
+/// returns its exit code.
+int report_error(const std::exception& error);
+
+/// "FILE:LINE: " when the option `name` (without --) was given by a config
+/// file, else empty: errors found later name where the value came from.
+std::string origin_of(std::string_view name);
+
+/// The flag(s) that set a library quantity ("fs" -> "--fs"), or empty.
+std::string flag_for(const std::string& quantity);
+
+}  // namespace pdp
