@@ -15,13 +15,7 @@ namespace {
 
 double quantity(std::string_view text, Dimension d) { return parse_quantity(text, d); }
 
-long long whole(std::string_view text, long long lo, long long hi) {
-  const double v = parse_quantity(text, Dimension::dimensionless);
-  if (v != std::floor(v) || v < static_cast<double>(lo) || v > static_cast<double>(hi)) {
-    throw std::invalid_argument(fmt::format("'{}' must be a whole number in [{}, {}]", text, lo, hi));
-  }
-  return static_cast<long long>(v);
-}
+long long whole(std::string_view text, long long lo, long long hi) { return parse_whole(text, lo, hi); }
 
 template <class E, std::size_t N>
 E choice(std::string_view text, const std::array<std::pair<const char*, E>, N>& choices) {

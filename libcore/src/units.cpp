@@ -122,4 +122,12 @@ std::string format_quantity(double value, Dimension dimension) {
   return fmt::format("{:.10g}{}", value / scale, symbol);
 }
 
+long long parse_whole(std::string_view text, long long lo, long long hi) {
+  const double v = parse_quantity(text, Dimension::dimensionless);
+  if (v != std::floor(v) || v < static_cast<double>(lo) || v > static_cast<double>(hi)) {
+    throw std::invalid_argument(fmt::format("'{}' must be a whole number in [{}, {}]", text, lo, hi));
+  }
+  return static_cast<long long>(v);
+}
+
 }  // namespace awcc

@@ -16,6 +16,7 @@
 #include "awcc/csv.hpp"
 #include "awcc/parallel.hpp"
 #include "awcc/random.hpp"
+#include "awcc/units.hpp"
 #include "awcc/version.hpp"
 
 namespace correction {
@@ -71,6 +72,61 @@ std::vector<double> predict(const QuantileForest& f, TargetForm form, const Trai
 }
 
 }  // namespace
+
+namespace {
+
+std::vector<int> whole_list(std::string_view text, long long lo, long long hi) {
+  std::vector<int> out;
+  for (const auto& item : split_cells(text)) out.push_back(static_cast<int>(awcc::parse_whole(item, lo, hi)));
+  return out;
+}
+
+std::string list_text(const std::vector<int>& values) {
+  std::string out;
+  for (int v : values) out += (out.empty() ? "" : ",") + std::to_string(v);
+  return out;
+}
+
+using T = TrainOptions;
+const awcc::OptionField<T> kTraining[] = {
+    {"trees", "-", "trees per forest: more give smoother quantiles at proportional cost",
+     [](T& o, std::string_view t) { o.trees = static_cast<int>(awcc::parse_whole(t, 1, 100000)); },
+     [](const T& o) { return std::to_string(o.trees); }},
+    {"min-windows", "-", "runs with fewer accepted AWCC windows are left out (and counted); rows below it are not corrected",
+     [](T& o, std::string_view t) { o.min_windows = awcc::parse_whole(t, 1, std::int64_t{1} << 40); },
+     [](const T& o) { return std::to_string(o.min_windows); }},
+    {"held-out", "-", "fraction of runs held out for the report (never trained on)",
+     [](T& o, std::string_view t) { o.held_out = awcc::parse_quantity(t, awcc::Dimension::dimensionless); },
+     [](const T& o) { return fmt::format("{:g}", o.held_out); }},
+    {"folds", "-", "cross-validation folds over the hyperparameter grids; 0 = none (the grids' first values)",
+     [](T& o, std::string_view t) { o.folds = static_cast<int>(awcc::parse_whole(t, 0, 100)); },
+     [](const T& o) { return std::to_string(o.folds); }},
+    {"cv-trees", "-", "trees per forest during cross-validation (fewer: a faster search)",
+     [](T& o, std::string_view t) { o.cv_trees = static_cast<int>(awcc::parse_whole(t, 1, 100000)); },
+     [](const T& o) { return std::to_string(o.cv_trees); }},
+    {"min-leaf", "-", "least training draws per leaf: the values tried",
+     [](T& o, std::string_view t) {
+       o.min_leaf_grid = whole_list(t, 1, 1000000);
+       o.min_leaf = o.min_leaf_grid.front();
+     },
+     [](const T& o) { return list_text(o.min_leaf_grid); }},
+    {"features-per-split", "-", "features tried per split (1-7): the values tried",
+     [](T& o, std::string_view t) {
+       o.features_per_split_grid = whole_list(t, 1, Features::count);
+       o.features_per_split = o.features_per_split_grid.front();
+     },
+     [](const T& o) { return list_text(o.features_per_split_grid); }},
+    {"seed", "-", "seed of the split, the folds and the forests",
+     [](T& o, std::string_view t) { o.seed = static_cast<std::uint64_t>(awcc::parse_whole(t, 0, std::int64_t{1} << 53)); },
+     [](const T& o) { return std::to_string(o.seed); }},
+    {"threads", "-", "threads (0 = all cores); the model is the same for any count",
+     [](T& o, std::string_view t) { o.threads = static_cast<int>(awcc::parse_whole(t, 0, 4096)); },
+     [](const T& o) { return std::to_string(o.threads); }},
+};
+
+}  // namespace
+
+std::span<const awcc::OptionField<TrainOptions>> training_option_fields() { return kTraining; }
 
 std::string TrainOptions::validate() const {
   if (trees < 1) return fmt::format("trees {}: give at least 1", trees);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_options.hpp"
 #include "command.hpp"
 
 namespace pdp {
@@ -14,15 +15,7 @@ namespace pdp {
 struct TrainCommandOptions {
   std::vector<std::string> sweeps;  ///< pdp sweep CSVs (shards may be given together)
   std::string output;               ///< model file (.qrf)
-  int trees = 100;
-  std::int64_t min_windows = 100;
-  double held_out = 0.2;
-  int folds = 5;
-  int cv_trees = 50;
-  std::string min_leaf_grid = "1,2,3,5,10,20";
-  std::string features_per_split_grid = "2,3,5,7";
-  std::uint64_t seed = 1;
-  int threads = 0;
+  OptionSet training;               ///< correction::training_option_fields()
   std::string predictions;          ///< held-out predictions CSV
   std::string learning_curve;       ///< learning curve CSV
   std::string report;               ///< the report as a text file (also on stdout)

@@ -21,6 +21,10 @@ std::string accepted_units(Dimension dimension);
 /// units accepted. Non-finite numbers are refused.
 double parse_quantity(std::string_view text, Dimension dimension);
 
+/// A whole number in [lo, hi] ("15", "1e3"); throws std::invalid_argument
+/// naming the text and the range.
+long long parse_whole(std::string_view text, long long lo, long long hi);
+
 /// Formats an SI value with a readable unit ("5mm", "500kHz", "0.1s").
 std::string format_quantity(double value, Dimension dimension);
 

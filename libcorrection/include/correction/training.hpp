@@ -34,6 +34,9 @@
 #include <string>
 #include <vector>
 
+#include <span>
+
+#include "awcc/option_field.hpp"
 #include "correction/model.hpp"
 
 namespace correction {
@@ -69,14 +72,19 @@ struct TrainOptions {
   int cv_trees = 50;                    ///< trees per forest during cross-validation
   std::vector<int> min_leaf_grid{1, 2, 3, 5, 10, 20};
   std::vector<int> features_per_split_grid{2, 3, 5, 7};
-  int min_leaf = 10;                    ///< without CV
-  int features_per_split = 3;           ///< without CV
+  int min_leaf = 1;                     ///< without CV: the first of min_leaf_grid
+  int features_per_split = 2;           ///< without CV: the first of features_per_split_grid
   TargetForm velocity_form = TargetForm::ratio;        ///< without CV
   TargetForm turbulence_form = TargetForm::difference; ///< without CV
   std::uint64_t seed = 1;
   int threads = 0;
   [[nodiscard]] std::string validate() const;
 };
+
+/// The declarations of the training options (awcc/option_field.hpp): names,
+/// help and defaults for the command line and settings files. The grids are
+/// lists ("5,10,20"); without cross-validation their first values are used.
+std::span<const awcc::OptionField<TrainOptions>> training_option_fields();
 
 struct CvEntry {
   std::string target;                   ///< "velocity" | "turbulence_intensity"
