@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fmt/format.h>
 
 #include "awcc/order_statistics.hpp"
 
@@ -58,6 +59,16 @@ Summary summarise_in_place(std::vector<double>& values) {
   return s;
 }
 
+std::string_view to_string(PhaseStatus status) {
+  switch (status) {
+    case PhaseStatus::ok: return "ok";
+    case PhaseStatus::no_air: return "no_air";
+    case PhaseStatus::all_air: return "all_air";
+    case PhaseStatus::too_few_chords: return "too_few_chords";
+  }
+  return "?";
+}
+
 PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisticsOptions& options) {
   PhaseStatistics p;
   const double fs = signal.fs;
@@ -84,7 +95,17 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
   // Confidence intervals of c and F (alternating renewal process, see header).
   p.void_fraction_ci95 = {p.void_fraction, p.void_fraction};
   p.bubble_count_rate_ci95 = {p.bubble_count_rate, p.bubble_count_rate};
-  if (air.size() >= 2 && water.size() >= 2) {
+  if (signal.air_samples() == 0) {
+    p.status = PhaseStatus::no_air;
+    p.message = "the tip saw no air";
+  } else if (signal.air_samples() == signal.sample_count) {
+    p.status = PhaseStatus::all_air;
+    p.message = "the tip saw only air";
+  } else if (air.size() < 2 || water.size() < 2) {
+    p.status = PhaseStatus::too_few_chords;
+    p.message = fmt::format("{} complete air and {} water chords: too few for confidence intervals", air.size(),
+                            water.size());
+  } else {
     const double ma = p.air_chord_time.mean, mw = p.water_chord_time.mean;
     const double va = variance(air, ma), vw = variance(water, mw);
     const double m = ma + mw;

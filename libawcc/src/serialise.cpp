@@ -54,6 +54,8 @@ json to_json(const ProcessResult& r) {
     const auto& p = t.phase;
     json tip{
         {"channel", t.channel},
+        {"status", to_string(p.status)},
+        {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
         {"threshold", t.threshold.threshold},
         {"threshold_rule", std::string(to_string(t.threshold.rule))},
         {"threshold_lower", t.threshold.lower},
@@ -207,6 +209,7 @@ std::string ProcessResult::report() const {
     }
     if (p.sauter_diameter) line(fmt::format("    Sauter diameter d32  {:.4f} mm", *p.sauter_diameter * 1e3));
     if (!t.threshold.note.empty()) line("    note: " + t.threshold.note);
+    if (p.status != PhaseStatus::ok) line("    note: " + p.message);
   }
   if (fscc) {
     const auto& f = *fscc;

@@ -71,3 +71,32 @@ TEST(PhaseStatistics, ConstantChannelHasNoChords) {
 }
 
 }  // namespace
+
+namespace {
+
+awcc::AirIntervals record(std::vector<awcc::AirInterval> iv, std::int64_t n) {
+  awcc::AirIntervals s;
+  s.intervals = std::move(iv);
+  s.sample_count = n;
+  s.fs = 1000.0;
+  return s;
+}
+
+}  // namespace
+
+// Each status at its limit: the intervals need 2 complete air and 2 water
+// chords; with fewer, the status says so (the interval is the point).
+TEST(PhaseStatus, EachStatusAtItsLimit) {
+  EXPECT_EQ(awcc::phase_statistics(record({}, 100)).status, awcc::PhaseStatus::no_air);
+  EXPECT_EQ(awcc::phase_statistics(record({{0, 100}}, 100)).status, awcc::PhaseStatus::all_air);
+  // Two complete air chords but one water chord between them: too few.
+  const auto one_water = awcc::phase_statistics(record({{10, 20}, {30, 40}}, 100));
+  EXPECT_EQ(one_water.status, awcc::PhaseStatus::too_few_chords);
+  EXPECT_EQ(one_water.void_fraction_ci95.lower, one_water.void_fraction);
+  EXPECT_NE(one_water.message.find("2 complete air and 1 water"), std::string::npos) << one_water.message;
+  // Three air chords, two water chords between them: intervals exist.
+  const auto enough = awcc::phase_statistics(record({{10, 20}, {30, 45}, {60, 62}}, 100));
+  EXPECT_EQ(enough.status, awcc::PhaseStatus::ok);
+  EXPECT_LT(enough.void_fraction_ci95.lower, enough.void_fraction);
+  EXPECT_GT(enough.void_fraction_ci95.upper, enough.void_fraction);
+}

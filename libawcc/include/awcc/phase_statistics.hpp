@@ -18,6 +18,8 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "awcc/air_intervals.hpp"
@@ -50,7 +52,18 @@ struct PhaseStatisticsOptions {
   std::optional<double> velocity;     ///< m/s: adds chord lengths and d32 when given
 };
 
+/// Whether the statistics of a tip hold everything, and if not why.
+enum class PhaseStatus {
+  ok,
+  no_air,           ///< the tip never saw air: c = 0, no chords
+  all_air,          ///< the tip saw only air: c = 1, no chords
+  too_few_chords,   ///< fewer than 2 complete air and water chords: no confidence intervals (given as the point)
+};
+std::string_view to_string(PhaseStatus status);
+
 struct PhaseStatistics {
+  PhaseStatus status = PhaseStatus::ok;
+  std::string message;                 ///< why not ok (empty when ok)
   double duration = 0.0;               ///< s
   double void_fraction = 0.0;          ///< -
   Interval95 void_fraction_ci95;
