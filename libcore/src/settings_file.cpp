@@ -56,11 +56,15 @@ toml::table parse(const std::filesystem::path& path) {
   }
 }
 
-std::vector<Setting> settings_of(const std::filesystem::path& path, const toml::table& t) {
+std::vector<Setting> settings_of(const std::filesystem::path& path, const toml::table& t, bool top) {
   std::vector<Setting> out;
   for (const auto& [key, node] : t) {
     const std::string k(key.str());
-    if (node.is_table()) continue;
+    if (node.is_table()) {
+      if (top) continue;
+      throw InputError(fmt::format("{}:{}: [{}] is a table inside a table; settings files have one level of tables",
+                                   path.string(), node.source().begin.line, k));
+    }
     try {
       out.push_back(setting_of(k, node));
     } catch (const std::invalid_argument& e) {
@@ -72,29 +76,37 @@ std::vector<Setting> settings_of(const std::filesystem::path& path, const toml::
 
 }  // namespace
 
-std::vector<Setting> read_settings(const std::filesystem::path& path, std::string_view table,
-                                   const std::vector<std::string>& other_tables) {
+std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path) {
   const toml::table t = parse(path);
-  const toml::table* source = &t;
-  if (!table.empty()) {
-    if (const auto* inner = t[table].as_table()) source = inner;
-  }
+  std::vector<SettingTable> out{{"", 1, settings_of(path, t, true)}};
   for (const auto& [key, node] : t) {
-    if (!node.is_table()) continue;
-    const std::string k(key.str());
-    if (k == table || std::find(other_tables.begin(), other_tables.end(), k) != other_tables.end()) continue;
-    throw InputError(fmt::format("{}:{}: unknown table [{}]{}", path.string(), node.source().begin.line, k,
-                                 table.empty() ? "" : fmt::format("; use top-level keys or [{}]", table)));
-  }
-  if (source != &t) {
-    for (const auto& [key, node] : t) {
-      if (!node.is_table()) {
-        throw InputError(fmt::format("{}:{}: {} stands outside [{}]; put every setting in the table",
-                                     path.string(), node.source().begin.line, key.str(), table));
-      }
+    if (const auto* inner = node.as_table()) {
+      out.push_back({std::string(key.str()), static_cast<int>(node.source().begin.line), settings_of(path, *inner, false)});
     }
   }
-  return settings_of(path, *source);
+  return out;
+}
+
+std::vector<Setting> read_settings(const std::filesystem::path& path, std::string_view table,
+                                   const std::vector<std::string>& other_tables) {
+  const auto tables = read_setting_tables(path);
+  const SettingTable* chosen = &tables.front();
+  for (const auto& t : tables) {
+    if (t.name.empty()) continue;
+    if (!table.empty() && t.name == table) {
+      chosen = &t;
+      continue;
+    }
+    if (std::find(other_tables.begin(), other_tables.end(), t.name) != other_tables.end()) continue;
+    throw InputError(fmt::format("{}:{}: unknown table [{}]{}", path.string(), t.line, t.name,
+                                 table.empty() ? "" : fmt::format("; use top-level keys or [{}]", table)));
+  }
+  if (chosen != &tables.front() && !tables.front().settings.empty()) {
+    const auto& stray = tables.front().settings.front();
+    throw InputError(fmt::format("{}:{}: {} stands outside [{}]; put every setting in the table", path.string(),
+                                 stray.line, stray.key, table));
+  }
+  return chosen->settings;
 }
 
 }  // namespace awcc

@@ -6,7 +6,8 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <toml++/toml.h>
+#include "awcc/errors.hpp"
+#include "awcc/settings_file.hpp"
 
 #include "awcc/units.hpp"
 #include "awcc/random.hpp"
@@ -14,14 +15,6 @@
 
 namespace pdp {
 namespace {
-
-std::string text_of(const toml::node& node) {
-  if (const auto* s = node.as_string()) return std::string(s->get());
-  if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
-  if (const auto* d = node.as_floating_point()) return fmt::format("{}", d->get());
-  if (const auto* b = node.as_boolean()) return b->get() ? "1" : "0";
-  throw std::invalid_argument("a number or a string");
-}
 
 bool is_field(const std::string& name) {
   if (name == "np" || name == "anisotropy") return true;
@@ -53,40 +46,46 @@ awcc::Dimension dimension_of(const std::string& name) {
 
 SweepDefinition load_sweep(const std::filesystem::path& path) {
   SweepDefinition d;
-  toml::table t;
   const std::string file = path.string();
-  try {
-    t = toml::parse_file(file);
-  } catch (const toml::parse_error& e) {
-    throw std::runtime_error(fmt::format("{}:{}: not valid TOML: {}", file, e.source().begin.line, e.description()));
-  }
   auto fail = [&](const std::string& where, const std::string& what) -> void {
     throw std::runtime_error(fmt::format("{}: {}: {}", file, where, what));
   };
-  for (const auto& [key, node] : t) {
-    const std::string k(key.str());
-    if (k != "sweep" && k != "base" && k != "grid" && k != "ranges") fail(k, "unknown table; use [sweep], [base], [grid] and [ranges]");
-    if (!node.is_table()) fail(k, "must be a table");
+  std::vector<awcc::SettingTable> tables;
+  try {
+    tables = awcc::read_setting_tables(path);
+  } catch (const awcc::InputError& e) {
+    throw std::runtime_error(e.what());
   }
-  if (const auto* s = t["sweep"].as_table()) {
-    for (const auto& [key, node] : *s) {
-      const std::string k(key.str());
-      if (k == "mode") {
-        const auto* v = node.as_string();
-        if (!v || (v->get() != "grid" && v->get() != "monte-carlo")) fail("[sweep] mode", "write \"grid\" or \"monte-carlo\"");
-        d.mode = v->get();
-      } else if (k == "runs" || k == "repeat" || k == "seed") {
-        const auto* v = node.as_integer();
-        if (!v || v->get() < (k == "seed" ? 0 : 1)) fail("[sweep] " + k, "must be a whole number >= " + std::string(k == "seed" ? "0" : "1"));
-        if (k == "runs") d.runs = v->get();
-        if (k == "repeat") d.repeat = v->get();
-        if (k == "seed") d.seed = static_cast<std::uint64_t>(v->get());
-      } else {
-        fail("[sweep] " + k, "unknown key; use mode, runs, repeat, seed");
-      }
+  std::map<std::string, const awcc::SettingTable*> by_name;
+  for (const auto& t : tables) {
+    if (t.name.empty()) {
+      if (!t.settings.empty()) fail(t.settings.front().key, "must be a table");
+      continue;
     }
-  } else {
-    fail("[sweep]", "missing: give at least mode = \"grid\" or \"monte-carlo\"");
+    if (t.name != "sweep" && t.name != "base" && t.name != "grid" && t.name != "ranges") {
+      fail(t.name, "unknown table; use [sweep], [base], [grid] and [ranges]");
+    }
+    by_name[t.name] = &t;
+  }
+  auto table = [&](const char* name) { return by_name.count(name) ? by_name[name]->settings : std::vector<awcc::Setting>{}; };
+  if (!by_name.count("sweep")) fail("[sweep]", "missing: give at least mode = \"grid\" or \"monte-carlo\"");
+  for (const auto& s : table("sweep")) {
+    if (s.key == "mode") {
+      if (s.text != "grid" && s.text != "monte-carlo") fail("[sweep] mode", "write \"grid\" or \"monte-carlo\"");
+      d.mode = s.text;
+    } else if (s.key == "runs" || s.key == "repeat" || s.key == "seed") {
+      long long v = 0;
+      try {
+        v = awcc::parse_whole(s.text, s.key == "seed" ? 0 : 1, std::int64_t{1} << 53);
+      } catch (const std::invalid_argument&) {
+        fail("[sweep] " + s.key, "must be a whole number >= " + std::string(s.key == "seed" ? "0" : "1"));
+      }
+      if (s.key == "runs") d.runs = v;
+      if (s.key == "repeat") d.repeat = v;
+      if (s.key == "seed") d.seed = static_cast<std::uint64_t>(v);
+    } else {
+      fail("[sweep] " + s.key, "unknown key; use mode, runs, repeat, seed");
+    }
   }
   if (d.mode == "monte-carlo" && d.runs < 1) fail("[sweep] runs", "monte-carlo needs runs >= 1");
   SweepRun probe;
@@ -98,60 +97,36 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
       fail(where, e.what());
     }
   };
-  if (const auto* b = t["base"].as_table()) {
-    for (const auto& [key, node] : *b) {
-      const std::string k(key.str());
-      if (!is_field(k)) fail("[base] " + k, "unknown field; use the names of pdp synth --help, np or anisotropy");
-      std::string text;
-      try {
-        text = text_of(node);
-      } catch (const std::exception& e) {
-        fail("[base] " + k, std::string("must be ") + e.what());
-      }
-      check_value("[base] " + k, k, text);
-      d.base[k] = text;
-    }
+  for (const auto& s : table("base")) {
+    if (!is_field(s.key)) fail("[base] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
+    check_value("[base] " + s.key, s.key, s.text);
+    d.base[s.key] = s.text;
   }
-  if (const auto* g = t["grid"].as_table()) {
-    for (const auto& [key, node] : *g) {
-      const std::string k(key.str());
-      if (!is_field(k)) fail("[grid] " + k, "unknown field; use the names of pdp synth --help, np or anisotropy");
-      const auto* list = node.as_array();
-      if (!list || list->empty()) fail("[grid] " + k, "must be a non-empty list of values");
-      for (const auto& v : *list) {
-        std::string text;
-        try {
-          text = text_of(v);
-        } catch (const std::exception& e) {
-          fail("[grid] " + k, std::string("values must be ") + e.what());
-        }
-        check_value("[grid] " + k, k, text);
-        d.grid[k].push_back(text);
-      }
+  for (const auto& s : table("grid")) {
+    if (!is_field(s.key)) fail("[grid] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
+    if (s.items.empty()) fail("[grid] " + s.key, "must be a non-empty list of values");
+    for (const auto& text : s.items) {
+      check_value("[grid] " + s.key, s.key, text);
+      d.grid[s.key].push_back(text);
     }
   }
   if (d.mode == "monte-carlo") {
-    using awcc::Dimension;
     d.ranges = {{"velocity", {1.0, 50.0}},       {"tu", {0.0, 0.35}},       {"time-scale", {1e-3, 1.0}},
                 {"void-fraction", {0.005, 0.4}}, {"bubble-diameter", {0.5e-3, 20e-3}}, {"dx", {0.5e-3, 10e-3}}};
   }
-  if (const auto* r = t["ranges"].as_table()) {
-    for (const auto& [key, node] : *r) {
-      const std::string k(key.str());
-      if (!is_field(k)) fail("[ranges] " + k, "unknown field; use the names of pdp synth --help, np or anisotropy");
-      const auto* list = node.as_array();
-      if (!list || list->size() != 2) fail("[ranges] " + k, "must be [min, max]");
-      double ends[2];
-      for (std::size_t i = 0; i < 2; ++i) {
-        try {
-          ends[i] = awcc::parse_quantity(text_of(*list->get(i)), dimension_of(k));
-        } catch (const std::exception& e) {
-          fail("[ranges] " + k, e.what());
-        }
+  for (const auto& s : table("ranges")) {
+    if (!is_field(s.key)) fail("[ranges] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
+    if (s.items.size() != 2) fail("[ranges] " + s.key, "must be [min, max]");
+    double ends[2];
+    for (std::size_t i = 0; i < 2; ++i) {
+      try {
+        ends[i] = awcc::parse_quantity(s.items[i], dimension_of(s.key));
+      } catch (const std::exception& e) {
+        fail("[ranges] " + s.key, e.what());
       }
-      if (!(ends[0] <= ends[1])) fail("[ranges] " + k, "min must not exceed max");
-      d.ranges[k] = {ends[0], ends[1]};
     }
+    if (!(ends[0] <= ends[1])) fail("[ranges] " + s.key, "min must not exceed max");
+    d.ranges[s.key] = {ends[0], ends[1]};
   }
   if (d.mode == "grid" && d.grid.empty()) fail("[grid]", "a grid sweep needs at least one list of values");
   // Canonical text: every setting, sorted.

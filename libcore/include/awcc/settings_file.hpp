@@ -20,6 +20,18 @@ struct Setting {
   int line = 0;                   ///< where the key is, for messages
 };
 
+/// One table of a settings file: "" for the top-level keys.
+struct SettingTable {
+  std::string name;
+  int line = 0;
+  std::vector<Setting> settings;
+};
+
+/// Every table of a file, the top-level keys first (name ""). Throws
+/// InputError naming the file and line: unreadable file, invalid TOML, a
+/// table inside a table, a value that is neither a scalar nor a list.
+std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path);
+
 /// The settings of a file: its top-level keys, or when it has a table named
 /// `table`, the keys of that table (other tables are refused unless listed in
 /// `other_tables`). Throws InputError naming the file and line: unreadable
