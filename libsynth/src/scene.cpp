@@ -143,7 +143,7 @@ std::vector<std::string> Scene::validate() const {
       if (std::hypot(p[i].x - p[j].x, p[i].y - p[j].y, p[i].z - p[j].z) < 1e-9) {
         errors.push_back(fmt::format(
             "{}: tips {} and {} are at the same point ({}, {}, {}) m; separate them (for a two-tip "
-            "probe, set a nonzero --dx)",
+            "probe, set a nonzero dx)",
             tip_field, i, j, p[i].x, p[i].y, p[i].z));
       }
     }

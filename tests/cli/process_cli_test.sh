@@ -38,7 +38,8 @@ head -1 "$dir/windows.csv" | grep -q "^start_time,duration,particles,lag,velocit
 out=$("$pdp" process "$dir/rec.flac" --dx 5mm --np 15 --filter-a 0.3 --roc off --weighting none --subsample parabolic \
   --velocity-range 2m/s,40m/s) || fail "awcc options"
 grep -q "AWCC: velocity" <<<"$out" || fail "AWCC summary: $out"
-grep -q "0 outlier cutoff" <<<"$out" || fail "--roc off still rejected windows"
+# ", 0 outlier cutoff," exactly: "10 outlier cutoff" must not pass.
+grep -q "lag, 0 outlier cutoff, " <<<"$out" || fail "--roc off still rejected windows: $(grep 'outlier cutoff' <<<"$out")"
 "$pdp" --log-level warn synth -q --duration 0.5s --fs 100kHz --signal voltage -o "$dir/volt.wav" || fail "voltage synth"
 out=$("$pdp" process "$dir/volt.wav" --dx 5mm --correlate raw) || fail "raw correlation"
 grep -q "AWCC" <<<"$out" || fail "raw correlation summary"

@@ -29,6 +29,17 @@ b=$("$pdp" validate --duration 2s --fs 100kHz | head -3)
 err=$("$pdp" validate --void-fraction 0.9 2>&1) && fail "bad scene accepted"
 grep -q "void-fraction" <<<"$err" || fail "bad scene message: $err"
 
+# Fewer than two distinct tips: a validation error naming tips, exit status 2.
+err=$("$pdp" validate --tips 0,0,0 --duration 1s 2>&1)
+status=$?
+[[ $status -eq 2 ]] || fail "one tip: exit status $status, expected 2: $err"
+grep -q "tips: the scene has 1 tip; FSCC and AWCC need two" <<<"$err" || fail "one tip: message lacks tips: $err"
+err=$("$pdp" validate --tips "0,0,0;0,0,0" --duration 1s 2>&1)
+status=$?
+[[ $status -eq 2 ]] || fail "two tips at one point: exit status $status, expected 2: $err"
+grep -q "tips: tips 0 and 1 are at the same point" <<<"$err" || fail "two tips at one point: message: $err"
+"$pdp" validate --tips "0,0,0;5mm,0,0" --duration 1s --fs 100kHz >/dev/null 2>&1 || fail "two distinct tips refused"
+
 out=$("$pdp" compare --duration 3s --fs 100kHz) || fail "compare scene"
 for text in "velocity (m/s)" "turbulence intensity" "R12max" "windows kept" "run time"; do
   grep -q "$text" <<<"$out" || fail "compare lacks '$text'"

@@ -52,6 +52,12 @@ Summary95 summarise95(const std::vector<double>& values) {
 }
 
 RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
+  // Processing correlates the first two tips: a study needs them (a one-tip
+  // scene is fine for pdp synth, not here).
+  if (scene.probe_tips().size() < 2) {
+    throw std::invalid_argument(fmt::format("tips: the scene has {} tip; FSCC and AWCC need two (give tips or dx)",
+                                            scene.probe_tips().size()));
+  }
   RunResult r;
   r.scene = scene;
   synth::SynthesisOptions so;
