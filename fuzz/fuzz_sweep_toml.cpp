@@ -13,7 +13,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& [k, v] : d.grid) combinations *= v.size();
     if (d.repeat * static_cast<std::int64_t>(combinations) < 10000 && d.runs * d.repeat < 10000) {
       const auto runs = d.expand();
-      for (const auto& r : runs) (void)pdp::sweep_row(r, nullptr, "x", pdp::study_id(d));
+      for (const auto& r : runs) (void)pdp::sweep_row(r, nullptr, "x", pdp::study_id(d), awcc::AwccOptions{});
     }
   } catch (const std::runtime_error&) {
   } catch (const std::invalid_argument&) {
