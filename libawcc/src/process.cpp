@@ -17,6 +17,7 @@ std::string ProcessOptions::validate() const {
   if (!(dx >= 0.0 && std::isfinite(dx))) return fmt::format("dx = {} m must be >= 0", dx);
   if (auto why = binarisation.validate(); !why.empty()) return why;
   if (auto why = fscc_options.validate(); !why.empty()) return why;
+  if (auto why = awcc_options.validate(); !why.empty()) return why;
   if (block_frames < 1) return "block_frames must be >= 1";
   return {};
 }

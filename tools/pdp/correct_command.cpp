@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "awcc/atomic_output.hpp"
@@ -56,7 +57,8 @@ int run_correct(const CorrectOptions& o) {
     const std::string model_name = std::filesystem::path(o.model).filename().string();
     const auto out = json ? correction::correct_process_json(model, text, defaults, o.input, model_name)
                           : correction::correct_profile_csv(model, text, defaults, o.input);
-    for (const auto& w : out.warnings) spdlog::warn("{}", w);
+    // One line per distinct warning (a profile repeats them row by row).
+    for (const auto& w : std::set<std::string>(out.warnings.begin(), out.warnings.end())) spdlog::warn("{}", w);
     if (o.output.empty()) fmt::print("{}", out.text);
     else awcc::write_text_atomically(o.output, out.text);
   } catch (const std::exception& e) {

@@ -54,7 +54,6 @@ awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
   o.library.apply(awcc::fscc_option_fields(), p.fscc_options);
   o.library.apply(awcc::awcc_option_fields(), p.awcc_options);
   p.fscc_options.subsample = p.awcc_options.subsample;  // FSCC refines its peak as AWCC does
-  if (auto why = p.awcc_options.validate(); !why.empty()) throw std::invalid_argument(why);
   if (auto why = p.validate(); !why.empty()) throw std::invalid_argument(why);
   if (!o.windows.empty() && o.files.size() != 1) {
     throw std::invalid_argument("--windows writes the window table of one recording; give one file");
