@@ -35,7 +35,17 @@ std::string_view to_string(AwccStatus status) {
     case AwccStatus::too_few_particles: return "too_few_particles";
     case AwccStatus::delay_below_one_sample: return "delay_below_one_sample";
     case AwccStatus::too_few_windows: return "too_few_windows";
+    case AwccStatus::tips_swapped: return "tips_swapped";
     case AwccStatus::no_tip_separation: return "no_tip_separation";
+  }
+  return "?";
+}
+
+std::string_view to_string(AwccQuality quality) {
+  switch (quality) {
+    case AwccQuality::ok: return "ok";
+    case AwccQuality::low: return "low";
+    case AwccQuality::insufficient: return "insufficient";
   }
   return "?";
 }
@@ -54,6 +64,10 @@ std::string AwccOptions::validate() const {
   if (max_lag_samples < 1) return fmt::format("max lag {} samples must be >= 1", max_lag_samples);
   if (velocity_min && !(*velocity_min > 0.0 && *velocity_max > *velocity_min))
     return fmt::format("velocity range {} to {} m/s must satisfy 0 < min < max", *velocity_min, *velocity_max);
+  if (windows_reported < 2) return fmt::format("windows reported {}: moments need at least 2 windows", windows_reported);
+  if (windows_ok < windows_reported)
+    return fmt::format("windows ok {} must be at least windows reported {}", windows_ok, windows_reported);
+  if (!(yield_ok >= 0.0 && yield_ok <= 1.0)) return fmt::format("yield ok {} must lie in [0, 1]", yield_ok);
   return {};
 }
 
@@ -522,6 +536,12 @@ void analyse_window(AwccWindow& w, std::span<const double> r, std::int64_t first
 void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   auto& windows = result.windows;
   result.windows_total = static_cast<std::int64_t>(windows.size());
+  std::int64_t clear_negative = 0, clear_positive = 0;
+  for (const auto& w : windows) {
+    const bool clear = w.r12_max / (w.spr * w.spr + 1.0) >= options.filter_a;
+    if (w.fate == WindowFate::accepted) ++clear_positive;
+    if (w.fate == WindowFate::lag && w.lag_samples < 0 && clear) ++clear_negative;
+  }
   std::vector<double> u(windows.size());
   std::vector<bool> keep(windows.size());
   for (std::size_t i = 0; i < windows.size(); ++i) {
@@ -534,7 +554,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
   }
   result.windows_accepted = result.rejected_correlation = result.rejected_lag = result.rejected_roc =
-      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = 0;
+      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = result.negative_lag_windows = 0;
   double sw = 0, swu = 0;
   for (const auto& w : windows) {
     switch (w.fate) {
@@ -546,20 +566,36 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       case WindowFate::too_short: ++result.rejected_too_short; break;
     }
     if (w.fate == WindowFate::lag && w.lag_samples == 0) ++result.lag_zero_windows;
+    if (w.fate == WindowFate::lag && w.lag_samples < 0) ++result.negative_lag_windows;
     if (w.fate != WindowFate::accepted) continue;
     const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
     sw += weight;
     swu += weight * w.velocity;
   }
   result.status = AwccStatus::too_few_windows;
+  result.quality = AwccQuality::insufficient;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
+  auto insufficient = [&result] { result.quality_reason = result.message; };
   if (result.windows_total == 0) {
     result.status = AwccStatus::too_few_particles;
     result.message = fmt::format("fewer than Np = {} particles on the leading tip: no window can be formed", options.np);
+    insufficient();
     return;
   }
-  if (result.windows_accepted < 2) {
+  // Swapped tips (or a dx of the wrong sign): the windows whose peak is clear
+  // (it passes the correlation filter whatever its sign) peak at negative
+  // lags. Unrelated signals peak on either side alike, negative ~ Binomial(n,
+  // 1/2), so negative - positive has sd sqrt(n): more than 3 sd of excess
+  // (one-sided p = 0.0013; at least 10 clear windows) says the tips are swapped.
+  if (static_cast<double>(clear_negative - clear_positive) > 3.0 * std::sqrt(static_cast<double>(clear_negative + clear_positive))) {
+    tips_swapped(result, fmt::format("{} of {} windows with a clear correlation peak have it at a negative lag: the "
+                                     "trailing tip's signal leads, so the tips are swapped (or dx has the wrong "
+                                     "sign); exchange the tips' channels",
+                                     clear_negative, clear_negative + clear_positive));
+    return;
+  }
+  if (result.windows_accepted < options.windows_reported) {
     if (result.lag_zero_windows * 2 > result.windows_total) {
       result.status = AwccStatus::delay_below_one_sample;
       result.message = "most windows peak at lag 0: the tip-to-tip delay is shorter than one sample, so the velocity "
@@ -567,12 +603,14 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     } else {
       result.message = fmt::format(
           "{} of {} windows accepted ({} rejected by the correlation filter, {} by a non-positive lag, {} by the "
-          "outlier cutoff, {} constant{}): too few for statistics",
+          "outlier cutoff, {} constant{}): too few for statistics (fewer than {})",
           result.windows_accepted, result.windows_total, result.rejected_correlation, result.rejected_lag,
           result.rejected_roc, result.rejected_constant,
           result.rejected_too_short ? fmt::format(", {} too short for the velocity range", result.rejected_too_short)
-                                    : std::string());
+                                    : std::string(),
+          options.windows_reported);
     }
+    insufficient();
     return;
   }
   const double mean = swu / sw;
@@ -596,6 +634,21 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.velocity_ci95 = {mean - hu, mean + hu};
   result.velocity_rms_ci95 = {rms - hr, rms + hr};
   result.turbulence_intensity_ci95 = {tu - ht, tu + ht};
+  const double yield = static_cast<double>(result.windows_accepted) / static_cast<double>(result.windows_total);
+  result.quality = AwccQuality::ok;
+  result.quality_reason.clear();
+  if (result.windows_accepted < options.windows_ok) {
+    result.quality = AwccQuality::low;
+    result.quality_reason = fmt::format("{} accepted windows (fewer than {}): Tu's 95 % interval is +/- {:.0f} %",
+                                        result.windows_accepted, options.windows_ok,
+                                        100.0 * ht / std::max(tu, 1e-300));
+  } else if (yield < options.yield_ok) {
+    result.quality = AwccQuality::low;
+    result.quality_reason = fmt::format("data yield {:.1f} % ({} of {} windows accepted, below {:g} %): the accepted "
+                                        "windows may not represent the flow",
+                                        100.0 * yield, result.windows_accepted, result.windows_total,
+                                        100.0 * options.yield_ok);
+  }
 }
 
 }  // namespace detail
@@ -654,6 +707,17 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
 void detail::no_tip_separation(AwccResult& result) {
   result.status = AwccStatus::no_tip_separation;
   result.message = "no tip separation given: the velocity cannot be computed";
+  result.quality = AwccQuality::insufficient;
+  result.quality_reason = result.message;
+  result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
+  result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
+}
+
+void detail::tips_swapped(AwccResult& result, const std::string& why) {
+  result.status = AwccStatus::tips_swapped;
+  result.message = why;
+  result.quality = AwccQuality::insufficient;
+  result.quality_reason = why;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
 }

@@ -26,6 +26,7 @@ std::string_view to_string(FsccStatus status) {
     case FsccStatus::no_common_segment: return "no_common_segment";
     case FsccStatus::no_positive_peak: return "no_positive_peak";
     case FsccStatus::non_positive_lag: return "non_positive_lag";
+    case FsccStatus::tips_swapped: return "tips_swapped";
     case FsccStatus::peak_at_lag_range_end: return "peak_at_lag_range_end";
     case FsccStatus::no_tip_separation: return "no_tip_separation";
   }
@@ -356,19 +357,25 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     out.status = FsccStatus::no_positive_peak;
     out.message = "the cross-correlation has no positive peak: the tips' signals are unrelated";
   } else if (out.lag_samples <= 0) {
-    out.status = FsccStatus::non_positive_lag;
+    out.status = out.lag_samples < 0 ? FsccStatus::tips_swapped : FsccStatus::non_positive_lag;
     out.message = fmt::format("the cross-correlation peaks at lag {} samples (not positive): no physical velocity; "
                               "check the tip order",
                               out.lag_samples);
   } else if (out.lag_samples == f.k12_min + static_cast<std::int64_t>(out.r12.size()) - 1) {
     out.status = FsccStatus::peak_at_lag_range_end;
-    out.message = "the cross-correlation peaks at the end of the lag range; widen the lag range";
+    out.message = "the cross-correlation peaks at the end of the lag range: the delay lies beyond the lags searched, "
+                  "or dx's unit or the sampling rate is wrong; check them, or widen the lag range";
   } else if (!(dx > 0.0)) {
     out.status = FsccStatus::no_tip_separation;
     out.message = "no tip separation given: the velocity cannot be computed";
   } else {
     out.status = FsccStatus::ok;
     out.velocity = dx / out.lag;
+    if (out.velocity > 100.0) {
+      out.warnings.push_back(fmt::format("FSCC velocity {:.4g} m/s is above 100 m/s, beyond air-water flows: check dx's "
+                                         "unit, the sampling rate and the lag range",
+                                         out.velocity));
+    }
   }
   // Time scales.
   std::string notes;

@@ -79,6 +79,12 @@ const OptionField<R> kReader[] = {
     {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; overrides a file's own)",
      [](R& o, std::string_view t) { o.fs = quantity(t, Dimension::frequency); },
      [](const R& o) { return o.fs > 0.0 ? format_quantity(o.fs, Dimension::frequency) : std::string("from the file"); }},
+    {"override-fs", "", "let --fs replace a different sampling rate recorded in the file",
+     [](R& o, std::string_view t) { o.override_fs = on_off(t); },
+     [](const R& o) { return std::string(o.override_fs ? "on" : "off"); }, true},
+    {"allow-truncated", "", "process what a WAV, W64 or RF64 file holds when its data is shorter than its header says",
+     [](R& o, std::string_view t) { o.allow_truncated = on_off(t); },
+     [](const R& o) { return std::string(o.allow_truncated ? "on" : "off"); }, true},
     {"raw-type", "", "raw files: sample type int16 | int32 | float32 | float64",
      [](R& o, std::string_view t) { o.raw.sample_type = choice(t, kTypes); },
      [](const R& o) { return name_of(o.raw.sample_type, kTypes); }},
@@ -229,6 +235,9 @@ const OptionField<P> kProcess[] = {
     {"histogram-bins", "-", "bins of the chord-time histograms",
      [](P& o, std::string_view t) { o.histogram_bins = static_cast<int>(whole(t, 1, 100000)); },
      [](const P& o) { return std::to_string(o.histogram_bins); }},
+    {"allow-unusual", "", "accept dx outside 0.1-100 mm, fs outside 1 kHz-100 MHz, velocities outside 0.01-200 m/s",
+     [](P& o, std::string_view t) { o.allow_unusual = on_off(t); },
+     [](const P& o) { return std::string(o.allow_unusual ? "on" : "off"); }, true},
 };
 
 }  // namespace

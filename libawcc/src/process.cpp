@@ -7,6 +7,7 @@
 
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/units.hpp"
 
 namespace awcc {
 
@@ -19,6 +20,29 @@ std::string ProcessOptions::validate() const {
   if (auto why = fscc_options.validate(); !why.empty()) return why;
   if (auto why = awcc_options.validate(); !why.empty()) return why;
   if (block_frames < 1) return "block_frames must be >= 1";
+  if (!allow_unusual) return implausible();
+  return {};
+}
+
+std::string ProcessOptions::implausible() const {
+  if (dx != 0.0 && (dx < 0.1e-3 || dx > 100e-3)) {
+    return fmt::format("dx = {} lies outside 0.1 mm to 100 mm, the tip separations of phase-detection probes: check "
+                       "its unit, or allow unusual values",
+                       format_quantity(dx, Dimension::length));
+  }
+  if (reader.fs > 0.0 && (reader.fs < plausible_fs_min || reader.fs > plausible_fs_max)) {
+    return fmt::format("fs = {} lies outside 1 kHz to 100 MHz, the sampling rates of probe recordings: check its "
+                       "unit, or allow unusual values",
+                       format_quantity(reader.fs, Dimension::frequency));
+  }
+  const auto& a = awcc_options;
+  for (const auto& v : {a.velocity_min, a.velocity_max}) {
+    if (v && (*v < 0.01 || *v > 200.0)) {
+      return fmt::format("the velocity range end {} lies outside 0.01 m/s to 200 m/s, the velocities of air-water "
+                         "flows: check its unit, or allow unusual values",
+                         format_quantity(*v, Dimension::velocity));
+    }
+  }
   return {};
 }
 
@@ -222,6 +246,12 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
   }
   const ChannelSelection ch{static_cast<std::size_t>(channels), static_cast<std::size_t>(options.leading_channel),
                             static_cast<std::size_t>(options.trailing_channel)};
+  if (!options.allow_unusual && (info.fs < plausible_fs_min || info.fs > plausible_fs_max)) {
+    throw InputError(fmt::format("{}: the file records a sampling rate of {}, outside 1 kHz to 100 MHz: is it a probe "
+                                 "recording? If so, allow unusual values",
+                                 path.string(), format_quantity(info.fs, Dimension::frequency)),
+                     "allow_unusual");
+  }
   BinarisationOptions bopt = options.binarisation;
   if (!info.volts_known && bopt.bin_width > 0.0 && bopt.rule != ThresholdRule::felder) bopt.bin_width = 0.0;
 
@@ -267,10 +297,49 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
 std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOptions& options,
                                    std::optional<double> velocity);
 
+namespace {
+
+// Swapped tips (METHOD 4, item 10): when either method sees the trailing
+// tip's signal lead, neither reports a velocity.
+void apply_tip_order(ProcessResult& r) {
+  const bool fscc_swapped = r.fscc && r.fscc->status == FsccStatus::tips_swapped;
+  const bool awcc_swapped = r.awcc && r.awcc->status == AwccStatus::tips_swapped;
+  if (fscc_swapped && r.awcc && r.awcc->status != AwccStatus::tips_swapped) {
+    detail::tips_swapped(*r.awcc, "FSCC peaks at a negative lag: the tips are swapped (or dx has the wrong sign); "
+                                  "exchange the tips' channels");
+  }
+  if (awcc_swapped && r.fscc && r.fscc->status != FsccStatus::tips_swapped) {
+    r.fscc->status = FsccStatus::tips_swapped;
+    r.fscc->message = "most AWCC windows peak at a negative lag: the tips are swapped (or dx has the wrong sign); "
+                      "exchange the tips' channels";
+    r.fscc->velocity = 0.0;
+    r.fscc->turbulence_intensity_chanson.reset();
+  }
+}
+
+}  // namespace
+
 std::optional<double> ProcessResult::velocity() const {
-  if (awcc && awcc->ok()) return awcc->velocity;
-  if (fscc && fscc->ok()) return fscc->velocity;
+  const auto s = velocity_source();
+  if (s == VelocitySource::awcc) return awcc->velocity;
+  if (s == VelocitySource::fscc) return fscc->velocity;
   return std::nullopt;
+}
+
+VelocitySource ProcessResult::velocity_source() const {
+  if (awcc && awcc->ok() && awcc->quality == AwccQuality::ok) return VelocitySource::awcc;
+  if (fscc && fscc->ok()) return VelocitySource::fscc;
+  if (awcc && awcc->ok()) return VelocitySource::awcc;  // low quality, flagged; FSCC gave nothing better
+  return VelocitySource::none;
+}
+
+std::string_view to_string(VelocitySource source) {
+  switch (source) {
+    case VelocitySource::awcc: return "awcc";
+    case VelocitySource::fscc: return "fscc";
+    case VelocitySource::none: return "none";
+  }
+  return "?";
 }
 
 ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOptions& options) {
@@ -282,6 +351,7 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   if (options.awcc && options.awcc_options.signal == CorrelationSignal::binary) {
     out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);
   }
+  apply_tip_order(out);
   out.tips = tip_results(r, options, out.velocity());
   return out;
 }
@@ -291,8 +361,14 @@ std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOpt
   PhaseStatisticsOptions po;
   po.histogram_bins = options.histogram_bins;
   po.velocity = velocity;
-  return {{options.leading_channel, r.leading_threshold, phase_statistics(r.leading, po)},
-          {options.trailing_channel, r.trailing_threshold, phase_statistics(r.trailing, po)}};
+  auto name = [&](int channel) {
+    const auto& n = r.info.channel_names;
+    return channel >= 0 && static_cast<std::size_t>(channel) < n.size() ? n[static_cast<std::size_t>(channel)]
+                                                                       : std::string();
+  };
+  return {{options.leading_channel, name(options.leading_channel), r.leading_threshold, phase_statistics(r.leading, po)},
+          {options.trailing_channel, name(options.trailing_channel), r.trailing_threshold,
+           phase_statistics(r.trailing, po)}};
 }
 
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
@@ -356,6 +432,7 @@ ProcessResult process_recording(const std::filesystem::path& path, const Process
   ProcessResult out = process_binarised(binarised, options);
   if (options.awcc && options.awcc_options.signal == CorrelationSignal::raw) {
     out.awcc = awcc_raw(path, binarised, options);
+    apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

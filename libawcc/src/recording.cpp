@@ -7,12 +7,14 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
+#include <optional>
 #include <sndfile.h>
 #include <stdexcept>
 #include <vector>
 
 #include "awcc/errors.hpp"
 #include "awcc/order_statistics.hpp"
+#include "awcc/units.hpp"
 
 namespace awcc {
 
@@ -50,6 +52,92 @@ namespace fs = std::filesystem;
   throw InputError(fmt::format("{}: {}", path.string(), what), std::move(quantity));
 }
 
+// The sampling rate of a file that records its own: the stated one must
+// agree with it (to 1e-6, a CSV's time stamps being rounded) unless forced.
+double stated_rate(const fs::path& path, const ReaderOptions& options, double recorded, const std::string& where) {
+  if (!(options.fs > 0.0)) return recorded;
+  if (options.override_fs || std::fabs(options.fs - recorded) <= 1e-6 * recorded) return options.fs;
+  fail(path,
+       fmt::format("{} records a sampling rate of {} but {} was stated; leave the rate out, or force the stated one",
+                   where, format_quantity(recorded, Dimension::frequency), format_quantity(options.fs, Dimension::frequency)),
+       "override_fs");
+}
+
+template <class T>
+T load(const char* p, bool swap) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  if (swap) {
+    char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    std::reverse(b, b + sizeof(T));
+    std::memcpy(&v, b, sizeof(T));
+  }
+  return v;
+}
+
+// The data bytes a WAV (RIFF), RF64 or W64 header promises, and where the
+// data start; empty for other files or headers that do not say (streaming
+// writers leave 0 or 0xFFFFFFFF). libsndfile reads a truncated data chunk
+// as if it were whole, so the promise is checked here.
+struct DataChunk {
+  std::uint64_t offset = 0, declared = 0;
+};
+std::optional<DataChunk> declared_data(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[40] = {};
+  in.read(head, 40);
+  if (in.gcount() < 40) return std::nullopt;
+  auto u32 = [](const char* p) { return load<std::uint32_t>(p, std::endian::native == std::endian::big); };
+  auto u64 = [](const char* p) { return load<std::uint64_t>(p, std::endian::native == std::endian::big); };
+  const std::string_view magic(head, 4);
+  if ((magic == "RIFF" || magic == "RF64") && std::string_view(head + 8, 4) == "WAVE") {
+    std::optional<std::uint64_t> ds64_data;
+    std::uint64_t pos = 12;
+    for (int chunks = 0; chunks < 64; ++chunks) {
+      char c[8];
+      in.clear();
+      in.seekg(static_cast<std::streamoff>(pos));
+      in.read(c, 8);
+      if (in.gcount() < 8) return std::nullopt;
+      const std::string_view id(c, 4);
+      const std::uint64_t size = u32(c + 4);
+      if (id == "ds64") {
+        char d[16];
+        in.read(d, 16);
+        if (in.gcount() < 16) return std::nullopt;
+        ds64_data = u64(d + 8);
+      }
+      if (id == "data") {
+        const std::uint64_t declared = (size == 0xFFFFFFFFu && ds64_data) ? *ds64_data : size;
+        if (declared == 0 || declared == 0xFFFFFFFFu) return std::nullopt;
+        return DataChunk{pos + 8, declared};
+      }
+      pos += 8 + size + (size & 1);
+    }
+    return std::nullopt;
+  }
+  static const unsigned char riff_guid[16] = {'r', 'i', 'f', 'f', 0x2E, 0x91, 0xCF, 0x11,
+                                              0xA5, 0xD6, 0x28, 0xDB, 0x04, 0xC1, 0x00, 0x00};
+  static const unsigned char data_guid[16] = {'d', 'a', 't', 'a', 0xF3, 0xAC, 0xD3, 0x11,
+                                              0x8C, 0xD1, 0x00, 0xC0, 0x4F, 0x8E, 0xDB, 0x8A};
+  if (std::memcmp(head, riff_guid, 16) == 0) {
+    std::uint64_t pos = 40;  // riff GUID, size, wave GUID
+    for (int chunks = 0; chunks < 64; ++chunks) {
+      char c[24];
+      in.clear();
+      in.seekg(static_cast<std::streamoff>(pos));
+      in.read(c, 24);
+      if (in.gcount() < 24) return std::nullopt;
+      const std::uint64_t size = u64(c + 16);  // includes the 24-byte chunk header
+      if (size < 24) return std::nullopt;
+      if (std::memcmp(c, data_guid, 16) == 0) return DataChunk{pos + 24, size - 24};
+      pos += (size + 7) / 8 * 8;
+    }
+  }
+  return std::nullopt;
+}
+
 std::string lower_extension(const fs::path& p) {
   std::string e = p.extension().string();
   std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -84,7 +172,7 @@ class SndfileRecording final : public Recording {
     info_.path = path;
     info_.format = InputFormat::sndfile;
     info_.channels = sf.channels;
-    info_.fs = options.fs > 0.0 ? options.fs : sf.samplerate;
+    info_.fs = stated_rate(path, options, sf.samplerate, "the file header");
     info_.frames = sf.frames;
     SF_FORMAT_INFO major{};
     major.format = sf.format & SF_FORMAT_TYPEMASK;
@@ -98,6 +186,7 @@ class SndfileRecording final : public Recording {
       default: bits = 0;
     }
     floating_ = bits == 0;
+    floating_double_ = (sf.format & SF_FORMAT_SUBMASK) == SF_FORMAT_DOUBLE;
     int16_ = bits == 16;
     // Values as counts for integer data, as stored for floating data.
     sf_command(file_, SFC_SET_NORM_FLOAT, nullptr, SF_FALSE);
@@ -111,10 +200,30 @@ class SndfileRecording final : public Recording {
       scale_ = vpc > 0.0 ? vpc : 1.0 / std::ldexp(1.0, bits - 1);
       info_.quantum = scale_;
     }
+    check_complete(path, options, sf, bits);
     info_.description = fmt::format("{} ({}, {})", major.name ? major.name : "audio",
                                     floating_ ? "floating point" : fmt::format("{}-bit integer", bits),
                                     info_.volts_known ? "volts" : "normalised units");
   }
+  // A data chunk shorter than the header promises is refused (or, when
+  // allowed, read with a warning naming the promised and present durations).
+  void check_complete(const fs::path& path, const ReaderOptions& options, const SF_INFO& sf, int bits) {
+    const auto chunk = declared_data(path);
+    if (!chunk) return;
+    std::error_code ec;
+    const std::uint64_t size = fs::file_size(path, ec);
+    const std::uint64_t present = size > chunk->offset ? size - chunk->offset : 0;
+    if (ec || present >= chunk->declared) return;
+    const double frame_bytes = static_cast<double>(sf.channels) * (bits > 0 ? bits / 8 : (floating_double_ ? 8 : 4));
+    const double rate = static_cast<double>(sf.samplerate);
+    const std::string what = fmt::format(
+        "the header promises {:.3f} s of data but the file holds {:.3f} s: it is truncated (a recording still being "
+        "written, or a copy cut short)",
+        static_cast<double>(chunk->declared) / frame_bytes / rate, static_cast<double>(present) / frame_bytes / rate);
+    if (!options.allow_truncated) fail(path, what + "; recover the whole file, or process what is there", "truncated");
+    info_.warnings.push_back(what + "; only what is there was processed");
+  }
+
   ~SndfileRecording() override {
     if (file_) sf_close(file_);
   }
@@ -157,6 +266,7 @@ class SndfileRecording final : public Recording {
  private:
   SNDFILE* file_ = nullptr;
   bool floating_ = false;
+  bool floating_double_ = false;
   bool int16_ = false;
   double scale_ = 1.0;
   std::int64_t position_ = 0;
@@ -165,18 +275,6 @@ class SndfileRecording final : public Recording {
 // ---------------------------------------------------------------------------
 // Binary layouts: UQ .dat and raw.
 
-template <class T>
-T load(const char* p, bool swap) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  if (swap) {
-    char b[sizeof(T)];
-    std::memcpy(b, &v, sizeof(T));
-    std::reverse(b, b + sizeof(T));
-    std::memcpy(&v, b, sizeof(T));
-  }
-  return v;
-}
 
 std::size_t sample_size(SampleType t) {
   switch (t) {
@@ -414,70 +512,176 @@ bool bounded_getline(std::istream& in, std::string& line, const fs::path& path, 
   }
 }
 
+// Column files as labs write them: comma, tab, semicolon or blank
+// separated; a decimal point or (European locales) a decimal comma; an
+// optional header row; LabVIEW .lvm text (header blocks ending in
+// ***End_of_Header***, X_Value as time, Delta_X as the sample interval, an
+// empty Comment column). Separator and decimal mark come from the content
+// (or the .lvm header); the time column from its name (time, t, zeit, temps,
+// tiempo, X_Value, with a unit in brackets) or from its values (strictly
+// increasing with a constant step, when the file has at least three columns).
 class CsvRecording final : public Recording {
  public:
   CsvRecording(const fs::path& path, const ReaderOptions& options) : in_(path, std::ios::binary) {
     if (!in_) fail(path, "cannot open for reading");
     info_.path = path;
     info_.format = InputFormat::csv;
-    std::string first;
-    std::streampos data_start = 0;
-    // Skip blank lines at the top.
+    std::string line;
     std::int64_t number = 0;
-    do {
-      data_start = in_.tellg();
-      if (!bounded_getline(in_, first, path, ++number)) fail(path, "the CSV file holds no rows");
-    } while (trim(first).empty());
-    delimiter_ = options.csv.delimiter;
+    // LabVIEW .lvm: header blocks up to the last ***End_of_Header*** before the data.
+    std::optional<double> lvm_delta;
+    char lvm_separator = 0, lvm_decimal = 0;
+    bool lvm = false;
+    std::streampos body = 0;
+    std::int64_t body_line = 0;
+    {
+      std::streampos at = in_.tellg();
+      if (bounded_getline(in_, line, path, 1) && trim(line).starts_with("LabVIEW Measurement")) lvm = true;
+      in_.clear();
+      in_.seekg(at);
+      if (lvm) {
+        while (bounded_getline(in_, line, path, ++number)) {
+          const auto cells = split(line, '\t');
+          const auto key = cells.empty() ? std::string_view{} : trim(cells[0]);
+          const auto value = cells.size() > 1 ? trim(cells[1]) : std::string_view{};
+          if (key == "Separator") lvm_separator = value == "Comma" ? ',' : (value == "Tab" ? '\t' : 0);
+          if (key == "Decimal_Separator" && !value.empty()) lvm_decimal = value[0];
+          if (key == "Delta_X") {
+            double d;
+            std::string v(value);
+            std::replace(v.begin(), v.end(), ',', '.');
+            if (parse_number(v, d) && d > 0.0) lvm_delta = d;
+          }
+          if (trim(line).starts_with("***End_of_Header***")) {
+            body = in_.tellg();
+            body_line = number;
+          }
+        }
+        if (body_line == 0) fail(path, "a LabVIEW measurement file without ***End_of_Header***: not a recording", "not_a_recording");
+        in_.clear();
+        in_.seekg(body);
+        number = body_line;
+      }
+    }
+    // The first rows: separator, decimal mark, header, columns.
+    std::vector<std::string> rows;
+    std::vector<std::int64_t> row_lines;
+    std::vector<std::streampos> row_starts;
+    while (rows.size() < 50) {
+      const std::streampos at = in_.tellg();
+      if (!bounded_getline(in_, line, path, ++number)) break;
+      if (trim(line).empty()) continue;
+      rows.push_back(line);
+      row_lines.push_back(number);
+      row_starts.push_back(at);
+    }
+    if (rows.empty()) fail(path, "the file holds no rows", "not_a_recording");
+    auto in_every = [&](char c) {
+      return std::all_of(rows.begin(), rows.end(), [c](const std::string& r) { return r.find(c) != std::string::npos; });
+    };
+    delimiter_ = options.csv.delimiter ? options.csv.delimiter : lvm_separator;
     if (!delimiter_) {
-      if (first.find('\t') != std::string::npos) delimiter_ = '\t';
-      else if (first.find(',') != std::string::npos) delimiter_ = ',';
-      else if (first.find(';') != std::string::npos) delimiter_ = ';';
+      if (in_every('\t')) delimiter_ = '\t';
+      else if (in_every(';')) delimiter_ = ';';
+      else if (in_every(',')) delimiter_ = ',';
       else delimiter_ = ' ';
     }
-    const auto cells = split(first, delimiter_);
-    bool all_numbers = true;
-    double v;
-    for (auto c : cells) all_numbers = all_numbers && parse_number(c, v);
-    const bool header = options.csv.header.value_or(!all_numbers);
-    columns_ = static_cast<int>(cells.size());
-    time_column_ = options.csv.time_column;
-    if (time_column_ == -2) {
-      time_column_ = -1;
-      if (header) {
-        for (int i = 0; i < columns_; ++i) {
-          std::string name(trim(cells[static_cast<std::size_t>(i)]));
-          std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-          if (name == "time" || name == "t" || name == "time_s" || name == "time (s)" || name == "seconds" || name == "s") {
-            time_column_ = i;
-            break;
+    decimal_ = lvm_decimal ? lvm_decimal : '.';
+    if (!lvm_decimal && delimiter_ != ',') {
+      // A decimal comma: digits on both sides of a comma in a cell, and no decimal point.
+      bool comma = false, point = false;
+      for (std::size_t r = rows.size() > 1 ? 1 : 0; r < rows.size(); ++r) {
+        for (auto cell : split(rows[r], delimiter_)) {
+          cell = trim(cell);
+          for (std::size_t k = 1; k + 1 < cell.size(); ++k) {
+            const bool digits = std::isdigit(static_cast<unsigned char>(cell[k - 1])) &&
+                                std::isdigit(static_cast<unsigned char>(cell[k + 1]));
+            if (cell[k] == ',' && digits) comma = true;
+            if (cell[k] == '.' && digits) point = true;
           }
         }
       }
+      if (comma && !point) decimal_ = ',';
     }
+    const auto first = split(rows[0], delimiter_);
+    bool all_numbers = true;
+    double v;
+    for (auto c : first) all_numbers = all_numbers && number_of(c, v);
+    const bool header = options.csv.header.value_or(!all_numbers);
+    columns_ = static_cast<int>(first.size());
+    const std::size_t first_data = header ? 1 : 0;
+    if (first_data >= rows.size()) fail(path, "the file holds a header row and no data: not a recording", "not_a_recording");
+    {
+      const auto cells = split(rows[first_data], delimiter_);
+      std::size_t numeric = 0;
+      for (auto c : cells) numeric += number_of(c, v) ? 1 : 0;
+      if (numeric == 0) {
+        fail(path, fmt::format("line {} holds no number: not a column file of samples", row_lines[first_data]),
+             "not_a_recording");
+      }
+    }
+    std::vector<std::string> names(static_cast<std::size_t>(columns_));
+    for (int c = 0; c < columns_; ++c) {
+      names[static_cast<std::size_t>(c)] =
+          header ? std::string(trim(first[static_cast<std::size_t>(c)])) : fmt::format("column {}", c);
+    }
+    // Columns that hold no samples: LabVIEW's Comment, or one left empty in every row (a trailing separator).
+    std::vector<bool> skip(static_cast<std::size_t>(columns_), false);
+    for (int c = 0; c < columns_; ++c) {
+      std::string lower = names[static_cast<std::size_t>(c)];
+      std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+      bool empty = true;
+      for (std::size_t r = first_data; r < rows.size(); ++r) {
+        const auto cells = split(rows[r], delimiter_);
+        if (static_cast<int>(cells.size()) > c && !trim(cells[static_cast<std::size_t>(c)]).empty()) empty = false;
+      }
+      skip[static_cast<std::size_t>(c)] = lower == "comment" || empty;
+    }
+    time_column_ = options.csv.time_column;
     if (time_column_ >= columns_) {
       fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_), "time_column");
     }
-    line_ = header ? 1 : 0;
-    if (!header) {
-      in_.clear();
-      in_.seekg(data_start);
+    if (time_column_ == -2) {
+      time_column_ = -1;
+      for (int c = 0; header && c < columns_ && time_column_ < 0; ++c) {
+        if (!skip[static_cast<std::size_t>(c)] && is_time_name(names[static_cast<std::size_t>(c)])) time_column_ = c;
+      }
+      const int usable = static_cast<int>(std::count(skip.begin(), skip.end(), false));
+      for (int c = 0; usable >= 3 && c < columns_ && time_column_ < 0; ++c) {
+        if (!skip[static_cast<std::size_t>(c)] && evenly_increasing(rows, first_data, c)) time_column_ = c;
+      }
     }
-    data_start_ = in_.tellg();
-    first_line_ = line_;
-    info_.channels = columns_ - (time_column_ >= 0 ? 1 : 0);
-    if (info_.channels <= 0) fail(path, "the CSV file has no data column besides its time column");
-    if (options.fs > 0.0) {
+    for (int c = 0; c < columns_; ++c) {
+      if (c == time_column_ || skip[static_cast<std::size_t>(c)]) continue;
+      data_columns_.push_back(c);
+      info_.channel_names.push_back(names[static_cast<std::size_t>(c)]);
+    }
+    info_.channels = static_cast<int>(data_columns_.size());
+    if (info_.channels <= 0) fail(path, "the file has no data column besides its time column", "not_a_recording");
+    data_start_ = row_starts[first_data];
+    first_line_ = row_lines[first_data] - 1;
+    in_.clear();
+    in_.seekg(data_start_);
+    line_ = first_line_;
+    if (time_column_ >= 0) {
+      info_.fs = stated_rate(path, options, fs_from_time_column(),
+                             fmt::format("its time column '{}'", names[static_cast<std::size_t>(time_column_)]));
+    } else if (lvm_delta) {
+      info_.fs = stated_rate(path, options, 1.0 / *lvm_delta, "its Delta_X");
+    } else if (options.fs > 0.0) {
       info_.fs = options.fs;
-    } else if (time_column_ >= 0) {
-      info_.fs = fs_from_time_column();
     } else {
-      fail(path, "the CSV file has no time column; state the sampling rate, or name the time column", "fs");
+      fail(path, "the file has no time column; state the sampling rate, or name the time column", "fs");
     }
     info_.volts_known = true;
     info_.quantum = 0.0;
-    info_.description = fmt::format("CSV ({} columns{}{})", columns_, header ? ", header row" : "",
-                                    time_column_ >= 0 ? fmt::format(", time in column {}", time_column_) : "");
+    std::string tips;
+    for (const auto& n : info_.channel_names) tips += (tips.empty() ? "'" : ", '") + n + "'";
+    info_.description = fmt::format(
+        "{} ({} columns, {} separated, decimal {}{}{}; channels {})", lvm ? "LabVIEW text" : "CSV", columns_,
+        delimiter_ == '\t' ? "tab" : (delimiter_ == ' ' ? "blank" : fmt::format("'{}'", delimiter_)),
+        decimal_ == ',' ? "comma" : "point", header ? ", header row" : "",
+        time_column_ >= 0 ? fmt::format(", time in '{}'", names[static_cast<std::size_t>(time_column_)]) : "", tips);
     rewind();
   }
 
@@ -493,16 +697,15 @@ class CsvRecording final : public Recording {
                                      cells.size(), columns_));
       }
       int k = 0;
-      for (int c = 0; c < columns_; ++c) {
+      for (int c : data_columns_) {
         double v;
-        if (!parse_number(cells[static_cast<std::size_t>(c)], v)) {
+        if (!number_of(cells[static_cast<std::size_t>(c)], v)) {
           fail(info_.path, fmt::format("line {}, column {}: '{}' is not a number; fix the cell or remove the line",
                                        line_, c + 1, trim(cells[static_cast<std::size_t>(c)])));
         }
         if (!std::isfinite(v)) {
           fail(info_.path, fmt::format("line {}, column {}: the value is not finite; the recording is damaged", line_, c + 1));
         }
-        if (c == time_column_) continue;
         out[static_cast<std::size_t>(n * info_.channels + k++)] = static_cast<float>(v);
       }
       ++n;
@@ -517,6 +720,46 @@ class CsvRecording final : public Recording {
   }
 
  private:
+  // A number in the file's decimal convention.
+  [[nodiscard]] bool number_of(std::string_view cell, double& value) const {
+    if (decimal_ == '.') return parse_number(cell, value);
+    std::string c(trim(cell));
+    std::replace(c.begin(), c.end(), ',', '.');
+    return parse_number(c, value);
+  }
+
+  static bool is_time_name(std::string name) {
+    // Without a unit in brackets, lower case: time, t, zeit, temps, tiempo, x_value, ...
+    for (const char* open : {"[", "("}) {
+      const auto at = name.find(open);
+      if (at != std::string::npos && at > 0) name.resize(at);
+    }
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    name = std::string(trim(name));
+    for (const char* known : {"time", "t", "zeit", "temps", "tiempo", "x_value", "time_s", "seconds", "s", "sec"}) {
+      if (name == known) return true;
+    }
+    return false;
+  }
+
+  // Strictly increasing with a constant step (to 1e-6 of it) over the sampled rows.
+  [[nodiscard]] bool evenly_increasing(const std::vector<std::string>& rows, std::size_t first, int column) const {
+    std::vector<double> t;
+    for (std::size_t r = first; r < rows.size(); ++r) {
+      const auto cells = split(rows[r], delimiter_);
+      double v;
+      if (static_cast<int>(cells.size()) <= column || !number_of(cells[static_cast<std::size_t>(column)], v)) return false;
+      t.push_back(v);
+    }
+    if (t.size() < 3) return false;
+    const double step = t[1] - t[0];
+    if (!(step > 0.0)) return false;
+    for (std::size_t i = 1; i < t.size(); ++i) {
+      if (std::fabs((t[i] - t[i - 1]) - step) > 1e-6 * std::fabs(step) + 1e-12 * std::fabs(t[i])) return false;
+    }
+    return true;
+  }
+
   double fs_from_time_column() {
     // The sampling interval from the first rows' time stamps (median step).
     std::vector<double> times;
@@ -526,7 +769,7 @@ class CsvRecording final : public Recording {
       if (trim(line).empty()) continue;
       const auto cells = split(line, delimiter_);
       double t;
-      if (static_cast<int>(cells.size()) != columns_ || !parse_number(cells[static_cast<std::size_t>(time_column_)], t)) break;
+      if (static_cast<int>(cells.size()) != columns_ || !number_of(cells[static_cast<std::size_t>(time_column_)], t)) break;
       times.push_back(t);
     }
     if (times.size() < 2) fail(info_.path, "too few rows to take the sampling rate from the time column; state the sampling rate", "fs");
@@ -539,8 +782,10 @@ class CsvRecording final : public Recording {
 
   std::ifstream in_;
   char delimiter_ = ',';
+  char decimal_ = '.';
   int columns_ = 0;
   int time_column_ = -1;
+  std::vector<int> data_columns_;
   std::streampos data_start_ = 0;
   std::int64_t line_ = 0, first_line_ = 0;
 };
@@ -572,7 +817,7 @@ bool audio_magic(const fs::path& path) {
 std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOptions& options) {
   std::error_code ec;
   if (!fs::exists(path, ec)) fail(path, "no such file");
-  if (fs::is_directory(path, ec)) fail(path, "is a folder, not a recording");
+  if (fs::is_directory(path, ec)) fail(path, "is a folder, not a recording", "not_a_recording");
   const auto size = fs::file_size(path, ec);
   if (ec) fail(path, fmt::format("cannot read: {}", ec.message()));
   if (size == 0) fail(path, "the file is empty");
@@ -581,11 +826,17 @@ std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOpti
   if (format == InputFormat::automatic) {
     static const std::string_view audio_ext[] = {".wav", ".w64", ".rf64", ".flac", ".aif", ".aiff", ".aifc",
                                                  ".au",  ".snd", ".caf",  ".ogg"};
+    static const std::string_view not_recordings[] = {".md", ".json", ".html", ".htm", ".pdf", ".png", ".jpg",
+                                                      ".svg", ".toml", ".py", ".sh", ".qrf", ".yaml", ".yml"};
+    if (std::find(std::begin(not_recordings), std::end(not_recordings), ext) != std::end(not_recordings)) {
+      fail(path, fmt::format("a {} file is not a recording", ext), "not_a_recording");
+    }
     if (ext == ".dat") format = InputFormat::uq_dat;
     else if (audio_magic(path) || std::find(std::begin(audio_ext), std::end(audio_ext), ext) != std::end(audio_ext))
       format = InputFormat::sndfile;
     else if (ext == ".raw" || ext == ".bin" || ext == ".pcm") format = InputFormat::raw;
-    else if (ext == ".csv" || ext == ".tsv" || ext == ".txt" || looks_like_text(path)) format = InputFormat::csv;
+    else if (ext == ".csv" || ext == ".tsv" || ext == ".txt" || ext == ".lvm" || looks_like_text(path))
+      format = InputFormat::csv;
     else fail(path, "cannot tell the recording's format from its name or content; state the format (sndfile, dat, raw or csv)", "format");
   }
   switch (format) {

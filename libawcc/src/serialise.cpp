@@ -2,7 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <span>
+
 #include "awcc/csv.hpp"
+#include "awcc/options.hpp"
+#include "awcc/sha256.hpp"
+#include "awcc/version.hpp"
 
 namespace awcc {
 
@@ -36,6 +44,45 @@ json histogram(const Histogram& h) { return json{{"bin_width", h.bin_width}, {"c
 
 }  // namespace
 
+namespace {
+
+template <class T>
+void add_options(json& out, std::span<const OptionField<T>> fields, const T& target) {
+  for (const auto& f : fields) out[std::string(f.name)] = f.format(target);
+}
+
+}  // namespace
+
+json options_json(const ProcessOptions& o) {
+  json out = json::object();
+  add_options(out, process_option_fields(), o);
+  add_options(out, reader_option_fields(), o.reader);
+  add_options(out, binarisation_option_fields(), o.binarisation);
+  add_options(out, fscc_option_fields(), o.fscc_options);
+  add_options(out, awcc_option_fields(), o.awcc_options);
+  return out;
+}
+
+json provenance_json(const ProcessOptions& options, const std::vector<std::string>& inputs,
+                     const std::string& command_line) {
+  json files = json::array();
+  for (const auto& path : inputs) {
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(path, ec);
+    files.push_back(json{{"file", path}, {"bytes", ec ? json(nullptr) : json(bytes)}, {"sha256", sha256_of_file(path)}});
+  }
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char when[32];
+  std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return json{{"pdp_version", version},
+              {"command_line", command_line},
+              {"options", options_json(options)},
+              {"inputs", files},
+              {"utc_time", when}};
+}
+
 json to_json(const AwccOptions& o) {
   return json{{"np", o.np},
               {"filter_a", o.filter_a},
@@ -54,6 +101,7 @@ json to_json(const ProcessResult& r) {
     const auto& p = t.phase;
     json tip{
         {"channel", t.channel},
+        {"name", t.name.empty() ? json(nullptr) : json(t.name)},
         {"status", to_string(p.status)},
         {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
         {"threshold", t.threshold.threshold},
@@ -89,6 +137,9 @@ json to_json(const ProcessResult& r) {
       {"dx", r.dx},
       {"dy", r.dy},
       {"tips", tips},
+      {"warnings", r.info.warnings},
+      {"chord_velocity_source", to_string(r.velocity_source())},
+      {"chord_velocity", optional(r.velocity())},
   };
   if (r.fscc) {
     const auto& f = *r.fscc;
@@ -106,6 +157,7 @@ json to_json(const ProcessResult& r) {
         {"txy", optional(f.txy)},
         {"turbulence_intensity_chanson", optional(f.turbulence_intensity_chanson)},
         {"note", f.note.empty() ? json(nullptr) : json(f.note)},
+        {"warnings", f.warnings},
     };
   }
   if (r.awcc) {
@@ -133,6 +185,12 @@ json to_json(const ProcessResult& r) {
         {"windows_rejected_too_short", a.rejected_too_short},
         {"windows_lag_zero", a.lag_zero_windows},
         {"roc_iterations", a.roc_iterations},
+        {"windows_negative_lag", a.negative_lag_windows},
+        {"quality", to_string(a.quality)},
+        {"quality_reason", a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
+        {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
+                                              static_cast<double>(a.windows_total))
+                                        : json(nullptr)},
     };
   }
   return out;
@@ -143,7 +201,11 @@ std::string profile_csv_header() {
          "void_fraction_trailing,bubble_count_rate_trailing,fscc_velocity,fscc_lag,fscc_r12_max,fscc_t05,fscc_tau05,"
          "fscc_turbulence_intensity_chanson,sauter_diameter,fscc_reason,awcc_velocity,awcc_velocity_rms,"
          "awcc_turbulence_intensity,awcc_windows_accepted,awcc_windows_total,awcc_reason,fscc_status,awcc_status,dx,dy,"
-         "np,awcc_filter_a,awcc_roc,awcc_weighting,awcc_signal,awcc_subsample";
+         "np,awcc_filter_a,awcc_roc,awcc_weighting,awcc_signal,awcc_subsample,fs,duration,awcc_quality,"
+         "awcc_quality_reason,void_fraction_ci95_lower,void_fraction_ci95_upper,bubble_count_rate_ci95_lower,"
+         "bubble_count_rate_ci95_upper,awcc_velocity_ci95_lower,awcc_velocity_ci95_upper,awcc_velocity_rms_ci95_lower,"
+         "awcc_velocity_rms_ci95_upper,awcc_turbulence_intensity_ci95_lower,awcc_turbulence_intensity_ci95_upper,"
+         "chord_velocity_source,pdp_version,warnings";
 }
 
 std::string profile_csv_row(const ProcessResult& r, const std::optional<double>& position) {
@@ -179,6 +241,23 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   } else {
     out += ",,,,,,";
   }
+  const double duration = r.info.fs > 0 ? static_cast<double>(r.info.frames) / r.info.fs : 0.0;
+  auto interval = [&](bool known, const Interval95& i) {
+    return known ? fmt::format("{},{}", number(i.lower), number(i.upper)) : std::string(",");
+  };
+  out += fmt::format(",{},{},{},{},{},{},{},{},{},{},{}", number(r.info.fs), number(duration),
+                     a ? to_string(a->quality) : "", csv_cell(a ? a->quality_reason : std::string()),
+                     interval(true, lead.void_fraction_ci95), interval(true, lead.bubble_count_rate_ci95),
+                     interval(awcc_ok, a ? a->velocity_ci95 : Interval95{}),
+                     interval(awcc_ok, a ? a->velocity_rms_ci95 : Interval95{}),
+                     interval(awcc_ok, a ? a->turbulence_intensity_ci95 : Interval95{}), to_string(r.velocity_source()),
+                     version);
+  std::string warnings;
+  for (const auto& w : r.info.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
+  if (f) {
+    for (const auto& w : f->warnings) warnings += (warnings.empty() ? "" : "; ") + w;
+  }
+  out += "," + csv_cell(warnings);
   return out;
 }
 
@@ -187,12 +266,13 @@ std::string ProcessResult::report() const {
   auto line = [&out](const std::string& s) { out += s + "\n"; };
   line(fmt::format("{}: {}, {} channels, {:.6g} Hz, {} samples ({:.3f} s)", info.path.string(), info.description,
                    info.channels, info.fs, info.frames, info.fs > 0 ? static_cast<double>(info.frames) / info.fs : 0.0));
+  for (const auto& w : info.warnings) line("  warning: " + w);
   const char* names[2] = {"leading", "trailing"};
   for (std::size_t i = 0; i < tips.size(); ++i) {
     const auto& t = tips[i];
     const auto& p = t.phase;
-    line(fmt::format("  {} tip (channel {}): threshold {:.4f} V ({}{}), air {:.4f} V, water {:.4f} V", names[i % 2],
-                     t.channel, t.threshold.threshold, to_string(t.threshold.rule),
+    line(fmt::format("  {} tip (channel {}{}): threshold {:.4f} V ({}{}), air {:.4f} V, water {:.4f} V", names[i % 2],
+                     t.channel, t.name.empty() ? std::string() : fmt::format(", '{}'", t.name), t.threshold.threshold, to_string(t.threshold.rule),
                      t.threshold.binary_input ? ", binary input" : "", t.threshold.air_level, t.threshold.water_level));
     line(fmt::format("    void fraction        {:.5f}  (95 % CI {:.5f} - {:.5f})", p.void_fraction,
                      p.void_fraction_ci95.lower, p.void_fraction_ci95.upper));
@@ -225,6 +305,7 @@ std::string ProcessResult::report() const {
                      f.turbulence_intensity_chanson ? fmt::format("{:.4f}", *f.turbulence_intensity_chanson)
                                                     : std::string("n/a")));
     if (!f.note.empty()) line("        note: " + f.note);
+    for (const auto& w : f.warnings) line("        warning: " + w);
   }
   if (awcc) {
     const auto& a = *awcc;
@@ -234,12 +315,19 @@ std::string ProcessResult::report() const {
                        a.velocity, a.velocity_ci95.lower, a.velocity_ci95.upper, a.velocity_rms,
                        a.turbulence_intensity, a.turbulence_intensity_ci95.lower, a.turbulence_intensity_ci95.upper));
     } else {
-      line(fmt::format("  AWCC: undefined: {}", a.message));
+      line(fmt::format("  AWCC: no velocity: {}", a.message));
     }
+    line(fmt::format("        quality {}{}", to_string(a.quality),
+                     a.quality == AwccQuality::low ? ": " + a.quality_reason : std::string()));
     line(fmt::format("        windows {} accepted of {} (rejected: {} correlation, {} lag, {} outlier cutoff, {} "
-                     "constant)",
+                     "constant{})",
                      a.windows_accepted, a.windows_total, a.rejected_correlation, a.rejected_lag, a.rejected_roc,
-                     a.rejected_constant));
+                     a.rejected_constant,
+                     a.rejected_too_short ? fmt::format(", {} too short", a.rejected_too_short) : std::string()));
+  }
+  if (const auto s = velocity_source(); s != VelocitySource::awcc && (awcc || fscc)) {
+    line(s == VelocitySource::fscc ? "  chord lengths and d32 use FSCC's velocity (AWCC's is not of quality ok)"
+                                   : "  chord lengths and d32: no velocity");
   }
   return out;
 }

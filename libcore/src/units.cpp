@@ -46,6 +46,19 @@ std::string_view dimension_name(Dimension dimension) {
   return "a quantity";
 }
 
+// The unit a lab usually writes for a dimension, and the SI one.
+std::pair<std::string_view, std::string_view> usual_units(Dimension dimension) {
+  switch (dimension) {
+    case Dimension::length: return {"mm", "m"};
+    case Dimension::time: return {"s", "ms"};
+    case Dimension::frequency: return {"Hz", "kHz"};
+    case Dimension::velocity: return {"m/s", "cm/s"};
+    case Dimension::voltage: return {"V", "mV"};
+    case Dimension::dimensionless: break;
+  }
+  return {"", ""};
+}
+
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
@@ -81,8 +94,7 @@ double parse_quantity(std::string_view text, Dimension dimension) {
     if (dimension == Dimension::dimensionless) {
       hint = "write a plain number, or a percentage such as 25%";
     } else {
-      hint = fmt::format("write a number with one of the units {} (a plain number is in {})", units,
-                         si_unit(dimension));
+      hint = fmt::format("write a number with one of the units {}", units);
     }
     throw std::invalid_argument(
         fmt::format("'{}' is not {}: {}; {}", text, dimension_name(dimension), why, hint));
@@ -90,7 +102,13 @@ double parse_quantity(std::string_view text, Dimension dimension) {
   if (ec != std::errc{} || ptr == first) return fail("no number at its start");
   if (!std::isfinite(value)) return fail("the number is not finite");
   const std::string_view unit = trim(std::string_view(ptr, static_cast<std::size_t>(last - ptr)));
-  if (unit.empty()) return value;  // a plain number is SI
+  if (unit.empty()) {
+    // A bare number of a dimensional quantity is refused: "--dx 7.15" meant
+    // millimetres and was taken as 7.15 m. Zero is zero in any unit.
+    if (dimension == Dimension::dimensionless || value == 0.0) return value;
+    const auto [usual, other] = usual_units(dimension);
+    throw std::invalid_argument(fmt::format("{} has no unit: write {}{} (or {}{})", s, s, usual, s, other));
+  }
   for (const auto& u : units_of(dimension)) {
     if (u.symbol == unit) return value * u.scale;
   }

@@ -9,6 +9,7 @@ std::string_view to_string(CorrectionStatus status) {
     case CorrectionStatus::corrected: return "corrected";
     case CorrectionStatus::awcc_not_run: return "awcc_not_run";
     case CorrectionStatus::no_awcc_velocity: return "no_awcc_velocity";
+    case CorrectionStatus::low_quality: return "low_quality";
     case CorrectionStatus::no_bubbles: return "no_bubbles";
     case CorrectionStatus::too_few_windows: return "too_few_windows";
     case CorrectionStatus::outside_training_range: return "outside_training_range";
@@ -30,7 +31,7 @@ FeatureResult make_features(const Measurement& m) {
     r.message = fmt::format("AWCC's velocity {:.6g} m/s is not positive", *m.velocity);
     return r;
   }
-  if (!(m.bubble_count_rate > 0.0)) {
+  if (!(m.bubble_count_rate > 0.0) && !(m.d32 && *m.d32 > 0.0)) {
     r.status = CorrectionStatus::no_bubbles;
     r.message = "no bubbles on the leading tip";
     return r;
@@ -39,7 +40,7 @@ FeatureResult make_features(const Measurement& m) {
   f.velocity = *m.velocity;
   f.turbulence_intensity = *m.turbulence_intensity;
   f.void_fraction = m.void_fraction;
-  f.d32 = 1.5 * f.velocity * m.void_fraction / m.bubble_count_rate;
+  f.d32 = m.bubble_count_rate > 0.0 ? 1.5 * f.velocity * m.void_fraction / m.bubble_count_rate : *m.d32;
   f.dx = m.dx;
   f.dy = m.dy;
   f.np = m.np;
@@ -57,6 +58,11 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   if (!r.awcc->ok()) {
     out.status = CorrectionStatus::no_awcc_velocity;
     out.message = "AWCC gave no velocity: " + r.awcc->message;
+    return out;
+  }
+  if (r.awcc->quality != awcc::AwccQuality::ok) {
+    out.status = CorrectionStatus::low_quality;
+    out.message = "AWCC's quality is low: " + r.awcc->quality_reason;
     return out;
   }
   auto& m = out.measurement;

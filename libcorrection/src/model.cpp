@@ -233,7 +233,7 @@ Correction not_corrected(CorrectionStatus status, std::string message) {
 }
 
 Correction CorrectionModel::correct(const Features& f) const {
-  if (f.windows_accepted < min_windows) {
+  if (f.windows_accepted >= 0 && f.windows_accepted < min_windows) {
     return not_corrected(CorrectionStatus::too_few_windows,
                          fmt::format("{} accepted windows; the model was trained on runs with at least {}",
                                      f.windows_accepted, min_windows));

@@ -67,6 +67,13 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
                          "AWCC gave no velocity: " +
                              (a.contains("reason") && a["reason"].is_string() ? a["reason"].get<std::string>() : std::string()));
   }
+  if (a.contains("quality") && a["quality"].is_string() && a["quality"].get<std::string>() != "ok") {
+    return not_corrected(CorrectionStatus::low_quality,
+                         "AWCC's quality is " + a["quality"].get<std::string>() +
+                             (a.contains("quality_reason") && a["quality_reason"].is_string()
+                                  ? ": " + a["quality_reason"].get<std::string>()
+                                  : std::string()));
+  }
   if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
     throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
   }
@@ -96,6 +103,78 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
   m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
   m.np = static_cast<int>(need(number(a, "np"), default_np(d), file, "np", "particles per window"));
   return model.correct(m);
+}
+
+constexpr const char* kLayouts =
+    "Give a profile CSV of pdp process with AWCC (columns void_fraction, bubble_count_rate, awcc_velocity, "
+    "awcc_turbulence_intensity, awcc_windows_accepted, ...; docs/output.md), or the CSV other AWCC tools write "
+    "(columns 'u [m/s]', 'u_rms [m/s]', 'c [-]', 'd_32a [m]', optional 'z [m]', with --dx, --dy and --np)";
+
+// The CSV other AWCC tools write (Kramer's toolbox style): one row per
+// position with units in the headers; Tu = u_rms / u, d32 as stated. It
+// records neither the accepted windows nor the processing: both are said.
+FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string& text, const RowDefaults& d,
+                                const std::string& file) {
+  FileCorrection out;
+  std::stringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const auto header = awcc::split_cells(line);
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  for (const char* name : {"u [m/s]", "u_rms [m/s]", "c [-]", "d_32a [m]"}) {
+    if (!col.count(name)) throw awcc::InputError(fmt::format("{}: no column '{}'. {}", file, name, kLayouts));
+  }
+  out.warnings.push_back(fmt::format("{}: the file records neither AWCC's accepted windows nor its processing: "
+                                     "assumed enough windows and the model's processing ({})",
+                                     file, describe(model.processing)));
+  out.text = line;
+  for (const char* q : {"u", "Tu"}) {
+    const char* unit = q[0] == 'u' ? "m/s" : "-";
+    out.text += fmt::format(",{}_corrected [{}]", q, unit);
+    for (const char* l : correction_level_names) out.text += fmt::format(",{}_q{} [{}]", q, l, unit);
+  }
+  out.text += ",correction_status [-],correction_reason [-]\n";
+  int number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = awcc::split_cells(line);
+    const std::string where = fmt::format("{}:{}", file, number);
+    if (cells.size() != header.size()) {
+      throw awcc::InputError(fmt::format("{}: {} cells where the header has {}", where, cells.size(), header.size()));
+    }
+    auto value = [&](const char* name) -> std::optional<double> {
+      const std::string& t = cells[col.at(name)];
+      if (t.empty() || t == "NaN" || t == "nan") return std::nullopt;
+      const auto v = awcc::cell_number(t);
+      if (!v) throw awcc::InputError(fmt::format("{}: column '{}' = '{}' is not a number", where, name, t));
+      return v;
+    };
+    Measurement m;
+    m.velocity = value("u [m/s]");
+    const auto u_rms = value("u_rms [m/s]");
+    if (m.velocity && u_rms && *m.velocity != 0.0) m.turbulence_intensity = *u_rms / *m.velocity;
+    m.void_fraction = value("c [-]").value_or(0.0);
+    m.d32 = value("d_32a [m]");
+    m.dx = need(std::nullopt, d.dx, where, "dx", "streamwise tip separation");
+    m.dy = need(std::nullopt, d.dy, where, "dy", "lateral tip separation");
+    m.np = static_cast<int>(need(std::nullopt, default_np(d), where, "np", "particles per window"));
+    const auto c = model.correct(m);
+    out.text += line;
+    for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
+      if (*q) {
+        out.text += fmt::format(",{:.10g}", (*q)->median());
+        for (double v : (*q)->quantiles) out.text += fmt::format(",{:.10g}", v);
+      } else {
+        out.text += std::string(1 + correction_levels.size(), ',');
+      }
+    }
+    out.text += fmt::format(",{},{}\n", to_string(c.status), awcc::csv_cell(c.message));
+  }
+  return out;
 }
 
 }  // namespace
@@ -137,11 +216,11 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
   const auto header = awcc::split_cells(line);
   std::map<std::string, std::size_t> col;
   for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  if (!col.count("awcc_velocity") && col.count("u [m/s]")) return correct_tool_csv(model, text, d, file);
   for (const char* name :
        {"void_fraction", "bubble_count_rate", "awcc_velocity", "awcc_turbulence_intensity", "awcc_windows_accepted"}) {
     if (!col.count(name)) {
-      throw awcc::InputError(fmt::format(
-          "{}: no column '{}'; give a profile CSV of pdp process with AWCC (docs/output.md)", file, name));
+      throw awcc::InputError(fmt::format("{}: no column '{}': not a layout pdp corrects. {}", file, name, kLayouts));
     }
   }
   if (col.count("correction_in_range")) {
@@ -175,6 +254,9 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
     const auto u = value("awcc_velocity"), tu = value("awcc_turbulence_intensity");
     if (!u || !tu) {
       c = not_corrected(CorrectionStatus::no_awcc_velocity, "AWCC gave no velocity");
+    } else if (!text_of("awcc_quality").empty() && text_of("awcc_quality") != "ok") {
+      c = not_corrected(CorrectionStatus::low_quality, "AWCC's quality is " + text_of("awcc_quality") + ": " +
+                                                           text_of("awcc_quality_reason"));
     } else {
       std::optional<Processing> processing;
       if (has_processing && value("awcc_filter_a")) {

@@ -267,8 +267,10 @@ TEST(Moments, DurationWeightedAndIntervalsByHand) {
   }
   awcc::AwccOptions o;
   o.roc = false;
+  o.windows_reported = 4;  // the moments of 4 windows, by hand
   awcc::detail::awcc_summarise(r, o);
   ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_EQ(r.quality, awcc::AwccQuality::low);  // fewer than 100 accepted windows
   // Weighted mean (10 + 36 + 16 + 22) / 8 = 10.5; variance
   // (0.25 + 3 * 2.25 + 2 * 6.25 + 2 * 0.25) / 8 = 20 / 8 = 2.5.
   EXPECT_DOUBLE_EQ(r.velocity, 10.5);

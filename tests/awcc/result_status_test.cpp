@@ -101,7 +101,7 @@ TEST(FsccStatus, PeakAtNegativeLagIsUndefined) {
   EXPECT_FALSE(r.ok());
   EXPECT_EQ(r.lag_samples, -5);
   EXPECT_TRUE(contains(r.message, "peaks at lag -5 samples (not positive)")) << r.message;
-  EXPECT_EQ(r.status, awcc::FsccStatus::non_positive_lag);
+  EXPECT_EQ(r.status, awcc::FsccStatus::tips_swapped);
   EXPECT_TRUE(contains(r.message, "check the tip order")) << r.message;
 }
 
@@ -126,7 +126,7 @@ TEST(FsccStatus, PeakAtTheEndOfTheLagRangeIsUndefinedOneLagInsideIsDefined) {
   const auto at_end = awcc::fscc(x, shifted(x, 20), 1.0, o);
   EXPECT_FALSE(at_end.ok());
   EXPECT_EQ(at_end.lag_samples, 20);
-  EXPECT_TRUE(contains(at_end.message, "peaks at the end of the lag range; widen the lag range")) << at_end.message;
+  EXPECT_TRUE(contains(at_end.message, "peaks at the end of the lag range: the delay lies beyond the lags searched, or dx's unit or the sampling rate is wrong")) << at_end.message;
   EXPECT_EQ(at_end.status, awcc::FsccStatus::peak_at_lag_range_end);
   const auto beyond = awcc::fscc(x, shifted(x, 50), 1.0, o);
   EXPECT_FALSE(beyond.ok());
@@ -209,7 +209,8 @@ TEST(AwccStatus, MostWindowsAtLagZeroIsUndefined) {
 }
 
 // Windows with the given fates (lag samples 0 for `lag` windows marked zero).
-awcc::AwccResult summarised(const std::vector<std::pair<WindowFate, std::int64_t>>& windows) {
+awcc::AwccResult summarised(const std::vector<std::pair<WindowFate, std::int64_t>>& windows,
+                            int windows_reported = 2) {
   awcc::AwccResult r;
   for (const auto& [fate, lag] : windows) {
     awcc::AwccWindow w;
@@ -221,6 +222,7 @@ awcc::AwccResult summarised(const std::vector<std::pair<WindowFate, std::int64_t
   }
   awcc::AwccOptions o;
   o.roc = false;
+  o.windows_reported = windows_reported;
   awcc::detail::awcc_summarise(r, o);
   return r;
 }
@@ -266,11 +268,62 @@ TEST(AwccStatus, EveryWindowAtNegativeLagIsUndefined) {
   EXPECT_EQ(r.rejected_lag, r.windows_total);
   EXPECT_EQ(r.lag_zero_windows, 0);
   for (const auto& w : r.windows) EXPECT_LT(w.lag_samples, 0);
-  const std::string n = std::to_string(r.windows_total);
-  EXPECT_TRUE(contains(r.message, "0 of " + n + " windows accepted (0 rejected by the correlation filter, " + n +
-                                     " by a non-positive lag"))
-      << r.message;
-  EXPECT_EQ(r.status, awcc::AwccStatus::too_few_windows);
+  // Most windows at negative lags: the tips are swapped (METHOD 4, item 10).
+  EXPECT_EQ(r.status, awcc::AwccStatus::tips_swapped);
+  EXPECT_EQ(r.negative_lag_windows, r.windows_total);
+  EXPECT_TRUE(contains(r.message, "have it at a negative lag: the trailing tip's signal leads")) << r.message;
+  EXPECT_EQ(r.quality, awcc::AwccQuality::insufficient);
+}
+
+// Swapped tips at the limit: clear negative-lag windows must exceed the
+// positive ones by more than 3 sqrt(n) (n clear windows), the 3-sd excess of
+// signals with no direction. 30 negative, 10 positive: 20 > 3 sqrt(40) =
+// 18.97: swapped. 29 and 11: 18 < 18.97: not. Unclear negative peaks (below
+// the filter) count for nothing.
+TEST(AwccStatus, SwappedTipsNeedASignificantExcessOfNegativeLags) {
+  using F = WindowFate;
+  auto with = [](int negative, int positive, double r12) {
+    awcc::AwccResult r;
+    for (int i = 0; i < negative + positive; ++i) {
+      awcc::AwccWindow w;
+      w.duration = 1.0;
+      w.r12_max = r12;
+      w.lag_samples = i < negative ? -4 : 4 + i % 2;
+      w.fate = i < negative ? F::lag : F::accepted;
+      w.velocity = w.lag_samples > 0 ? 1000.0 / static_cast<double>(w.lag_samples) : 0.0;
+      r.windows.push_back(w);
+    }
+    awcc::AwccOptions o;
+    o.roc = false;
+    awcc::detail::awcc_summarise(r, o);
+    return r;
+  };
+  EXPECT_EQ(with(30, 10, 0.9).status, awcc::AwccStatus::tips_swapped);
+  EXPECT_EQ(with(29, 11, 0.9).status, awcc::AwccStatus::ok) << with(29, 11, 0.9).message;
+  EXPECT_EQ(with(30, 10, 0.3).status, awcc::AwccStatus::ok);  // below A = 0.4: no clear peaks
+}
+
+// The quality levels at their limits (METHOD 4, item 10): windows_reported
+// (10) and windows_ok (100) accepted windows, and a yield of yield_ok (5 %).
+TEST(AwccQuality, LevelsAtTheirLimits) {
+  using F = WindowFate;
+  auto with = [](int accepted, int rejected) {
+    std::vector<std::pair<F, std::int64_t>> w;
+    for (int i = 0; i < accepted; ++i) w.emplace_back(F::accepted, 4 + i % 3);
+    for (int i = 0; i < rejected; ++i) w.emplace_back(F::correlation, 5);
+    return summarised(w, 10);
+  };
+  EXPECT_EQ(with(9, 0).quality, awcc::AwccQuality::insufficient);
+  EXPECT_FALSE(with(9, 0).ok());
+  EXPECT_EQ(with(10, 0).quality, awcc::AwccQuality::low);
+  EXPECT_TRUE(with(10, 0).ok());
+  EXPECT_EQ(with(99, 0).quality, awcc::AwccQuality::low);
+  EXPECT_EQ(with(100, 0).quality, awcc::AwccQuality::ok);
+  // Yield: 100 of 2000 windows is exactly 5 %: ok; 100 of 2001 is below: low.
+  EXPECT_EQ(with(100, 1900).quality, awcc::AwccQuality::ok);
+  const auto low = with(100, 1901);
+  EXPECT_EQ(low.quality, awcc::AwccQuality::low);
+  EXPECT_NE(low.quality_reason.find("data yield 5.0 %"), std::string::npos) << low.quality_reason;
 }
 
 TEST(AwccStatus, TrailingTipConstantInEveryWindowIsUndefined) {

@@ -15,10 +15,11 @@ TEST(ParseQuantity, ConvertsEachUnitToSI) {
   EXPECT_DOUBLE_EQ(parse_quantity("7.15 mm", Dimension::length), 0.00715);
   EXPECT_DOUBLE_EQ(parse_quantity("250um", Dimension::length), 250e-6);
   EXPECT_DOUBLE_EQ(parse_quantity("2cm", Dimension::length), 0.02);
-  EXPECT_DOUBLE_EQ(parse_quantity("0.003", Dimension::length), 0.003);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.003m", Dimension::length), 0.003);
+  EXPECT_DOUBLE_EQ(parse_quantity("0", Dimension::length), 0.0);  // zero is zero in any unit
   EXPECT_DOUBLE_EQ(parse_quantity("500kHz", Dimension::frequency), 500e3);
   EXPECT_DOUBLE_EQ(parse_quantity("2MHz", Dimension::frequency), 2e6);
-  EXPECT_DOUBLE_EQ(parse_quantity("20000", Dimension::frequency), 20000.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("20000Hz", Dimension::frequency), 20000.0);
   EXPECT_DOUBLE_EQ(parse_quantity("300s", Dimension::time), 300.0);
   EXPECT_DOUBLE_EQ(parse_quantity("1ms", Dimension::time), 1e-3);
   EXPECT_DOUBLE_EQ(parse_quantity("5min", Dimension::time), 300.0);
@@ -28,7 +29,25 @@ TEST(ParseQuantity, ConvertsEachUnitToSI) {
   EXPECT_DOUBLE_EQ(parse_quantity("25%", Dimension::dimensionless), 0.25);
   EXPECT_DOUBLE_EQ(parse_quantity("+4.2V", Dimension::voltage), 4.2);
   EXPECT_DOUBLE_EQ(parse_quantity("20mV", Dimension::voltage), 0.02);
-  EXPECT_DOUBLE_EQ(parse_quantity("1e-3", Dimension::time), 1e-3);
+  EXPECT_DOUBLE_EQ(parse_quantity("1e-3s", Dimension::time), 1e-3);
+}
+
+// Issue 12: "--dx 7.15" meant millimetres and was taken as 7.15 m. A bare
+// number of a dimensional quantity is refused with the fix; dimensionless
+// quantities take bare numbers.
+TEST(ParseQuantity, DimensionalQuantitiesNeedTheirUnit) {
+  try {
+    (void)parse_quantity("7.15", Dimension::length);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "7.15 has no unit: write 7.15mm (or 7.15m)");
+  }
+  for (auto d : {Dimension::time, Dimension::frequency, Dimension::velocity, Dimension::voltage}) {
+    EXPECT_THROW((void)parse_quantity("2.5", d), std::invalid_argument);
+    EXPECT_THROW((void)parse_quantity("-1e-3", d), std::invalid_argument);
+  }
+  EXPECT_DOUBLE_EQ(parse_quantity("0.25", Dimension::dimensionless), 0.25);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.0", Dimension::velocity), 0.0);
 }
 
 TEST(ParseQuantity, RefusesWrongUnitsWithAMessageNamingThem) {

@@ -47,7 +47,7 @@ cmp -s "$dir/a.qrf" "$dir/b.qrf" || fail "models differ between 1 and 2 threads"
 
 # A recording well inside the training ranges (mid-range in every feature:
 # the ranges of 30 training runs are narrow).
-"$pdp" --log-level warn synth -q --duration 4s --fs 100kHz --velocity 5 --tu 0.1 --void-fraction 0.2 --bubble-diameter 2mm \
+"$pdp" --log-level warn synth -q --duration 4s --fs 100kHz --velocity 5m/s --tu 0.1 --void-fraction 0.2 --bubble-diameter 2mm \
   --dx 4.5mm --dy 0.5mm --seed 9 -o "$dir/rec.flac" || fail "synth"
 out=$("$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc --correct "$dir/a.qrf" \
   --json "$dir/rec.json") || fail "process --correct"

@@ -256,6 +256,10 @@ TEST(Correction, MeasurementOfAProcessedRecording) {
   EXPECT_EQ(m.status, correction::CorrectionStatus::no_awcc_velocity);
   EXPECT_NE(m.message.find("1 of 9 windows"), std::string::npos);
   r.awcc->status = awcc::AwccStatus::ok;
+  r.awcc->quality = awcc::AwccQuality::low;
+  r.awcc->quality_reason = "42 accepted windows";
+  EXPECT_EQ(correction::measurement_of(r).status, correction::CorrectionStatus::low_quality);  // only ok rows
+  r.awcc->quality = awcc::AwccQuality::ok;
   r.awcc->velocity = 10.0;
   r.awcc->turbulence_intensity = 0.25;
   r.awcc->np = 12;

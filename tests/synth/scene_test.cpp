@@ -164,9 +164,9 @@ TEST(SceneToml, LoadsNumbersStringsWithUnitsAndTipArrays) {
     f << "velocity = \"5 m/s\"\n"
          "tu = 0.1\n"
          "bubble-diameter = \"2mm\"\n"
-         "fs = 100000\n"
+         "fs = \"100000Hz\"\n"
          "arrival = \"equal-space\"\n"
-         "tips = [[0, 0, 0], [\"5mm\", \"0.5mm\", 0]]\n"
+         "tips = [[0, 0, 0], [\"5mm\", \"0.5mm\", 0]]\n"  // zero needs no unit
          "seed = 42\n";
   }
   Scene s;

@@ -9,6 +9,7 @@
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/order_statistics.hpp"
+#include "awcc/units.hpp"
 #include "awcc/process.hpp"
 #include "synth/recording.hpp"
 #include "synth/synthesiser.hpp"
@@ -24,7 +25,7 @@ void setup_bench(CLI::App& app, Command& command, BenchOptions& o) {
   cmd->add_option("--repeat", o.repeat, "timings per setting; the median is kept")->check(CLI::Range(1, 100))
       ->capture_default_str();
   cmd->add_option("--scenes", o.scenes, "scenes: base, high-tu, small-bubbles, low-c, short-T")->capture_default_str();
-  cmd->add_option("--duration", o.duration, "record length of the method settings, s")->check(CLI::Range(0.1, 3600.0))
+  cmd->add_option("--duration", o.duration, "record length of the method settings (0.1s to 1h)")
       ->capture_default_str();
   cmd->add_flag("--quick", o.quick, "short records and fewer settings (for tests)");
 }
@@ -90,12 +91,21 @@ int run_bench(const BenchOptions& o) {
   std::string out =
       "scene,method,setting,duration,fs,seconds,velocity,truth_velocity,velocity_error,turbulence_intensity,"
       "truth_turbulence_intensity,turbulence_intensity_error,windows_accepted\n";
+  double method_duration = 0.0;
   try {
     for (const auto& name : scenes) named_scene(name);
+    try {
+      method_duration = awcc::parse_quantity(o.duration, awcc::Dimension::time);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format("--duration: {}", e.what()));
+    }
+    if (!(method_duration >= 0.1 && method_duration <= 3600.0)) {
+      throw std::invalid_argument(fmt::format("--duration {}: give 0.1s to 1h", o.duration));
+    }
   } catch (const std::invalid_argument& e) {
     return report_error(e);
   }
-  const double base_duration = o.quick ? std::min(o.duration, 2.0) : o.duration;
+  const double base_duration = o.quick ? std::min(method_duration, 2.0) : method_duration;
   const std::vector<double> durations = o.quick ? std::vector<double>{1.0, 2.0} : std::vector<double>{10, 30, 100, 300};
   const std::vector<double> rates = o.quick ? std::vector<double>{100e3, 500e3}
                                             : std::vector<double>{20e3, 100e3, 500e3, 2e6};

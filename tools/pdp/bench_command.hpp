@@ -14,7 +14,7 @@ struct BenchOptions {
   std::string output;          ///< CSV
   int repeat = 3;              ///< timings per setting (median)
   std::string scenes = "base,high-tu,small-bubbles,low-c,short-T";
-  double duration = 30.0;      ///< s, for the method and Np settings
+  std::string duration = "30s"; ///< record length of the method and Np settings (a time with its unit)
   bool quick = false;          ///< short records and fewer settings (tests)
 };
 

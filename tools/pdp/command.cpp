@@ -19,6 +19,30 @@ std::map<std::string, std::string, std::less<>>& origins() {
 }
 }  // namespace
 
+namespace {
+std::string& the_command_line() {
+  static std::string text;
+  return text;
+}
+}  // namespace
+
+void set_command_line(int argc, char** argv) {
+  std::string text;
+  for (int i = 0; i < argc; ++i) {
+    std::string a = argv[i];
+    const bool plain = !a.empty() && a.find_first_of(" \t\"'\\$`;&|<>*?()") == std::string::npos;
+    if (!plain) {
+      std::string q = "'";
+      for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      a = q + "'";
+    }
+    text += (i ? " " : "") + a;
+  }
+  the_command_line() = text;
+}
+
+const std::string& command_line() { return the_command_line(); }
+
 std::string origin_of(std::string_view name) {
   const auto it = origins().find(name);
   return it == origins().end() ? std::string() : it->second;
@@ -79,6 +103,9 @@ std::string flag_for(const std::string& quantity) {
       {"dy", "--dy"},
       {"np", "--np"},
       {"lag_range", "--max-lag"},
+      {"allow_unusual", "--allow-unusual"},
+      {"override_fs", "--override-fs"},
+      {"truncated", "--allow-truncated"},
   };
   const auto it = flags.find(quantity);
   return it == flags.end() ? std::string() : it->second;

@@ -43,6 +43,11 @@ int report_error(const std::exception& error);
 /// file, else empty: errors found later name where the value came from.
 std::string origin_of(std::string_view name);
 
+/// The command line as typed (each argument quoted when it needs it), for
+/// the provenance of outputs; set once by main().
+void set_command_line(int argc, char** argv);
+const std::string& command_line();
+
 /// The flag(s) that set a library quantity ("fs" -> "--fs"), or empty.
 std::string flag_for(const std::string& quantity);
 

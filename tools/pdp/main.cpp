@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   // Logs go to stderr; results to files or stdout.
   spdlog::set_default_logger(spdlog::stderr_color_mt("pdp"));
   spdlog::set_pattern("%^[%l]%$ %v");
+  pdp::set_command_line(argc, argv);
 
   CLI::App app{"pdp: dual-tip phase-detection probe toolkit (AWCC processing, synthetic probe)"};
 #ifdef PDP_WITH_MPI

@@ -8,6 +8,7 @@
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/options.hpp"
 #include "awcc/serialise.hpp"
 #include "awcc/units.hpp"
@@ -23,8 +24,10 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      cmd->add_option("files", o.files, "recordings (one: a summary; several: a profile, one CSV row each)")
-          ->check(CLI::ExistingFile));
+      cmd->add_option("files", o.files,
+                      "recordings (one: a summary; several: a profile, one CSV row each; among several, files that "
+                      "are not recordings are skipped with a warning)")
+          ->check(CLI::ExistingPath));
   const awcc::ProcessOptions defaults;
   o.library.add(cmd, awcc::process_option_fields(), defaults, "Probe and methods");
   o.library.add(cmd, awcc::reader_option_fields(), defaults.reader, "Input");
@@ -54,6 +57,9 @@ awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
   o.library.apply(awcc::fscc_option_fields(), p.fscc_options);
   o.library.apply(awcc::awcc_option_fields(), p.awcc_options);
   p.fscc_options.subsample = p.awcc_options.subsample;  // FSCC refines its peak as AWCC does
+  if (!p.allow_unusual) {
+    if (auto why = p.implausible(); !why.empty()) throw awcc::OptionError(why, "allow_unusual");
+  }
   if (auto why = p.validate(); !why.empty()) throw std::invalid_argument(why);
   if (!o.windows.empty() && o.files.size() != 1) {
     throw std::invalid_argument("--windows writes the window table of one recording; give one file");
@@ -157,6 +163,8 @@ int run_process(const ProcessCommandOptions& o) {
     return report_error(e);
   }
   std::vector<awcc::ProcessResult> results;
+  std::vector<std::optional<double>> kept_positions;
+  std::vector<std::string> inputs, skipped;
   try {
     Progress progress("processing");
     for (std::size_t i = 0; i < o.files.size(); ++i) {
@@ -165,14 +173,34 @@ int run_process(const ProcessCommandOptions& o) {
       if (!(file_options.reader.volts_per_count > 0.0)) {
         if (const auto vpc = synth::sidecar_volts_per_count(o.files[i])) file_options.reader.volts_per_count = *vpc;
       }
-      results.push_back(awcc::process_recording(o.files[i], file_options));
+      try {
+        results.push_back(awcc::process_recording(o.files[i], file_options));
+      } catch (const awcc::InputError& e) {
+        // Among several inputs (a glob), a file that is not a recording is
+        // skipped and said; a damaged recording still stops the profile.
+        if (o.files.size() == 1 || e.quantity() != "not_a_recording") throw;
+        spdlog::warn("skipped: {}", e.what());
+        skipped.push_back(e.what());
+        continue;
+      }
       add_flag_hints(results.back());
+      kept_positions.push_back(positions[i]);
+      inputs.push_back(o.files[i]);
+      for (const auto& w : results.back().info.warnings) spdlog::warn("{}: {}", o.files[i], w);
+      if (results.back().fscc) {
+        for (const auto& w : results.back().fscc->warnings) spdlog::warn("{}: {}", o.files[i], w);
+      }
       spdlog::debug("{}: {:.3f} s", o.files[i], results.back().seconds);
       progress(static_cast<double>(i + 1) / static_cast<double>(o.files.size()));
+    }
+    if (results.empty()) {
+      throw awcc::InputError(fmt::format("none of the {} inputs is a recording", o.files.size()));
     }
   } catch (const std::exception& e) {
     return report_error(e);
   }
+  positions = kept_positions;
+  const auto provenance = awcc::provenance_json(options, inputs, command_line());
   std::vector<correction::Correction> corrections;
   if (model) {
     for (const auto& r : results) {
@@ -192,7 +220,7 @@ int run_process(const ProcessCommandOptions& o) {
   try {
     if (!o.json.empty()) {
       nlohmann::json j;
-      if (results.size() == 1) {
+      if (results.size() == 1 && o.files.size() == 1) {
         j = awcc::to_json(results[0]);
         if (model) j["correction"] = correction_json(0);
       } else {
@@ -203,13 +231,15 @@ int run_process(const ProcessCommandOptions& o) {
           if (model) row["correction"] = correction_json(i);
           j["profile"].push_back(row);
         }
+        if (!skipped.empty()) j["skipped"] = skipped;
       }
+      j["provenance"] = provenance;
       awcc::write_text_atomically(o.json, j.dump(2) + "\n");
     }
     if (!o.windows.empty() && results[0].awcc) {
       awcc::write_text_atomically(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
     }
-    if (results.size() == 1 && o.csv.empty()) {
+    if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {
       fmt::print("{}", results[0].report());
       if (model) fmt::print("{}", correction_report(corrections[0]));
     } else {

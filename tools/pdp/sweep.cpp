@@ -191,7 +191,8 @@ std::vector<SweepRun> SweepDefinition::expand() const {
           v = range.first + (range.second - range.first) * rng.uniform();
         }
         if (k == "np") v = std::round(v);
-        apply(run, k, fmt::format("{:.17g}", v));
+        // Every digit of the draw, in SI with its unit.
+        apply(run, k, fmt::format("{:.17g}{}", v, awcc::si_unit(dimension_of(k))));
       }
       run = finish(run, tu_y_set, tu_z_set);
       for (std::int64_t r = 0; r < repeat; ++r) {

@@ -33,6 +33,13 @@
 // 8. 95 % intervals, N accepted windows: u +/- 1.96 u_rms / sqrt(N);
 //    u_rms +/- 1.96 u_rms / sqrt(2N); Tu +/- 1.96 sigma_T with
 //    sigma_T^2 = Tu^2 (Tu^2 / N + 1 / (2N)).
+// 9. Quality (METHOD 4, item 10): insufficient below `windows_reported`
+//    accepted windows (10: the Tu interval's relative half-width
+//    1.96 sqrt(Tu^2 / N + 1 / (2N)) is 0.45 at N = 10 for Tu = 0.2): no
+//    velocity or Tu, the reason instead; low below `windows_ok` (100: 0.14)
+//    or a data yield (accepted / total windows) below `yield_ok` (5 %):
+//    reported and flagged; ok otherwise. Windows that mostly peak at negative
+//    lags mean swapped tips (or a dx of the wrong sign): no velocity.
 
 #include <cstdint>
 #include <optional>
@@ -86,6 +93,13 @@ struct AwccOptions {
   /// pathological windows (a record of a few enormous bubbles); 2^20 is far
   /// beyond any physical transit (2 s at 500 kHz).
   std::int64_t max_lag_samples = std::int64_t{1} << 20;
+  /// Fewest accepted windows whose moments are reported (quality
+  /// `insufficient` below): fewer give a confident-looking but meaningless mean.
+  int windows_reported = 10;
+  /// Fewest accepted windows of quality `ok` (`low` below).
+  int windows_ok = 100;
+  /// Least data yield (accepted / total windows) of quality `ok`, -.
+  double yield_ok = 0.05;
 
   [[nodiscard]] std::string validate() const;
 };
@@ -112,15 +126,22 @@ enum class AwccStatus {
   ok,
   too_few_particles,       ///< fewer than Np particles: no window
   delay_below_one_sample,  ///< most windows peak at lag 0: sample faster or separate the tips more
-  too_few_windows,         ///< fewer than 2 windows accepted
+  too_few_windows,         ///< fewer accepted windows than reported (options.windows_reported)
+  tips_swapped,            ///< most windows (or FSCC) peak at negative lags: the tips are swapped
   no_tip_separation,       ///< dx = 0: no velocity can be computed
 };
 std::string_view to_string(AwccStatus status);
+
+/// How far to trust an AWCC result (item 9 above).
+enum class AwccQuality { ok, low, insufficient };
+std::string_view to_string(AwccQuality quality);
 
 struct AwccResult {
   AwccStatus status = AwccStatus::too_few_particles;
   std::string message;          ///< why not ok (empty when ok)
   [[nodiscard]] bool ok() const { return status == AwccStatus::ok; }
+  AwccQuality quality = AwccQuality::insufficient;  ///< insufficient whenever not ok
+  std::string quality_reason;   ///< why low or insufficient (empty when ok)
   int np = 0;                   ///< particles per window used
   AwccOptions options;          ///< the options that made this result
   double velocity = 0.0;        ///< m/s (0 unless ok)
@@ -131,6 +152,7 @@ struct AwccResult {
   std::int64_t rejected_correlation = 0, rejected_lag = 0, rejected_roc = 0, rejected_constant = 0;
   std::int64_t rejected_too_short = 0;  ///< windows shorter than the velocity range's least lag
   std::int64_t lag_zero_windows = 0;  ///< windows peaking at lag 0 (delay below one sample)
+  std::int64_t negative_lag_windows = 0;  ///< windows peaking at a negative lag
   int roc_iterations = 0;
   std::vector<AwccWindow> windows;
 };

@@ -52,7 +52,8 @@ enum class FsccStatus {
   constant_trailing,      ///< the trailing tip's signal is constant
   no_common_segment,      ///< no segment holds bubbles on both tips
   no_positive_peak,       ///< R12 has no positive maximum: the signals are unrelated
-  non_positive_lag,       ///< the peak is at a lag <= 0: tips swapped, or no delay
+  non_positive_lag,       ///< the peak is at lag 0: the delay is below one sample
+  tips_swapped,           ///< the peak is at a negative lag (or AWCC's windows are): the tips are swapped
   peak_at_lag_range_end,  ///< the peak sits on the last lag searched: the range is too short
   no_tip_separation,      ///< dx = 0: no velocity can be computed
 };
@@ -69,6 +70,7 @@ struct FsccResult {
   std::optional<double> t05, tau05, txx, txy;       ///< s
   std::optional<double> turbulence_intensity_chanson;
   std::string note;                  ///< e.g. why a time scale is missing
+  std::vector<std::string> warnings; ///< a velocity that is defined but implausible, with the likely cause
   std::int64_t r11_first_lag = 0, r12_first_lag = 0;  ///< lag (samples) of r11[0], r12[0]
   std::vector<double> r11, r12;      ///< the correlation functions over the lags searched
 };

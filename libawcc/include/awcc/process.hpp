@@ -30,14 +30,30 @@ struct ProcessOptions {
   /// AWCC settings; signal = raw correlates the voltages (one more pass over the file).
   AwccOptions awcc_options;
   int histogram_bins = 50;            ///< chord-time histogram bins
+  /// Accept values outside the plausible ranges of the instrument (below):
+  /// off, because a value out of them is nearly always a unit slip.
+  bool allow_unusual = false;
   std::int64_t block_frames = 1 << 16;  ///< frames read at a time
   bool single_pass = true;            ///< allow the one-pass path for 16-bit data (same result, faster)
 
+  /// Empty when valid, else what is wrong; includes implausible() unless allow_unusual.
   [[nodiscard]] std::string validate() const;
+  /// Empty when every stated value is plausible for a phase-detection probe:
+  /// dx 0.1-100 mm (or 0: no velocity), fs 1 kHz-100 MHz, a velocity range
+  /// within 0.01-200 m/s; else the value, its range and the likely slip.
+  [[nodiscard]] std::string implausible() const;
 };
+
+/// The plausible sampling rates of a probe recording, Hz (a file's own rate is checked too).
+inline constexpr double plausible_fs_min = 1e3, plausible_fs_max = 100e6;
+
+/// Which method's velocity the chord lengths and d32 use.
+enum class VelocitySource { none, awcc, fscc };
+std::string_view to_string(VelocitySource source);
 
 struct TipResult {
   int channel = 0;
+  std::string name;                   ///< the channel's name in a column file's header (else empty)
   Threshold threshold;
   PhaseStatistics phase;
 };
@@ -57,8 +73,11 @@ struct ProcessResult {
   std::optional<AwccResult> awcc;
   double seconds = 0.0;               ///< wall time of the processing
 
-  /// The velocity used for chord lengths and d32: AWCC's when defined, else FSCC's.
+  /// The velocity of chord lengths and d32 (velocity_source()).
   [[nodiscard]] std::optional<double> velocity() const;
+  /// AWCC's of quality ok; else FSCC's when defined; else AWCC's of low
+  /// quality (flagged); else none (METHOD 4, item 10).
+  [[nodiscard]] VelocitySource velocity_source() const;
 
   [[nodiscard]] std::string report() const;
 };

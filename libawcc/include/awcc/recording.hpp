@@ -7,7 +7,9 @@
 //    rows x channels little-endian int16, volts = counts * 5 / 32768;
 //  - headerless raw files with a stated layout (sample type, byte order,
 //    channels, header bytes, volts per count);
-//  - CSV/TSV columns (header row optional, a time column optional).
+//  - column files (CSV, TSV, semicolon-separated with decimal commas, LabVIEW
+//    .lvm text; header row optional, a time column found by name or by its
+//    values).
 // Every reader hands out interleaved float volts (frames x channels) in
 // blocks, so memory does not depend on the file's length; rewind() starts
 // again for a second pass. Damaged input is refused with a message naming the
@@ -20,6 +22,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace awcc {
 
@@ -49,7 +52,15 @@ struct ReaderOptions {
   InputFormat format = InputFormat::automatic;
   RawLayout raw;
   CsvLayout csv;
-  double fs = 0.0;                 ///< Hz; required for raw files and CSV without a time column; overrides otherwise
+  /// Hz; required for .dat, raw files and CSV without a time column. A file
+  /// that records its own rate (audio containers, a CSV time column) must
+  /// agree with it, unless override_fs: a wrong rate scales every velocity.
+  double fs = 0.0;
+  bool override_fs = false;        ///< fs replaces a different rate recorded in the file
+  /// Read what a WAV, W64 or RF64 file holds when its data is shorter than
+  /// its header says (a recording still being written, a copy cut short),
+  /// with a warning in the recording's info; refused otherwise.
+  bool allow_truncated = false;
   double volts_per_count = 0.0;    ///< overrides the file's scale when > 0 (sndfile integer data, .dat)
 };
 
@@ -62,6 +73,8 @@ struct RecordingInfo {
   std::int64_t frames = -1;        ///< -1 when unknown before reading (CSV)
   double quantum = 0.0;            ///< volts per count for integer samples, 0 for floating data
   bool volts_known = false;        ///< values are in volts (not normalised units)
+  std::vector<std::string> warnings;  ///< what the reader accepted but the user must know (a truncated file)
+  std::vector<std::string> channel_names;  ///< a column file's names of its data channels (header or "column k")
 };
 
 class Recording {

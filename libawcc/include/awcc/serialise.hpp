@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "awcc/process.hpp"
 
@@ -13,6 +14,15 @@ namespace awcc {
 
 nlohmann::json to_json(const ProcessResult& result);
 nlohmann::json to_json(const AwccOptions& options);
+
+/// Every effective option of a processing run, defaults included, by its
+/// declared name (awcc/options.hpp) as text with its unit.
+nlohmann::json options_json(const ProcessOptions& options);
+
+/// How an output was made: {"pdp_version", "command_line", "options"
+/// (options_json), "inputs": [{"file", "bytes", "sha256"}], "utc_time"}.
+nlohmann::json provenance_json(const ProcessOptions& options, const std::vector<std::string>& inputs,
+                               const std::string& command_line);
 
 /// The per-window table of AWCC as CSV.
 std::string awcc_windows_csv(const AwccResult& result);

@@ -1,7 +1,9 @@
 #pragma once
 // Physical quantities written with units, as a hydraulics lab writes them:
-// "5mm", "7.15 mm", "500kHz", "300s", "10m/s", "25%". A plain number is taken
-// in SI units (metres, seconds, hertz, metres per second, volts).
+// "5mm", "7.15 mm", "500kHz", "300s", "10m/s", "25%". A dimensional quantity
+// (length, time, frequency, velocity, voltage) needs its unit: a bare number
+// is refused (but 0), because "7.15" for a tip separation in millimetres
+// would silently be 7.15 m. Dimensionless ones take bare numbers.
 
 #include <string>
 #include <string_view>
@@ -16,9 +18,9 @@ std::string_view si_unit(Dimension dimension);
 /// Units accepted for a dimension, for error messages ("m, cm, mm, um").
 std::string accepted_units(Dimension dimension);
 
-/// Parses a number with an optional unit into SI. Throws std::invalid_argument
-/// with a message that names the text, the expected kind of quantity and the
-/// units accepted. Non-finite numbers are refused.
+/// Parses a number with its unit into SI. Throws std::invalid_argument with a
+/// message that names the text, the expected kind of quantity and the units
+/// accepted. Non-finite numbers and bare dimensional numbers are refused.
 double parse_quantity(std::string_view text, Dimension dimension);
 
 /// A whole number in [lo, hi] ("15", "1e3"); throws std::invalid_argument

@@ -6,8 +6,9 @@
 // Features, in this order: measured mean velocity u (m/s), measured
 // turbulence intensity Tu, measured void fraction c (leading tip), measured
 // Sauter diameter d32 = 1.5 u c / F (m, F the leading tip's bubble count
-// rate, u AWCC's velocity), streamwise and lateral tip separations dx and dy
-// (m, the geometry that was processed), particles per window Np.
+// rate, u AWCC's velocity; a file of another AWCC tool states d32, computed
+// the same way, instead of F), streamwise and lateral tip separations dx and
+// dy (m, the geometry that was processed), particles per window Np.
 //
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
@@ -33,6 +34,7 @@ enum class CorrectionStatus {
   corrected,               ///< the quantiles are there
   awcc_not_run,            ///< the results hold no AWCC
   no_awcc_velocity,        ///< AWCC gave no (positive) velocity
+  low_quality,             ///< AWCC's quality is low (METHOD 4, item 10): only ok rows are corrected
   no_bubbles,              ///< the leading tip saw no complete bubble (F = 0)
   too_few_windows,         ///< fewer accepted windows than the model's training runs had
   outside_training_range,  ///< a feature outside the model's training data
@@ -45,9 +47,10 @@ struct Measurement {
   std::optional<double> turbulence_intensity;  ///< AWCC Tu, -
   double void_fraction = 0.0;                  ///< leading tip, -
   double bubble_count_rate = 0.0;              ///< leading tip, 1/s
+  std::optional<double> d32;                   ///< m, when a file states it instead of F
   double dx = 0.0, dy = 0.0;                   ///< tip separations processed, m
   int np = 0;                                  ///< particles per window
-  std::int64_t windows_accepted = 0;
+  std::int64_t windows_accepted = -1;          ///< -1: not known (another tool's file)
 };
 
 /// The features of one measurement.
@@ -56,7 +59,7 @@ struct Features {
   static constexpr std::array<const char*, 7> names{"velocity", "turbulence_intensity", "void_fraction", "d32",
                                                     "dx",       "dy",                   "np"};
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
-  std::int64_t windows_accepted = 0;  ///< not a feature: rows below the model's minimum are not corrected
+  std::int64_t windows_accepted = -1;  ///< not a feature: rows below the model's minimum are not corrected; -1 unknown
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
@@ -75,7 +78,7 @@ FeatureResult make_features(const Measurement& m);
 
 /// The measurement of a processed recording (AWCC's velocity and Tu, the
 /// leading tip's c and F, the processed dx and dy, Np); `status` says when
-/// AWCC did not run or gave no velocity.
+/// AWCC did not run, gave no velocity, or one of low quality.
 struct MeasurementResult {
   CorrectionStatus status = CorrectionStatus::corrected;
   std::string message;

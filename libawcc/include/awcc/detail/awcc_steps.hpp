@@ -85,6 +85,8 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options);
 
 /// Marks an otherwise good result as having no velocity for want of dx.
 void no_tip_separation(AwccResult& result);
+/// Marks a result as having no velocity because the tips are swapped (`why`).
+void tips_swapped(AwccResult& result, const std::string& why);
 
 /// Scratch of the window correlations (AwccWorkspace owns one).
 struct AwccScratch {
