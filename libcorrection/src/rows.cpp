@@ -105,6 +105,23 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
   return model.correct(m);
 }
 
+// Calls fn(line, cells, "FILE:LINE") for every non-empty row after the
+// header; a row with another number of cells than the header is refused.
+template <class Fn>
+void for_each_row(std::istream& in, const std::string& file, std::size_t columns, Fn&& fn) {
+  std::string line;
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = awcc::split_cells(line);
+    const std::string where = fmt::format("{}:{}", file, number);
+    if (cells.size() != columns) {
+      throw awcc::InputError(fmt::format("{}: {} cells where the header has {}", where, cells.size(), columns));
+    }
+    fn(line, cells, where);
+  }
+}
+
 constexpr const char* kLayouts =
     "Give a profile CSV of pdp process with AWCC (columns void_fraction, bubble_count_rate, awcc_velocity, "
     "awcc_turbulence_intensity, awcc_windows_accepted, ...; docs/output.md), or the CSV other AWCC tools write "
@@ -136,16 +153,8 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     for (const char* l : correction_level_names) out.text += fmt::format(",{}_q{} [{}]", q, l, unit);
   }
   out.text += ",correction_status [-],correction_reason [-]\n";
-  int number = 1;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const auto cells = awcc::split_cells(line);
-    const std::string where = fmt::format("{}:{}", file, number);
-    if (cells.size() != header.size()) {
-      throw awcc::InputError(fmt::format("{}: {} cells where the header has {}", where, cells.size(), header.size()));
-    }
+  for_each_row(in, file, header.size(), [&](const std::string& row, const std::vector<std::string>& cells,
+                                            const std::string& where) {
     auto value = [&](const char* name) -> std::optional<double> {
       const std::string& t = cells[col.at(name)];
       if (t.empty() || t == "NaN" || t == "nan") return std::nullopt;
@@ -163,7 +172,7 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     m.dy = need(std::nullopt, d.dy, where, "dy", "lateral tip separation");
     m.np = static_cast<int>(need(std::nullopt, default_np(d), where, "np", "particles per window"));
     const auto c = model.correct(m);
-    out.text += line;
+    out.text += row;
     for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
       if (*q) {
         out.text += fmt::format(",{:.10g}", (*q)->median());
@@ -173,7 +182,7 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
       }
     }
     out.text += fmt::format(",{},{}\n", to_string(c.status), awcc::csv_cell(c.message));
-  }
+  });
   return out;
 }
 
@@ -229,16 +238,8 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
   const bool has_processing = col.count("awcc_filter_a") && col.count("awcc_roc") && col.count("awcc_weighting") &&
                               col.count("awcc_signal") && col.count("awcc_subsample");
   out.text = line + "," + correction_csv_header() + "\n";
-  int number = 1;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const auto cells = awcc::split_cells(line);
-    const std::string where = fmt::format("{}:{}", file, number);
-    if (cells.size() != header.size()) {
-      throw awcc::InputError(fmt::format("{}: {} cells where the header has {}", where, cells.size(), header.size()));
-    }
+  for_each_row(in, file, header.size(), [&](const std::string& row, const std::vector<std::string>& cells,
+                                            const std::string& where) {
     auto text_of = [&](const char* name) -> std::string {
       const auto it = col.find(name);
       return it == col.end() ? std::string() : cells[it->second];
@@ -275,8 +276,8 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
       c = model.correct(m);
     }
-    out.text += line + "," + correction_csv_cells(c) + "\n";
-  }
+    out.text += row + "," + correction_csv_cells(c) + "\n";
+  });
   return out;
 }
 

@@ -9,19 +9,7 @@ set -u
 pdp=$1
 dir=$2/config_cli
 rm -rf "$dir" && mkdir -p "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-json() { /usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
-# expect CODE TEXT CMD...: the command exits with CODE and its stderr holds TEXT.
-expect() {
-  local code=$1 text=$2
-  shift 2
-  local err
-  err=$("$@" 2>&1 >/dev/null)
-  local got=$?
-  [[ $got -eq $code ]] || fail "$*: exit $got, expected $code ($err)"
-  grep -qF -- "$text" <<<"$err" || fail "$*: message lacks '$text': $err"
-}
+source "$(dirname "$0")/lib.sh"
 
 # Every subcommand refuses a missing or unknown-keyed config file.
 printf 'no-such-option = 1\n' >"$dir/unknown.toml"

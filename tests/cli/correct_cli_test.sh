@@ -10,8 +10,7 @@ pdp=$1
 dir=$2/correct_cli
 src=$3
 rm -rf "$dir" && mkdir -p "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+source "$(dirname "$0")/lib.sh"
 
 cat >"$dir/mc.toml" <<'TOML'
 [sweep]
@@ -79,9 +78,6 @@ sys.exit(0 if a==b else 1)" || fail "pdp correct and process --correct disagree"
 "$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" -o "$dir/corrected.csv" || fail "correct CSV"
 head -1 "$dir/corrected.csv" | grep -q ",correction_in_range,correction_reason,corrected_velocity,corrected_velocity_q0.025," ||
   fail "CSV correction columns"
-column() {  # the cells of a named column, header excluded
-  python3 -c "import csv,sys; [print(r[sys.argv[2]]) for r in csv.DictReader(open(sys.argv[1]))]" "$1" "$2"
-}
 [[ $(column "$dir/corrected.csv" correction_in_range | sort -u) == "1" ]] || fail "profile rows not corrected"
 [[ $(column "$dir/corrected.csv" correction_status | sort -u) == "corrected" ]] || fail "profile rows' status"
 

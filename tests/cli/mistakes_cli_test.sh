@@ -12,20 +12,7 @@ dir=$2/mistakes_cli
 src=$3
 data=$src/../shared/data/felder-stepped-spillway
 rm -rf "$dir" && mkdir -p "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-py() { /usr/bin/python3 "$@"; }
-# expect CODE TEXT CMD...: exit status CODE and TEXT in stderr.
-expect() {
-  local code=$1 text=$2
-  shift 2
-  local err
-  err=$("$@" 2>&1 >/dev/null)
-  local got=$?
-  [[ $got -eq $code ]] || fail "$*: exit $got, expected $code ($err)"
-  grep -qF -- "$text" <<<"$err" || fail "$*: message lacks '$text': $err"
-}
-column() { py -c "import csv,sys; [print(r[sys.argv[2]]) for r in csv.DictReader(open(sys.argv[1]))]" "$1" "$2" 2>/dev/null; }
+source "$(dirname "$0")/lib.sh"
 
 "$pdp" --log-level warn synth -q --duration 2s --fs 100kHz --velocity 4m/s --dy 0mm --signal voltage -o "$dir/rec.wav" ||
   fail "synth"
