@@ -10,6 +10,7 @@ pdp=$1
 dir=$2/config_cli
 rm -rf "$dir" && mkdir -p "$dir"
 source "$(dirname "$0")/lib.sh"
+json() { /usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
 
 # Every subcommand refuses a missing or unknown-keyed config file.
 printf 'no-such-option = 1\n' >"$dir/unknown.toml"

@@ -13,6 +13,7 @@ src=$3
 data=$src/../shared/data/felder-stepped-spillway
 rm -rf "$dir" && mkdir -p "$dir"
 source "$(dirname "$0")/lib.sh"
+py() { /usr/bin/python3 "$@"; }
 
 "$pdp" --log-level warn synth -q --duration 2s --fs 100kHz --velocity 4m/s --dy 0mm --signal voltage -o "$dir/rec.wav" ||
   fail "synth"
