@@ -76,7 +76,7 @@ const OptionField<R> kReader[] = {
     {"format", "", "recording format: auto | sndfile | dat | raw | csv (auto: from content and extension)",
      [](R& o, std::string_view t) { o.format = choice(t, kFormats); },
      [](const R& o) { return name_of(o.format, kFormats); }},
-    {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; overrides a file's own)",
+    {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; must agree with a file's own)",
      [](R& o, std::string_view t) { o.fs = quantity(t, Dimension::frequency); },
      [](const R& o) { return o.fs > 0.0 ? format_quantity(o.fs, Dimension::frequency) : std::string("from the file"); }},
     {"override-fs", "", "let --fs replace a different sampling rate recorded in the file",
