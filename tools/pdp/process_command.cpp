@@ -200,7 +200,6 @@ int run_process(const ProcessCommandOptions& o) {
     return report_error(e);
   }
   positions = kept_positions;
-  const auto provenance = awcc::provenance_json(options, inputs, command_line());
   std::vector<correction::Correction> corrections;
   if (model) {
     for (const auto& r : results) {
@@ -233,7 +232,8 @@ int run_process(const ProcessCommandOptions& o) {
         }
         if (!skipped.empty()) j["skipped"] = skipped;
       }
-      j["provenance"] = provenance;
+      // Hashing the inputs costs a read of each: only for the JSON, which records it.
+      j["provenance"] = awcc::provenance_json(options, inputs, command_line());
       awcc::write_text_atomically(o.json, j.dump(2) + "\n");
     }
     if (!o.windows.empty() && results[0].awcc) {
