@@ -79,7 +79,7 @@ const OptionField<R> kReader[] = {
     {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; must agree with a file's own)",
      [](R& o, std::string_view t) { o.fs = quantity(t, Dimension::frequency); },
      [](const R& o) { return o.fs > 0.0 ? format_quantity(o.fs, Dimension::frequency) : std::string("from the file"); }},
-    {"override-fs", "", "let --fs replace a different sampling rate recorded in the file",
+    {"override-fs", "", "let the stated sampling rate replace a different one recorded in the file",
      [](R& o, std::string_view t) { o.override_fs = on_off(t); },
      [](const R& o) { return std::string(o.override_fs ? "on" : "off"); }, true},
     {"allow-truncated", "", "process what a WAV, W64 or RF64 file holds when its data is shorter than its header says",

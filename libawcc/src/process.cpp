@@ -252,6 +252,12 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
                                  path.string(), format_quantity(info.fs, Dimension::frequency)),
                      "allow_unusual");
   }
+  if (options.binarisation.rule == ThresholdRule::fixed && !info.volts_known) {
+    throw InputError(fmt::format("{}: a fixed threshold is a voltage, but the recording's samples are not in volts "
+                                 "(its scale is unknown); state its volts per count",
+                                 path.string()),
+                     "volts_per_count");
+  }
   BinarisationOptions bopt = options.binarisation;
   if (!info.volts_known && bopt.bin_width > 0.0 && bopt.rule != ThresholdRule::felder) bopt.bin_width = 0.0;
 

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <sndfile.h>
 #include <stdexcept>
@@ -54,9 +55,10 @@ namespace fs = std::filesystem;
 
 // The sampling rate of a file that records its own: the stated one must
 // agree with it (to 1e-6, a CSV's time stamps being rounded) unless forced.
-double stated_rate(const fs::path& path, const ReaderOptions& options, double recorded, const std::string& where) {
+double stated_rate(const fs::path& path, const ReaderOptions& options, double recorded, const std::string& where,
+                   double tolerance = 1e-6) {
   if (!(options.fs > 0.0)) return recorded;
-  if (options.override_fs || std::fabs(options.fs - recorded) <= 1e-6 * recorded) return options.fs;
+  if (options.override_fs || std::fabs(options.fs - recorded) <= tolerance * recorded) return options.fs;
   fail(path,
        fmt::format("{} records a sampling rate of {} but {} was stated; leave the rate out, or force the stated one",
                    where, format_quantity(recorded, Dimension::frequency), format_quantity(options.fs, Dimension::frequency)),
@@ -163,7 +165,8 @@ class SndfileRecording final : public Recording {
  public:
   SndfileRecording(const fs::path& path, const ReaderOptions& options) {
     SF_INFO sf{};
-    file_ = sf_open(path.c_str(), SFM_READ, &sf);
+    // Owned from here: a refusal below (thrown from the constructor) closes it.
+    file_.reset(sf_open(path.c_str(), SFM_READ, &sf));
     if (!file_) {
       fail(path, fmt::format("not a readable audio file (libsndfile: {}); check the file or state its format", 
                              sf_strerror(nullptr)));
@@ -176,7 +179,7 @@ class SndfileRecording final : public Recording {
     info_.frames = sf.frames;
     SF_FORMAT_INFO major{};
     major.format = sf.format & SF_FORMAT_TYPEMASK;
-    sf_command(file_, SFC_GET_FORMAT_INFO, &major, sizeof(major));
+    sf_command(file_.get(), SFC_GET_FORMAT_INFO, &major, sizeof(major));
     int bits = 0;
     switch (sf.format & SF_FORMAT_SUBMASK) {
       case SF_FORMAT_PCM_S8: case SF_FORMAT_PCM_U8: bits = 8; break;
@@ -185,14 +188,21 @@ class SndfileRecording final : public Recording {
       case SF_FORMAT_PCM_32: bits = 32; break;
       default: bits = 0;
     }
-    floating_ = bits == 0;
-    floating_double_ = (sf.format & SF_FORMAT_SUBMASK) == SF_FORMAT_DOUBLE;
+    const int sub = sf.format & SF_FORMAT_SUBMASK;
+    floating_ = sub == SF_FORMAT_FLOAT || sub == SF_FORMAT_DOUBLE;
+    floating_double_ = sub == SF_FORMAT_DOUBLE;
     int16_ = bits == 16;
+    // Companded or compressed samples (u-law, A-law, ADPCM, Vorbis, ...) have
+    // no volts: read normalised to full scale 1.
+    const bool coded = bits == 0 && !floating_;
     // Values as counts for integer data, as stored for floating data.
-    sf_command(file_, SFC_SET_NORM_FLOAT, nullptr, SF_FALSE);
+    sf_command(file_.get(), SFC_SET_NORM_FLOAT, nullptr, coded ? SF_TRUE : SF_FALSE);
     const double vpc = options.volts_per_count;
-    info_.volts_known = vpc > 0.0 || floating_;
-    if (floating_) {
+    info_.volts_known = !coded && (vpc > 0.0 || floating_);
+    if (coded) {
+      scale_ = 1.0;
+      info_.quantum = 0.0;
+    } else if (floating_) {
       scale_ = vpc > 0.0 ? vpc : 1.0;
       info_.quantum = 0.0;
     } else {
@@ -202,7 +212,8 @@ class SndfileRecording final : public Recording {
     }
     check_complete(path, options, sf, bits);
     info_.description = fmt::format("{} ({}, {})", major.name ? major.name : "audio",
-                                    floating_ ? "floating point" : fmt::format("{}-bit integer", bits),
+                                    floating_ ? "floating point"
+                                              : (coded ? "compressed" : fmt::format("{}-bit integer", bits)),
                                     info_.volts_known ? "volts" : "normalised units");
   }
   // A data chunk shorter than the header promises is refused (or, when
@@ -224,12 +235,9 @@ class SndfileRecording final : public Recording {
     info_.warnings.push_back(what + "; only what is there was processed");
   }
 
-  ~SndfileRecording() override {
-    if (file_) sf_close(file_);
-  }
 
   std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
-    const sf_count_t got = sf_readf_float(file_, out.data(), max_frames);
+    const sf_count_t got = sf_readf_float(file_.get(), out.data(), max_frames);
     if (got < 0) fail(info_.path, "read error");
     const auto n = static_cast<std::size_t>(got) * static_cast<std::size_t>(info_.channels);
     if (scale_ != 1.0) {
@@ -246,14 +254,14 @@ class SndfileRecording final : public Recording {
   }
 
   void rewind() override {
-    sf_seek(file_, 0, SEEK_SET);
+    sf_seek(file_.get(), 0, SEEK_SET);
     position_ = 0;
   }
 
   [[nodiscard]] bool has_int16() const override { return int16_; }
 
   std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
-    const sf_count_t got = sf_readf_short(file_, out.data(), max_frames);
+    const sf_count_t got = sf_readf_short(file_.get(), out.data(), max_frames);
     if (got < 0) fail(info_.path, "read error");
     position_ += got;
     if (got == 0 && info_.frames >= 0 && position_ < info_.frames) {
@@ -264,7 +272,7 @@ class SndfileRecording final : public Recording {
   }
 
  private:
-  SNDFILE* file_ = nullptr;
+  std::unique_ptr<SNDFILE, int (*)(SNDFILE*)> file_{nullptr, &sf_close};
   bool floating_ = false;
   bool floating_double_ = false;
   bool int16_ = false;
@@ -456,6 +464,20 @@ std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& o
 
 std::vector<std::string_view> split(std::string_view line, char delimiter) {
   std::vector<std::string_view> cells;
+  if (delimiter != ' ' && line.find('"') != std::string_view::npos) {
+    // Quoted cells ("0,001";"1,5"): split outside the quotes; trim() drops the quotes.
+    bool quoted = false;
+    std::size_t start = 0;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      if (line[i] == '"') quoted = !quoted;
+      else if (line[i] == delimiter && !quoted) {
+        cells.push_back(line.substr(start, i - start));
+        start = i + 1;
+      }
+    }
+    cells.push_back(line.substr(start));
+    return cells;
+  }
   if (delimiter == ' ') {
     std::size_t i = 0;
     while (i < line.size()) {
@@ -532,6 +554,7 @@ class CsvRecording final : public Recording {
     std::optional<double> lvm_delta;
     char lvm_separator = 0, lvm_decimal = 0;
     bool lvm = false;
+    int markers = 0;
     std::streampos body = 0;
     std::int64_t body_line = 0;
     {
@@ -555,6 +578,10 @@ class CsvRecording final : public Recording {
           if (trim(line).starts_with("***End_of_Header***")) {
             body = in_.tellg();
             body_line = number;
+            // The file header, then the first segment's: its data follow.
+            // Later segments (their headers inside the data) are refused
+            // by read() as rows that are not numbers.
+            if (++markers == 2) break;
           }
         }
         if (body_line == 0) fail(path, "a LabVIEW measurement file without ***End_of_Header***: not a recording", "not_a_recording");
@@ -606,7 +633,7 @@ class CsvRecording final : public Recording {
     const auto first = split(rows[0], delimiter_);
     bool all_numbers = true;
     double v;
-    for (auto c : first) all_numbers = all_numbers && number_of(c, v);
+    for (auto c : first) all_numbers = all_numbers && (trim(c).empty() || number_of(c, v));
     const bool header = options.csv.header.value_or(!all_numbers);
     columns_ = static_cast<int>(first.size());
     const std::size_t first_data = header ? 1 : 0;
@@ -653,6 +680,8 @@ class CsvRecording final : public Recording {
     }
     for (int c = 0; c < columns_; ++c) {
       if (c == time_column_ || skip[static_cast<std::size_t>(c)]) continue;
+      // LabVIEW's one X column per channel: the other time columns are not data.
+      if (time_column_ >= 0 && header && is_time_name(names[static_cast<std::size_t>(c)])) continue;
       data_columns_.push_back(c);
       info_.channel_names.push_back(names[static_cast<std::size_t>(c)]);
     }
@@ -663,11 +692,14 @@ class CsvRecording final : public Recording {
     in_.clear();
     in_.seekg(data_start_);
     line_ = first_line_;
-    if (time_column_ >= 0) {
-      info_.fs = stated_rate(path, options, fs_from_time_column(),
-                             fmt::format("its time column '{}'", names[static_cast<std::size_t>(time_column_)]));
-    } else if (lvm_delta) {
+    if (lvm_delta) {
       info_.fs = stated_rate(path, options, 1.0 / *lvm_delta, "its Delta_X");
+    } else if (time_column_ >= 0) {
+      const double unit = time_unit(header ? names[static_cast<std::size_t>(time_column_)] : std::string());
+      // Time stamps are printed rounded: the rate from them agrees with a
+      // stated one to 0.1 %, not to the last digit.
+      info_.fs = stated_rate(path, options, fs_from_time_column() / unit,
+                             fmt::format("its time column '{}'", names[static_cast<std::size_t>(time_column_)]), 1e-3);
     } else if (options.fs > 0.0) {
       info_.fs = options.fs;
     } else {
@@ -728,6 +760,34 @@ class CsvRecording final : public Recording {
     return parse_number(c, value);
   }
 
+  // The rounding step of printed stamps: the least gap between distinct step
+  // values (steps of 3 and 4 us at 300 kHz printed to 1 us give 1 us); 0
+  // when every step is the same.
+  static double resolution(std::vector<double> steps) {
+    std::sort(steps.begin(), steps.end());
+    double r = 0.0;
+    for (std::size_t i = 1; i < steps.size(); ++i) {
+      const double d = steps[i] - steps[i - 1];
+      if (d > 1e-9 * std::fabs(steps[i]) && (r == 0.0 || d < r)) r = d;
+    }
+    return r;
+  }
+
+  // Seconds per unit of a time column named with a unit in brackets
+  // ("Time [ms]", "t (us)"); 1 without one.
+  double time_unit(const std::string& name) const {
+    for (auto [open, close] : {std::pair{'[', ']'}, std::pair{'(', ')'}}) {
+      const auto a = name.find(open), b = name.find(close);
+      if (a == std::string::npos || b == std::string::npos || b <= a + 1) continue;
+      try {
+        return parse_quantity("1" + name.substr(a + 1, b - a - 1), Dimension::time);
+      } catch (const std::invalid_argument&) {
+        fail(info_.path, fmt::format("the time column '{}' has a unit that is not a time", name), "time_column");
+      }
+    }
+    return 1.0;
+  }
+
   static bool is_time_name(std::string name) {
     // Without a unit in brackets, lower case: time, t, zeit, temps, tiempo, x_value, ...
     for (const char* open : {"[", "("}) {
@@ -775,8 +835,20 @@ class CsvRecording final : public Recording {
     if (times.size() < 2) fail(info_.path, "too few rows to take the sampling rate from the time column; state the sampling rate", "fs");
     std::vector<double> steps;
     for (std::size_t i = 1; i < times.size(); ++i) steps.push_back(times[i] - times[i - 1]);
-    const double dt = median(steps);
-    if (!(dt > 0.0)) fail(info_.path, "the time column does not increase; state the sampling rate or fix the column", "fs");
+    // The mean step (last minus first over the steps) is as exact as the
+    // stamps' rounding allows; the median guards against a column that is
+    // not a clock (steps that vary by more than 1 %).
+    const double dt = (times.back() - times.front()) / static_cast<double>(times.size() - 1);
+    const double typical = median(steps);
+    if (!(dt > 0.0) || !(typical > 0.0)) {
+      fail(info_.path, "the time column does not increase; state the sampling rate or fix the column", "time_column");
+    }
+    if (std::fabs(typical / dt - 1.0) > 0.01 && std::fabs(typical - dt) > 1.001 * resolution(steps)) {
+      fail(info_.path, fmt::format("the time column's steps are uneven ({:.6g} typical, {:.6g} on average): not a "
+                                   "clock of evenly spaced samples; name the time column or state the sampling rate",
+                                   typical, dt),
+           "time_column");
+    }
     return 1.0 / dt;
   }
 

@@ -9,14 +9,20 @@
 
 namespace awcc {
 
-void write_atomically(const std::filesystem::path& target,
-                      const std::function<void(const std::filesystem::path&)>& write) {
+void check_output_folder(const std::filesystem::path& target) {
   namespace fs = std::filesystem;
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::is_directory(parent)) {
     throw OutputError(fmt::format("{}: the folder {} does not exist; create it or choose another output path",
-                                         target.string(), parent.string()));
+                                  target.string(), parent.string()));
   }
+}
+
+void write_atomically(const std::filesystem::path& target,
+                      const std::function<void(const std::filesystem::path&)>& write) {
+  namespace fs = std::filesystem;
+  check_output_folder(target);
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   const fs::path temporary =
       parent / fmt::format(".{}.{}.partial", target.filename().string(), static_cast<long>(::getpid()));
   try {

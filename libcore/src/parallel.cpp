@@ -30,7 +30,12 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
   const unsigned t = thread_count(threads, n);
   std::vector<std::thread> pool;
   pool.reserve(t - 1);
-  for (unsigned i = 1; i < t; ++i) pool.emplace_back(work);
+  try {
+    for (unsigned i = 1; i < t; ++i) pool.emplace_back(work);
+  } catch (...) {
+    // No more threads to be had (a process limit): the ones running and this
+    // one finish the work.
+  }
   work();
   for (auto& th : pool) th.join();
   if (failure) std::rethrow_exception(failure);

@@ -125,7 +125,8 @@ void for_each_row(std::istream& in, const std::string& file, std::size_t columns
 constexpr const char* kLayouts =
     "Give a profile CSV of pdp process with AWCC (columns void_fraction, bubble_count_rate, awcc_velocity, "
     "awcc_turbulence_intensity, awcc_windows_accepted, ...; docs/output.md), or the CSV other AWCC tools write "
-    "(columns 'u [m/s]', 'u_rms [m/s]', 'c [-]', 'd_32a [m]', optional 'z [m]', with --dx, --dy and --np)";
+    "(columns 'u [m/s]', 'u_rms [m/s]', 'c [-]', 'd_32a [m]', optional 'z [m]', with the tip separations and Np "
+    "stated)";
 
 // The CSV other AWCC tools write (Kramer's toolbox style): one row per
 // position with units in the headers; Tu = u_rms / u, d32 as stated. It
@@ -166,12 +167,14 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     m.velocity = value("u [m/s]");
     const auto u_rms = value("u_rms [m/s]");
     if (m.velocity && u_rms && *m.velocity != 0.0) m.turbulence_intensity = *u_rms / *m.velocity;
-    m.void_fraction = value("c [-]").value_or(0.0);
+    const auto c_value = value("c [-]");
+    m.void_fraction = c_value.value_or(0.0);
     m.d32 = value("d_32a [m]");
     m.dx = need(std::nullopt, d.dx, where, "dx", "streamwise tip separation");
     m.dy = need(std::nullopt, d.dy, where, "dy", "lateral tip separation");
     m.np = static_cast<int>(need(std::nullopt, default_np(d), where, "np", "particles per window"));
-    const auto c = model.correct(m);
+    const auto c = c_value ? model.correct(m)
+                           : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
     out.text += row;
     for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
       if (*q) {
@@ -203,13 +206,18 @@ FileCorrection correct_process_json(const CorrectionModel& model, const std::str
     c["model"] = model_name;
     row["correction"] = c;
   };
-  if (j.is_object() && j.contains("profile") && j["profile"].is_array()) {
-    for (auto& row : j["profile"]) add(row);
-  } else if (j.is_object() && j.contains("tips")) {
-    add(j);
-  } else {
-    throw awcc::InputError(fmt::format(
-        "{}: neither a recording's result (tips) nor a profile; give a JSON written by pdp process", file));
+  try {
+    if (j.is_object() && j.contains("profile") && j["profile"].is_array()) {
+      for (auto& row : j["profile"]) add(row);
+    } else if (j.is_object() && j.contains("tips")) {
+      add(j);
+    } else {
+      throw awcc::InputError(fmt::format(
+          "{}: neither a recording's result (tips) nor a profile; give a JSON written by pdp process", file));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    // A value of the wrong type (a string where a number or a boolean belongs).
+    throw awcc::InputError(fmt::format("{}: not a JSON written by pdp process ({})", file, e.what()));
   }
   out.text = j.dump(2) + "\n";
   return out;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/units.hpp"
 
 namespace synth {
@@ -108,7 +109,7 @@ void write_recording(const std::filesystem::path& path, const Scene& scene,
     info.format = sf_major(options.format) | SF_FORMAT_PCM_16;
     SNDFILE* file = sf_open(temporary.c_str(), SFM_WRITE, &info);
     if (!file) {
-      throw std::runtime_error(fmt::format("{}: cannot create the {} file: {}", path.string(), to_string(options.format),
+      throw awcc::OutputError(fmt::format("{}: cannot create the {} file: {}", path.string(), to_string(options.format),
                                            sf_strerror(nullptr)));
     }
     struct Closer {
@@ -139,13 +140,13 @@ void write_recording(const std::filesystem::path& path, const Scene& scene,
           for (std::size_t j = 0; j < channels; ++j) out[i * channels + j] = static_cast<std::int16_t>(air[j][i]);
       }
       if (sf_writef_short(file, out.data(), static_cast<sf_count_t>(n)) != static_cast<sf_count_t>(n)) {
-        throw std::runtime_error(fmt::format("{}: writing failed after {} frames: {}", path.string(), first,
+        throw awcc::OutputError(fmt::format("{}: writing failed after {} frames: {}", path.string(), first,
                                              sf_strerror(file)));
       }
       if (options.progress) options.progress(static_cast<double>(first + static_cast<std::int64_t>(n)) / static_cast<double>(frames));
     }
     closer.f = nullptr;
-    if (sf_close(file) != 0) throw std::runtime_error(fmt::format("{}: closing the file failed", path.string()));
+    if (sf_close(file) != 0) throw awcc::OutputError(fmt::format("{}: closing the file failed", path.string()));
   });
 }
 

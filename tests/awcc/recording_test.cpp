@@ -1,5 +1,7 @@
 #include "awcc/recording.hpp"
 
+#include <algorithm>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "awcc/errors.hpp"
@@ -250,3 +252,84 @@ TEST(Detection, BadFilesGetClearMessages) {
 }
 
 }  // namespace
+
+namespace {
+
+// Reads every frame of a column file written by `write`.
+std::pair<awcc::RecordingInfo, std::vector<float>> read_columns(const std::string& name, const std::string& text,
+                                                                const ReaderOptions& o = {}) {
+  const auto p = scratch(name);
+  std::ofstream(p, std::ios::binary) << text;
+  auto r = open_recording(p, o);
+  auto all = read_all(*r);
+  return {r->info(), all};
+}
+
+}  // namespace
+
+// Time stamps printed to 1 us at 300 kHz step 3 or 4 us: the rate from the
+// mean step is 300 kHz to the stamps' rounding (1 us over 2000 steps: 2e-6
+// relative at worst... here 5e-5 with the first and last stamps rounded),
+// where the median step (3 us) gave 333 kHz.
+TEST(Csv, SamplingRateFromRoundedTimeStamps) {
+  std::string text = "time,a,b\n";
+  for (int i = 0; i < 3000; ++i) text += fmt::format("{:.6f},{},{}\n", i / 300e3, i % 7 < 3 ? 0 : 4, i % 5 < 2 ? 0 : 4);
+  const auto [info, samples] = read_columns("rounded_time.csv", text);
+  EXPECT_NEAR(info.fs, 300e3, 300e3 * 1e-4);
+  // A stated rate that agrees to 0.1 % is taken; one that does not is refused.
+  ReaderOptions o;
+  o.fs = 300e3;
+  EXPECT_EQ(read_columns("rounded_time_stated.csv", text, o).first.fs, 300e3);
+  o.fs = 30e3;
+  EXPECT_NE(error_of(scratch("rounded_time.csv"), o).find("[override_fs]"), std::string::npos);
+}
+
+// A unit in the time column's name is honoured: "Time [ms]" at 20 kHz.
+TEST(Csv, TimeColumnUnitInBrackets) {
+  std::string text = "Time [ms];Spitze 1 [V];Spitze 2 [V]\n";
+  for (int i = 0; i < 200; ++i) {
+    std::string t = fmt::format("{:.2f}", i * 0.05);
+    std::replace(t.begin(), t.end(), '.', ',');
+    text += fmt::format("{};{};{}\n", t, i % 7 < 3 ? "0,3" : "4,1", "4,0");
+  }
+  const auto [info, samples] = read_columns("time_ms.csv", text);
+  EXPECT_NEAR(info.fs, 20e3, 1e-6 * 20e3);
+  ASSERT_EQ(info.channel_names.size(), 2u);
+  EXPECT_EQ(info.channel_names[0], "Spitze 1 [V]");
+  EXPECT_FLOAT_EQ(samples[0], 0.3f);  // decimal comma
+}
+
+// A trailing separator on header-less rows: the first row is data, and the
+// empty last column is no channel.
+TEST(Csv, TrailingSeparatorIsNeitherAHeaderNorAChannel) {
+  ReaderOptions o;
+  o.fs = 1000;
+  const auto [info, samples] = read_columns("trailing_tab.tsv", "1.5\t2.5\t\n3\t4\t\n5\t6\t\n", o);
+  EXPECT_EQ(info.channels, 2);
+  ASSERT_EQ(samples.size(), 6u);
+  EXPECT_FLOAT_EQ(samples[0], 1.5f);
+}
+
+// Quoted cells with decimal commas ("0,3";"4,1") split at the separators only.
+TEST(Csv, QuotedCellsWithDecimalCommas) {
+  ReaderOptions o;
+  o.fs = 1000;
+  const auto [info, samples] = read_columns("quoted.csv", "\"0,3\";\"4,1\"\n\"0,4\";\"4,2\"\n\"0,5\";\"4,3\"\n", o);
+  EXPECT_EQ(info.channels, 2);
+  ASSERT_EQ(samples.size(), 6u);
+  EXPECT_FLOAT_EQ(samples[5], 4.3f);
+}
+
+// LabVIEW .lvm with one X column per channel: the second X_Value is no tip;
+// Delta_X gives the rate; only the first segment is read.
+TEST(Lvm, MultipleXColumnsAndDeltaX) {
+  std::string text = "LabVIEW Measurement\t\nSeparator\tTab\nDecimal_Separator\t.\n***End_of_Header***\t\n\n"
+                     "Channels\t2\t\nDelta_X\t0.00005\t0.00005\t\n***End_of_Header***\t\n"
+                     "X_Value\tVoltage\tX_Value\tVoltage_0\tComment\n";
+  for (int i = 0; i < 100; ++i) text += fmt::format("{:.6f}\t{}\t{:.6f}\t{}\t\n", i * 5e-5, i % 3 ? 4.1 : 0.3, i * 5e-5, 4.0);
+  const auto [info, samples] = read_columns("multi_x.lvm", text);
+  EXPECT_DOUBLE_EQ(info.fs, 20e3);
+  EXPECT_EQ(info.channels, 2);
+  EXPECT_EQ(info.channel_names, (std::vector<std::string>{"Voltage", "Voltage_0"}));
+  EXPECT_EQ(samples.size(), 200u);
+}

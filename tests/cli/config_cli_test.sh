@@ -4,10 +4,11 @@
 # a missing file, an unknown key or a bad value is an error (exit 2) naming
 # the file and line. Also: pdp sweep --np applies to every run unless the
 # study sets np (then it is a conflict), and the documented exit codes.
-# Usage: config_cli_test.sh PDP SCRATCH_DIR
+# Usage: config_cli_test.sh PDP SCRATCH_DIR SOURCE_DIR
 set -u
 pdp=$1
 dir=$2/config_cli
+src=$3
 rm -rf "$dir" && mkdir -p "$dir"
 source "$(dirname "$0")/lib.sh"
 json() { /usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
@@ -97,11 +98,23 @@ expect 2 "train.toml:1: --trees" "$pdp" train "$dir/sweep.csv" -o "$dir/m.qrf" -
 printf 'dx = "fast"\n' >"$dir/correct.toml"
 expect 2 "--dx" "$pdp" correct "$dir/a.json" -m "$dir/a.json" --config "$dir/correct.toml"
 
+# One file may hold several subcommands' tables.
+printf '[process]\ndx = "5mm"\n[correct]\nnp = 10\n' >"$dir/both.toml"
+"$pdp" --log-level error process "$dir/a.flac" --config "$dir/both.toml" >/dev/null || fail "a file with two tables"
+
 # Exit codes (README): 2 bad usage, 1 bad input data, 3 an output not written.
 expect 2 "" "$pdp" process "$dir/a.flac" --no-such-flag
 printf 'not a recording' >"$dir/junk.dat"
 expect 1 "junk.dat" "$pdp" process "$dir/junk.dat" --fs 20kHz --dx 5mm
 expect 3 "does not exist" "$pdp" process "$dir/a.flac" --dx 5mm --json "$dir/no/such/folder/a.json"
+# Outputs are all written or none: a CSV into a missing folder leaves no JSON.
+rm -f "$dir/b.json"
+expect 3 "does not exist" "$pdp" process "$dir/a.flac" "$dir/a.flac" --dx 5mm --json "$dir/b.json" \
+  --csv "$dir/no/such/folder/b.csv"
+[[ -e $dir/b.json ]] && fail "a JSON was written although the CSV could not be"
+printf '{"tips": [{"void_fraction": "x"}], "awcc": {"defined": true, "velocity": 1, "turbulence_intensity": 0.1, "windows_accepted": "many", "options": {"filter_a": 0.4, "roc": "on"}}}' >"$dir/typed.json"
+expect 1 "not a JSON written by pdp process" "$pdp" correct "$dir/typed.json" -m "$src/samples/model/awcc.qrf" --dx 5mm \
+  --dy 0 --np 10
 
 [[ $failures -eq 0 ]] && echo "config CLI: all checks passed"
 exit $((failures > 0))

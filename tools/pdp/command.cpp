@@ -58,7 +58,14 @@ void finish_parsing(Command& c) {
   if (!c.config.empty()) {
     std::vector<awcc::Setting> settings;
     try {
-      settings = awcc::read_settings(c.config, c.app->get_name());
+      // One file may hold the settings of several subcommands, a table each.
+      std::vector<std::string> others;
+      if (auto* parent = c.app->get_parent()) {
+        for (const auto* sub : parent->get_subcommands([](const CLI::App*) { return true; })) {
+          others.push_back(sub->get_name());
+        }
+      }
+      settings = awcc::read_settings(c.config, c.app->get_name(), others);
     } catch (const awcc::InputError& e) {
       throw std::invalid_argument(std::string("--config: ") + e.what());
     }
@@ -106,6 +113,7 @@ std::string flag_for(const std::string& quantity) {
       {"allow_unusual", "--allow-unusual"},
       {"override_fs", "--override-fs"},
       {"truncated", "--allow-truncated"},
+      {"volts_per_count", "--volts-per-count"},
   };
   const auto it = flags.find(quantity);
   return it == flags.end() ? std::string() : it->second;

@@ -103,14 +103,17 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
         throw std::invalid_argument(fmt::format("{}:{}: {}", o.manifest, number, e.what()));
       }
     }
+    std::map<std::string, std::string> seen;
     for (std::size_t i = 0; i < o.files.size(); ++i) {
       const auto name = std::filesystem::path(o.files[i]).filename().string();
-      const auto it = by_name.find(name);
-      if (it == by_name.end()) {
-        throw std::invalid_argument(
-            fmt::format("{}: no position for {}; add a row '{},<position>'", o.manifest, name, name));
+      if (const auto [at, fresh] = seen.emplace(name, o.files[i]); !fresh) {
+        throw std::invalid_argument(fmt::format("{} and {} share the name {}, which the manifest matches by: rename "
+                                                "one or give --positions",
+                                                at->second, o.files[i], name));
       }
-      out[i] = it->second;
+      // A file without a row is refused once it proves to be a recording
+      // (a README caught by the same glob is skipped, not positioned).
+      if (const auto it = by_name.find(name); it != by_name.end()) out[i] = it->second;
     }
   }
   return out;
@@ -184,6 +187,11 @@ int run_process(const ProcessCommandOptions& o) {
         continue;
       }
       add_flag_hints(results.back());
+      if (!o.manifest.empty() && !positions[i]) {
+        const auto name = std::filesystem::path(o.files[i]).filename().string();
+        throw std::invalid_argument(
+            fmt::format("{}: no position for {}; add a row '{},<position>'", o.manifest, name, name));
+      }
       kept_positions.push_back(positions[i]);
       inputs.push_back(o.files[i]);
       for (const auto& w : results.back().info.warnings) spdlog::warn("{}: {}", o.files[i], w);
@@ -217,6 +225,10 @@ int run_process(const ProcessCommandOptions& o) {
     return c;
   };
   try {
+    // Every output is rendered and its folder checked before any is written:
+    // a run fails whole or writes all.
+    std::vector<std::pair<std::string, std::string>> outputs;
+    std::string stdout_text;
     if (!o.json.empty()) {
       nlohmann::json j;
       if (results.size() == 1 && o.files.size() == 1) {
@@ -234,14 +246,12 @@ int run_process(const ProcessCommandOptions& o) {
       }
       // Hashing the inputs costs a read of each: only for the JSON, which records it.
       j["provenance"] = awcc::provenance_json(options, inputs, command_line());
-      awcc::write_text_atomically(o.json, j.dump(2) + "\n");
+      outputs.emplace_back(o.json, j.dump(2) + "\n");
     }
-    if (!o.windows.empty() && results[0].awcc) {
-      awcc::write_text_atomically(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
-    }
+    if (!o.windows.empty() && results[0].awcc) outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
     if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {
-      fmt::print("{}", results[0].report());
-      if (model) fmt::print("{}", correction_report(corrections[0]));
+      stdout_text = results[0].report();
+      if (model) stdout_text += correction_report(corrections[0]);
     } else {
       std::string table = awcc::profile_csv_header();
       table += model ? "," + correction::correction_csv_header() + "\n" : "\n";
@@ -249,9 +259,12 @@ int run_process(const ProcessCommandOptions& o) {
         table += awcc::profile_csv_row(results[i], positions[i]);
         table += model ? "," + correction::correction_csv_cells(corrections[i]) + "\n" : "\n";
       }
-      if (o.csv.empty()) fmt::print("{}", table);
-      else awcc::write_text_atomically(o.csv, table);
+      if (o.csv.empty()) stdout_text = table;
+      else outputs.emplace_back(o.csv, table);
     }
+    for (const auto& [path, text] : outputs) awcc::check_output_folder(path);
+    for (const auto& [path, text] : outputs) awcc::write_text_atomically(path, text);
+    fmt::print("{}", stdout_text);
   } catch (const std::exception& e) {
     return report_error(e);
   }

@@ -15,6 +15,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/parallel.hpp"
+#include "awcc/units.hpp"
 #include "sweep.hpp"
 #include "terminal.hpp"
 
@@ -144,8 +145,8 @@ int run_sweep(const SweepOptions& o) {
     if (!o.shard.empty()) {
       const auto slash = o.shard.find('/');
       if (slash == std::string::npos) throw std::invalid_argument("--shard: write i/n, e.g. 3/10");
-      shard = std::stoll(o.shard.substr(0, slash));
-      shards = std::stoll(o.shard.substr(slash + 1));
+      shard = awcc::parse_whole(o.shard.substr(0, slash), 0, std::int64_t{1} << 40);
+      shards = awcc::parse_whole(o.shard.substr(slash + 1), 1, std::int64_t{1} << 40);
       if (shards < 1 || shard < 0 || shard >= shards) throw std::invalid_argument("--shard i/n needs 0 <= i < n");
     }
   } catch (const std::exception& e) {

@@ -44,11 +44,16 @@ int run_train(const TrainCommandOptions& o) {
                  t.min_windows);
     Progress progress("training");
     const auto result = correction::train_model(set, t, [&](double f) { progress(f); });
-    result.model.save(o.output);
-    if (!o.predictions.empty()) awcc::write_text_atomically(o.predictions, correction::predictions_csv(result.predictions));
-    if (!o.learning_curve.empty()) awcc::write_text_atomically(o.learning_curve, correction::learning_curve_csv(result.learning_curve));
+    // Every output's folder is checked before any is written.
     const auto report = result.report();
-    if (!o.report.empty()) awcc::write_text_atomically(o.report, report);
+    std::vector<std::pair<std::string, std::string>> texts;
+    if (!o.predictions.empty()) texts.emplace_back(o.predictions, correction::predictions_csv(result.predictions));
+    if (!o.learning_curve.empty()) texts.emplace_back(o.learning_curve, correction::learning_curve_csv(result.learning_curve));
+    if (!o.report.empty()) texts.emplace_back(o.report, report);
+    awcc::check_output_folder(o.output);
+    for (const auto& [path, text] : texts) awcc::check_output_folder(path);
+    result.model.save(o.output);
+    for (const auto& [path, text] : texts) awcc::write_text_atomically(path, text);
     fmt::print("{}", report);
     spdlog::info("{}: written ({:.1f} MB)", o.output, static_cast<double>(std::filesystem::file_size(o.output)) / 1e6);
   } catch (const std::exception& e) {

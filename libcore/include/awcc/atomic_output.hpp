@@ -14,6 +14,10 @@ namespace awcc {
 void write_atomically(const std::filesystem::path& target,
                       const std::function<void(const std::filesystem::path&)>& write);
 
+/// Throws OutputError when the folder `target` would be written into does not
+/// exist (checked before several outputs are written, so that none is).
+void check_output_folder(const std::filesystem::path& target);
+
 /// Writes text to `target` atomically.
 void write_text_atomically(const std::filesystem::path& target, std::string_view text);
 
