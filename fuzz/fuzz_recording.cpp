@@ -2,6 +2,7 @@
 // statistics, FSCC, AWCC) on arbitrary bytes. The first byte picks the
 // container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV),
 // the rest is the file.
+#include "awcc/json_text.hpp"
 #include "awcc/serialise.hpp"
 #include <stdexcept>
 
@@ -26,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.block_frames = 1 + (selector % 7) * 1000;
   try {
     const auto r = awcc::process_recording(path, o);
-    (void)awcc::to_json(r).dump();
+    (void)awcc::json_text(awcc::to_json(r));  // every result can be written
     (void)r.report();
   } catch (const std::runtime_error&) {
   } catch (const std::invalid_argument&) {

@@ -7,6 +7,7 @@
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/json_text.hpp"
 
 namespace correction {
 
@@ -219,7 +220,7 @@ FileCorrection correct_process_json(const CorrectionModel& model, const std::str
     // A value of the wrong type (a string where a number or a boolean belongs).
     throw awcc::InputError(fmt::format("{}: not a JSON written by pdp process ({})", file, e.what()));
   }
-  out.text = j.dump(2) + "\n";
+  out.text = awcc::json_text(j);
   return out;
 }
 

@@ -116,6 +116,11 @@ for o in others:
     assert abs(o["tips"][0]["bubble_count_rate"] / ref["tips"][0]["bubble_count_rate"] - 1) < 1e-9
 PY
 
+# A Latin-1 header (a German 'ä' not in UTF-8) still gives a JSON (the byte replaced).
+{ printf 'Zeit [s];Spitze\xe4 1 [V];Spitze 2 [V]\n'; tail -n +2 "$dir/euro.csv"; } >"$dir/latin1.csv"
+"$pdp" --log-level error process "$dir/latin1.csv" --dx 5mm --json "$dir/latin1.json" >/dev/null || fail "a Latin-1 header"
+py -c "import json; json.load(open('$dir/latin1.json'))" || fail "the JSON of a Latin-1 header is not valid"
+
 # 9. A folder, a README.md, a path with spaces and a file name with a comma among the inputs.
 mkdir -p "$dir/a folder"
 cp "$dir/rec.wav" "$dir/a folder/with space, and comma.wav"

@@ -9,6 +9,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
 #include "awcc/serialise.hpp"
 #include "awcc/units.hpp"
@@ -246,7 +247,7 @@ int run_process(const ProcessCommandOptions& o) {
       }
       // Hashing the inputs costs a read of each: only for the JSON, which records it.
       j["provenance"] = awcc::provenance_json(options, inputs, command_line());
-      outputs.emplace_back(o.json, j.dump(2) + "\n");
+      outputs.emplace_back(o.json, awcc::json_text(j));
     }
     if (!o.windows.empty() && results[0].awcc) outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
     if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/json_text.hpp"
 #include "synth/recording.hpp"
 #include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
@@ -79,7 +80,7 @@ int run_synth(const SynthOptions& options) {
       const auto sidecar = synth::sidecar_path(out);
       awcc::write_atomically(out, [&](const std::filesystem::path& temporary) {
         synth::write_recording(temporary, scene, synthesis.signals, recording);
-        awcc::write_text_atomically(sidecar, synth::sidecar_json(synthesis.truth, recording, out).dump(2) + "\n");
+        awcc::write_text_atomically(sidecar, awcc::json_text(synth::sidecar_json(synthesis.truth, recording, out)));
       });
       spdlog::info("wrote {} and {}", out.string(), sidecar.string());
     }

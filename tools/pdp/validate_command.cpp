@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/json_text.hpp"
 #include "awcc/random.hpp"
 #include "study.hpp"
 #include "terminal.hpp"
@@ -101,7 +102,7 @@ int run_validate(const ValidateOptions& o) {
   }
   if (!o.json.empty()) {
     try {
-      awcc::write_text_atomically(o.json, j.dump(2) + "\n");
+      awcc::write_text_atomically(o.json, awcc::json_text(j));
     } catch (const std::exception& e) {
       return report_error(e);
     }
