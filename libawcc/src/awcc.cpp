@@ -27,7 +27,6 @@ std::string_view to_string(WindowFate fate) {
 
 std::string_view to_string(Weighting weighting) { return weighting == Weighting::duration ? "duration" : "none"; }
 
-std::string_view to_string(CorrelationSignal signal) { return signal == CorrelationSignal::raw ? "raw" : "binary"; }
 
 std::string_view to_string(AwccStatus status) {
   switch (status) {

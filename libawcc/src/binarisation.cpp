@@ -127,6 +127,14 @@ std::vector<std::pair<std::int64_t, std::int64_t>> VoltageHistogram::regroup(dou
   return out;
 }
 
+std::vector<std::pair<double, std::int64_t>> VoltageHistogram::values() const {
+  std::vector<std::pair<double, std::int64_t>> out;
+  for (std::size_t k = 0; k < counts_.size(); ++k) {
+    if (counts_[k]) out.emplace_back(static_cast<double>(offset_ + static_cast<std::int64_t>(k)) * width_, counts_[k]);
+  }
+  return out;
+}
+
 Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions& o) {
   Threshold t;
   t.rule = o.rule;

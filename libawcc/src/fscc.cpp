@@ -1,6 +1,7 @@
 #include "awcc/fscc.hpp"
 
 #include "awcc/detail/fscc_steps.hpp"
+#include "awcc/lagged_pearson.hpp"
 #include "overlap_impulses.hpp"
 
 #include <algorithm>
@@ -172,19 +173,9 @@ class AirPrefix {
   std::vector<std::int64_t> cumulative_;
 };
 
-struct Functions {
-  std::vector<double> r11, r12;
-  std::int64_t k11_min = 0, k12_min = 0;
-  FsccStatus status = FsccStatus::ok;  // ok: the functions exist
-  std::string message;
-};
-
 // Full-record normalised correlations (METHOD 3).
-Functions full_record(const AirIntervals& x, const AirIntervals& y, std::int64_t k11_max, std::int64_t k12_min,
-                      std::int64_t k12_max, FftPlanCache& plans) {
-  Functions f;
-  f.k11_min = 0;
-  f.k12_min = k12_min;
+void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& lags, FftPlanCache& plans,
+                 CorrelationFunctions& f) {
   const std::int64_t n = x.sample_count;
   const double sx = static_cast<double>(x.air_samples()), sy = static_cast<double>(y.air_samples());
   const double mx = sx / static_cast<double>(n), my = sy / static_cast<double>(n);
@@ -193,7 +184,7 @@ Functions full_record(const AirIntervals& x, const AirIntervals& y, std::int64_t
   if (!(qx > 0.0) || !(qy > 0.0)) {
     f.status = qx > 0.0 ? FsccStatus::constant_trailing : FsccStatus::constant_leading;
     f.message = qx > 0.0 ? "the trailing tip's signal is constant (no bubble)" : "the leading tip's signal is constant (no bubble)";
-    return f;
+    return;
   }
   const AirPrefix px(x), py(y);
   auto normalised = [&](const AirIntervals& a, const AirIntervals& b, const AirPrefix& pa, const AirPrefix& pb,
@@ -212,27 +203,32 @@ Functions full_record(const AirIntervals& x, const AirIntervals& y, std::int64_t
     }
     return r;
   };
-  f.r11 = normalised(x, x, px, px, mx, mx, qx, qx, 0, k11_max);
-  f.r12 = normalised(x, y, px, py, mx, my, qx, qy, k12_min, k12_max);
-  return f;
+  f.r11 = normalised(x, x, px, px, mx, mx, qx, qx, 0, lags.r11_last);
+  f.r12 = normalised(x, y, px, py, mx, my, qx, qy, lags.r12_first, lags.r12_last);
+  f.segments_used = 1;
 }
 
-// Felder's segmented Pearson coefficients, averaged over the segments.
-Functions segmented(const AirIntervals& x, const AirIntervals& y, int segments, std::int64_t k11_max,
-                    std::int64_t k12_min, std::int64_t k12_max, FftPlanCache& plans) {
-  Functions f;
-  f.k12_min = k12_min;
+// The window of x in segment [s0, s0 + length) for lags [kmin, kmax]:
+// Felder's B = L - (lags) samples, starting where the most negative lag
+// still reads y inside the segment.
+std::pair<std::int64_t, std::int64_t> segment_window(std::int64_t s0, std::int64_t length, std::int64_t kmin,
+                                                     std::int64_t kmax) {
+  const std::int64_t t0 = s0 + std::max<std::int64_t>(0, -kmin);
+  return {t0, t0 + length - (kmax - kmin + 1)};
+}
+
+// Felder's segmented Pearson coefficients of binary signals, averaged over the segments.
+void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const FsccLags& lags, FftPlanCache& plans,
+               CorrelationFunctions& f) {
   const std::int64_t n = x.sample_count;
   const std::int64_t length = n / segments;
-  f.r11.assign(static_cast<std::size_t>(k11_max + 1), 0.0);
-  f.r12.assign(static_cast<std::size_t>(k12_max - k12_min + 1), 0.0);
+  f.r11.assign(static_cast<std::size_t>(lags.r11_last + 1), 0.0);
+  f.r12.assign(static_cast<std::size_t>(lags.r12_last - lags.r12_first + 1), 0.0);
   int used11 = 0, used12 = 0;
   const AirPrefix px(x), py(y);
-  auto pearson = [&](const AirIntervals& a, const AirIntervals& b, const AirPrefix& pa, const AirPrefix& pb,
-                     std::int64_t s0, std::int64_t kmin,
-                     std::int64_t kmax, std::vector<double>& acc) {
-    const std::int64_t t0 = s0 + std::max<std::int64_t>(0, -kmin);
-    const std::int64_t t1 = s0 + length - std::max<std::int64_t>(0, kmax);
+  auto pearson = [&](const AirIntervals& a, const AirPrefix& pa, const AirPrefix& pb, const AirIntervals& b,
+                     std::int64_t s0, std::int64_t kmin, std::int64_t kmax, std::vector<double>& acc) {
+    const auto [t0, t1] = segment_window(s0, length, kmin, kmax);
     const std::int64_t w = t1 - t0;
     if (w < 2) return false;
     const double wd = static_cast<double>(w);
@@ -253,86 +249,224 @@ Functions segmented(const AirIntervals& x, const AirIntervals& y, int segments, 
   };
   for (int s = 0; s < segments; ++s) {
     const std::int64_t s0 = static_cast<std::int64_t>(s) * length;
-    used11 += pearson(x, x, px, px, s0, 0, k11_max, f.r11);
-    used12 += pearson(x, y, px, py, s0, k12_min, k12_max, f.r12);
+    used11 += pearson(x, px, px, x, s0, 0, lags.r11_last, f.r11);
+    used12 += pearson(x, px, py, y, s0, lags.r12_first, lags.r12_last, f.r12);
   }
   if (used11 == 0 || used12 == 0) {
     f.status = FsccStatus::no_common_segment;
     f.message = "no segment holds bubbles on both tips";
-    return f;
+    return;
   }
   for (auto& v : f.r11) v /= used11;
   for (auto& v : f.r12) v /= used12;
-  return f;
-}
-
-// Lag (in samples, fractional) where r first falls to `level` going from
-// index `from` in direction `step`; empty when it never does.
-std::optional<double> crossing(const std::vector<double>& r, std::size_t from, int step, double level) {
-  std::int64_t i = static_cast<std::int64_t>(from);
-  const auto n = static_cast<std::int64_t>(r.size());
-  while (true) {
-    const std::int64_t next = i + step;
-    if (next < 0 || next >= n) return std::nullopt;
-    const double a = r[static_cast<std::size_t>(i)], b = r[static_cast<std::size_t>(next)];
-    if (b <= level) {
-      const double frac = a == b ? 0.0 : (a - level) / (a - b);
-      return static_cast<double>(i) + step * frac;
-    }
-    i = next;
-  }
-}
-
-// Integral (in samples) of r from index `from` to its first zero, trapezoid rule.
-std::optional<double> integral_to_zero(const std::vector<double>& r, std::size_t from) {
-  double sum = 0.0;
-  for (std::size_t i = from; i + 1 < r.size(); ++i) {
-    if (r[i + 1] <= 0.0) {
-      const double frac = r[i] / (r[i] - r[i + 1]);
-      return sum + 0.5 * r[i] * frac;
-    }
-    sum += 0.5 * (r[i] + r[i + 1]);
-  }
-  return std::nullopt;
+  f.segments_used = std::min(used11, used12);
 }
 
 }  // namespace
 
-FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options) {
+std::string_view to_string(CorrelationSignal signal) { return signal == CorrelationSignal::raw ? "raw" : "binary"; }
+
+FsccLags fscc_lags(std::int64_t samples, double fs, const FsccOptions& options) {
+  FsccLags l;
+  if (options.felder_lags) {
+    l.r11_last = 999;
+    l.r12_first = -199;
+    l.r12_last = 800;
+  } else {
+    l.r11_last = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::llround(options.max_lag * fs)));
+    l.r12_first = -l.r11_last;
+    l.r12_last = l.r11_last;
+  }
+  // Every window keeps at least half of its segment.
+  const std::int64_t limit = std::max<std::int64_t>(1, samples / std::max(1, options.segments) / 4);
+  l.r11_last = std::min(l.r11_last, limit);
+  l.r12_last = std::min(l.r12_last, limit);
+  l.r12_first = std::max(l.r12_first, -limit);
+  return l;
+}
+
+CorrelationFunctions correlation_functions(const AirIntervals& leading, const AirIntervals& trailing,
+                                           const FsccOptions& options) {
   if (const auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   if (leading.sample_count != trailing.sample_count || leading.fs != trailing.fs) {
     throw std::invalid_argument("FSCC needs two signals of the same length and sampling rate");
   }
-  FsccResult out;
-  const double fs = leading.fs;
-  const std::int64_t n = leading.sample_count;
-  std::int64_t k11_max, k12_min, k12_max;
-  if (options.felder_lags) {
-    k11_max = 999;
-    k12_min = -199;
-    k12_max = 800;
-  } else {
-    k11_max = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::llround(options.max_lag * fs)));
-    k12_min = -k11_max;
-    k12_max = k11_max;
-  }
-  const std::int64_t limit = std::max<std::int64_t>(1, n / std::max(1, options.segments) / 2);
-  k11_max = std::min(k11_max, limit);
-  k12_max = std::min(k12_max, limit);
-  k12_min = std::max(k12_min, -limit);
-
+  CorrelationFunctions f;
+  f.fs = leading.fs;
+  f.signal = CorrelationSignal::binary;
+  const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
+  f.r11_first_lag = 0;
+  f.r12_first_lag = lags.r12_first;
   FftPlanCache plans;
-  Functions f = options.segments == 1 ? full_record(leading, trailing, k11_max, k12_min, k12_max, plans)
-                                      : segmented(leading, trailing, options.segments, k11_max, k12_min, k12_max, plans);
+  if (options.segments == 1) full_record(leading, trailing, lags, plans, f);
+  else segmented(leading, trailing, options.segments, lags, plans, f);
+  return f;
+}
+
+// ---- Raw voltages ----
+
+struct RawCorrelation::Segment {
+  LaggedPearson r11, r12;
+};
+
+RawCorrelation::RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options)
+    : samples_(samples), fs_(fs), lags_(fscc_lags(samples, fs, options)), segments_(options.segments) {
+  if (const auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  length_ = samples / segments_;
+  if (length_ - (lags_.r12_last - lags_.r12_first + 1) < 2) {
+    throw std::invalid_argument(fmt::format("{} samples in {} segments leave no correlation window", samples, segments_));
+  }
+  sum11_.assign(static_cast<std::size_t>(lags_.r11_last + 1), 0.0);
+  sum12_.assign(static_cast<std::size_t>(lags_.r12_last - lags_.r12_first + 1), 0.0);
+}
+
+RawCorrelation::~RawCorrelation() = default;
+
+void RawCorrelation::open_segment() {
+  const std::int64_t s0 = static_cast<std::int64_t>(next_) * length_;
+  const auto [a0, a1] = segment_window(s0, length_, 0, lags_.r11_last);
+  const auto [c0, c1] = segment_window(s0, length_, lags_.r12_first, lags_.r12_last);
+  current_ = std::make_unique<Segment>(Segment{LaggedPearson(a0, a1 - a0, 0, lags_.r11_last, plans_),
+                                               LaggedPearson(c0, c1 - c0, lags_.r12_first, lags_.r12_last, plans_)});
+  ++next_;
+}
+
+void RawCorrelation::feed(std::int64_t first, std::span<const double> leading, std::span<const double> trailing) {
+  const std::int64_t end = first + static_cast<std::int64_t>(leading.size());
+  for (;;) {
+    if (!current_) {
+      if (next_ >= segments_) return;
+      // The next segment begins after this block: nothing more in it.
+      if (static_cast<std::int64_t>(next_) * length_ >= end) return;
+      open_segment();
+    }
+    current_->r11.feed(first, leading, leading);
+    current_->r12.feed(first, leading, trailing);
+    if (!(current_->r11.complete() && current_->r12.complete())) return;
+    const auto r11 = current_->r11.coefficients();
+    const auto r12 = current_->r12.coefficients();
+    const bool bad11 = std::any_of(r11.begin(), r11.end(), [](double v) { return std::isnan(v); });
+    const bool bad12 = std::any_of(r12.begin(), r12.end(), [](double v) { return std::isnan(v); });
+    if (!bad11) constant_leading_ = false;
+    if (!bad12) constant_trailing_ = false;
+    if (!bad11 && !bad12) {
+      for (std::size_t j = 0; j < r11.size(); ++j) sum11_[j] += r11[j];
+      for (std::size_t j = 0; j < r12.size(); ++j) sum12_[j] += r12[j];
+      ++used_;
+    }
+    current_.reset();
+  }
+}
+
+CorrelationFunctions RawCorrelation::finish() {
+  if (current_ || next_ < segments_) {
+    throw std::logic_error(fmt::format("RawCorrelation: {} of {} segments were fed", next_ - (current_ ? 1 : 0), segments_));
+  }
+  CorrelationFunctions f;
+  f.fs = fs_;
+  f.signal = CorrelationSignal::raw;
+  f.r11_first_lag = 0;
+  f.r12_first_lag = lags_.r12_first;
+  f.segments_used = used_;
+  if (used_ == 0) {
+    f.status = constant_leading_ ? FsccStatus::constant_leading
+                                 : (constant_trailing_ ? FsccStatus::constant_trailing : FsccStatus::no_common_segment);
+    f.message = constant_leading_ ? "the leading tip's voltage is constant in every segment"
+                                  : (constant_trailing_ ? "the trailing tip's voltage is constant in every segment"
+                                                        : "no segment holds a varying voltage on both tips");
+    return f;
+  }
+  f.r11 = sum11_;
+  f.r12 = sum12_;
+  for (auto& v : f.r11) v /= used_;
+  for (auto& v : f.r12) v /= used_;
+  return f;
+}
+
+// ---- Scales ----
+
+namespace {
+
+float fl32(double v) { return static_cast<float>(v); }
+
+// Lag times of the functions' indices: k / fs, or Felder's float32 times.
+struct LagTimes {
+  double fs;
+  std::int64_t first;
+  bool felder;
+  double operator()(std::size_t j) const {
+    if (!felder) return static_cast<double>(first + static_cast<std::int64_t>(j)) / fs;
+    const float f = fl32(fs);
+    if (first == 0) return fl32(static_cast<float>(j) / f);
+    return fl32(fl32(static_cast<float>(first) / f) + fl32(static_cast<float>(j) / f));
+  }
+};
+
+// The first index i >= from with r[i] <= level, and the lag time there
+// (exact when equal, else linear between i - 1 and i).
+struct Reached {
+  std::size_t index;
+  double time;
+};
+std::optional<Reached> first_at_or_below(const std::vector<double>& r, std::size_t from, double level,
+                                         const LagTimes& tau) {
+  for (std::size_t i = from; i < r.size(); ++i) {
+    if (!(r[i] <= level)) continue;
+    if (r[i] == level || i == 0) return Reached{i, tau(i)};
+    const double t0 = tau(i - 1), t1 = tau(i);
+    return Reached{i, t0 + (t1 - t0) * (level - r[i - 1]) / (r[i] - r[i - 1])};
+  }
+  return std::nullopt;
+}
+
+// The minimum of r over [from, end) (Felder: also bounded by `cap`, the first
+// index within 1e-5 of it, and the last lag left out).
+std::pair<std::size_t, double> minimum(const std::vector<double>& r, std::size_t from, double cap, bool felder) {
+  const std::size_t end = felder ? r.size() - 1 : r.size();
+  double m = felder ? cap : r[from];
+  for (std::size_t i = from; i < end; ++i) m = std::min(m, r[i]);
+  for (std::size_t i = from; i < end; ++i) {
+    if (felder ? r[i] - m < 1e-5 : r[i] == m) return {i, m};
+  }
+  return {from, m};
+}
+
+// Trapezoid integral of r, in s, from index `from`: to the interpolated zero
+// crossing (`zero`), or to index `to`. Felder: whole trapezoids up to and
+// including the one that starts at `to` (one lag past), the thousandth lag
+// taken as r / fs.
+double integral(const std::vector<double>& r, std::size_t from, std::size_t to, std::optional<double> zero_fraction,
+                double fs, bool felder) {
+  double sum = 0.0;
+  if (felder) {
+    for (std::size_t i = from; i <= to && i < r.size(); ++i) {
+      sum += (i + 1 == 1000 || i + 1 >= r.size()) ? r[i] / fs : (r[i] + r[i + 1]) / (2.0 * fs);
+    }
+    return sum;
+  }
+  for (std::size_t i = from; i < to; ++i) sum += 0.5 * (r[i] + r[i + 1]);
+  if (zero_fraction) sum += 0.5 * r[to] * *zero_fraction;  // triangle to the zero after `to`
+  return sum / fs;
+}
+
+}  // namespace
+
+FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOptions& options) {
+  FsccResult out;
+  const double fs = f.fs;
+  out.signal = f.signal;
+  out.segments_used = f.segments_used;
   out.r11 = std::move(f.r11);
   out.r12 = std::move(f.r12);
-  out.r11_first_lag = f.k11_min;
-  out.r12_first_lag = f.k12_min;
+  out.r11_first_lag = f.r11_first_lag;
+  out.r12_first_lag = f.r12_first_lag;
   if (f.status != FsccStatus::ok) {
     out.status = f.status;
     out.message = f.message;
     return out;
   }
+  const bool felder = options.felder_scales;
+  const LagTimes tau11{fs, 0, felder}, tau12{fs, out.r12_first_lag, felder};
   // Peak: the maximum (first occurrence), or Felder's first lag within 1e-5 of it.
   const auto max_it = std::max_element(out.r12.begin(), out.r12.end());
   std::size_t peak = static_cast<std::size_t>(max_it - out.r12.begin());
@@ -345,14 +479,15 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     }
   }
   out.r12_max = out.r12[peak];
-  out.lag_samples = f.k12_min + static_cast<std::int64_t>(peak);
-  double lag = static_cast<double>(out.lag_samples);
+  out.lag_samples = out.r12_first_lag + static_cast<std::int64_t>(peak);
+  double lag = static_cast<double>(out.lag_samples) / fs;
+  if (felder) lag = tau12(peak);
   if (options.subsample == Subsample::parabolic && peak > 0 && peak + 1 < out.r12.size()) {
     const double a = out.r12[peak - 1], b = out.r12[peak], c = out.r12[peak + 1];
     const double denom = a - 2 * b + c;
-    if (denom < 0.0) lag += 0.5 * (a - c) / denom;
+    if (denom < 0.0) lag += 0.5 * (a - c) / denom / fs;
   }
-  out.lag = lag / fs;
+  out.lag = lag;
   if (!(out.r12_max > 0.0)) {
     out.status = FsccStatus::no_positive_peak;
     out.message = "the cross-correlation has no positive peak: the tips' signals are unrelated";
@@ -361,7 +496,7 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     out.message = fmt::format("the cross-correlation peaks at lag {} samples (not positive): no physical velocity; "
                               "check the tip order",
                               out.lag_samples);
-  } else if (out.lag_samples == f.k12_min + static_cast<std::int64_t>(out.r12.size()) - 1) {
+  } else if (out.lag_samples == out.r12_first_lag + static_cast<std::int64_t>(out.r12.size()) - 1) {
     out.status = FsccStatus::peak_at_lag_range_end;
     out.message = "the cross-correlation peaks at the end of the lag range: the delay lies beyond the lags searched, "
                   "or dx's unit or the sampling rate is wrong; check them, or widen the lag range";
@@ -370,36 +505,79 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     out.message = "no tip separation given: the velocity cannot be computed";
   } else {
     out.status = FsccStatus::ok;
-    out.velocity = dx / out.lag;
+    // Felder: V = fl32(dx in mm / 1000) / T_max.
+    out.velocity = felder ? static_cast<double>(fl32(static_cast<double>(fl32(dx * 1e3)) / 1000.0)) / out.lag
+                          : dx / out.lag;
     if (out.velocity > 100.0) {
       out.warnings.push_back(fmt::format("FSCC velocity {:.4g} m/s is above 100 m/s, beyond air-water flows: check dx's "
                                          "unit, the sampling rate and the lag range",
                                          out.velocity));
     }
   }
-  // Time scales.
-  std::string notes;
-  if (auto k = crossing(out.r11, 0, +1, 0.5)) out.t05 = *k / fs;
-  else notes += "R11 never falls to 0.5 within the lags searched; ";
-  if (auto i = integral_to_zero(out.r11, 0)) out.txx = *i / fs;
+  auto missing = [&](const char* name, std::string why) { out.scale_notes.emplace_back(name, std::move(why)); };
+  const std::string lags11 = fmt::format("lags 0 to {}", out.r11.size() - 1);
+  const std::string lags12 =
+      fmt::format("lags up to {}", out.r12_first_lag + static_cast<std::int64_t>(out.r12.size()) - 1);
+  // Auto-correlation scales.
+  if (const auto half = first_at_or_below(out.r11, 0, 0.5, tau11)) out.t05 = half->time;
+  else missing("t05", "R11 stays above 0.5 within " + lags11);
+  std::size_t r11_end = 0;
+  std::optional<double> r11_fraction;
+  if (const auto zero = first_at_or_below(out.r11, 0, 0.0, tau11)) {
+    out.t_r11_zero = out.t_r11_min = zero->time;
+    out.r11_min = 0.0;
+    r11_end = felder ? zero->index : zero->index - 1;
+    if (!felder) r11_fraction = out.r11[zero->index - 1] / (out.r11[zero->index - 1] - out.r11[zero->index]);
+  } else {
+    // Felder integrates to the minimum instead; the default leaves Txx
+    // empty rather than report an integral cut short by the lag range.
+    missing("t_r11_zero", "R11 stays above 0 within " + lags11);
+    if (!felder) missing("txx", "R11 does not reach 0 within " + lags11);
+    const auto [i, m] = minimum(out.r11, 0, 1.0, felder);
+    out.r11_min = m;
+    out.t_r11_min = tau11(i);
+    r11_end = i;
+  }
+  if (out.t_r11_zero || felder) out.txx = integral(out.r11, 0, r11_end, r11_fraction, fs, felder);
+  // Cross-correlation scales, right of the peak.
   if (out.r12_max > 0.0) {
-    const auto right = crossing(out.r12, peak, +1, 0.5 * out.r12_max);
-    const auto left = crossing(out.r12, peak, -1, 0.5 * out.r12_max);
-    if (right && left) out.tau05 = 0.5 * (*right - *left) / fs;
-    else if (right) out.tau05 = (*right - static_cast<double>(peak)) / fs;
-    else if (left) out.tau05 = (static_cast<double>(peak) - *left) / fs;
-    if (auto i = integral_to_zero(out.r12, peak)) out.txy = *i / fs;
-  }
-  if (out.ok() && out.t05 && out.tau05) {
-    if (*out.tau05 > *out.t05) {
-      out.turbulence_intensity_chanson = 0.851 * std::sqrt(*out.tau05 * *out.tau05 - *out.t05 * *out.t05) / out.lag;
+    if (const auto half = first_at_or_below(out.r12, peak, 0.5 * out.r12_max, tau12)) {
+      out.t_half = half->time;
+      out.tau05 = half->time - tau12(peak);
     } else {
-      notes += "tau05 <= T05: Chanson's turbulence intensity is undefined; ";
+      missing("tau05", "R12 stays above R12max / 2 right of its peak within " + lags12);
     }
+    std::size_t r12_end = peak;
+    std::optional<double> r12_fraction;
+    if (const auto zero = first_at_or_below(out.r12, peak, 0.0, tau12)) {
+      out.t_r12_zero = out.t_r12_min = zero->time;
+      out.r12_min = 0.0;
+      r12_end = felder ? zero->index : zero->index - 1;
+      if (!felder) r12_fraction = out.r12[zero->index - 1] / (out.r12[zero->index - 1] - out.r12[zero->index]);
+    } else {
+      missing("t_r12_zero", "R12 stays above 0 right of its peak within " + lags12);
+      if (!felder) missing("txy", "R12 does not reach 0 right of its peak within " + lags12);
+      const auto [i, m] = minimum(out.r12, peak, out.r12_max, felder);
+      out.r12_min = m;
+      out.t_r12_min = tau12(i);
+      r12_end = i;
+    }
+    if (out.t_r12_zero || felder) out.txy = integral(out.r12, peak, r12_end, r12_fraction, fs, felder);
+  } else {
+    missing("tau05", "R12 has no positive peak");
   }
-  if (!notes.empty()) notes.resize(notes.size() - 2);
-  out.note = notes;
+  if (out.t05 && out.tau05 && out.lag > 0.0) {
+    const double radicand = *out.tau05 * *out.tau05 - *out.t05 * *out.t05;
+    if (radicand >= 0.0) out.turbulence_intensity_chanson = 0.851 * std::sqrt(radicand) / out.lag;
+    else missing("turbulence_intensity_chanson", "tau05 < T05: Chanson's turbulence intensity is undefined");
+  }
+  if (!out.ok()) out.turbulence_intensity_chanson.reset();
+  for (const auto& [name, why] : out.scale_notes) out.note += (out.note.empty() ? "" : "; ") + why;
   return out;
+}
+
+FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options) {
+  return fscc_from_functions(correlation_functions(leading, trailing, options), dx, options);
 }
 
 }  // namespace awcc

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "awcc/csv.hpp"
 #include "awcc/units.hpp"
 
 namespace awcc {
@@ -170,6 +171,84 @@ const OptionField<F> kFscc[] = {
     {"felder-lags", "", "Felder's program: auto lags 0..999, cross lags -199..800 samples, first peak within 1e-5",
      [](F& o, std::string_view t) { o.felder_lags = on_off(t); },
      [](const F& o) { return std::string(o.felder_lags ? "on" : "off"); }, true},
+    {"felder-scales", "",
+     "Felder's program's time-scale rules: float32 lag times, first minimum within 1e-5, Txx and Txy one lag past "
+     "the zero or to the minimum",
+     [](F& o, std::string_view t) { o.felder_scales = on_off(t); },
+     [](const F& o) { return std::string(o.felder_scales ? "on" : "off"); }, true},
+};
+
+std::vector<double> quantity_list(std::string_view text, Dimension d, const char* example) {
+  std::vector<double> out;
+  for (const auto& cell : split_cells(text)) out.push_back(quantity(cell, d));
+  if (out.empty()) throw std::invalid_argument(fmt::format("write the limits separated by commas, e.g. {}", example));
+  return out;
+}
+
+std::string format_list(const std::vector<double>& values, Dimension d) {
+  std::string out;
+  for (double v : values) out += (out.empty() ? "" : ",") + format_quantity(v, d);
+  return out;
+}
+
+using S = StructureOptions;
+const OptionField<S> kStructure[] = {
+    {"structure", "", "chord and voltage PDFs, clusters and inter-particle arrivals: on | off",
+     [](S& o, std::string_view t) { o.enabled = on_off(t); },
+     [](const S& o) { return std::string(o.enabled ? "on" : "off"); }},
+    {"felder-defects", "",
+     "Felder's program's chord, cluster and arrival conventions and defects (to reproduce his printed numbers; "
+     "docs/output.md lists them)",
+     [](S& o, std::string_view t) { o.felder_defects = on_off(t); },
+     [](const S& o) { return std::string(o.felder_defects ? "on" : "off"); }, true},
+    {"voltage-pdf-bin", "V", "bin width of the voltage PDF of each tip",
+     [](S& o, std::string_view t) { o.voltage_bin = quantity(t, Dimension::voltage); },
+     [](const S& o) { return format_quantity(o.voltage_bin, Dimension::voltage); }},
+    {"chord-time-bin", "s", "bin width of the chord-time PDF",
+     [](S& o, std::string_view t) { o.chord_time.bin_width = quantity(t, Dimension::time); },
+     [](const S& o) { return format_quantity(o.chord_time.bin_width, Dimension::time); }},
+    {"chord-time-max", "s", "upper end of the chord-time PDF (longer chords: the overflow bin)",
+     [](S& o, std::string_view t) { o.chord_time.max = quantity(t, Dimension::time); },
+     [](const S& o) { return format_quantity(o.chord_time.max, Dimension::time); }},
+    {"chord-length-bin", "m", "bin width of the chord-length PDF",
+     [](S& o, std::string_view t) { o.chord_length.bin_width = quantity(t, Dimension::length); },
+     [](const S& o) { return format_quantity(o.chord_length.bin_width, Dimension::length); }},
+    {"chord-length-max", "m", "upper end of the chord-length PDF (longer chords: the overflow bin)",
+     [](S& o, std::string_view t) { o.chord_length.max = quantity(t, Dimension::length); },
+     [](const S& o) { return format_quantity(o.chord_length.max, Dimension::length); }},
+    {"cluster-median-fraction", "-", "median cluster criterion: fraction of the median separation (Chanson's 0.1)",
+     [](S& o, std::string_view t) { o.clusters.median_fraction = quantity(t, Dimension::dimensionless); },
+     [](const S& o) { return fmt::format("{:g}", o.clusters.median_fraction); }},
+    {"cluster-constant-length", "m", "constant cluster criterion on chord lengths",
+     [](S& o, std::string_view t) { o.clusters.constant_length = quantity(t, Dimension::length); },
+     [](const S& o) { return format_quantity(o.clusters.constant_length, Dimension::length); }},
+    {"cluster-constant-time", "s", "constant cluster criterion on chord times",
+     [](S& o, std::string_view t) { o.clusters.constant_time = quantity(t, Dimension::time); },
+     [](const S& o) { return format_quantity(o.clusters.constant_time, Dimension::time); }},
+    {"arrival-bin", "s", "bin width of the inter-particle arrival-time histograms",
+     [](S& o, std::string_view t) { o.arrivals.bin_width = quantity(t, Dimension::time); },
+     [](const S& o) { return format_quantity(o.arrivals.bin_width, Dimension::time); }},
+    {"arrival-bins", "-", "bins of the arrival-time histograms before the overflow bin",
+     [](S& o, std::string_view t) { o.arrivals.bins = static_cast<int>(whole(t, 1, 1000000)); },
+     [](const S& o) { return std::to_string(o.arrivals.bins); }},
+    {"arrival-length-classes", "m", "upper limits of the particle size classes by chord length (a last class takes the rest)",
+     [](S& o, std::string_view t) { o.arrivals.length_classes = quantity_list(t, Dimension::length, "1mm,3mm,6mm,10mm"); },
+     [](const S& o) { return format_list(o.arrivals.length_classes, Dimension::length); }},
+    {"arrival-time-classes", "s", "upper limits of the particle size classes by chord time (a last class takes the rest)",
+     [](S& o, std::string_view t) { o.arrivals.time_classes = quantity_list(t, Dimension::time, "0.5ms,1.5ms,3ms,5ms"); },
+     [](const S& o) { return format_list(o.arrivals.time_classes, Dimension::time); }},
+};
+
+// Felder's program (felder-program.md): his threshold rule, 15 segments of
+// raw voltages, his lags and scale rules, his chord, cluster and arrival
+// conventions; he had no AWCC.
+constexpr PresetSetting kFelder[] = {
+    {"threshold-rule", "felder"},  {"threshold", "0.5"},        {"segments", "15"},
+    {"felder-lags", "on"},         {"felder-scales", "on"},      {"correlate", "raw"},
+    {"method", "fscc"},            {"felder-defects", "on"},     {"voltage-pdf-bin", "0.1V"},
+    {"chord-time-bin", "0.1ms"},   {"chord-time-max", "10ms"},   {"chord-length-bin", "0.5mm"},
+    {"chord-length-max", "20mm"},  {"cluster-median-fraction", "0.1"}, {"cluster-constant-length", "1mm"},
+    {"cluster-constant-time", "1ms"},
 };
 
 using A = AwccOptions;
@@ -188,7 +267,7 @@ const OptionField<A> kAwcc[] = {
     {"weighting", "", "AWCC moments: duration (window-duration weights, Buchhave 1979) | none",
      [](A& o, std::string_view t) { o.weighting = choice(t, kWeightings); },
      [](const A& o) { return name_of(o.weighting, kWeightings); }},
-    {"correlate", "", "AWCC correlates the binarised signals or the raw voltages: binary | raw",
+    {"correlate", "", "FSCC and AWCC correlate the binarised signals or the raw voltages (Felder's and Chanson's practice): binary | raw",
      [](A& o, std::string_view t) { o.signal = choice(t, kSignals); },
      [](const A& o) { return name_of(o.signal, kSignals); }},
     {"velocity-range", "m/s", "AWCC lags searched from a velocity range 'min,max' (e.g. 0.5m/s,20m/s); default all lags",
@@ -256,5 +335,11 @@ std::span<const OptionField<BinarisationOptions>> binarisation_option_fields() {
 std::span<const OptionField<FsccOptions>> fscc_option_fields() { return kFscc; }
 std::span<const OptionField<AwccOptions>> awcc_option_fields() { return kAwcc; }
 std::span<const OptionField<ProcessOptions>> process_option_fields() { return kProcess; }
+std::span<const OptionField<StructureOptions>> structure_option_fields() { return kStructure; }
+
+std::span<const PresetSetting> preset_settings(std::string_view name) {
+  if (name == "felder") return kFelder;
+  throw std::invalid_argument(fmt::format("'{}' is not a preset; the presets are: felder", name));
+}
 
 }  // namespace awcc

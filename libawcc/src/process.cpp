@@ -19,6 +19,7 @@ std::string ProcessOptions::validate() const {
   if (auto why = binarisation.validate(); !why.empty()) return why;
   if (auto why = fscc_options.validate(); !why.empty()) return why;
   if (auto why = awcc_options.validate(); !why.empty()) return why;
+  if (auto why = structure.validate(); !why.empty()) return why;
   if (block_frames < 1) return "block_frames must be >= 1";
   if (!allow_unusual) return implausible();
   return {};
@@ -70,6 +71,8 @@ void binarise_two_pass(Recording& recording, const ProcessOptions& options, cons
   if (frames == 0) throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
   out.leading_threshold = choose_threshold(h_lead, bopt);
   out.trailing_threshold = choose_threshold(h_trail, bopt);
+  out.leading_histogram = std::move(h_lead);
+  out.trailing_histogram = std::move(h_trail);
   recording.rewind();
   Binariser b_lead(out.leading_threshold, recording.info().fs), b_trail(out.trailing_threshold, recording.info().fs);
   for (;;) {
@@ -277,8 +280,10 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
           trail.feed(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail);
           n = recording->read_int16(block, options.block_frames);
         }
-        out.leading_threshold = choose_threshold(lead.histogram(info.quantum), bopt);
-        out.trailing_threshold = choose_threshold(trail.histogram(info.quantum), bopt);
+        out.leading_histogram = lead.histogram(info.quantum);
+        out.trailing_histogram = trail.histogram(info.quantum);
+        out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
+        out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt);
         if (lead.covers(out.leading_threshold, info.quantum) && trail.covers(out.trailing_threshold, info.quantum)) {
           out.leading = lead.resolve(out.leading_threshold, info.quantum, info.fs);
           out.trailing = trail.resolve(out.trailing_threshold, info.quantum, info.fs);
@@ -325,6 +330,30 @@ void apply_tip_order(ProcessResult& r) {
 
 }  // namespace
 
+namespace {
+
+// The structure outputs need the velocity of the chord lengths, known once
+// every correlation has run. Felder's conventions use his FSCC velocity.
+void add_structure(ProcessResult& out, const BinarisedRecording& b, const ProcessOptions& options) {
+  if (!options.structure.enabled) return;
+  std::optional<double> velocity = out.velocity();
+  std::string source(to_string(out.velocity_source()));
+  if (options.structure.felder_defects) {
+    velocity.reset();
+    source = "none";
+    if (out.fscc && out.fscc->ok()) {
+      velocity = out.fscc->velocity;
+      source = "fscc";
+    }
+  }
+  out.structure = analyse_structure(b.leading, b.trailing, out.tips.at(0).phase.void_fraction,
+                                    b.leading_histogram ? &*b.leading_histogram : nullptr,
+                                    b.trailing_histogram ? &*b.trailing_histogram : nullptr, velocity, source,
+                                    options.structure);
+}
+
+}  // namespace
+
 std::optional<double> ProcessResult::velocity() const {
   const auto s = velocity_source();
   if (s == VelocitySource::awcc) return awcc->velocity;
@@ -353,12 +382,15 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   out.info = r.info;
   out.dx = options.dx;
   out.dy = options.dy;
-  if (options.fscc) out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options);
+  if (options.fscc && options.awcc_options.signal == CorrelationSignal::binary) {
+    out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options);
+  }
   if (options.awcc && options.awcc_options.signal == CorrelationSignal::binary) {
     out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);
   }
   apply_tip_order(out);
   out.tips = tip_results(r, options, out.velocity());
+  if (options.awcc_options.signal == CorrelationSignal::binary) add_structure(out, r, options);
   return out;
 }
 
@@ -432,14 +464,46 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
   return result;
 }
 
+FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
+  auto recording = open_recording(path, options.reader);
+  const auto stride = static_cast<std::size_t>(recording->info().channels);
+  const auto lead = static_cast<std::size_t>(options.leading_channel);
+  const auto trail = static_cast<std::size_t>(options.trailing_channel);
+  RawCorrelation correlation(b.info.frames, b.info.fs, options.fscc_options);
+  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
+  std::vector<double> xs, ys;
+  std::int64_t position = 0;
+  for (;;) {
+    const std::int64_t n = recording->read(block, options.block_frames);
+    if (n == 0) break;
+    xs.resize(static_cast<std::size_t>(n));
+    ys.resize(static_cast<std::size_t>(n));
+    for (std::size_t f = 0; f < static_cast<std::size_t>(n); ++f) {
+      xs[f] = block[f * stride + lead];
+      ys[f] = block[f * stride + trail];
+    }
+    correlation.feed(position, xs, ys);
+    position += n;
+  }
+  if (position != b.info.frames) {
+    throw InputError(fmt::format("{}: reading it again for FSCC gave {} frames instead of {}; the file changed while "
+                                 "being read",
+                                 path.string(), position, b.info.frames));
+  }
+  return fscc_from_functions(correlation.finish(), options.dx, options.fscc_options);
+}
+
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const auto binarised = binarise_recording(path, options);
   ProcessResult out = process_binarised(binarised, options);
-  if (options.awcc && options.awcc_options.signal == CorrelationSignal::raw) {
-    out.awcc = awcc_raw(path, binarised, options);
+  const bool raw = options.awcc_options.signal == CorrelationSignal::raw;
+  if (options.fscc && raw) out.fscc = fscc_raw(path, binarised, options);
+  if (options.awcc && raw) out.awcc = awcc_raw(path, binarised, options);
+  if (raw) {
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
+    add_structure(out, binarised, options);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -60,6 +60,7 @@ json options_json(const ProcessOptions& o) {
   add_options(out, binarisation_option_fields(), o.binarisation);
   add_options(out, fscc_option_fields(), o.fscc_options);
   add_options(out, awcc_option_fields(), o.awcc_options);
+  add_options(out, structure_option_fields(), o.structure);
   return out;
 }
 
@@ -93,6 +94,94 @@ json to_json(const AwccOptions& o) {
               {"prominence_fraction", o.prominence_fraction},
               {"velocity_min", optional(o.velocity_min)},
               {"velocity_max", optional(o.velocity_max)}};
+}
+
+namespace {
+
+json optional_array(const std::optional<std::array<double, 20>>& a) { return a ? json(*a) : json(nullptr); }
+
+json to_json(const ChordPdf& p) {
+  std::vector<double> lower;
+  for (std::size_t k = 0; k < p.air_counts.size(); ++k) lower.push_back(p.lower_edge(k));
+  return json{{"basis", to_string(p.basis)},   {"bin_width", p.bin_width},       {"max", p.max},
+              {"air_chords", p.air_chords},     {"water_chords", p.water_chords}, {"lower_edges", lower},
+              {"air_counts", p.air_counts},     {"air_fraction", p.air_fraction}, {"water_counts", p.water_counts},
+              {"water_fraction", p.water_fraction}};
+}
+
+json to_json(const VoltagePdf& p) {
+  return json{{"lower", p.lower}, {"upper", p.upper}, {"fraction", p.fraction}, {"samples", p.samples}};
+}
+
+json to_json(const ClusterAnalysis& c) {
+  json criteria = json::object();
+  for (const auto& s : c.criteria) {
+    criteria[std::string(to_string(s.criterion))] = json{
+        {"criterion_value", optional(s.criterion_value)},
+        {"n_particles", s.particles},
+        {"n_in_clusters", s.in_clusters},
+        {"pct_in_clusters", s.percent_in_clusters},
+        {"n_clusters", s.clusters},
+        {"clusters_per_s", s.clusters_per_second},
+        {"mean_particles_per_cluster", optional(s.mean_particles_per_cluster)},
+        {"mean_chord_in_cluster", optional(s.mean_chord_in_cluster)},
+        {"ratio_cluster_chord_to_mean_chord", optional(s.ratio_cluster_chord_to_mean_chord)},
+        {"ratio_lead_to_cluster_mean_chord", optional(s.ratio_lead_to_cluster_mean_chord)},
+        {"size_counts", s.size_counts},
+        {"size_pdf", optional_array(s.size_pdf)},
+    };
+  }
+  return json{{"status", to_string(c.status)},
+              {"reason", c.message.empty() ? json(nullptr) : json(c.message)},
+              {"regime", to_string(c.regime)},
+              {"basis", to_string(c.basis)},
+              {"criteria", criteria}};
+}
+
+json to_json(const ArrivalAnalysis& a) {
+  json classes = json::array();
+  for (const auto& c : a.classes) {
+    classes.push_back(json{{"lower", optional(c.lower)},
+                           {"upper", optional(c.upper)},
+                           {"particles", c.particles},
+                           {"intervals", c.intervals},
+                           {"counts", c.counts},
+                           {"pdf", c.pdf.empty() ? json(nullptr) : json(c.pdf)},
+                           {"reference", c.reference.empty() ? json(nullptr) : json(c.reference)},
+                           {"excess_first_bin", optional(c.excess_first_bin)},
+                           {"excess_first_bin_se", optional(c.excess_first_bin_se)}});
+  }
+  return json{{"status", to_string(a.status)},
+              {"reason", a.message.empty() ? json(nullptr) : json(a.message)},
+              {"regime", to_string(a.regime)},
+              {"basis", to_string(a.basis)},
+              {"bin_width", a.bin_width},
+              {"classes", classes}};
+}
+
+}  // namespace
+
+json felder_counts(const StructureResult& r) {
+  if (!r.felder_counts) return nullptr;
+  json tips = json::array();
+  for (const auto& c : *r.felder_counts) {
+    tips.push_back(json{{"void_fraction", c.void_fraction}, {"bubble_count_rate", c.bubble_count_rate}, {"bubbles", c.bubbles}});
+  }
+  return tips;
+}
+
+json to_json(const StructureResult& r) {
+  auto volts = [](const std::optional<VoltagePdf>& p) { return p ? to_json(*p) : json(nullptr); };
+  return json{{"conventions", r.felder_defects ? "felder" : "default"},
+              {"bubbles_used", r.bubbles_used},
+              {"chord_velocity", optional(r.velocity)},
+              {"chord_velocity_source", r.velocity_source},
+              {"voltage_pdf", json{{"leading", volts(r.voltage_leading)}, {"trailing", volts(r.voltage_trailing)}}},
+              {"chord_time_pdf", to_json(r.chord_time)},
+              {"chord_length_pdf", r.chord_length ? to_json(*r.chord_length) : json(nullptr)},
+              {"clusters", json{{"time", to_json(r.clusters_time)}, {"length", to_json(r.clusters_length)}}},
+              {"arrivals", json{{"time", to_json(r.arrivals_time)}, {"length", to_json(r.arrivals_length)}}},
+              {"felder_counts", felder_counts(r)}};
 }
 
 json to_json(const ProcessResult& r) {
@@ -158,8 +247,21 @@ json to_json(const ProcessResult& r) {
         {"turbulence_intensity_chanson", optional(f.turbulence_intensity_chanson)},
         {"note", f.note.empty() ? json(nullptr) : json(f.note)},
         {"warnings", f.warnings},
+        {"signal", to_string(f.signal)},
+        {"segments_used", f.segments_used},
+        {"t_r11_zero", optional(f.t_r11_zero)},
+        {"t_r11_min", optional(f.t_r11_min)},
+        {"r11_min", optional(f.r11_min)},
+        {"t_half", optional(f.t_half)},
+        {"t_r12_zero", optional(f.t_r12_zero)},
+        {"t_r12_min", optional(f.t_r12_min)},
+        {"r12_min", optional(f.r12_min)},
     };
+    json notes = json::object();
+    for (const auto& [name, why] : f.scale_notes) notes[name] = why;
+    out["fscc"]["scale_notes"] = notes;
   }
+  if (r.structure) out["structure"] = to_json(*r.structure);
   if (r.awcc) {
     const auto& a = *r.awcc;
     auto value = [&](double v) { return a.ok() ? json(v) : json(nullptr); };
@@ -259,6 +361,114 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   }
   out += "," + csv_cell(warnings);
   return out;
+}
+
+std::string correlation_functions_csv(const std::vector<const ProcessResult*>& results) {
+  std::string out = "file,lag_s,r11,r12\n";
+  for (const auto* r : results) {
+    if (!r->fscc) continue;
+    const auto& f = *r->fscc;
+    const auto n11 = static_cast<std::int64_t>(f.r11.size()), n12 = static_cast<std::int64_t>(f.r12.size());
+    if (n11 == 0 && n12 == 0) continue;
+    const std::int64_t first = std::min(f.r11_first_lag, f.r12_first_lag);
+    const std::int64_t last = std::max(f.r11_first_lag + n11, f.r12_first_lag + n12) - 1;
+    const std::string file = csv_cell(r->info.path.filename().string());
+    for (std::int64_t k = first; k <= last; ++k) {
+      auto cell = [k](const std::vector<double>& v, std::int64_t k0) {
+        const std::int64_t j = k - k0;
+        // Shortest text that reads back as the same double: the functions are compared digit for digit.
+        return j >= 0 && j < static_cast<std::int64_t>(v.size()) ? fmt::format("{}", v[static_cast<std::size_t>(j)])
+                                                                 : std::string();
+      };
+      out += fmt::format("{},{},{},{}\n", file, csv_number(static_cast<double>(k) / r->info.fs), cell(f.r11, f.r11_first_lag),
+                         cell(f.r12, f.r12_first_lag));
+    }
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> structure_csv_tables(
+    const std::vector<const ProcessResult*>& results, const std::vector<std::optional<double>>& positions) {
+  std::string voltage = "file,position,tip,v_lower_V,v_upper_V,fraction\n";
+  std::string chords = "file,position,basis,unit,bin_lower,bin_upper,air_count,air_fraction,water_count,water_fraction\n";
+  std::string clusters =
+      "file,position,basis,unit,regime,status,criterion,criterion_value,n_particles,n_in_clusters,pct_in_clusters,"
+      "n_clusters,clusters_per_s,mean_particles_per_cluster,mean_chord_in_cluster,ratio_cluster_chord_to_mean_chord,"
+      "ratio_lead_to_cluster_mean_chord,reason\n";
+  std::string sizes = "file,position,basis,criterion,particles,count,fraction\n";
+  std::string classes =
+      "file,position,basis,unit,regime,status,class_lower,class_upper,particles,intervals,excess_first_bin,"
+      "excess_first_bin_se,reason\n";
+  std::string arrivals = "file,position,basis,class_lower,class_upper,bin_lower_s,bin_upper_s,count,pdf,reference\n";
+  auto unit = [](ChordBasis b) { return b == ChordBasis::length ? "m" : "s"; };
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto* r = results[i];
+    if (!r->structure) continue;
+    const auto& s = *r->structure;
+    const std::string where = fmt::format("{},{}", csv_cell(r->info.path.filename().string()), csv_number(positions[i]));
+    for (const auto& [tip, pdf] : {std::pair{"leading", &s.voltage_leading}, std::pair{"trailing", &s.voltage_trailing}}) {
+      if (!*pdf) continue;
+      const auto& p = **pdf;
+      for (std::size_t k = 0; k < p.fraction.size(); ++k) {
+        voltage += fmt::format("{},{},{},{},{}\n", where, tip, std::isfinite(p.lower[k]) ? csv_number(p.lower[k]) : std::string(),
+                               csv_number(p.upper[k]), csv_number(p.fraction[k]));
+      }
+    }
+    for (const auto* pdf : {&s.chord_time, s.chord_length ? &*s.chord_length : nullptr}) {
+      if (!pdf) continue;
+      for (std::size_t k = 0; k < pdf->air_counts.size(); ++k) {
+        const bool overflow = k + 1 == pdf->air_counts.size();
+        chords += fmt::format("{},{},{},{},{},{},{},{},{}\n", where, to_string(pdf->basis), unit(pdf->basis),
+                              csv_number(pdf->lower_edge(k)), overflow ? std::string() : csv_number(pdf->lower_edge(k + 1)),
+                              pdf->air_counts[k], csv_number(pdf->air_fraction[k]), pdf->water_counts[k],
+                              csv_number(pdf->water_fraction[k]));
+      }
+    }
+    for (const auto* c : {&s.clusters_time, &s.clusters_length}) {
+      const std::string head = fmt::format("{},{},{},{},{}", where, to_string(c->basis), unit(c->basis), to_string(c->regime),
+                                           to_string(c->status));
+      if (c->criteria.empty()) {
+        clusters += fmt::format("{},,,,,,,,,,,,{}\n", head, csv_cell(c->message));
+        continue;
+      }
+      for (const auto& k : c->criteria) {
+        clusters += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},\n", head, to_string(k.criterion),
+                                csv_number(k.criterion_value), k.particles, k.in_clusters,
+                                csv_number(k.percent_in_clusters), k.clusters, csv_number(k.clusters_per_second),
+                                csv_number(k.mean_particles_per_cluster), csv_number(k.mean_chord_in_cluster),
+                                csv_number(k.ratio_cluster_chord_to_mean_chord),
+                                csv_number(k.ratio_lead_to_cluster_mean_chord));
+        for (std::size_t j = 0; j < k.size_counts.size(); ++j) {
+          sizes += fmt::format("{},{},{},{},{},{}\n", where, to_string(c->basis), to_string(k.criterion),
+                               j + 1 == k.size_counts.size() ? std::string("21+") : std::to_string(j + 2),
+                               k.size_counts[j], k.size_pdf ? csv_number((*k.size_pdf)[j]) : std::string());
+        }
+      }
+    }
+    for (const auto* a : {&s.arrivals_time, &s.arrivals_length}) {
+      const std::string head = fmt::format("{},{},{},{},{}", where, to_string(a->basis), unit(a->basis), to_string(a->regime),
+                                           to_string(a->status));
+      if (a->classes.empty()) {
+        classes += fmt::format("{},,,,,,,{}\n", head, csv_cell(a->message));
+        continue;
+      }
+      for (const auto& c : a->classes) {
+        const std::string bounds = fmt::format("{},{}", csv_number(c.lower), csv_number(c.upper));
+        classes += fmt::format("{},{},{},{},{},{},\n", head, bounds, c.particles, c.intervals,
+                               csv_number(c.excess_first_bin), csv_number(c.excess_first_bin_se));
+        for (std::size_t m = 0; m < c.counts.size(); ++m) {
+          const bool overflow = m + 1 == c.counts.size();
+          arrivals += fmt::format("{},{},{},{},{},{},{},{}\n", where, to_string(a->basis), bounds,
+                                  csv_number(static_cast<double>(m) * a->bin_width),
+                                  overflow ? std::string() : csv_number(static_cast<double>(m + 1) * a->bin_width),
+                                  c.counts[m], c.pdf.empty() ? std::string() : csv_number(c.pdf[m]),
+                                  c.reference.empty() ? std::string() : csv_number(c.reference[m]));
+        }
+      }
+    }
+  }
+  return {{"_voltage_pdf.csv", voltage},   {"_chord_pdf.csv", chords},          {"_clusters.csv", clusters},
+          {"_cluster_sizes.csv", sizes},   {"_arrival_classes.csv", classes},   {"_arrivals.csv", arrivals}};
 }
 
 std::string ProcessResult::report() const {

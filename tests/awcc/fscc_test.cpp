@@ -134,7 +134,8 @@ TEST(Fscc, SegmentedMatchesNaivePearsonAverages) {
   for (std::int64_t k : {-199, -50, 0, 9, 300, 800}) {
     long double acc = 0;
     for (int s = 0; s < 3; ++s) {
-      const std::int64_t t0 = s * length + 199, t1 = (s + 1) * length - 800;
+      // Felder's window: B = L - 1000 samples from the segment's start + 199.
+      const std::int64_t t0 = s * length + 199, t1 = t0 + length - 1000;
       long double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
       const long double w = static_cast<long double>(t1 - t0);
       for (std::int64_t t = t0; t < t1; ++t) {

@@ -36,7 +36,7 @@ Written write_scene(const synth::Scene& s, synth::SignalKind signal, const std::
   return w;
 }
 
-std::int64_t complete_chords(const awcc::AirIntervals& s) {
+std::int64_t complete_air_chords(const awcc::AirIntervals& s) {
   std::int64_t n = 0;
   for (const auto& iv : s.intervals) n += iv.start > 0 && iv.stop < s.sample_count;
   return n;
@@ -57,7 +57,7 @@ TEST(ProcessSynthetic, BinaryFileGivesTheTruthExactly) {
     EXPECT_TRUE(r.tips[j].threshold.binary_input);
     EXPECT_DOUBLE_EQ(r.tips[j].phase.void_fraction, w.synthesis.truth.tips[j].void_fraction);
     EXPECT_DOUBLE_EQ(r.tips[j].phase.bubble_count_rate,
-                     static_cast<double>(complete_chords(w.synthesis.signals[j])) / s.duration);
+                     static_cast<double>(complete_air_chords(w.synthesis.signals[j])) / s.duration);
   }
   // Delay: transit dx / u = 250 samples. The FSCC peak sits at the most
   // frequent transit time; with Tu = 0.05 the transit times spread by +/- 5 %
@@ -88,7 +88,7 @@ TEST(ProcessSynthetic, VoltageFileIsBinarisedBackToTheTruth) {
     const auto& truth = w.synthesis.signals[j];
     const double bound = static_cast<double>(truth.intervals.size()) / static_cast<double>(truth.sample_count);
     EXPECT_NEAR(r.tips[j].phase.void_fraction, truth.void_fraction(), bound);
-    EXPECT_DOUBLE_EQ(r.tips[j].phase.bubble_count_rate, static_cast<double>(complete_chords(truth)) / s.duration);
+    EXPECT_DOUBLE_EQ(r.tips[j].phase.bubble_count_rate, static_cast<double>(complete_air_chords(truth)) / s.duration);
     // Modes are bin centres of 0.1 V bins next to the levels 0.3 V and 4.0 V
     // (the noise puts each level on a bin edge, either side may win).
     EXPECT_NEAR(r.tips[j].threshold.air_level, 0.3, 0.05 + 1e-9);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "awcc/option_field.hpp"
+#include "awcc/options.hpp"
 #include "command.hpp"
 
 namespace pdp {
@@ -37,13 +38,31 @@ class OptionSet {
     }
   }
 
-  /// Applies every given option of `fields` to `target`, in declaration
-  /// order. Throws std::invalid_argument naming the flag and the problem.
+  /// A preset's values (awcc::preset_settings), applied to the options the
+  /// user does not give.
+  void set_preset(std::string name, std::span<const awcc::PresetSetting> settings) {
+    preset_name_ = std::move(name);
+    preset_.assign(settings.begin(), settings.end());
+  }
+
+  /// Applies every given option of `fields` (or the preset's value, when the
+  /// user gave none) to `target`, in declaration order. Throws
+  /// std::invalid_argument naming the flag and the problem.
   template <class T>
   void apply(std::span<const awcc::OptionField<T>> fields, T& target) const {
     for (const auto& f : fields) {
       const Entry* e = find(f.name);
-      if (!e || e->option->count() == 0) continue;
+      if (!e || e->option->count() == 0) {
+        for (const auto& p : preset_) {
+          if (p.name != f.name) continue;
+          try {
+            f.parse(target, p.value);
+          } catch (const std::invalid_argument& err) {
+            throw std::invalid_argument(fmt::format("--preset {}: --{} {}: {}", preset_name_, f.name, p.value, err.what()));
+          }
+        }
+        continue;
+      }
       try {
         f.parse(target, f.flag ? std::string_view(e->flag ? "on" : "off") : std::string_view(e->value));
       } catch (const std::invalid_argument& err) {
@@ -70,6 +89,8 @@ class OptionSet {
     return nullptr;
   }
   std::deque<Entry> entries_;  // stable addresses: CLI11 writes into them
+  std::string preset_name_;
+  std::vector<awcc::PresetSetting> preset_;
 };
 
 }  // namespace pdp

@@ -35,10 +35,18 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   o.library.add(cmd, awcc::binarisation_option_fields(), defaults.binarisation, "Binarisation");
   o.library.add(cmd, awcc::fscc_option_fields(), defaults.fscc_options, "FSCC");
   o.library.add(cmd, awcc::awcc_option_fields(), defaults.awcc_options, "AWCC");
+  o.library.add(cmd, awcc::structure_option_fields(), defaults.structure, "Structure (PDFs, clusters, arrivals)");
+  cmd->add_option("--preset", o.preset,
+                  "felder: Felder's program (his threshold rule, 15 segments of raw voltages, his lags, scale rules, "
+                  "bins and defects; FSCC only); options given as well override it")
+      ->group("Probe and methods");
   const auto* out = "Output";
   cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)")->group(out);
   cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)")->group(out);
   cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)")->group(out);
+  cmd->add_option("--correlation-functions", o.correlation_functions,
+                  "FSCC's auto- and cross-correlation functions as CSV: file, lag_s, r11, r12")
+      ->group(out);
   cmd->add_option("--positions", o.positions, "profile positions, one per file: '2mm,8mm,...'")->group(out);
   cmd->add_option("--manifest", o.manifest, "profile manifest CSV with columns file,position")
       ->check(CLI::ExistingFile)->group(out);
@@ -50,13 +58,21 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
 
 namespace {
 
-awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
+awcc::ProcessOptions build_options(ProcessCommandOptions& o) {
   awcc::ProcessOptions p;
+  if (!o.preset.empty()) {
+    try {
+      o.library.set_preset(o.preset, awcc::preset_settings(o.preset));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format("{}--preset: {}", origin_of("preset"), e.what()));
+    }
+  }
   o.library.apply(awcc::process_option_fields(), p);
   o.library.apply(awcc::reader_option_fields(), p.reader);
   o.library.apply(awcc::binarisation_option_fields(), p.binarisation);
   o.library.apply(awcc::fscc_option_fields(), p.fscc_options);
   o.library.apply(awcc::awcc_option_fields(), p.awcc_options);
+  o.library.apply(awcc::structure_option_fields(), p.structure);
   p.fscc_options.subsample = p.awcc_options.subsample;  // FSCC refines its peak as AWCC does
   if (!p.allow_unusual) {
     if (auto why = p.implausible(); !why.empty()) throw awcc::OptionError(why, "allow_unusual");
@@ -66,6 +82,9 @@ awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
     throw std::invalid_argument("--windows writes the window table of one recording; give one file");
   }
   if (!o.windows.empty() && !p.awcc) throw std::invalid_argument("--windows needs --method awcc or both");
+  if (!o.correlation_functions.empty() && !p.fscc) {
+    throw std::invalid_argument("--correlation-functions writes FSCC's functions: use --method fscc or both");
+  }
   return p;
 }
 
@@ -134,7 +153,7 @@ std::string correction_report(const correction::Correction& c) {
 
 }  // namespace
 
-int run_process(const ProcessCommandOptions& o) {
+int run_process(ProcessCommandOptions& o) {
   awcc::ProcessOptions options;
   std::vector<std::optional<double>> positions;
   std::optional<correction::CorrectionModel> model;
@@ -145,7 +164,7 @@ int run_process(const ProcessCommandOptions& o) {
       throw std::invalid_argument("--correct corrects AWCC's estimates; use --method awcc or both");
     }
     // Inputs are never modified: refuse an output that is one of them.
-    for (const auto& output : {o.json, o.csv, o.windows}) {
+    for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions}) {
       if (output.empty() || !std::filesystem::exists(output)) continue;
       for (const auto& input : o.files) {
         if (std::filesystem::equivalent(output, input)) {
@@ -250,6 +269,18 @@ int run_process(const ProcessCommandOptions& o) {
       outputs.emplace_back(o.json, awcc::json_text(j));
     }
     if (!o.windows.empty() && results[0].awcc) outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
+    std::vector<const awcc::ProcessResult*> all;
+    for (const auto& r : results) all.push_back(&r);
+    if (!o.correlation_functions.empty()) {
+      outputs.emplace_back(o.correlation_functions, awcc::correlation_functions_csv(all));
+    }
+    // The structure tables sit next to the profile CSV: profile.csv, profile_chord_pdf.csv, ...
+    if (!o.csv.empty() && options.structure.enabled) {
+      const std::filesystem::path base(o.csv);
+      for (const auto& [suffix, text] : awcc::structure_csv_tables(all, positions)) {
+        outputs.emplace_back((base.parent_path() / (base.stem().string() + suffix)).string(), text);
+      }
+    }
     if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {
       stdout_text = results[0].report();
       if (model) stdout_text += correction_report(corrections[0]);

@@ -14,12 +14,13 @@ namespace pdp {
 struct ProcessCommandOptions {
   std::vector<std::string> files;
   OptionSet library;                                 // the libraries' options (awcc/options.hpp)
-  std::string json, csv, windows;                    // output files
+  std::string json, csv, windows, correlation_functions;  // output files
+  std::string preset;                                // named option values (awcc::preset_settings)
   std::string positions, manifest;                   // profile positions
   std::string correct;                               // correction model (.qrf); empty = no correction
 };
 
 void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& options);
-int run_process(const ProcessCommandOptions& options);
+int run_process(ProcessCommandOptions& options);
 
 }  // namespace pdp

@@ -59,14 +59,10 @@ namespace awcc {
 
 enum class Weighting { duration, none };
 enum class CorrelationPath { automatic, fft, intervals };
-/// What the windows correlate: the binarised signals, or the raw voltages
-/// (windows still cut from the binarised leading tip).
-enum class CorrelationSignal { binary, raw };
 enum class WindowFate { accepted, correlation, lag, roc, constant, too_short };
 
 std::string_view to_string(WindowFate fate);
 std::string_view to_string(Weighting weighting);
-std::string_view to_string(CorrelationSignal signal);
 
 struct AwccOptions {
   /// Particles (air chords of the leading tip) per window, 1-1000. Fewer give
@@ -80,7 +76,8 @@ struct AwccOptions {
   /// Moments weighted by window duration (Buchhave 1979: removes the bias
   /// towards fast windows) or not at all.
   Weighting weighting = Weighting::duration;
-  /// Correlate the binarised signals or the raw voltages.
+  /// Correlate the binarised signals or the raw voltages (windows are still
+  /// cut from the binarised leading tip). pdp process applies it to FSCC too.
   CorrelationSignal signal = CorrelationSignal::binary;
   Subsample subsample = Subsample::none;  ///< parabolic refinement of the peak lag
   CorrelationPath path = CorrelationPath::automatic;  ///< automatic: intervals for binary signals

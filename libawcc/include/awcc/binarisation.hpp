@@ -67,6 +67,8 @@ class VoltageHistogram {
   [[nodiscard]] std::optional<std::vector<double>> binary_levels() const;
   /// Counts regrouped into bins [k w, (k+1) w): (k, count) for nonempty bins.
   [[nodiscard]] std::vector<std::pair<std::int64_t, std::int64_t>> regroup(double width) const;
+  /// The values seen (at the histogram's resolution) with their counts, in increasing order.
+  [[nodiscard]] std::vector<std::pair<double, std::int64_t>> values() const;
   [[nodiscard]] double min_value() const;
   [[nodiscard]] double max_value() const;
 

@@ -1,28 +1,43 @@
 #pragma once
 // Full-signal cross-correlation (FSCC), METHOD.md 3.
 //
-// With x (leading) and y (trailing) the mean-removed binary signals,
+// Correlation functions. Binary (default): with x (leading) and y
+// (trailing) the mean-removed binary signals,
 //   R12(k) = sum_t x(t) y(t + k) / sqrt(sum x^2 sum y^2),   R11 likewise,
-// summed over the t where both samples exist. tau = lag of the R12 maximum,
-// u = dx / tau, R12max the peak. T05: lag where R11 first falls to 0.5;
-// tau05: half-width at half maximum of R12 around its peak (both sides, or the
-// one found); Txx = integral of R11 from 0 to its first zero; Txy = integral of
-// R12 from its peak to its first zero; Chanson's turbulence intensity
-// Tu = 0.851 sqrt(tau05^2 - T05^2) / tau (known to overestimate badly).
-//
+// summed over the t where both samples exist. Raw: the voltages, always as
+// the segmented form below (S = 1 is the whole record).
 // Segmented (Felder's program): the record is cut into S non-overlapping
-// segments; in each, a Pearson coefficient per lag over a fixed window
-// (the segment less the lag span, so that every lag uses the same samples of
-// x); the S coefficients are averaged. Felder's lags: auto 0..999, cross
-// -199..800 samples, and the peak is the first lag within 1e-5 of the maximum,
-// without interpolation.
+// segments of L = N div S samples; in each, Pearson's coefficient per lag over
+// a fixed window of B = L - (lags) samples of x (awcc/lagged_pearson.hpp), and
+// the S coefficients are averaged. Felder's lags: auto 0..999, cross
+// -199..800 samples, and the peak is the first lag within 1e-5 of the maximum.
 //
-// The lagged products are computed from the pairs of air intervals within the
-// lag range, or from FFTs of blocks (overlap-save) when bubbles are so dense
-// that the pairs cost more; memory depends on the lag range, not on the
-// record's length.
+// Scales (lags in s, tau_k = k / fs; "interpolated" = linearly between the
+// two lags around the first one at or below the level):
+//   R12max = max R12 (not below 0), T_R12max its lag; u = dx / T_R12max;
+//   T05: R11 first at or below 0.5, interpolated;
+//   T_R11zero: R11 first at or below 0, interpolated; R11min and T_R11min:
+//     0 and T_R11zero when R11 crosses 0, else its minimum and lag;
+//   Txx: integral of R11 from 0 to T_R11zero (else to T_R11min), trapezoids;
+//   T_half: R12 first at or below R12max / 2 right of the peak,
+//     interpolated; tau05 = T_half - T_R12max (Chanson's half-width);
+//   T_R12zero, R12min, T_R12min and Txy likewise from the peak;
+//   Tu = 0.851 sqrt(tau05^2 - T05^2) / T_R12max (Chanson's; known to
+//     overestimate badly).
+// A scale that is not reached within the lags searched is empty, and
+// scale_notes says why. Felder's scale rules (felder_scales, his program's
+// printed values): lag times in float32, the peak and minima as the first
+// lags within 1e-5, and integrals that run one lag past the zero or minimum
+// (felder-program.md 3).
+//
+// The lagged products of binary signals are computed from the pairs of air
+// intervals within the lag range, or from FFTs of blocks (overlap-save) when
+// bubbles are so dense that the pairs cost more; memory depends on the lag
+// range, not on the record's length.
 
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -36,10 +51,15 @@ namespace awcc {
 enum class Subsample { none, parabolic };
 std::string_view to_string(Subsample subsample);
 
+/// What FSCC correlates: the binarised signals or the raw voltages.
+enum class CorrelationSignal { binary, raw };
+std::string_view to_string(CorrelationSignal signal);
+
 struct FsccOptions {
   int segments = 1;                  ///< 1 = full record; Felder used 15
   double max_lag = 0.02;             ///< s: auto lags [0, max], cross lags [-max, max]
   bool felder_lags = false;          ///< Felder's lag ranges in samples and first-maximum peak rule
+  bool felder_scales = false;        ///< Felder's rules for the time scales (see above)
   Subsample subsample = Subsample::none;
 
   [[nodiscard]] std::string validate() const;
@@ -67,13 +87,74 @@ struct FsccResult {
   std::int64_t lag_samples = 0;      ///< integer lag of the peak
   double lag = 0.0;                  ///< s (refined when requested)
   double velocity = 0.0;             ///< dx / lag, m/s (0 unless ok)
+  CorrelationSignal signal = CorrelationSignal::binary;
+  int segments_used = 0;             ///< segments averaged (1 for the full record)
   std::optional<double> t05, tau05, txx, txy;       ///< s
+  std::optional<double> t_r11_zero, t_r11_min, r11_min;  ///< s, s, -
+  std::optional<double> t_half, t_r12_zero, t_r12_min, r12_min;  ///< s (lags, not widths), -
   std::optional<double> turbulence_intensity_chanson;
-  std::string note;                  ///< e.g. why a time scale is missing
+  /// Scales that are empty, with the reason ("t_r12_zero": "R12 stays above 0 ...").
+  std::vector<std::pair<std::string, std::string>> scale_notes;
+  std::string note;                  ///< the scale notes in one sentence
   std::vector<std::string> warnings; ///< a velocity that is defined but implausible, with the likely cause
   std::int64_t r11_first_lag = 0, r12_first_lag = 0;  ///< lag (samples) of r11[0], r12[0]
   std::vector<double> r11, r12;      ///< the correlation functions over the lags searched
 };
+
+/// The lag ranges searched, in samples, for a record of `samples` at fs.
+struct FsccLags {
+  std::int64_t r11_last = 0;                  ///< R11 at lags 0 .. r11_last
+  std::int64_t r12_first = 0, r12_last = 0;   ///< R12 at lags r12_first .. r12_last
+};
+FsccLags fscc_lags(std::int64_t samples, double fs, const FsccOptions& options);
+
+/// R11 and R12 over the lags searched, before any scale is read from them.
+struct CorrelationFunctions {
+  double fs = 0.0;
+  CorrelationSignal signal = CorrelationSignal::binary;
+  std::int64_t r11_first_lag = 0, r12_first_lag = 0;
+  std::vector<double> r11, r12;
+  int segments_used = 0;
+  FsccStatus status = FsccStatus::ok;  ///< ok, constant_*, no_common_segment
+  std::string message;
+};
+
+/// The correlation functions of two binary signals of equal length and rate.
+CorrelationFunctions correlation_functions(const AirIntervals& leading, const AirIntervals& trailing,
+                                           const FsccOptions& options);
+
+/// The correlation functions of raw voltages (always segmented; S = 1 is the
+/// whole record), fed block by block: memory is that of the lag range and an
+/// FFT chunk, not of the record.
+class RawCorrelation {
+ public:
+  RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options);
+  ~RawCorrelation();
+  RawCorrelation(const RawCorrelation&) = delete;
+  RawCorrelation& operator=(const RawCorrelation&) = delete;
+  /// Feeds frames [first, first + leading.size()) of both tips, in order.
+  void feed(std::int64_t first, std::span<const double> leading, std::span<const double> trailing);
+  /// After every frame was fed.
+  CorrelationFunctions finish();
+
+ private:
+  struct Segment;
+  void open_segment();
+  std::int64_t samples_;
+  double fs_;
+  FsccLags lags_;
+  int segments_;
+  std::int64_t length_;
+  int next_ = 0;
+  FftPlanCache plans_;
+  std::unique_ptr<Segment> current_;
+  std::vector<double> sum11_, sum12_;
+  int used_ = 0;
+  bool constant_leading_ = true, constant_trailing_ = true;
+};
+
+/// Peak, velocity (dx in m) and time scales from the correlation functions.
+FsccResult fscc_from_functions(CorrelationFunctions functions, double dx, const FsccOptions& options);
 
 /// FSCC of two binary signals of equal length and rate; dx in m.
 FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options = {});

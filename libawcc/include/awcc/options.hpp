@@ -8,6 +8,7 @@
 // (`subsample` is declared once, with AWCC's options).
 
 #include <span>
+#include <string_view>
 
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
@@ -25,5 +26,15 @@ std::span<const OptionField<AwccOptions>> awcc_option_fields();
 /// The options of a whole processing run that belong to none of the above:
 /// tip separations, channels, methods, histogram bins.
 std::span<const OptionField<ProcessOptions>> process_option_fields();
+std::span<const OptionField<StructureOptions>> structure_option_fields();
+
+/// A named set of option values (`--preset felder`): applied before what the
+/// user gives, which overrides it.
+struct PresetSetting {
+  std::string_view name;   ///< an option's declared name
+  std::string_view value;  ///< as a user would type it
+};
+/// The settings of a preset; throws std::invalid_argument for an unknown name.
+std::span<const PresetSetting> preset_settings(std::string_view name);
 
 }  // namespace awcc

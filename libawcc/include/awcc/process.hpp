@@ -14,6 +14,7 @@
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/recording.hpp"
+#include "awcc/structure.hpp"
 
 namespace awcc {
 
@@ -27,9 +28,12 @@ struct ProcessOptions {
   bool fscc = true;                   ///< run FSCC
   FsccOptions fscc_options;
   bool awcc = true;                   ///< run AWCC
-  /// AWCC settings; signal = raw correlates the voltages (one more pass over the file).
+  /// AWCC settings; signal = raw makes FSCC and AWCC correlate the voltages
+  /// (one more pass over the file for each).
   AwccOptions awcc_options;
   int histogram_bins = 50;            ///< chord-time histogram bins
+  /// Chord and voltage PDFs, clusters, inter-particle arrivals (and Felder's conventions).
+  StructureOptions structure;
   /// Accept values outside the plausible ranges of the instrument (below):
   /// off, because a value out of them is nearly always a unit slip.
   bool allow_unusual = false;
@@ -63,6 +67,8 @@ struct BinarisedRecording {
   RecordingInfo info;
   Threshold leading_threshold, trailing_threshold;
   AirIntervals leading, trailing;
+  /// The voltage histograms the thresholds came from (the voltage PDFs).
+  std::optional<VoltageHistogram> leading_histogram, trailing_histogram;
 };
 
 struct ProcessResult {
@@ -71,6 +77,7 @@ struct ProcessResult {
   std::vector<TipResult> tips;        ///< leading tip first
   std::optional<FsccResult> fscc;
   std::optional<AwccResult> awcc;
+  std::optional<StructureResult> structure;
   double seconds = 0.0;               ///< wall time of the processing
 
   /// The velocity of chord lengths and d32 (velocity_source()).
@@ -96,7 +103,13 @@ ProcessResult process_binarised(const BinarisedRecording& recording, const Proce
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
                     const ProcessOptions& options);
 
-/// Both of the above.
+/// FSCC correlating the raw voltages of the recording (reads the file once
+/// more, block by block; fscc_options.segments segments, S = 1 the whole record).
+FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
+                    const ProcessOptions& options);
+
+/// All of the above, as the options ask (awcc_options.signal chooses what
+/// both FSCC and AWCC correlate).
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options);
 
 }  // namespace awcc

@@ -14,6 +14,7 @@ namespace awcc {
 
 nlohmann::json to_json(const ProcessResult& result);
 nlohmann::json to_json(const AwccOptions& options);
+nlohmann::json to_json(const StructureResult& result);
 
 /// Every effective option of a processing run, defaults included, by its
 /// declared name (awcc/options.hpp) as text with its unit.
@@ -31,5 +32,15 @@ std::string awcc_windows_csv(const AwccResult& result);
 /// optional position (m).
 std::string profile_csv_header();
 std::string profile_csv_row(const ProcessResult& result, const std::optional<double>& position);
+
+/// The correlation functions of recordings as CSV: file, lag_s, r11, r12
+/// (empty where a function has no value at that lag).
+std::string correlation_functions_csv(const std::vector<const ProcessResult*>& results);
+
+/// The structure outputs of a profile as CSV tables, one row per position
+/// and bin or class (docs/output.md): the file suffix ("_chord_pdf.csv")
+/// and its text. Recordings without structure results give no rows.
+std::vector<std::pair<std::string, std::string>> structure_csv_tables(
+    const std::vector<const ProcessResult*>& results, const std::vector<std::optional<double>>& positions);
 
 }  // namespace awcc
