@@ -532,7 +532,7 @@ FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOpti
     // Felder integrates to the minimum instead; the default leaves Txx
     // empty rather than report an integral cut short by the lag range.
     missing("t_r11_zero", "R11 stays above 0 within " + lags11);
-    if (!felder) missing("txx", "R11 does not reach 0 within " + lags11);
+    if (!felder) missing("txx", "no Txx without R11's zero");
     const auto [i, m] = minimum(out.r11, 0, 1.0, felder);
     out.r11_min = m;
     out.t_r11_min = tau11(i);
@@ -556,7 +556,7 @@ FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOpti
       if (!felder) r12_fraction = out.r12[zero->index - 1] / (out.r12[zero->index - 1] - out.r12[zero->index]);
     } else {
       missing("t_r12_zero", "R12 stays above 0 right of its peak within " + lags12);
-      if (!felder) missing("txy", "R12 does not reach 0 right of its peak within " + lags12);
+      if (!felder) missing("txy", "no Txy without R12's zero");
       const auto [i, m] = minimum(out.r12, peak, out.r12_max, felder);
       out.r12_min = m;
       out.t_r12_min = tau12(i);

@@ -9,8 +9,8 @@ dir=$2/process_cli
 src=$3
 data=$src/../shared/data/felder-stepped-spillway
 rm -rf "$dir" && mkdir -p "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+# shellcheck source=lib.sh
+source "$src/tests/cli/lib.sh"
 
 # A synthetic recording to process.
 "$pdp" --log-level warn synth -q --duration 1s --fs 100kHz --tu 0.05 --dy 0 -o "$dir/rec.flac" || fail "synth"
@@ -62,7 +62,39 @@ if [[ -d $data ]]; then
   "$pdp" process "$data"/dc157_0{3,4}.dat --fs 20kHz --dx 7.15mm --segments 15 --felder-lags \
     --threshold-rule felder >"$dir/real.csv" || fail "real recordings"
   [[ $(wc -l <"$dir/real.csv") -eq 3 ]] || fail "real profile rows"
+  # Felder's preset: FSCC of raw voltages peaks at his 54 samples on file 03
+  # (2.648148 m/s); the structure tables sit beside the profile CSV; an
+  # option given as well overrides the preset.
+  mkdir -p "$dir/felder"
+  "$pdp" process "$data"/dc157_0{3,4}.dat --fs 20kHz --dx 7.15mm --preset felder --csv "$dir/felder/p.csv" \
+    --correlation-functions "$dir/felder/cf.csv" --json "$dir/felder/p.json" || fail "felder preset"
+  [[ $(column "$dir/felder/p.csv" fscc_velocity | head -1) == 2.648148* ]] || fail "felder preset velocity"
+  for t in voltage_pdf chord_pdf clusters cluster_sizes arrival_classes arrivals; do
+    [[ -s $dir/felder/p_$t.csv ]] || fail "felder preset: no p_$t.csv"
+  done
+  # Two recordings x 2 bases x 3 criteria; lags -199..999 of both functions per recording.
+  [[ $(($(wc -l <"$dir/felder/p_clusters.csv") - 1)) -eq 12 ]] || fail "cluster rows"
+  [[ $(($(wc -l <"$dir/felder/cf.csv") - 1)) -eq 2398 ]] || fail "correlation function rows"
+  /usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); o=j['provenance']['options'];
+assert o['segments']=='15' and o['felder-defects']=='on' and o['correlate']=='raw', o" "$dir/felder/p.json" ||
+    fail "felder preset options not recorded"
+  "$pdp" process "$data"/dc157_03.dat --fs 20kHz --dx 7.15mm --preset felder --segments 1 --json "$dir/felder/s1.json" \
+    >/dev/null || fail "preset with an override"
+  /usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j['provenance']['options']['segments']=='1'
+assert j['fscc']['segments_used']==1" "$dir/felder/s1.json" || fail "an option given does not override the preset"
 fi
+expect 2 "not a preset" "$pdp" process "$dir/rec.flac" --dx 5mm --preset kramer
+
+# The structure tables of a synthetic profile: each chord PDF sums to 1 over its bins.
+mkdir -p "$dir/structure"
+"$pdp" process "$dir/rec.flac" "$dir/rec2.flac" --dx 5mm --csv "$dir/structure/p.csv" || fail "structure tables"
+/usr/bin/python3 - "$dir/structure/p_chord_pdf.csv" <<'PY' || fail "chord PDF fractions do not sum to 1"
+import csv, sys, collections
+sums = collections.defaultdict(float)
+for r in csv.DictReader(open(sys.argv[1])):
+    sums[(r["file"], r["basis"])] += float(r["air_fraction"])
+assert sums and all(abs(v - 1) < 1e-9 for v in sums.values()), sums
+PY
 
 expect_refusal() {  # name, message fragment, pdp process arguments...
   local name=$1 fragment=$2
