@@ -511,6 +511,8 @@ std::string ProcessResult::report() const {
     }
     auto ms = [](const std::optional<double>& v) { return v ? fmt::format("{:.4f} ms", *v * 1e3) : std::string("n/a"); };
     line(fmt::format("        T05 {}, tau05 {}, Txx {}, Txy {}", ms(f.t05), ms(f.tau05), ms(f.txx), ms(f.txy)));
+    line(fmt::format("        R11 zero {}, R12 zero {} (correlating {} signals, {} segment{})", ms(f.t_r11_zero),
+                     ms(f.t_r12_zero), to_string(f.signal), f.segments_used, f.segments_used == 1 ? "" : "s"));
     line(fmt::format("        Chanson turbulence intensity {}",
                      f.turbulence_intensity_chanson ? fmt::format("{:.4f}", *f.turbulence_intensity_chanson)
                                                     : std::string("n/a")));
@@ -534,6 +536,36 @@ std::string ProcessResult::report() const {
                      a.windows_accepted, a.windows_total, a.rejected_correlation, a.rejected_lag, a.rejected_roc,
                      a.rejected_constant,
                      a.rejected_too_short ? fmt::format(", {} too short", a.rejected_too_short) : std::string()));
+  }
+  if (structure) {
+    const auto& st = *structure;
+    line(fmt::format("  structure of the leading tip ({} conventions): {} bubbles, {} regime", st.felder_defects ? "Felder's" : "default",
+                     st.bubbles_used, to_string(st.clusters_time.regime)));
+    for (const auto* c : {&st.clusters_time, &st.clusters_length}) {
+      if (c->status != ClusterStatus::ok) {
+        line(fmt::format("    clusters by {}: {}", to_string(c->basis), c->message));
+        continue;
+      }
+      std::string counts, shares;
+      for (const auto& k : c->criteria) {
+        counts += fmt::format("{}{}", counts.empty() ? "" : " / ", k.clusters);
+        shares += fmt::format("{}{:.1f}", shares.empty() ? "" : " / ", k.percent_in_clusters);
+      }
+      line(fmt::format("    clusters by {} (median / constant / near-wake): {} clusters, {} % of particles in them",
+                       to_string(c->basis), counts, shares));
+    }
+    for (const auto* a : {&st.arrivals_time, &st.arrivals_length}) {
+      if (a->status != ClusterStatus::ok) continue;
+      std::string excess;
+      for (const auto& k : a->classes) {
+        if (!k.excess_first_bin) continue;
+        excess += fmt::format("{}{:.2f} +/- {:.2f}", excess.empty() ? "" : ", ", *k.excess_first_bin, *k.excess_first_bin_se);
+      }
+      if (!excess.empty()) {
+        line(fmt::format("    arrivals by {}: observed / random intervals in the first bin, per class: {}",
+                         to_string(a->basis), excess));
+      }
+    }
   }
   if (const auto s = velocity_source(); s != VelocitySource::awcc && (awcc || fscc)) {
     line(s == VelocitySource::fscc ? "  chord lengths and d32 use FSCC's velocity (AWCC's is not of quality ok)"
