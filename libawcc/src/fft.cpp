@@ -47,8 +47,8 @@ FftPlan::~FftPlan() {
 void FftPlan::forward() { fftw_execute(static_cast<fftw_plan>(forward_)); }
 void FftPlan::inverse() { fftw_execute(static_cast<fftw_plan>(inverse_)); }
 
-FftPlan& FftPlanCache::get(std::size_t n) {
-  auto& slot = plans_[n];
+FftPlan& FftPlanCache::get(std::size_t n, int instance) {
+  auto& slot = plans_[{n, instance}];
   if (!slot) slot = std::make_unique<FftPlan>(n);
   return *slot;
 }

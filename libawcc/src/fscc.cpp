@@ -309,8 +309,8 @@ struct RawCorrelation::Segment {
   LaggedPearson r11, r12;
 };
 
-RawCorrelation::RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options)
-    : samples_(samples), fs_(fs), lags_(fscc_lags(samples, fs, options)), segments_(options.segments) {
+RawCorrelation::RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options, FftPlanCache& plans)
+    : samples_(samples), fs_(fs), lags_(fscc_lags(samples, fs, options)), segments_(options.segments), plans_(plans) {
   if (const auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   length_ = samples / segments_;
   if (length_ - (lags_.r12_last - lags_.r12_first + 1) < 2) {
@@ -326,8 +326,16 @@ void RawCorrelation::open_segment() {
   const std::int64_t s0 = static_cast<std::int64_t>(next_) * length_;
   const auto [a0, a1] = segment_window(s0, length_, 0, lags_.r11_last);
   const auto [c0, c1] = segment_window(s0, length_, lags_.r12_first, lags_.r12_last);
-  current_ = std::make_unique<Segment>(Segment{LaggedPearson(a0, a1 - a0, 0, lags_.r11_last, plans_),
-                                               LaggedPearson(c0, c1 - c0, lags_.r12_first, lags_.r12_last, plans_)});
+  // Every segment has the same windows and lags: the accumulators (and
+  // their buffers) of the first serve them all.
+  if (!accumulators_) {
+    accumulators_ = std::make_unique<Segment>(Segment{LaggedPearson(a0, a1 - a0, 0, lags_.r11_last, plans_, true),
+                                                      LaggedPearson(c0, c1 - c0, lags_.r12_first, lags_.r12_last, plans_)});
+  } else {
+    accumulators_->r11.restart(a0);
+    accumulators_->r12.restart(c0);
+  }
+  current_ = accumulators_.get();
   ++next_;
 }
 
@@ -354,7 +362,7 @@ void RawCorrelation::feed(std::int64_t first, std::span<const double> leading, s
       for (std::size_t j = 0; j < r12.size(); ++j) sum12_[j] += r12[j];
       ++used_;
     }
-    current_.reset();
+    current_ = nullptr;
   }
 }
 

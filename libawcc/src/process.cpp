@@ -469,18 +469,26 @@ FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording&
   const auto stride = static_cast<std::size_t>(recording->info().channels);
   const auto lead = static_cast<std::size_t>(options.leading_channel);
   const auto trail = static_cast<std::size_t>(options.trailing_channel);
-  RawCorrelation correlation(b.info.frames, b.info.fs, options.fscc_options);
-  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
+  // Plans are built once per thread and serve every record processed on it
+  // (planning costs as much as a record's transforms).
+  thread_local FftPlanCache plans;
+  RawCorrelation correlation(b.info.frames, b.info.fs, options.fscc_options, plans);
+  // 16-bit counts are read as they are stored (volts = count x quantum, exact in double).
+  const bool counts = recording->has_int16() && recording->info().quantum > 0.0;
+  const double quantum = recording->info().quantum;
+  std::vector<float> block(counts ? 0 : static_cast<std::size_t>(options.block_frames) * stride);
+  std::vector<std::int16_t> block16(counts ? static_cast<std::size_t>(options.block_frames) * stride : 0);
   std::vector<double> xs, ys;
   std::int64_t position = 0;
   for (;;) {
-    const std::int64_t n = recording->read(block, options.block_frames);
+    const std::int64_t n = counts ? recording->read_int16(block16, options.block_frames)
+                                  : recording->read(block, options.block_frames);
     if (n == 0) break;
     xs.resize(static_cast<std::size_t>(n));
     ys.resize(static_cast<std::size_t>(n));
     for (std::size_t f = 0; f < static_cast<std::size_t>(n); ++f) {
-      xs[f] = block[f * stride + lead];
-      ys[f] = block[f * stride + trail];
+      xs[f] = counts ? block16[f * stride + lead] * quantum : block[f * stride + lead];
+      ys[f] = counts ? block16[f * stride + trail] * quantum : block[f * stride + trail];
     }
     correlation.feed(position, xs, ys);
     position += n;
@@ -496,11 +504,16 @@ FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording&
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const auto binarised = binarise_recording(path, options);
-  ProcessResult out = process_binarised(binarised, options);
-  const bool raw = options.awcc_options.signal == CorrelationSignal::raw;
-  if (options.fscc && raw) out.fscc = fscc_raw(path, binarised, options);
-  if (options.awcc && raw) out.awcc = awcc_raw(path, binarised, options);
-  if (raw) {
+  ProcessResult out;
+  if (options.awcc_options.signal == CorrelationSignal::binary) {
+    out = process_binarised(binarised, options);
+  } else {
+    // The phase statistics wait for the velocity of the raw correlations.
+    out.info = binarised.info;
+    out.dx = options.dx;
+    out.dy = options.dy;
+    if (options.fscc) out.fscc = fscc_raw(path, binarised, options);
+    if (options.awcc) out.awcc = awcc_raw(path, binarised, options);
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
     add_structure(out, binarised, options);

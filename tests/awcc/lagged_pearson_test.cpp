@@ -69,6 +69,23 @@ TEST(LaggedPearson, EqualsANaiveLongDoubleSumWhateverTheBlocks) {
   }
 }
 
+TEST(LaggedPearson, AnAutoCorrelationReadsXFromY) {
+  // same_signal: X is taken from y's samples and its sums from y's prefix sums.
+  const auto v = probe_voltages(20'000, 0, 5);
+  for (auto [start, window, k0, k1] : {std::tuple<std::int64_t, std::int64_t, std::int64_t, std::int64_t>{0, 19'000, 0, 999},
+                                       {300, 15'000, -199, 800}}) {
+    const auto naive = awcc::lagged_pearson_naive(v.leading, v.leading, start, window, k0, k1);
+    awcc::FftPlanCache plans;
+    awcc::LaggedPearson p(start, window, k0, k1, plans, true);
+    const std::vector<double> ignored(v.leading.size(), 99.0);  // x is not read
+    feed_in_blocks(p, ignored, v.leading, 4096);
+    ASSERT_TRUE(p.complete());
+    const auto fast = p.coefficients();
+    for (std::size_t j = 0; j < fast.size(); ++j) ASSERT_NEAR(fast[j], naive[j], 1e-12) << j;
+    EXPECT_NEAR(fast[static_cast<std::size_t>(-k0)], 1.0, 1e-12);
+  }
+}
+
 TEST(LaggedPearson, AConstantWindowHasNoCoefficient) {
   std::vector<double> x(2'000, 4.1), y(2'000);
   for (std::size_t i = 0; i < y.size(); ++i) y[i] = (i / 7) % 2 ? 0.3 : 4.1;
@@ -115,7 +132,8 @@ TEST(RawCorrelation, MatchesFeldersSegmentedPearsonAndRecoversTheDelay) {
   awcc::FsccOptions o;
   o.segments = 3;
   o.felder_lags = true;
-  awcc::RawCorrelation raw(static_cast<std::int64_t>(n), 20e3, o);
+  awcc::FftPlanCache plans;
+  awcc::RawCorrelation raw(static_cast<std::int64_t>(n), 20e3, o, plans);
   for (std::size_t i = 0; i < n; i += 4096) {
     const std::size_t len = std::min<std::size_t>(4096, n - i);
     raw.feed(static_cast<std::int64_t>(i), std::span<const double>(v.leading.data() + i, len),
@@ -149,8 +167,9 @@ TEST(RawCorrelation, SaysWhichTipIsConstant) {
   const std::vector<double> flat(n, 4.1);
   awcc::FsccOptions o;
   o.max_lag = 0.005;
+  awcc::FftPlanCache plans;
   for (bool leading_flat : {true, false}) {
-    awcc::RawCorrelation raw(static_cast<std::int64_t>(n), 20e3, o);
+    awcc::RawCorrelation raw(static_cast<std::int64_t>(n), 20e3, o, plans);
     raw.feed(0, leading_flat ? flat : v.leading, leading_flat ? v.trailing : flat);
     const auto f = raw.finish();
     EXPECT_EQ(f.status, leading_flat ? awcc::FsccStatus::constant_leading : awcc::FsccStatus::constant_trailing);

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <span>
+#include <utility>
 
 namespace awcc {
 
@@ -45,10 +46,12 @@ class FftPlan {
 /// FFTW's planner is not thread-safe).
 class FftPlanCache {
  public:
-  FftPlan& get(std::size_t n);
+  /// The plan of size n; `instance` > 0 gives another plan of that size,
+  /// for transforms whose results must coexist (two spectra at once).
+  FftPlan& get(std::size_t n, int instance = 0);
 
  private:
-  std::map<std::size_t, std::unique_ptr<FftPlan>> plans_;
+  std::map<std::pair<std::size_t, int>, std::unique_ptr<FftPlan>> plans_;
 };
 
 }  // namespace awcc

@@ -128,7 +128,9 @@ CorrelationFunctions correlation_functions(const AirIntervals& leading, const Ai
 /// FFT chunk, not of the record.
 class RawCorrelation {
  public:
-  RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options);
+  /// plans: FFT plans and scratch, owned by the caller so that records
+  /// processed in turn share them.
+  RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options, FftPlanCache& plans);
   ~RawCorrelation();
   RawCorrelation(const RawCorrelation&) = delete;
   RawCorrelation& operator=(const RawCorrelation&) = delete;
@@ -146,8 +148,9 @@ class RawCorrelation {
   int segments_;
   std::int64_t length_;
   int next_ = 0;
-  FftPlanCache plans_;
-  std::unique_ptr<Segment> current_;
+  FftPlanCache& plans_;
+  std::unique_ptr<Segment> accumulators_;
+  Segment* current_ = nullptr;  // the segment being fed (accumulators_), or none
   std::vector<double> sum11_, sum12_;
   int used_ = 0;
   bool constant_leading_ = true, constant_trailing_ = true;

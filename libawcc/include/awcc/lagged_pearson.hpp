@@ -26,8 +26,14 @@ class LaggedPearson {
  public:
   /// The window [x_start, x_start + window) of x against y at lags
   /// [k_first, k_last]; y is read over [x_start + k_first, x_start + window + k_last).
+  /// same_signal: x is y (an auto-correlation, k_first <= 0 <= k_last):
+  /// x is read from y's samples and feed() ignores its x.
   LaggedPearson(std::int64_t x_start, std::int64_t window, std::int64_t k_first, std::int64_t k_last,
-                FftPlanCache& plans);
+                FftPlanCache& plans, bool same_signal = false);
+
+  /// Starts again with the window at x_start (same length and lags),
+  /// keeping the buffers: the next segment of a segmented correlation.
+  void restart(std::int64_t x_start);
 
   /// Feeds samples [first, first + x.size()) of both signals (x.size() ==
   /// y.size()), consecutively from wherever the caller starts; samples
@@ -48,13 +54,14 @@ class LaggedPearson {
  private:
   void run_chunks(bool final);
 
-  std::int64_t x_begin_, x_end_, k_first_, k_last_, y_begin_, y_end_;
+  std::int64_t window_, x_begin_ = 0, x_end_ = 0, k_first_, k_last_, y_begin_ = 0, y_end_ = 0;
   std::size_t lags_, chunk_;
-  FftPlan* plan_;
-  std::vector<std::complex<double>> x_spectrum_;
+  FftPlan* plan_;    // y's transform and the inverse
+  FftPlan* x_plan_;  // x's transform (its spectrum stays while y's is made)
   // x from x_next_ (next chunk start) on; y from x_next_ + k_first on.
   std::vector<double> x_buffer_, y_buffer_;
-  std::int64_t x_next_, x_fed_, y_fed_;  // next chunk start; samples fed so far up to these indices
+  std::int64_t x_next_ = 0, x_fed_ = 0, y_fed_ = 0;  // next chunk start; samples fed so far up to these indices
+  bool same_signal_ = false;
   bool offsets_set_ = false;
   double x_offset_ = 0.0, y_offset_ = 0.0;
   long double sx_ = 0, sxx_ = 0;          // window sums of X
