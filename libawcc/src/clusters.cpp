@@ -101,9 +101,9 @@ ClusterAnalysis cluster_analysis(const ChordSequence& chords, double void_fracti
   double all = 0.0;
   for (const auto p : particle) all += static_cast<double>(p) * scale;
   const double mean_all = all / static_cast<double>(m);
-  std::vector<double> sorted(gap.size());
-  for (std::size_t i = 0; i < gap.size(); ++i) sorted[i] = static_cast<double>(gap[i]) * scale;
-  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> gaps(gap.size());
+  for (std::size_t i = 0; i < gap.size(); ++i) gaps[i] = static_cast<double>(gap[i]) * scale;
+  const double median_gap = median(gaps);
   const double duration = static_cast<double>(chords.sample_count) / chords.fs;
   for (const auto criterion : kCriteria) {
     ClusterStatistics s;
@@ -114,7 +114,7 @@ ClusterAnalysis cluster_analysis(const ChordSequence& chords, double void_fracti
       for (std::size_t i = 0; i + 1 < m; ++i) clustered[i] = gap[i] <= particle[i];
     } else {
       const double limit = criterion == ClusterCriterion::median
-                               ? options.median_fraction * quantile_of_sorted(sorted, 0.5)
+                               ? options.median_fraction * median_gap
                                : (basis == ChordBasis::length ? options.constant_length : options.constant_time);
       s.criterion_value = limit;
       for (std::size_t i = 0; i + 1 < m; ++i) clustered[i] = static_cast<double>(gap[i]) * scale <= limit;
@@ -173,10 +173,9 @@ ClusterAnalysis felder_cluster_analysis(const FelderChords& f, double void_fract
   double all = 0.0;
   for (std::size_t i = 1; i <= m; ++i) all += particle[i];
   const double mean_all = all / static_cast<double>(m);
-  std::vector<double> sorted(separator.begin() + 1, separator.begin() + 1 + static_cast<std::ptrdiff_t>(flags));
-  std::sort(sorted.begin(), sorted.end());
-  const std::size_t h = sorted.size();
-  const double median = h % 2 == 0 ? (sorted[h / 2 - 1] + sorted[h / 2]) / 2 : sorted[h / 2];
+  // His median: the middle value, the mean of the two middle ones for an even count.
+  std::vector<double> separations(separator.begin() + 1, separator.begin() + 1 + static_cast<std::ptrdiff_t>(flags));
+  const double median_separation = median(separations);
   const double tolerance = 1e-5f;
   const auto duration = static_cast<float>(static_cast<double>(chords.sample_count) / chords.fs);
   for (const auto criterion : kCriteria) {
@@ -216,7 +215,7 @@ ClusterAnalysis felder_cluster_analysis(const FelderChords& f, double void_fract
       }
     } else {
       const double limit = criterion == ClusterCriterion::median
-                               ? median * static_cast<double>(static_cast<float>(options.median_fraction))
+                               ? median_separation * static_cast<double>(static_cast<float>(options.median_fraction))
                                : static_cast<double>(static_cast<float>(
                                      (basis == ChordBasis::length ? options.constant_length : options.constant_time) * 1e3));
       s.criterion_value = limit * 1e-3;

@@ -149,7 +149,16 @@ void LaggedPearson::run_chunks(bool final) {
     std::fill(r.begin() + static_cast<std::ptrdiff_t>(needed), r.end(), 0.0);
     plan.forward();
     auto spectrum = plan.spectrum();
-    for (std::size_t i = 0; i < spectrum.size(); ++i) spectrum[i] *= std::conj(x_spectrum[i]);
+    // Y conj(X), written out: std::complex's product guards against
+    // infinities at a call per element; these values are finite.
+    auto* y = reinterpret_cast<double*>(spectrum.data());
+    const auto* x = reinterpret_cast<const double*>(x_spectrum.data());
+    for (std::size_t i = 0; i < 2 * spectrum.size(); i += 2) {
+      const double re = y[i] * x[i] + y[i + 1] * x[i + 1];
+      const double im = y[i + 1] * x[i] - y[i] * x[i + 1];
+      y[i] = re;
+      y[i + 1] = im;
+    }
     plan.inverse();
     const double scale = 1.0 / static_cast<double>(m);
     for (std::size_t j = 0; j < lags_; ++j) products_[j] += r[j] * scale;
