@@ -24,19 +24,11 @@ struct Particle {
 };
 
 bool refused(ArrivalAnalysis& out, double void_fraction, ChordBasis basis, double velocity) {
-  if (out.regime == FlowRegime::intermediate) {
-    out.status = ClusterStatus::intermediate_void_fraction;
-    out.message = fmt::format("void fraction {:.4f} lies in 0.3 to 0.7: neither bubbles nor droplets are particles; no "
-                              "inter-particle arrival analysis",
-                              void_fraction);
-    return true;
-  }
-  if (basis == ChordBasis::length && !(velocity > 0.0)) {
-    out.status = ClusterStatus::no_velocity;
-    out.message = "no velocity: chord lengths are unknown; the time-based analysis stands";
-    return true;
-  }
-  return false;
+  auto why = particle_refusal(out.regime, void_fraction, basis, velocity, "inter-particle arrival analysis");
+  if (!why) return false;
+  out.status = why->status;
+  out.message = std::move(why->message);
+  return true;
 }
 
 std::size_t class_of(double size, const std::vector<double>& limits) {

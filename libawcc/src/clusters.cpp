@@ -41,6 +41,21 @@ FlowRegime flow_regime(double void_fraction) {
   return FlowRegime::intermediate;
 }
 
+std::optional<ParticleRefusal> particle_refusal(FlowRegime regime, double void_fraction, ChordBasis basis,
+                                                double velocity, std::string_view analysis) {
+  if (regime == FlowRegime::intermediate) {
+    return ParticleRefusal{ClusterStatus::intermediate_void_fraction,
+                           fmt::format("void fraction {:.4f} lies in 0.3 to 0.7: neither bubbles nor droplets are "
+                                       "particles; no {}",
+                                       void_fraction, analysis)};
+  }
+  if (basis == ChordBasis::length && !(velocity > 0.0)) {
+    return ParticleRefusal{ClusterStatus::no_velocity,
+                           "no velocity: chord lengths are unknown; the time-based analysis stands"};
+  }
+  return std::nullopt;
+}
+
 namespace {
 
 constexpr std::array<ClusterCriterion, 3> kCriteria{ClusterCriterion::median, ClusterCriterion::constant,
@@ -48,16 +63,9 @@ constexpr std::array<ClusterCriterion, 3> kCriteria{ClusterCriterion::median, Cl
 
 // The checks every analysis makes before it runs.
 bool refused(ClusterAnalysis& out, double void_fraction, ChordBasis basis, double velocity, std::size_t particles) {
-  if (out.regime == FlowRegime::intermediate) {
-    out.status = ClusterStatus::intermediate_void_fraction;
-    out.message = fmt::format("void fraction {:.4f} lies in 0.3 to 0.7: neither bubbles nor droplets are particles; no "
-                              "cluster analysis",
-                              void_fraction);
-    return true;
-  }
-  if (basis == ChordBasis::length && !(velocity > 0.0)) {
-    out.status = ClusterStatus::no_velocity;
-    out.message = "no velocity: chord lengths are unknown; the time-based analysis stands";
+  if (auto why = particle_refusal(out.regime, void_fraction, basis, velocity, "cluster analysis")) {
+    out.status = why->status;
+    out.message = std::move(why->message);
     return true;
   }
   if (particles < 3) {

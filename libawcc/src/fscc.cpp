@@ -529,24 +529,39 @@ FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOpti
   // Auto-correlation scales.
   if (const auto half = first_at_or_below(out.r11, 0, 0.5, tau11)) out.t05 = half->time;
   else missing("t05", "R11 stays above 0.5 within " + lags11);
-  std::size_t r11_end = 0;
-  std::optional<double> r11_fraction;
-  if (const auto zero = first_at_or_below(out.r11, 0, 0.0, tau11)) {
-    out.t_r11_zero = out.t_r11_min = zero->time;
-    out.r11_min = 0.0;
-    r11_end = felder ? zero->index : zero->index - 1;
-    if (!felder) r11_fraction = out.r11[zero->index - 1] / (out.r11[zero->index - 1] - out.r11[zero->index]);
-  } else {
-    // Felder integrates to the minimum instead; the default leaves Txx
-    // empty rather than report an integral cut short by the lag range.
-    missing("t_r11_zero", "R11 stays above 0 within " + lags11);
-    if (!felder) missing("txx", "no Txx without R11's zero");
-    const auto [i, m] = minimum(out.r11, 0, 1.0, felder);
-    out.r11_min = m;
-    out.t_r11_min = tau11(i);
-    r11_end = i;
-  }
-  if (out.t_r11_zero || felder) out.txx = integral(out.r11, 0, r11_end, r11_fraction, fs, felder);
+  // The first zero crossing from `from`, or (without one) the minimum; the
+  // integral runs to it. Felder integrates to the minimum instead of leaving
+  // it empty; the default leaves it empty rather than report an integral cut
+  // short by the lag range.
+  struct Descent {
+    std::optional<double> t_zero, t_min, min, integral;
+  };
+  auto descend = [&](const std::vector<double>& r, std::size_t from, double cap, const LagTimes& tau,
+                     const char* zero_name, const char* integral_name, const std::string& where) {
+    Descent d;
+    std::size_t end = from;
+    std::optional<double> fraction;
+    if (const auto zero = first_at_or_below(r, from, 0.0, tau)) {
+      d.t_zero = d.t_min = zero->time;
+      d.min = 0.0;
+      end = felder ? zero->index : zero->index - 1;
+      if (!felder) fraction = r[zero->index - 1] / (r[zero->index - 1] - r[zero->index]);
+    } else {
+      missing(zero_name, where);
+      if (!felder) missing(integral_name, fmt::format("no {} without a zero crossing", integral_name));
+      const auto [i, m] = minimum(r, from, cap, felder);
+      d.min = m;
+      d.t_min = tau(i);
+      end = i;
+    }
+    if (d.t_zero || felder) d.integral = integral(r, from, end, fraction, fs, felder);
+    return d;
+  };
+  const auto r11_descent = descend(out.r11, 0, 1.0, tau11, "t_r11_zero", "txx", "R11 stays above 0 within " + lags11);
+  out.t_r11_zero = r11_descent.t_zero;
+  out.t_r11_min = r11_descent.t_min;
+  out.r11_min = r11_descent.min;
+  out.txx = r11_descent.integral;
   // Cross-correlation scales, right of the peak.
   if (out.r12_max > 0.0) {
     if (const auto half = first_at_or_below(out.r12, peak, 0.5 * out.r12_max, tau12)) {
@@ -555,22 +570,12 @@ FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOpti
     } else {
       missing("tau05", "R12 stays above R12max / 2 right of its peak within " + lags12);
     }
-    std::size_t r12_end = peak;
-    std::optional<double> r12_fraction;
-    if (const auto zero = first_at_or_below(out.r12, peak, 0.0, tau12)) {
-      out.t_r12_zero = out.t_r12_min = zero->time;
-      out.r12_min = 0.0;
-      r12_end = felder ? zero->index : zero->index - 1;
-      if (!felder) r12_fraction = out.r12[zero->index - 1] / (out.r12[zero->index - 1] - out.r12[zero->index]);
-    } else {
-      missing("t_r12_zero", "R12 stays above 0 right of its peak within " + lags12);
-      if (!felder) missing("txy", "no Txy without R12's zero");
-      const auto [i, m] = minimum(out.r12, peak, out.r12_max, felder);
-      out.r12_min = m;
-      out.t_r12_min = tau12(i);
-      r12_end = i;
-    }
-    if (out.t_r12_zero || felder) out.txy = integral(out.r12, peak, r12_end, r12_fraction, fs, felder);
+    const auto r12_descent = descend(out.r12, peak, out.r12_max, tau12, "t_r12_zero", "txy",
+                                     "R12 stays above 0 right of its peak within " + lags12);
+    out.t_r12_zero = r12_descent.t_zero;
+    out.t_r12_min = r12_descent.t_min;
+    out.r12_min = r12_descent.min;
+    out.txy = r12_descent.integral;
   } else {
     missing("tau05", "R12 has no positive peak");
   }

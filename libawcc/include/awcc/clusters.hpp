@@ -49,6 +49,15 @@ std::string_view to_string(ClusterStatus status);
 /// The regime of a void fraction (c < 0.3 bubbly, c > 0.7 droplet).
 FlowRegime flow_regime(double void_fraction);
 
+/// Why an analysis of particles (clusters, arrivals) cannot run: the regime
+/// between 0.3 and 0.7, or chord lengths without a velocity; empty when it can.
+struct ParticleRefusal {
+  ClusterStatus status = ClusterStatus::ok;
+  std::string message;
+};
+std::optional<ParticleRefusal> particle_refusal(FlowRegime regime, double void_fraction, ChordBasis basis,
+                                                double velocity, std::string_view analysis);
+
 struct ClusterOptions {
   /// Median criterion: fraction of the median separation, -. 0.1 is Chanson's.
   double median_fraction = 0.1;
