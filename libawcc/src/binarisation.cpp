@@ -3,6 +3,7 @@
 #include "awcc/errors.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
@@ -14,6 +15,7 @@ std::string_view to_string(ThresholdRule rule) {
   switch (rule) {
     case ThresholdRule::histogram: return "histogram";
     case ThresholdRule::felder: return "felder";
+    case ThresholdRule::kramer: return "kramer";
     case ThresholdRule::fixed: return "fixed";
     case ThresholdRule::hysteresis: return "hysteresis";
   }
@@ -30,7 +32,16 @@ std::string BinarisationOptions::validate() const {
   if (rule == ThresholdRule::fixed && !fixed_threshold)
     return "the fixed threshold rule needs a threshold voltage (e.g. 2.5V)";
   if (fixed_threshold && !std::isfinite(*fixed_threshold)) return "the fixed threshold must be finite";
+  if (fixed_threshold_trailing && rule != ThresholdRule::fixed)
+    return "a trailing tip's own threshold is a voltage of the fixed rule (--threshold-rule fixed)";
+  if (fixed_threshold_trailing && !std::isfinite(*fixed_threshold_trailing)) return "the trailing threshold must be finite";
   return {};
+}
+
+BinarisationOptions BinarisationOptions::for_trailing_tip() const {
+  BinarisationOptions o = *this;
+  if (fixed_threshold_trailing) o.fixed_threshold = fixed_threshold_trailing;
+  return o;
 }
 
 VoltageHistogram::VoltageHistogram(double quantum) : width_(quantum > 0.0 ? quantum : 1e-4) {}
@@ -135,6 +146,78 @@ std::vector<std::pair<double, std::int64_t>> VoltageHistogram::values() const {
   return out;
 }
 
+namespace {
+
+// MATLAB's eps(x): the distance from |x| to the next larger double.
+double matlab_eps(double x) {
+  const double a = std::fabs(x);
+  return a == 0.0 ? std::numeric_limits<double>::denorm_min() : std::nextafter(a, HUGE_VAL) - a;
+}
+
+// Kramer's thres.m on a histogram of the channel's values (see the header).
+Threshold kramer_threshold(const VoltageHistogram& h, const BinarisationOptions& o, Threshold t) {
+  constexpr int bins = 100;
+  const auto values = h.values();
+  const double lo = values.front().first, hi = values.back().first;
+  if (lo == hi) {
+    t.constant = true;
+    t.air_level = t.water_level = lo;
+    t.threshold = t.lower = t.upper = o.probe == ProbeType::conductivity ? lo - 1.0 : hi + 1.0;
+    t.note = "every sample has one value: no interface, taken as water";
+    return t;
+  }
+  // hist(Signal, 100): edges miny + w k (the last exactly maxy), each
+  // shifted up by eps so that a value on an edge belongs to the bin below.
+  const double width = (hi - lo) / bins;
+  std::array<double, bins + 1> edge{};
+  std::array<double, bins> centre{};
+  for (int k = 0; k <= bins; ++k) edge[static_cast<std::size_t>(k)] = lo + width * k;
+  edge[bins] = hi;
+  for (int k = 0; k < bins; ++k) centre[static_cast<std::size_t>(k)] = edge[static_cast<std::size_t>(k)] + width / 2;
+  for (auto& e : edge) e += matlab_eps(e);
+  std::array<std::int64_t, bins> count{};
+  for (const auto& [v, c] : values) {
+    const auto above = std::upper_bound(edge.begin(), edge.end(), v) - edge.begin();  // edges <= v
+    count[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(above - 1, 0, bins - 1))] += c;
+  }
+  const double split = centre[bins - 1] / 2;  // max(centers) / 2
+  // The mode of one side: the mean of the centres of every bin holding the
+  // side's largest count, on either side.
+  auto mode = [&](bool below, bool& quirk) {
+    std::int64_t top = -1;
+    for (int k = 0; k < bins; ++k) {
+      const double x = centre[static_cast<std::size_t>(k)];
+      if (below ? x < split : x > split) top = std::max(top, count[static_cast<std::size_t>(k)]);
+    }
+    if (top < 0) throw InputError(fmt::format("kramer threshold: no histogram bin {} half the largest centre ({:.4g} V)",
+                                              below ? "below" : "above", split),
+                                  "threshold");
+    double sum = 0.0;
+    int n = 0;
+    for (int k = 0; k < bins; ++k) {
+      if (count[static_cast<std::size_t>(k)] != top) continue;
+      const double x = centre[static_cast<std::size_t>(k)];
+      quirk = quirk || (below ? !(x < split) : !(x > split));
+      sum += x;
+      ++n;
+    }
+    return sum / n;
+  };
+  bool quirk = false;
+  const double low_mode = mode(true, quirk), high_mode = mode(false, quirk);
+  const bool air_low = o.probe == ProbeType::conductivity;
+  t.air_level = air_low ? low_mode : high_mode;
+  t.water_level = air_low ? high_mode : low_mode;
+  t.threshold = t.lower = t.upper = t.air_level + o.theta * (t.water_level - t.air_level);
+  if (quirk) {
+    t.note = "thres.m's quirk: a bin on the other side of the first split holds a mode's count and was averaged into "
+             "that mode (as Kramer's toolbox does)";
+  }
+  return t;
+}
+
+}  // namespace
+
 Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions& o) {
   Threshold t;
   t.rule = o.rule;
@@ -163,6 +246,7 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
     t.threshold = t.lower = t.upper = o.fixed_threshold.value_or(0.0);
     return t;
   }
+  if (o.rule == ThresholdRule::kramer) return kramer_threshold(h, o, t);
   double width = o.bin_width;
   const double lo = h.min_value(), hi = h.max_value();
   if (width == 0.0 || o.rule == ThresholdRule::felder) {
@@ -234,17 +318,18 @@ void Binariser::feed(std::span<const float> values, std::size_t first, std::size
   const bool binary = t_.binary_input;
   const bool air_low = !binary && t_.probe == ProbeType::conductivity;
   // Air test per sample: conductivity air below, optical and binary air above.
-  const auto lower = static_cast<float>(t_.lower + (air_low ? t_.tolerance : -t_.tolerance));
-  const auto upper = static_cast<float>(t_.upper + (air_low ? t_.tolerance : -t_.tolerance));
+  // Compared in double: a threshold between two floats must not move to one of them.
+  const double lower = t_.lower + (air_low ? t_.tolerance : -t_.tolerance);
+  const double upper = t_.upper + (air_low ? t_.tolerance : -t_.tolerance);
   const bool hysteresis = t_.rule == ThresholdRule::hysteresis && !binary;
   std::int64_t n = position_;
   for (std::size_t i = first; i < values.size(); i += stride, ++n) {
-    const float v = values[i];
+    const double v = values[i];
     bool air;
     if (!hysteresis) {
       air = air_low ? v < upper : v > lower;
     } else if (!started_) {
-      air = air_low ? v < 0.5f * (lower + upper) : v > 0.5f * (lower + upper);
+      air = air_low ? v < 0.5 * (lower + upper) : v > 0.5 * (lower + upper);
     } else if (in_air_) {
       air = air_low ? !(v > upper) : !(v < lower);
     } else {

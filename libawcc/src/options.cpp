@@ -56,8 +56,9 @@ constexpr std::array<std::pair<const char*, SampleType>, 4> kTypes{{{"int16", Sa
                                                                     {"float64", SampleType::float64}}};
 constexpr std::array<std::pair<const char*, ByteOrder>, 2> kOrders{{{"little", ByteOrder::little},
                                                                     {"big", ByteOrder::big}}};
-constexpr std::array<std::pair<const char*, ThresholdRule>, 4> kRules{{{"histogram", ThresholdRule::histogram},
+constexpr std::array<std::pair<const char*, ThresholdRule>, 5> kRules{{{"histogram", ThresholdRule::histogram},
                                                                       {"felder", ThresholdRule::felder},
+                                                                      {"kramer", ThresholdRule::kramer},
                                                                       {"fixed", ThresholdRule::fixed},
                                                                       {"hysteresis", ThresholdRule::hysteresis}}};
 constexpr std::array<std::pair<const char*, ProbeType>, 2> kProbes{{{"conductivity", ProbeType::conductivity},
@@ -125,7 +126,9 @@ const OptionField<R> kReader[] = {
 
 using B = BinarisationOptions;
 const OptionField<B> kBinarisation[] = {
-    {"threshold-rule", "", "histogram | felder (Felder's program) | fixed (a voltage) | hysteresis (two thresholds)",
+    {"threshold-rule", "",
+     "histogram | felder (Felder's program) | kramer (Kramer's toolbox, thres.m) | fixed (a voltage) | hysteresis (two "
+     "thresholds)",
      [](B& o, std::string_view t) { o.rule = choice(t, kRules); },
      [](const B& o) { return name_of(o.rule, kRules); }},
     {"threshold", "",
@@ -134,7 +137,8 @@ const OptionField<B> kBinarisation[] = {
      [](B& o, std::string_view t) {
        switch (o.rule) {
          case ThresholdRule::histogram:
-         case ThresholdRule::felder: o.theta = quantity(t, Dimension::dimensionless); break;
+         case ThresholdRule::felder:
+         case ThresholdRule::kramer: o.theta = quantity(t, Dimension::dimensionless); break;
          case ThresholdRule::fixed: o.fixed_threshold = quantity(t, Dimension::voltage); break;
          case ThresholdRule::hysteresis: {
            const auto [lo, hi] = pair_of(t, "0.4,0.6");
@@ -151,6 +155,12 @@ const OptionField<B> kBinarisation[] = {
          case ThresholdRule::hysteresis: return fmt::format("{:g},{:g}", o.hysteresis_low, o.hysteresis_high);
          default: return fmt::format("{:g}", o.theta);
        }
+     }},
+    {"threshold-trailing", "V", "fixed rule: the trailing tip's own threshold voltage (default: the leading tip's)",
+     [](B& o, std::string_view t) { o.fixed_threshold_trailing = quantity(t, Dimension::voltage); },
+     [](const B& o) {
+       return o.fixed_threshold_trailing ? format_quantity(*o.fixed_threshold_trailing, Dimension::voltage)
+                                         : std::string("the leading tip's");
      }},
     {"probe", "", "conductivity (air is the low level) | optical (air is the high level)",
      [](B& o, std::string_view t) { o.probe = choice(t, kProbes); },

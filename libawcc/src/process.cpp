@@ -70,7 +70,7 @@ void binarise_two_pass(Recording& recording, const ProcessOptions& options, cons
   }
   if (frames == 0) throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
   out.leading_threshold = choose_threshold(h_lead, bopt);
-  out.trailing_threshold = choose_threshold(h_trail, bopt);
+  out.trailing_threshold = choose_threshold(h_trail, bopt.for_trailing_tip());
   out.leading_histogram = std::move(h_lead);
   out.trailing_histogram = std::move(h_trail);
   recording.rewind();
@@ -272,7 +272,8 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
       std::vector<std::int16_t> block(static_cast<std::size_t>(options.block_frames) * ch.stride);
       std::int64_t n = recording->read_int16(block, options.block_frames);
       const auto band_lead = band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.lead, info.quantum, bopt);
-      const auto band_trail = band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail, info.quantum, bopt);
+      const auto band_trail =
+          band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail, info.quantum, bopt.for_trailing_tip());
       if (n > 0 && band_lead && band_trail) {
         BandRecorder lead(band_lead->first, band_lead->second), trail(band_trail->first, band_trail->second);
         while (n > 0) {
@@ -283,7 +284,7 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
         out.leading_histogram = lead.histogram(info.quantum);
         out.trailing_histogram = trail.histogram(info.quantum);
         out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
-        out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt);
+        out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt.for_trailing_tip());
         if (lead.covers(out.leading_threshold, info.quantum) && trail.covers(out.trailing_threshold, info.quantum)) {
           out.leading = lead.resolve(out.leading_threshold, info.quantum, info.fs);
           out.trailing = trail.resolve(out.trailing_threshold, info.quantum, info.fs);

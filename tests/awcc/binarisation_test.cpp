@@ -153,3 +153,60 @@ TEST(BinarisationOptions, Validation) {
 }
 
 }  // namespace
+
+namespace {
+
+// Samples of given values (V) and counts, histogrammed at 0.01 V.
+VoltageHistogram histogram_of(const std::vector<std::pair<float, int>>& values) {
+  VoltageHistogram h(0.01);
+  std::vector<float> v;
+  for (const auto& [value, n] : values) v.insert(v.end(), static_cast<std::size_t>(n), value);
+  h.add(v, 0, 1);
+  return h;
+}
+
+// thres.m on a hand-made record from 0 V to 10 V: 100 bins of 0.1 V, centres
+// 0.05 .. 9.95, first split at 9.95 / 2 = 4.975. Air side: 50 samples at
+// 0.55 V (bin centre 0.55); water side: 80 at 9.05 V, and 50 at 6.05 V,
+// which ties with the air side's largest count: thres.m averages that bin
+// into the air mode, (0.55 + 6.05) / 2 = 3.3 V; threshold (3.3 + 9.05) / 2.
+TEST(Threshold, KramerRuleAveragesATieAcrossTheSplitAsThresMDoes) {
+  BinarisationOptions o;
+  o.rule = ThresholdRule::kramer;
+  const auto t = awcc::choose_threshold(histogram_of({{0.0f, 1}, {0.55f, 50}, {6.05f, 50}, {9.05f, 80}, {10.0f, 1}}), o);
+  EXPECT_NEAR(t.air_level, 3.3, 1e-9);
+  EXPECT_NEAR(t.water_level, 9.05, 1e-9);
+  EXPECT_NEAR(t.threshold, (3.3 + 9.05) / 2, 1e-9);
+  EXPECT_NE(t.note.find("quirk"), std::string::npos);
+  // Without the tie: no quirk, the air mode is its own bin.
+  const auto plain = awcc::choose_threshold(histogram_of({{0.0f, 1}, {0.55f, 50}, {6.05f, 40}, {9.05f, 80}, {10.0f, 1}}), o);
+  EXPECT_NEAR(plain.air_level, 0.55, 1e-9);
+  EXPECT_TRUE(plain.note.empty());
+}
+
+TEST(Threshold, KramerRulePutsAValueOnABinEdgeInTheBinBelow) {
+  // MATLAB's hist shifts each edge up by eps: 60 samples at exactly 2.0 V
+  // (the edge between the bins centred on 1.95 and 2.05) count in the bin
+  // centred on 1.95, which becomes the air mode.
+  BinarisationOptions o;
+  o.rule = ThresholdRule::kramer;
+  const auto t = awcc::choose_threshold(histogram_of({{0.0f, 1}, {2.0f, 60}, {0.55f, 50}, {9.05f, 80}, {10.0f, 1}}), o);
+  EXPECT_NEAR(t.air_level, 1.95, 1e-9);
+  EXPECT_NEAR(t.threshold, (1.95 + 9.05) / 2, 1e-9);
+}
+
+TEST(BinarisationOptions, TheTrailingTipsOwnThresholdIsAFixedRuleVoltage) {
+  BinarisationOptions o;
+  o.rule = ThresholdRule::fixed;
+  o.fixed_threshold = 2.7;
+  o.fixed_threshold_trailing = 2.6;
+  EXPECT_TRUE(o.validate().empty());
+  EXPECT_DOUBLE_EQ(*o.for_trailing_tip().fixed_threshold, 2.6);
+  o.fixed_threshold_trailing.reset();
+  EXPECT_DOUBLE_EQ(*o.for_trailing_tip().fixed_threshold, 2.7);
+  o.rule = ThresholdRule::histogram;
+  o.fixed_threshold_trailing = 2.6;
+  EXPECT_NE(o.validate().find("fixed rule"), std::string::npos);
+}
+
+}  // namespace

@@ -82,7 +82,19 @@ assert o['segments']=='15' and o['felder-defects']=='on' and o['correlate']=='ra
     >/dev/null || fail "preset with an override"
   /usr/bin/python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j['provenance']['options']['segments']=='1'
 assert j['fscc']['segments_used']==1" "$dir/felder/s1.json" || fail "an option given does not override the preset"
+  # Per-tip fixed thresholds; Kramer's rule reported as such.
+  "$pdp" process "$data"/dc157_03.dat --fs 20kHz --dx 7.15mm --method fscc --threshold-rule fixed --threshold 2.70V \
+    --threshold-trailing 2.60V --json "$dir/fixed.json" >/dev/null || fail "per-tip fixed thresholds"
+  /usr/bin/python3 -c "import json,sys; t=json.load(open(sys.argv[1]))['tips']
+assert abs(t[0]['threshold']-2.7)<1e-12 and abs(t[1]['threshold']-2.6)<1e-12, t" "$dir/fixed.json" ||
+    fail "the trailing tip's own threshold not applied"
+  "$pdp" process "$data"/dc157_03.dat --fs 20kHz --dx 7.15mm --method fscc --threshold-rule kramer \
+    --json "$dir/kramer.json" >/dev/null || fail "kramer rule"
+  /usr/bin/python3 -c "import json,sys; t=json.load(open(sys.argv[1]))['tips']
+assert t[0]['threshold_rule']=='kramer' and 2.6 < t[0]['threshold'] < 2.8, t[0]['threshold']" "$dir/kramer.json" ||
+    fail "kramer threshold"
 fi
+expect 2 "fixed rule" "$pdp" process "$dir/rec.flac" --dx 5mm --threshold-trailing 2.6V
 expect 2 "not a preset" "$pdp" process "$dir/rec.flac" --dx 5mm --preset kramer
 
 # The structure tables of a synthetic profile: each chord PDF sums to 1 over its bins.

@@ -12,7 +12,17 @@
 //    threshold = V_air + theta (V_water - V_air), and a sample is air when
 //    V - threshold < 1e-5. Its threshold sits 0.05 V above the histogram
 //    rule's; offered so that a lab can reproduce its past results exactly.
-//  - fixed: a stated voltage.
+//  - kramer: Kramer's toolbox (thres.m): MATLAB's hist with 100 equal bins
+//    from the channel's minimum to its maximum (bins (e_k, e_k+1], the first
+//    closed, identified by their centres); a first split at half the
+//    largest centre; the air mode is the mean of the centres of every bin
+//    whose count equals the largest count below the split (a bin on the
+//    other side with the same count is averaged in: the toolbox's quirk,
+//    noted when it happens), the water mode likewise above; threshold =
+//    V_air + theta (V_water - V_air) (thres.m: theta = 0.5); air when V is
+//    below it. Exact for integer recordings (floating ones are histogrammed
+//    at 0.1 mV).
+//  - fixed: a stated voltage (the trailing tip may have its own).
 //  - hysteresis: two thresholds at fractions theta_low and theta_high (0.4,
 //    0.6) between the modes; the state changes only when the signal crosses
 //    the far one, which suppresses chatter on noisy signals.
@@ -31,7 +41,7 @@
 namespace awcc {
 
 enum class ProbeType { conductivity, optical };
-enum class ThresholdRule { histogram, felder, fixed, hysteresis };
+enum class ThresholdRule { histogram, felder, kramer, fixed, hysteresis };
 
 std::string_view to_string(ThresholdRule rule);
 std::string_view to_string(ProbeType probe);
@@ -41,6 +51,7 @@ struct BinarisationOptions {
   ProbeType probe = ProbeType::conductivity;
   double theta = 0.5;                ///< histogram/felder: fraction from air mode to water mode, -
   std::optional<double> fixed_threshold;  ///< fixed: threshold, V (required by the fixed rule)
+  std::optional<double> fixed_threshold_trailing;  ///< fixed: the trailing tip's own threshold, V (else fixed_threshold)
   double hysteresis_low = 0.4;       ///< hysteresis: fraction of the nearer-to-air threshold, -
   double hysteresis_high = 0.6;      ///< hysteresis: fraction of the nearer-to-water threshold, -
   double bin_width = 0.1;            ///< histogram: bin width, V; 0 = 100 bins over the observed range
@@ -48,6 +59,8 @@ struct BinarisationOptions {
 
   /// Empty when valid, else what is wrong with which option.
   [[nodiscard]] std::string validate() const;
+  /// The options of the trailing tip (its own fixed threshold, when given).
+  [[nodiscard]] BinarisationOptions for_trailing_tip() const;
 };
 
 /// Voltage histogram of one channel at the resolution of the data (one bin
