@@ -21,6 +21,7 @@ std::string_view to_string(WindowFate fate) {
     case WindowFate::roc: return "roc";
     case WindowFate::constant: return "constant";
     case WindowFate::too_short: return "too_short";
+    case WindowFate::correction: return "correction";
   }
   return "?";
 }
@@ -55,6 +56,7 @@ AwccWorkspace::AwccWorkspace(AwccWorkspace&&) noexcept = default;
 AwccWorkspace& AwccWorkspace::operator=(AwccWorkspace&&) noexcept = default;
 
 std::string AwccOptions::validate() const {
+  if (auto why = probe_correction.validate(); !why.empty()) return why;
   if (np < 1 || np > 1000) return fmt::format("np = {}: particles per window must lie in [1, 1000]", np);
   if (!(filter_a >= 0.0 && filter_a <= 1.0)) return fmt::format("filter A = {} must lie in [0, 1]", filter_a);
   if (!(prominence_fraction >= 0.0 && prominence_fraction <= 1.0))
@@ -532,6 +534,21 @@ void analyse_window(AwccWindow& w, std::span<const double> r, std::int64_t first
   analyse_window(w, p, r.empty(), first_lag, dx, fs, options);
 }
 
+void correct_windows(AwccResult& result, double dx, const AwccOptions& options) {
+  for (auto& w : result.windows) w.measured_velocity = w.velocity;
+  const auto& o = options.probe_correction;
+  if (!o.enabled) return;
+  result.probe_corrected = true;
+  result.windows_not_bubbly = 0;
+  for (auto& w : result.windows) {
+    if (w.fate != WindowFate::accepted) continue;
+    const auto c = correct_window(w.velocity, w.void_fraction, w.count_rate, dx, o);
+    if (c.outcome == CorrectionOutcome::failed) w.fate = WindowFate::correction;
+    else w.velocity = c.velocity;
+    if (c.outcome == CorrectionOutcome::not_bubbly) ++result.windows_not_bubbly;
+  }
+}
+
 void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   auto& windows = result.windows;
   result.windows_total = static_cast<std::int64_t>(windows.size());
@@ -553,7 +570,8 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
   }
   result.windows_accepted = result.rejected_correlation = result.rejected_lag = result.rejected_roc =
-      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = result.negative_lag_windows = 0;
+      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = result.negative_lag_windows =
+          result.rejected_correction = 0;
   double sw = 0, swu = 0;
   for (const auto& w : windows) {
     switch (w.fate) {
@@ -563,6 +581,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       case WindowFate::roc: ++result.rejected_roc; break;
       case WindowFate::constant: ++result.rejected_constant; break;
       case WindowFate::too_short: ++result.rejected_too_short; break;
+      case WindowFate::correction: ++result.rejected_correction; break;
     }
     if (w.fate == WindowFate::lag && w.lag_samples == 0) ++result.lag_zero_windows;
     if (w.fate == WindowFate::lag && w.lag_samples < 0) ++result.negative_lag_windows;
@@ -630,6 +649,24 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   const double hu = 1.96 * rms / std::sqrt(n);
   const double hr = 1.96 * rms / std::sqrt(2.0 * n);
   const double ht = 1.96 * std::sqrt(tu * tu * (tu * tu / n + 1.0 / (2.0 * n)));
+  if (result.probe_corrected) {
+    // The measured moments over the same windows, for comparison.
+    double mw = 0;
+    for (const auto& w : windows) {
+      if (w.fate != WindowFate::accepted) continue;
+      mw += (options.weighting == Weighting::duration ? w.duration : 1.0) * w.measured_velocity;
+    }
+    const double measured_mean = mw / sw;
+    double md = 0;
+    for (const auto& w : windows) {
+      if (w.fate != WindowFate::accepted) continue;
+      const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
+      md += weight * (w.measured_velocity - measured_mean) * (w.measured_velocity - measured_mean);
+    }
+    result.velocity_measured = measured_mean;
+    result.velocity_rms_measured = std::sqrt(md / sw);
+    result.turbulence_intensity_measured = result.velocity_rms_measured / measured_mean;
+  }
   result.velocity_ci95 = {mean - hu, mean + hu};
   result.velocity_rms_ci95 = {rms - hr, rms + hr};
   result.turbulence_intensity_ci95 = {tu - ht, tu + ht};
@@ -698,6 +735,7 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
       analyse_window(w, p, r.empty(), k_min, dx, fs, options);
     }
   }
+  correct_windows(result, dx, options);
   awcc_summarise(result, options);
   if (!(dx > 0.0) && result.ok()) no_tip_separation(result);
   return result;

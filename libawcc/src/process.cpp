@@ -460,6 +460,7 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
       ++w;
     }
   }
+  detail::correct_windows(result, options.dx, ao);
   detail::awcc_summarise(result, ao);
   if (!(options.dx > 0.0) && result.ok()) detail::no_tip_separation(result);
   return result;

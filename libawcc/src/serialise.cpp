@@ -15,11 +15,11 @@
 namespace awcc {
 
 std::string awcc_windows_csv(const AwccResult& result) {
-  std::string out = "start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate\n";
+  std::string out = "start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate,measured_velocity\n";
   for (const auto& w : result.windows) {
-    out += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.9g},{:.6f},{:.6f},{:.6f},{:.6g},{}\n", w.start_time, w.duration,
+    out += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.9g},{:.6f},{:.6f},{:.6f},{:.6g},{},{:.9g}\n", w.start_time, w.duration,
                        w.particles, w.lag, w.velocity, w.r12_max, w.spr, w.void_fraction, w.count_rate,
-                       to_string(w.fate));
+                       to_string(w.fate), w.measured_velocity);
   }
   return out;
 }
@@ -290,6 +290,12 @@ json to_json(const ProcessResult& r) {
         {"windows_negative_lag", a.negative_lag_windows},
         {"quality", to_string(a.quality)},
         {"quality_reason", a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
+        {"probe_corrected", a.probe_corrected},
+        {"velocity_measured", a.probe_corrected ? value(a.velocity_measured) : json(nullptr)},
+        {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
+        {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
+        {"windows_rejected_correction", a.rejected_correction},
+        {"windows_not_bubbly", a.windows_not_bubbly},
         {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
                                               static_cast<double>(a.windows_total))
                                         : json(nullptr)},
@@ -528,6 +534,12 @@ std::string ProcessResult::report() const {
                        a.turbulence_intensity, a.turbulence_intensity_ci95.lower, a.turbulence_intensity_ci95.upper));
     } else {
       line(fmt::format("  AWCC: no velocity: {}", a.message));
+    }
+    if (a.probe_corrected && a.ok()) {
+      line(fmt::format("        bubble-probe corrected (measured: velocity {:.4f} m/s, u_rms {:.4f} m/s, Tu {:.4f}); {} "
+                       "windows failed the correction, {} not bubbly (as measured)",
+                       a.velocity_measured, a.velocity_rms_measured, a.turbulence_intensity_measured,
+                       a.rejected_correction, a.windows_not_bubbly));
     }
     line(fmt::format("        quality {}{}", to_string(a.quality),
                      a.quality == AwccQuality::low ? ": " + a.quality_reason : std::string()));

@@ -3,6 +3,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <numbers>
 #include <fmt/format.h>
 #include <stdexcept>
 #include <vector>
@@ -30,6 +31,14 @@ std::vector<Unit> units_of(Dimension dimension) {
       return {{"m/s", 1.0}, {"cm/s", 1e-2}, {"mm/s", 1e-3}, {"km/h", 1.0 / 3.6}};
     case Dimension::voltage:
       return {{"V", 1.0}, {"mV", 1e-3}};
+    case Dimension::angle:
+      return {{"rad", 1.0}, {"deg", std::numbers::pi / 180.0}};
+    case Dimension::density:
+      return {{"kg/m3", 1.0}, {"g/cm3", 1e3}};
+    case Dimension::kinematic_viscosity:
+      return {{"m2/s", 1.0}, {"mm2/s", 1e-6}};
+    case Dimension::surface_tension:
+      return {{"N/m", 1.0}, {"mN/m", 1e-3}};
   }
   return {};
 }
@@ -42,6 +51,10 @@ std::string_view dimension_name(Dimension dimension) {
     case Dimension::frequency: return "a frequency";
     case Dimension::velocity: return "a velocity";
     case Dimension::voltage: return "a voltage";
+    case Dimension::angle: return "an angle";
+    case Dimension::density: return "a density";
+    case Dimension::kinematic_viscosity: return "a kinematic viscosity";
+    case Dimension::surface_tension: return "a surface tension";
   }
   return "a quantity";
 }
@@ -54,6 +67,10 @@ std::pair<std::string_view, std::string_view> usual_units(Dimension dimension) {
     case Dimension::frequency: return {"Hz", "kHz"};
     case Dimension::velocity: return {"m/s", "cm/s"};
     case Dimension::voltage: return {"V", "mV"};
+    case Dimension::angle: return {"deg", "rad"};
+    case Dimension::density: return {"kg/m3", "g/cm3"};
+    case Dimension::kinematic_viscosity: return {"m2/s", "mm2/s"};
+    case Dimension::surface_tension: return {"N/m", "mN/m"};
     case Dimension::dimensionless: break;
   }
   return {"", ""};
@@ -133,6 +150,10 @@ std::string format_quantity(double value, Dimension dimension) {
     case Dimension::frequency:
       if (a >= 1e6) { symbol = "MHz"; scale = 1e6; }
       else if (a >= 1e3) { symbol = "kHz"; scale = 1e3; }
+      break;
+    case Dimension::angle:  // a lab writes degrees
+      symbol = "deg";
+      scale = std::numbers::pi / 180.0;
       break;
     default:
       break;

@@ -54,12 +54,13 @@
 #include "awcc/fft.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
+#include "awcc/probe_correction.hpp"
 
 namespace awcc {
 
 enum class Weighting { duration, none };
 enum class CorrelationPath { automatic, fft, intervals };
-enum class WindowFate { accepted, correlation, lag, roc, constant, too_short };
+enum class WindowFate { accepted, correlation, lag, roc, constant, too_short, correction };
 
 std::string_view to_string(WindowFate fate);
 std::string_view to_string(Weighting weighting);
@@ -97,6 +98,9 @@ struct AwccOptions {
   int windows_ok = 100;
   /// Least data yield (accepted / total windows) of quality `ok`, -.
   double yield_ok = 0.05;
+  /// Bubble-probe interaction correction of every accepted window before the
+  /// outlier cutoff and the moments (awcc/probe_correction.hpp); off by default.
+  ProbeCorrectionOptions probe_correction;
 
   [[nodiscard]] std::string validate() const;
 };
@@ -110,7 +114,8 @@ struct AwccWindow {
   int particles = 0;            ///< air chords of the leading tip starting in the window
   std::int64_t lag_samples = 0; ///< integer lag of the peak
   double lag = 0.0;             ///< s (refined when asked)
-  double velocity = 0.0;        ///< dx / lag, m/s (0 when the lag is not positive)
+  double velocity = 0.0;        ///< dx / lag, m/s (0 when the lag is not positive); corrected when asked
+  double measured_velocity = 0.0;  ///< dx / lag before the bubble-probe correction, m/s
   double r12_max = 0.0;
   double spr = 0.0;             ///< secondary peak ratio
   double void_fraction = 0.0;   ///< leading tip, in the window
@@ -151,6 +156,12 @@ struct AwccResult {
   std::int64_t lag_zero_windows = 0;  ///< windows peaking at lag 0 (delay below one sample)
   std::int64_t negative_lag_windows = 0;  ///< windows peaking at a negative lag
   int roc_iterations = 0;
+  /// Bubble-probe correction: the moments above are of the corrected
+  /// velocities; these of the measured ones over the same windows.
+  bool probe_corrected = false;
+  double velocity_measured = 0.0, velocity_rms_measured = 0.0, turbulence_intensity_measured = 0.0;
+  std::int64_t rejected_correction = 0;   ///< windows whose correction failed
+  std::int64_t windows_not_bubbly = 0;    ///< accepted windows above the bubbly void fraction: as measured
   std::vector<AwccWindow> windows;
 };
 

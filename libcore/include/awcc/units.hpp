@@ -10,7 +10,18 @@
 
 namespace awcc {
 
-enum class Dimension { dimensionless, length, time, frequency, velocity, voltage };
+enum class Dimension {
+  dimensionless,
+  length,
+  time,
+  frequency,
+  velocity,
+  voltage,
+  angle,                ///< rad (deg accepted)
+  density,              ///< kg/m3
+  kinematic_viscosity,  ///< m2/s
+  surface_tension,      ///< N/m
+};
 
 /// SI unit symbol of a dimension ("m", "s", "Hz", "m/s", "V", "").
 std::string_view si_unit(Dimension dimension);

@@ -83,6 +83,11 @@ void analyse_window(AwccWindow& window, const CorrelationPeak& peak, bool consta
 /// moments, intervals, counts, the status and its message.
 void awcc_summarise(AwccResult& result, const AwccOptions& options);
 
+/// The bubble-probe correction of every accepted window (when the options
+/// ask for it): velocity becomes u0, measured_velocity keeps dx / lag; a
+/// failure rejects the window (fate correction). Run before awcc_summarise.
+void correct_windows(AwccResult& result, double dx, const AwccOptions& options);
+
 /// Marks an otherwise good result as having no velocity for want of dx.
 void no_tip_separation(AwccResult& result);
 /// Marks a result as having no velocity because the tips are swapped (`why`).
