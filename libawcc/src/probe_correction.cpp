@@ -122,19 +122,46 @@ double rise_velocity(double d, const ProbeCorrectionOptions& o) {
   return cosine > 0.0 ? u : -u;
 }
 
+namespace {
+
+// The force balance of one bubble (diameter and carrier fixed), its
+// constants computed once: the integrator evaluates it thousands of times.
+struct BubbleModel {
+  BubbleModel(double d, double carrier_velocity, const ProbeCorrectionOptions& o) : carrier(carrier_velocity) {
+    const double m = o.air_density + o.virtual_mass * o.water_density;
+    const double d3 = d * d * d;
+    reynolds_per_speed = d / o.water_viscosity;
+    const double eo = o.gravity * (o.water_density - o.air_density) * d * d / o.surface_tension;
+    eotvos_drag = 8.0 / 3.0 * eo / (eo + 4.0);
+    drag = 3.0 * o.water_density / (4.0 * m * d);
+    constant = (o.air_density - o.water_density) * o.gravity * std::cos(o.probe_angle) / m -
+               6.0 * o.contact_factor * o.surface_tension * o.needle_diameter / (m * d3);
+    impact = 3.0 * o.impact_pressure * o.air_density * o.needle_diameter * o.needle_diameter / (4.0 * m * d3);
+    deformation = 6.0 * o.surface_tension / (std::numbers::pi * d * d * m);
+    weber_per_u2 = o.air_density * d / o.surface_tension;
+  }
+  double operator()(double u) const {
+    const double relative = carrier - u;
+    double cd = 0.0;
+    if (relative != 0.0) {
+      // Tomiyama: max(min(24/Re (1 + 0.15 Re^0.687), 72/Re), 8/3 Eo/(Eo + 4));
+      // above Re = 50 the min is 72/Re (the bracket exceeds 3 from Re = 43.4).
+      const double re = std::fabs(relative) * reynolds_per_speed;
+      const double viscous = re < 50.0 ? std::min(24.0 / re * (1.0 + 0.15 * std::pow(re, 0.687)), 72.0 / re) : 72.0 / re;
+      cd = std::max(viscous, eotvos_drag);
+    }
+    const double rb = reynolds_per_speed * u;
+    const double cs = std::max(0.0, -7.2e-8 * rb * rb + 0.002 * rb - 0.589);
+    const double deform = cs > 0.0 ? cs * deformation * std::sqrt(std::sqrt(weber_per_u2 * u * u)) : 0.0;
+    return drag * cd * relative * std::fabs(relative) + constant - impact * u * u - deform;
+  }
+  double carrier, reynolds_per_speed, eotvos_drag, drag, constant, impact, deformation, weber_per_u2;
+};
+
+}  // namespace
+
 double bubble_acceleration(double u, double d, double carrier, const ProbeCorrectionOptions& o) {
-  const double m = o.air_density + o.virtual_mass * o.water_density;
-  const double relative = carrier - u;
-  const double d3 = d * d * d;
-  const double drag =
-      3.0 * drag_coefficient(relative, d, o) * o.water_density * relative * std::fabs(relative) / (4.0 * m * d);
-  const double buoyancy = (o.air_density - o.water_density) * o.gravity * std::cos(o.probe_angle) / m;
-  const double contact = 6.0 * o.contact_factor * o.surface_tension * o.needle_diameter / (m * d3);
-  const double impact = 3.0 * o.impact_pressure * o.air_density * u * u * o.needle_diameter * o.needle_diameter / (4.0 * m * d3);
-  const double deformation = 6.0 * deformation_coefficient(u, d, o) * o.surface_tension *
-                             std::pow(o.air_density * u * u * d / o.surface_tension, 0.25) /
-                             (std::numbers::pi * d * d * m);
-  return drag + buoyancy - contact - impact - deformation;
+  return BubbleModel(d, carrier, o)(u);
 }
 
 std::optional<double> integrate_velocity(const std::function<double(double)>& f, double u0, double t1, double rtol,
@@ -199,16 +226,26 @@ WindowCorrection correct_window(double measured_velocity, double void_fraction, 
   auto residual = [&](double u0) {
     const double d = 1.5 * u0 * void_fraction / count_rate;
     const double carrier = u0 - detail::rise_velocity(d, o);
-    const auto exit = detail::integrate_velocity(
-        [&](double u) { return detail::bubble_acceleration(u, d, carrier, o); }, u0, t1, 1e-13, o.max_steps);
+    const detail::BubbleModel model(d, carrier, o);
+    const auto exit = detail::integrate_velocity(std::cref(model), u0, t1, 1e-12, o.max_steps);
     stopped = !exit;
     return u0 + exit.value_or(0.0) - 2.0 * um;
   };
   // Bracket: the bubble is slowed (u0 above u_m) unless buoyancy speeds it up.
   double a = um, fa = residual(um);
   double b = a, fb = fa;
-  for (int k = 1; k <= 40 && (fa > 0) == (fb > 0); ++k) {
-    b = fa < 0 ? um * (1.0 + 0.1 * k) : um * std::pow(0.9, k);
+  // Steps of 15 % (the toolbox's first guess) growing geometrically: u0 up to
+  // 8.1 u_m, or down to 0.28 u_m when buoyancy speeds the bubble up.
+  for (int k = 1; k <= 15 && (fa > 0) == (fb > 0); ++k) {
+    if (fa < 0) {
+      a = b;
+      fa = fb;
+      b = um * std::pow(1.15, k);
+    } else {
+      a = b;
+      fa = fb;
+      b = um * std::pow(0.92, k);
+    }
     fb = residual(b);
   }
   if ((fa > 0) == (fb > 0)) {

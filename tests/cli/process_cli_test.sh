@@ -32,7 +32,7 @@ for key in awcc velocity velocity_rms turbulence_intensity velocity_ci95 turbule
   grep -q "\"$key\"" "$dir/awcc.json" || fail "AWCC JSON lacks $key"
 done
 grep -q '"fscc"' "$dir/awcc.json" && fail "--method awcc also ran FSCC"
-head -1 "$dir/windows.csv" | grep -q "^start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate$" ||
+head -1 "$dir/windows.csv" | grep -q "^start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate,measured_velocity$" ||
   fail "window table header"
 [[ $(wc -l <"$dir/windows.csv") -gt 10 ]] || fail "window table rows"
 out=$("$pdp" process "$dir/rec.flac" --dx 5mm --np 15 --filter-a 0.3 --roc off --weighting none --subsample parabolic \
@@ -95,6 +95,8 @@ assert t[0]['threshold_rule']=='kramer' and 2.6 < t[0]['threshold'] < 2.8, t[0][
     fail "kramer threshold"
 fi
 expect 2 "fixed rule" "$pdp" process "$dir/rec.flac" --dx 5mm --threshold-trailing 2.6V
+expect 2 "use one of them" "$pdp" process "$dir/rec.flac" --dx 5mm --probe-correction --correct "$src/samples/model/awcc.qrf"
+expect 2 "has no unit" "$pdp" process "$dir/rec.flac" --dx 5mm --probe-correction --probe-angle 45
 expect 2 "not a preset" "$pdp" process "$dir/rec.flac" --dx 5mm --preset kramer
 
 # The structure tables of a synthetic profile: each chord PDF sums to 1 over its bins.

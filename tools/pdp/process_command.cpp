@@ -163,6 +163,10 @@ int run_process(ProcessCommandOptions& o) {
     if (!o.correct.empty() && !options.awcc) {
       throw std::invalid_argument("--correct corrects AWCC's estimates; use --method awcc or both");
     }
+    if (!o.correct.empty() && options.awcc_options.probe_correction.enabled) {
+      throw std::invalid_argument("--correct and --probe-correction both correct AWCC's velocity: the model was trained "
+                                  "on synthetic records without bubble-probe interaction; use one of them");
+    }
     // Inputs are never modified: refuse an output that is one of them.
     for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions}) {
       if (output.empty() || !std::filesystem::exists(output)) continue;
