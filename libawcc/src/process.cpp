@@ -20,6 +20,7 @@ std::string ProcessOptions::validate() const {
   if (auto why = fscc_options.validate(); !why.empty()) return why;
   if (auto why = awcc_options.validate(); !why.empty()) return why;
   if (auto why = structure.validate(); !why.empty()) return why;
+  if (auto why = spectrum.validate(); !why.empty()) return why;
   if (block_frames < 1) return "block_frames must be >= 1";
   if (!allow_unusual) return implausible();
   return {};
@@ -335,6 +336,12 @@ namespace {
 
 // The structure outputs need the velocity of the chord lengths, known once
 // every correlation has run. Felder's conventions use his FSCC velocity.
+void add_spectrum(ProcessResult& out, const ProcessOptions& options) {
+  if (!options.velocity_spectrum || !out.awcc) return;
+  const double duration = out.info.fs > 0.0 ? static_cast<double>(out.info.frames) / out.info.fs : 0.0;
+  out.spectrum = velocity_spectrum(*out.awcc, duration, options.spectrum);
+}
+
 void add_structure(ProcessResult& out, const BinarisedRecording& b, const ProcessOptions& options) {
   if (!options.structure.enabled) return;
   std::optional<double> velocity = out.velocity();
@@ -391,7 +398,10 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   }
   apply_tip_order(out);
   out.tips = tip_results(r, options, out.velocity());
-  if (options.awcc_options.signal == CorrelationSignal::binary) add_structure(out, r, options);
+  if (options.awcc_options.signal == CorrelationSignal::binary) {
+    add_structure(out, r, options);
+    add_spectrum(out, options);
+  }
   return out;
 }
 
@@ -519,6 +529,7 @@ ProcessResult process_recording(const std::filesystem::path& path, const Process
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
     add_structure(out, binarised, options);
+    add_spectrum(out, options);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

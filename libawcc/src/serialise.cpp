@@ -262,6 +262,19 @@ json to_json(const ProcessResult& r) {
     out["fscc"]["scale_notes"] = notes;
   }
   if (r.structure) out["structure"] = to_json(*r.structure);
+  if (r.spectrum) {
+    const auto& v = *r.spectrum;
+    const bool ok = v.status == SpectrumStatus::ok;
+    out["velocity_spectrum"] = json{{"status", to_string(v.status)},
+                                    {"reason", v.message.empty() ? json(nullptr) : json(v.message)},
+                                    {"mean_window_duration", ok ? json(v.mean_window_duration) : json(nullptr)},
+                                    {"resample_rate", ok ? json(v.resample_rate) : json(nullptr)},
+                                    {"resolvable_frequency", ok ? json(v.resolvable_frequency) : json(nullptr)},
+                                    {"segments", v.psd.segments},
+                                    {"integral_time_scale", optional(v.integral_time_scale)},
+                                    {"time_scale_ratio", optional(v.time_scale_ratio)},
+                                    {"warning", v.warning.empty() ? json(nullptr) : json(v.warning)}};
+  }
   if (r.awcc) {
     const auto& a = *r.awcc;
     auto value = [&](double v) { return a.ok() ? json(v) : json(nullptr); };
@@ -388,6 +401,24 @@ std::string correlation_functions_csv(const std::vector<const ProcessResult*>& r
       };
       out += fmt::format("{},{},{},{}\n", file, csv_number(static_cast<double>(k) / r->info.fs), cell(f.r11, f.r11_first_lag),
                          cell(f.r12, f.r12_first_lag));
+    }
+  }
+  return out;
+}
+
+std::string velocity_spectrum_csv(const std::vector<const ProcessResult*>& results) {
+  std::string out = "file,quantity,x,value,below_resolvable_frequency\n";
+  for (const auto* r : results) {
+    if (!r->spectrum || r->spectrum->status != SpectrumStatus::ok) continue;
+    const auto& v = *r->spectrum;
+    const std::string file = csv_cell(r->info.path.filename().string());
+    for (std::size_t k = 0; k < v.psd.frequency.size(); ++k) {
+      out += fmt::format("{},psd,{},{},{}\n", file, csv_number(v.psd.frequency[k]), csv_number(v.psd.density[k]),
+                         v.psd.frequency[k] < v.resolvable_frequency ? 1 : 0);
+    }
+    for (std::size_t k = 0; k < v.autocorrelation.size(); ++k) {
+      out += fmt::format("{},autocorrelation,{},{},\n", file, csv_number(static_cast<double>(k) / v.resample_rate),
+                         csv_number(v.autocorrelation[k]));
     }
   }
   return out;
@@ -578,6 +609,16 @@ std::string ProcessResult::report() const {
                          to_string(a->basis), excess));
       }
     }
+  }
+  if (spectrum && spectrum->status == SpectrumStatus::ok) {
+    line(fmt::format("  velocity series: integral time scale {}, mean window {:.2f} ms (ratio {}); spectrum resolvable "
+                     "below {:.1f} Hz",
+                     spectrum->integral_time_scale ? fmt::format("{:.2f} ms", *spectrum->integral_time_scale * 1e3)
+                                                   : std::string("n/a"),
+                     spectrum->mean_window_duration * 1e3,
+                     spectrum->time_scale_ratio ? fmt::format("{:.2f}", *spectrum->time_scale_ratio) : std::string("n/a"),
+                     spectrum->resolvable_frequency));
+    if (!spectrum->warning.empty()) line("        warning: " + spectrum->warning);
   }
   if (const auto s = velocity_source(); s != VelocitySource::awcc && (awcc || fscc)) {
     line(s == VelocitySource::fscc ? "  chord lengths and d32 use FSCC's velocity (AWCC's is not of quality ok)"

@@ -44,6 +44,9 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)")->group(out);
   cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)")->group(out);
   cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)")->group(out);
+  cmd->add_option("--spectrum", o.spectrum,
+                  "AWCC's velocity series as CSV: Welch spectrum and autocorrelation (sample-and-hold resampling)")
+      ->group(out);
   cmd->add_option("--correlation-functions", o.correlation_functions,
                   "FSCC's auto- and cross-correlation functions as CSV: file, lag_s, r11, r12")
       ->group(out);
@@ -82,6 +85,10 @@ awcc::ProcessOptions build_options(ProcessCommandOptions& o) {
     throw std::invalid_argument("--windows writes the window table of one recording; give one file");
   }
   if (!o.windows.empty() && !p.awcc) throw std::invalid_argument("--windows needs --method awcc or both");
+  if (!o.spectrum.empty() && (!p.awcc || !p.velocity_spectrum)) {
+    throw std::invalid_argument("--spectrum writes AWCC's velocity spectrum: use --method awcc or both, and "
+                                "--velocity-spectrum on");
+  }
   if (!o.correlation_functions.empty() && !p.fscc) {
     throw std::invalid_argument("--correlation-functions writes FSCC's functions: use --method fscc or both");
   }
@@ -168,7 +175,7 @@ int run_process(ProcessCommandOptions& o) {
                                   "on synthetic records without bubble-probe interaction; use one of them");
     }
     // Inputs are never modified: refuse an output that is one of them.
-    for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions}) {
+    for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum}) {
       if (output.empty() || !std::filesystem::exists(output)) continue;
       for (const auto& input : o.files) {
         if (std::filesystem::equivalent(output, input)) {
@@ -221,6 +228,9 @@ int run_process(ProcessCommandOptions& o) {
       for (const auto& w : results.back().info.warnings) spdlog::warn("{}: {}", o.files[i], w);
       if (results.back().fscc) {
         for (const auto& w : results.back().fscc->warnings) spdlog::warn("{}: {}", o.files[i], w);
+      }
+      if (results.back().spectrum && !results.back().spectrum->warning.empty()) {
+        spdlog::warn("{}: {}", o.files[i], results.back().spectrum->warning);
       }
       spdlog::debug("{}: {:.3f} s", o.files[i], results.back().seconds);
       progress(static_cast<double>(i + 1) / static_cast<double>(o.files.size()));
@@ -278,6 +288,7 @@ int run_process(ProcessCommandOptions& o) {
     if (!o.correlation_functions.empty()) {
       outputs.emplace_back(o.correlation_functions, awcc::correlation_functions_csv(all));
     }
+    if (!o.spectrum.empty()) outputs.emplace_back(o.spectrum, awcc::velocity_spectrum_csv(all));
     // The structure tables sit next to the profile CSV: profile.csv, profile_chord_pdf.csv, ...
     if (!o.csv.empty() && options.structure.enabled) {
       const std::filesystem::path base(o.csv);

@@ -15,6 +15,7 @@
 #include "awcc/phase_statistics.hpp"
 #include "awcc/recording.hpp"
 #include "awcc/structure.hpp"
+#include "awcc/velocity_series.hpp"
 
 namespace awcc {
 
@@ -34,6 +35,9 @@ struct ProcessOptions {
   int histogram_bins = 50;            ///< chord-time histogram bins
   /// Chord and voltage PDFs, clusters, inter-particle arrivals (and Felder's conventions).
   StructureOptions structure;
+  /// The AWCC velocity series' spectrum and integral time scale (METHOD 10).
+  bool velocity_spectrum = true;
+  SpectrumOptions spectrum;
   /// Accept values outside the plausible ranges of the instrument (below):
   /// off, because a value out of them is nearly always a unit slip.
   bool allow_unusual = false;
@@ -78,6 +82,7 @@ struct ProcessResult {
   std::optional<FsccResult> fscc;
   std::optional<AwccResult> awcc;
   std::optional<StructureResult> structure;
+  std::optional<VelocitySpectrum> spectrum;  ///< of AWCC's series, when AWCC ran
   double seconds = 0.0;               ///< wall time of the processing
 
   /// The velocity of chord lengths and d32 (velocity_source()).

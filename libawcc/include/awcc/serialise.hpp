@@ -37,6 +37,11 @@ std::string profile_csv_row(const ProcessResult& result, const std::optional<dou
 /// (empty where a function has no value at that lag).
 std::string correlation_functions_csv(const std::vector<const ProcessResult*>& results);
 
+/// AWCC's velocity spectra and autocorrelations as CSV: file, quantity
+/// (psd: x in Hz, value in (m/s)^2/Hz; autocorrelation: x in s), x, value,
+/// below_resolvable_frequency (psd rows).
+std::string velocity_spectrum_csv(const std::vector<const ProcessResult*>& results);
+
 /// The structure outputs of a profile as CSV tables, one row per position
 /// and bin or class (docs/output.md): the file suffix ("_chord_pdf.csv")
 /// and its text. Recordings without structure results give no rows.

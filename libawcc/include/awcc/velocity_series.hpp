@@ -1,0 +1,90 @@
+#pragma once
+// The AWCC velocity series: resampling, spectrum and time scale (METHOD.md 10).
+//
+// AWCC gives an irregular series u_i at the centres of its accepted windows.
+// As for irregular LDA data (Velte et al. 2014), the series is resampled by
+// sample-and-hold (zero-order hold: each instant takes the latest accepted
+// window's velocity) at about the window rate, 1 / T_W with T_W the mean
+// window duration. Then:
+//  - the power spectral density by Welch's method: segments of L samples,
+//    Hann windows, 50 % overlap, each segment's mean removed, one-sided
+//    density P(f) = 2 |X(f)|^2 / (f_r sum w^2) (not doubled at 0 and f_r/2),
+//    averaged over the segments, (m/s)^2/Hz;
+//  - the frequencies the windows can resolve: below 1 / (2 T_W); sample and
+//    hold also low-pass filters and biases the spectrum towards the holding
+//    rate (Adrian and Yao 1987), so the PSD is trustworthy well below that;
+//  - the autocorrelation of u (biased estimator, mean removed) and its
+//    integral time scale T_u = integral from 0 to its first zero (trapezoids,
+//    the last piece to the interpolated zero).
+// T_u / T_W < 2 means the windows are too long to follow the turbulence:
+// AWCC's Tu is then underestimated (the paper's error E4); said in a warning.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "awcc/awcc.hpp"
+
+namespace awcc {
+
+struct SpectrumOptions {
+  /// Welch segment length in resampled points: longer resolves lower
+  /// frequencies, shorter averages more segments (less noise).
+  int segment_length = 256;
+  [[nodiscard]] std::string validate() const;
+};
+
+/// A regularly sampled series.
+struct RegularSeries {
+  double rate = 0.0;            ///< Hz
+  double start = 0.0;           ///< s: time of the first value
+  std::vector<double> values;
+};
+
+/// Sample-and-hold of values at irregular instants (ascending): at
+/// start + k / rate each point takes the latest value at or before it; points
+/// before the first instant take the first value.
+RegularSeries sample_and_hold(std::span<const double> times, std::span<const double> values, double rate, double start,
+                              double end);
+
+struct PowerSpectrum {
+  std::vector<double> frequency;  ///< Hz
+  std::vector<double> density;    ///< per Hz, one-sided
+  int segments = 0;
+};
+
+/// Welch's PSD of x sampled at rate (see above); empty when x is shorter
+/// than one segment.
+PowerSpectrum welch_psd(std::span<const double> x, double rate, int segment_length);
+
+/// Normalised autocorrelation r(k), k = 0..max_lag, of x (mean removed,
+/// biased: sum over the overlap divided by the sum of squares).
+std::vector<double> autocorrelation(std::span<const double> x, std::size_t max_lag);
+
+/// Integral of r (sampled every dt) from 0 to its first zero; empty when r
+/// stays positive.
+std::optional<double> integral_to_first_zero(std::span<const double> r, double dt);
+
+enum class SpectrumStatus { ok, no_awcc_velocity, too_few_points };
+std::string_view to_string(SpectrumStatus status);
+
+struct VelocitySpectrum {
+  SpectrumStatus status = SpectrumStatus::no_awcc_velocity;
+  std::string message;
+  double mean_window_duration = 0.0;  ///< T_W, s
+  double resample_rate = 0.0;         ///< Hz (1 / T_W)
+  double resolvable_frequency = 0.0;  ///< 1 / (2 T_W), Hz
+  PowerSpectrum psd;
+  std::vector<double> autocorrelation;  ///< at lags k / resample_rate
+  std::optional<double> integral_time_scale;  ///< T_u, s
+  std::optional<double> time_scale_ratio;     ///< T_u / T_W
+  std::string warning;                ///< T_u / T_W < 2, or T_u not reached
+};
+
+/// The spectrum and time scale of AWCC's accepted windows over a record of
+/// `duration` s.
+VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, const SpectrumOptions& options);
+
+}  // namespace awcc

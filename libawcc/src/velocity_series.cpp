@@ -1,0 +1,155 @@
+#include "awcc/velocity_series.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <numbers>
+
+#include "awcc/fft.hpp"
+
+namespace awcc {
+
+std::string SpectrumOptions::validate() const {
+  if (segment_length < 8 || segment_length > (1 << 24)) {
+    return fmt::format("spectrum segment length {} must lie in 8 to 16777216 points", segment_length);
+  }
+  return {};
+}
+
+std::string_view to_string(SpectrumStatus status) {
+  switch (status) {
+    case SpectrumStatus::ok: return "ok";
+    case SpectrumStatus::no_awcc_velocity: return "no_awcc_velocity";
+    case SpectrumStatus::too_few_points: return "too_few_points";
+  }
+  return "?";
+}
+
+RegularSeries sample_and_hold(std::span<const double> times, std::span<const double> values, double rate, double start,
+                              double end) {
+  RegularSeries out;
+  out.rate = rate;
+  out.start = start;
+  if (times.empty() || !(rate > 0.0) || !(end >= start)) return out;
+  const auto n = static_cast<std::size_t>(std::floor((end - start) * rate)) + 1;
+  out.values.resize(n);
+  std::size_t j = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = start + static_cast<double>(k) / rate;
+    while (j + 1 < times.size() && times[j + 1] <= t) ++j;
+    out.values[k] = values[j];
+  }
+  return out;
+}
+
+PowerSpectrum welch_psd(std::span<const double> x, double rate, int segment_length) {
+  PowerSpectrum p;
+  const auto l = static_cast<std::size_t>(segment_length);
+  if (x.size() < l || l < 2) return p;
+  const std::size_t step = l / 2;
+  std::vector<double> window(l);
+  double power = 0.0;
+  for (std::size_t n = 0; n < l; ++n) {
+    // Periodic Hann (spectral analysis), as scipy.signal.welch.
+    window[n] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(n) / static_cast<double>(l));
+    power += window[n] * window[n];
+  }
+  FftPlan plan(l);
+  const std::size_t bins = l / 2 + 1;
+  p.density.assign(bins, 0.0);
+  for (std::size_t first = 0; first + l <= x.size(); first += step) {
+    double mean = 0.0;
+    for (std::size_t n = 0; n < l; ++n) mean += x[first + n];
+    mean /= static_cast<double>(l);
+    auto r = plan.real();
+    for (std::size_t n = 0; n < l; ++n) r[n] = (x[first + n] - mean) * window[n];
+    plan.forward();
+    const auto s = plan.spectrum();
+    for (std::size_t k = 0; k < bins; ++k) p.density[k] += std::norm(s[k]);
+    ++p.segments;
+  }
+  const double scale = 1.0 / (rate * power * p.segments);
+  for (std::size_t k = 0; k < bins; ++k) {
+    const bool doubled = k > 0 && !(l % 2 == 0 && k == l / 2);  // one-sided: all but 0 and Nyquist
+    p.density[k] *= scale * (doubled ? 2.0 : 1.0);
+    p.frequency.push_back(static_cast<double>(k) * rate / static_cast<double>(l));
+  }
+  return p;
+}
+
+std::vector<double> autocorrelation(std::span<const double> x, std::size_t max_lag) {
+  const std::size_t n = x.size();
+  if (n == 0) return {};
+  max_lag = std::min(max_lag, n - 1);
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  // Through the FFT: |X|^2 of the zero-padded series is the circular
+  // autocorrelation, linear for lags below the padding.
+  FftPlan plan(fast_fft_size(n + max_lag + 1));
+  auto r = plan.real();
+  std::fill(r.begin(), r.end(), 0.0);
+  for (std::size_t i = 0; i < n; ++i) r[i] = x[i] - mean;
+  plan.forward();
+  for (auto& c : plan.spectrum()) c = std::norm(c);
+  plan.inverse();
+  std::vector<double> out(max_lag + 1);
+  const double zero = plan.real()[0];
+  for (std::size_t k = 0; k <= max_lag; ++k) out[k] = zero > 0.0 ? plan.real()[k] / zero : 0.0;
+  return out;
+}
+
+std::optional<double> integral_to_first_zero(std::span<const double> r, double dt) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i + 1 < r.size(); ++i) {
+    if (r[i + 1] <= 0.0) return (sum + 0.5 * r[i] * r[i] / (r[i] - r[i + 1])) * dt;
+    sum += 0.5 * (r[i] + r[i + 1]);
+  }
+  return std::nullopt;
+}
+
+VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, const SpectrumOptions& options) {
+  VelocitySpectrum out;
+  if (!awcc.ok()) {
+    out.status = SpectrumStatus::no_awcc_velocity;
+    out.message = "AWCC gave no velocity series";
+    return out;
+  }
+  std::vector<double> times, values;
+  double total = 0.0;
+  for (const auto& w : awcc.windows) {
+    if (w.fate != WindowFate::accepted) continue;
+    times.push_back(w.start_time + 0.5 * w.duration);
+    values.push_back(w.velocity);
+    total += w.duration;
+  }
+  out.mean_window_duration = total / static_cast<double>(times.size());
+  out.resample_rate = 1.0 / out.mean_window_duration;
+  out.resolvable_frequency = 0.5 * out.resample_rate;
+  const auto series = sample_and_hold(times, values, out.resample_rate, times.front(), std::min(times.back(), duration));
+  if (series.values.size() < static_cast<std::size_t>(options.segment_length)) {
+    out.status = SpectrumStatus::too_few_points;
+    out.message = fmt::format("{} resampled points, fewer than one spectrum segment of {}: record longer, or give a "
+                              "shorter segment",
+                              series.values.size(), options.segment_length);
+    return out;
+  }
+  out.status = SpectrumStatus::ok;
+  out.psd = welch_psd(series.values, series.rate, options.segment_length);
+  out.autocorrelation = autocorrelation(series.values, series.values.size() / 2);
+  out.integral_time_scale = integral_to_first_zero(out.autocorrelation, 1.0 / series.rate);
+  if (out.integral_time_scale) {
+    out.time_scale_ratio = *out.integral_time_scale / out.mean_window_duration;
+    if (*out.time_scale_ratio < 2.0) {
+      out.warning = fmt::format("the velocity's integral time scale is {:.2f} mean window durations (below 2): the "
+                                "windows are too long to follow its fluctuations, and AWCC's turbulence intensity is "
+                                "underestimated (Kramer et al.'s error E4); use fewer particles per window",
+                                *out.time_scale_ratio);
+    }
+  } else {
+    out.warning = "the velocity's autocorrelation does not reach zero within half the record: no integral time scale";
+  }
+  return out;
+}
+
+}  // namespace awcc

@@ -1,0 +1,104 @@
+// The velocity series (awcc/velocity_series.hpp): sample-and-hold, Welch's
+// PSD, the autocorrelation and its integral time scale, against exact values
+// and sampling-theory bounds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "awcc/velocity_series.hpp"
+
+namespace {
+
+TEST(SampleAndHold, EachPointTakesTheLatestValue) {
+  const std::vector<double> t{0.10, 0.25, 0.40}, v{1.0, 2.0, 3.0};
+  const auto s = awcc::sample_and_hold(t, v, 10.0, 0.1, 0.5);  // points at 0.1, 0.2, ..., 0.5
+  EXPECT_EQ(s.values, (std::vector<double>{1.0, 1.0, 2.0, 3.0, 3.0}));
+  EXPECT_EQ(s.rate, 10.0);
+}
+
+TEST(WelchPsd, ASinusoidPeaksAtItsFrequencyAndTheSpectrumHoldsTheVariance) {
+  // A = 2 at 12.5 Hz (a bin centre of 256-point segments at 200 Hz), plus
+  // white noise of sd 0.5. Parseval: the integral of the one-sided PSD is the
+  // variance, A^2 / 2 + 0.25 = 2.25; Welch with Hann windows keeps it to the
+  // sampling error of the noise part (below 1 % here: 780 segments).
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  const double rate = 200.0;
+  std::vector<double> x(100'000);
+  for (std::size_t i = 0; i < x.size(); ++i)
+    x[i] = 2.0 * std::sin(2 * std::numbers::pi * 12.5 * static_cast<double>(i) / rate) + noise(rng);
+  const auto p = awcc::welch_psd(x, rate, 256);
+  ASSERT_EQ(p.frequency.size(), 129u);
+  EXPECT_EQ(p.segments, 780);
+  double integral = 0.0;
+  for (double d : p.density) integral += d * rate / 256.0;
+  EXPECT_NEAR(integral, 2.25, 0.03);
+  const auto peak = std::max_element(p.density.begin(), p.density.end()) - p.density.begin();
+  EXPECT_DOUBLE_EQ(p.frequency[static_cast<std::size_t>(peak)], 12.5);
+  // Away from the peak the density is the noise's, 2 sigma^2 / rate = 0.0025 per Hz;
+  // the mean over 80 bins of 780 averaged segments has a relative sd of about
+  // 1 / sqrt(780 x 80 / 2) = 0.6 %: 5 % holds with a wide margin.
+  double far = 0.0;
+  for (std::size_t k = 40; k < 120; ++k) far += p.density[k];
+  EXPECT_NEAR(far / 80.0, 0.0025, 0.0025 * 0.05);
+}
+
+TEST(Autocorrelation, EqualsTheDirectSumAndRecoversAnAr1TimeScale) {
+  // AR(1) x_{k+1} = phi x_k + e: r(k) = phi^k; the trapezoid integral to the
+  // first zero is dt (1 / (1 - phi) - 1/2) = 9.5 dt for phi = 0.9, less the
+  // tail beyond the zero crossing (~ lag 45 where r ~ its sd, sqrt(9.5 / N)
+  // ~ 0.007: phi^45 / (1 - phi) = 0.09 dt). The integral's sampling sd is
+  // about dt (lags to the zero) x sd(r) ~ 45 x 0.007 dt = 0.3 dt: 1.5 dt
+  // (5 sd) bounds the estimate around 9.4 dt.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> e(0.0, 1.0);
+  std::vector<double> x(200'000);
+  for (std::size_t i = 1; i < x.size(); ++i) x[i] = 0.9 * x[i - 1] + e(rng);
+  const auto r = awcc::autocorrelation(x, 200);
+  ASSERT_EQ(r.size(), 201u);
+  EXPECT_DOUBLE_EQ(r[0], 1.0);
+  // The FFT path against the direct biased sum at a few lags.
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(x.size());
+  long double q = 0;
+  for (double v : x) q += (v - mean) * (v - mean);
+  for (std::size_t k : {1u, 7u, 50u, 200u}) {
+    long double s = 0;
+    for (std::size_t i = 0; i + k < x.size(); ++i) s += (x[i] - mean) * (x[i + k] - mean);
+    EXPECT_NEAR(r[k], static_cast<double>(s / q), 1e-12) << k;
+  }
+  EXPECT_NEAR(r[1], 0.9, 0.01);
+  const auto t = awcc::integral_to_first_zero(r, 0.01);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 0.094, 0.015);
+  EXPECT_FALSE(awcc::integral_to_first_zero(std::vector<double>{1.0, 0.8, 0.5}, 1.0));
+  EXPECT_NEAR(*awcc::integral_to_first_zero(std::vector<double>{1.0, 0.5, -0.5}, 1.0), 0.75 + 0.125, 1e-15);
+}
+
+TEST(VelocitySpectrum, NeedsAnAwccSeriesLongerThanASegment) {
+  awcc::AwccResult none;
+  EXPECT_EQ(awcc::velocity_spectrum(none, 10.0, {}).status, awcc::SpectrumStatus::no_awcc_velocity);
+  awcc::AwccResult few;
+  few.status = awcc::AwccStatus::ok;
+  for (int i = 0; i < 50; ++i) {
+    awcc::AwccWindow w;
+    w.start_time = 0.01 * i;
+    w.duration = 0.01;
+    w.velocity = 3.0 + 0.1 * (i % 3);
+    few.windows.push_back(w);
+  }
+  const auto s = awcc::velocity_spectrum(few, 0.5, {});
+  EXPECT_EQ(s.status, awcc::SpectrumStatus::too_few_points);
+  EXPECT_NE(s.message.find("segment"), std::string::npos);
+  awcc::SpectrumOptions shorter;
+  shorter.segment_length = 16;
+  const auto ok = awcc::velocity_spectrum(few, 0.5, shorter);
+  EXPECT_EQ(ok.status, awcc::SpectrumStatus::ok);
+  EXPECT_NEAR(ok.resample_rate, 100.0, 1e-9);
+  EXPECT_NEAR(ok.resolvable_frequency, 50.0, 1e-9);
+}
+
+}  // namespace
