@@ -272,6 +272,7 @@ json to_json(const ProcessResult& r) {
                                     {"resolvable_frequency", ok ? json(v.resolvable_frequency) : json(nullptr)},
                                     {"segments", v.psd.segments},
                                     {"integral_time_scale", optional(v.integral_time_scale)},
+                                    {"integral_time_scale_held", optional(v.integral_time_scale_held)},
                                     {"time_scale_ratio", optional(v.time_scale_ratio)},
                                     {"warning", v.warning.empty() ? json(nullptr) : json(v.warning)}};
   }

@@ -99,6 +99,35 @@ std::vector<double> autocorrelation(std::span<const double> x, std::size_t max_l
   return out;
 }
 
+std::vector<double> slotted_autocorrelation(std::span<const double> times, std::span<const double> values, double slot,
+                                            std::size_t slots) {
+  const std::size_t n = values.size();
+  std::vector<double> r(slots + 1, 0.0);
+  if (n < 2 || !(slot > 0.0)) return r;
+  double mean = 0.0;
+  for (double v : values) mean += v;
+  mean /= static_cast<double>(n);
+  double variance = 0.0;
+  for (double v : values) variance += (v - mean) * (v - mean);
+  variance /= static_cast<double>(n);
+  std::vector<double> sum(slots + 1, 0.0);
+  std::vector<std::int64_t> count(slots + 1, 0);
+  const double reach = (static_cast<double>(slots) + 0.5) * slot;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n && times[j] - times[i] <= reach; ++j) {
+      const auto k = static_cast<std::size_t>(std::ceil((times[j] - times[i]) / slot - 0.5));
+      if (k == 0 || k > slots) continue;
+      sum[k] += (values[i] - mean) * (values[j] - mean);
+      ++count[k];
+    }
+  }
+  r[0] = 1.0;
+  for (std::size_t k = 1; k <= slots; ++k) {
+    r[k] = count[k] > 0 && variance > 0.0 ? sum[k] / static_cast<double>(count[k]) / variance : r[k - 1];
+  }
+  return r;
+}
+
 std::optional<double> integral_to_first_zero(std::span<const double> r, double dt) {
   double sum = 0.0;
   for (std::size_t i = 0; i + 1 < r.size(); ++i) {
@@ -137,7 +166,12 @@ VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, cons
   out.status = SpectrumStatus::ok;
   out.psd = welch_psd(series.values, series.rate, options.segment_length);
   out.autocorrelation = autocorrelation(series.values, series.values.size() / 2);
-  out.integral_time_scale = integral_to_first_zero(out.autocorrelation, 1.0 / series.rate);
+  out.integral_time_scale_held = integral_to_first_zero(out.autocorrelation, 1.0 / series.rate);
+  // Slots of half a window, out to a quarter of the record (at most 4096 slots).
+  const double slot = 0.5 * out.mean_window_duration;
+  const auto slots = static_cast<std::size_t>(
+      std::clamp((times.back() - times.front()) / 4.0 / slot, 1.0, 4096.0));
+  out.integral_time_scale = integral_to_first_zero(slotted_autocorrelation(times, values, slot, slots), slot);
   if (out.integral_time_scale) {
     out.time_scale_ratio = *out.integral_time_scale / out.mean_window_duration;
     if (*out.time_scale_ratio < 2.0) {

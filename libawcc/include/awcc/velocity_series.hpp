@@ -16,6 +16,17 @@
 //  - the autocorrelation of u (biased estimator, mean removed) and its
 //    integral time scale T_u = integral from 0 to its first zero (trapezoids,
 //    the last piece to the interpolated zero).
+// Sample-and-hold lengthens the autocorrelation by the holding: with
+// accepted windows at a mean rate nu (gaps where windows are rejected), an
+// exponential autocorrelation of scale T becomes
+//   rho_SH(tau) = e^{-nu tau} + (1 - e^{-nu tau}) e^{-tau/T},
+// whose integral is T + 1/nu - T / (1 + nu T): the held series' scale is
+// biased up by about 1/nu when windows are sparse (validation.md). The
+// integral time scale reported is therefore the slotted one (Mayo 1974;
+// Tummers and Passchier 1996): products u'_i u'_j of every pair of accepted
+// windows binned by their separation in slots of T_W / 2, normalised by the
+// variance, integrated to the first zero; the held series' scale is reported
+// beside it.
 // T_u / T_W < 2 means the windows are too long to follow the turbulence:
 // AWCC's Tu is then underestimated (the paper's error E4); said in a warning.
 
@@ -63,6 +74,12 @@ PowerSpectrum welch_psd(std::span<const double> x, double rate, int segment_leng
 /// biased: sum over the overlap divided by the sum of squares).
 std::vector<double> autocorrelation(std::span<const double> x, std::size_t max_lag);
 
+/// The slotted autocorrelation of irregular samples: r(k) for lags in
+/// ((k - 1/2) w, (k + 1/2) w], k = 1..slots, r(0) = 1; a slot without pairs
+/// takes the previous slot's value.
+std::vector<double> slotted_autocorrelation(std::span<const double> times, std::span<const double> values, double slot,
+                                            std::size_t slots);
+
 /// Integral of r (sampled every dt) from 0 to its first zero; empty when r
 /// stays positive.
 std::optional<double> integral_to_first_zero(std::span<const double> r, double dt);
@@ -78,7 +95,8 @@ struct VelocitySpectrum {
   double resolvable_frequency = 0.0;  ///< 1 / (2 T_W), Hz
   PowerSpectrum psd;
   std::vector<double> autocorrelation;  ///< at lags k / resample_rate
-  std::optional<double> integral_time_scale;  ///< T_u, s
+  std::optional<double> integral_time_scale;  ///< T_u, s, slotted (unbiased by the holding)
+  std::optional<double> integral_time_scale_held;  ///< s, of the sample-and-hold series (biased up by the holding)
   std::optional<double> time_scale_ratio;     ///< T_u / T_W
   std::string warning;                ///< T_u / T_W < 2, or T_u not reached
 };
