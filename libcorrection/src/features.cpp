@@ -13,6 +13,7 @@ std::string_view to_string(CorrectionStatus status) {
     case CorrectionStatus::no_bubbles: return "no_bubbles";
     case CorrectionStatus::too_few_windows: return "too_few_windows";
     case CorrectionStatus::outside_training_range: return "outside_training_range";
+    case CorrectionStatus::probe_corrected: return "probe_corrected";
   }
   return "unknown";
 }
@@ -58,6 +59,11 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   if (!r.awcc->ok()) {
     out.status = CorrectionStatus::no_awcc_velocity;
     out.message = "AWCC gave no velocity: " + r.awcc->message;
+    return out;
+  }
+  if (r.awcc->probe_corrected) {
+    out.status = CorrectionStatus::probe_corrected;
+    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC";
     return out;
   }
   if (r.awcc->quality != awcc::AwccQuality::ok) {

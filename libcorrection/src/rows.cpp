@@ -75,6 +75,13 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
                                   ? ": " + a["quality_reason"].get<std::string>()
                                   : std::string()));
   }
+  if (a.value("probe_corrected", false)) {
+    // The model learnt AWCC's bias on synthetic records without the needle:
+    // a bubble-probe-corrected velocity is not what it corrects.
+    return not_corrected(CorrectionStatus::probe_corrected,
+                         "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
+                         "uncorrected AWCC; process without the probe correction to correct it");
+  }
   if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
     throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
   }

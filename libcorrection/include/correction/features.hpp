@@ -38,6 +38,7 @@ enum class CorrectionStatus {
   no_bubbles,              ///< the leading tip saw no complete bubble (F = 0)
   too_few_windows,         ///< fewer accepted windows than the model's training runs had
   outside_training_range,  ///< a feature outside the model's training data
+  probe_corrected,         ///< AWCC was bubble-probe corrected: the model corrects uncorrected AWCC
 };
 std::string_view to_string(CorrectionStatus status);
 
