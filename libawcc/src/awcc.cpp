@@ -572,7 +572,6 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.windows_accepted = result.rejected_correlation = result.rejected_lag = result.rejected_roc =
       result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = result.negative_lag_windows =
           result.rejected_correction = 0;
-  double sw = 0, swu = 0;
   for (const auto& w : windows) {
     switch (w.fate) {
       case WindowFate::accepted: ++result.windows_accepted; break;
@@ -585,10 +584,6 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     }
     if (w.fate == WindowFate::lag && w.lag_samples == 0) ++result.lag_zero_windows;
     if (w.fate == WindowFate::lag && w.lag_samples < 0) ++result.negative_lag_windows;
-    if (w.fate != WindowFate::accepted) continue;
-    const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
-    sw += weight;
-    swu += weight * w.velocity;
   }
   result.status = AwccStatus::too_few_windows;
   result.quality = AwccQuality::insufficient;
@@ -631,14 +626,25 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     insufficient();
     return;
   }
-  const double mean = swu / sw;
-  double swd = 0;
-  for (const auto& w : windows) {
-    if (w.fate != WindowFate::accepted) continue;
-    const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
-    swd += weight * (w.velocity - mean) * (w.velocity - mean);
-  }
-  const double rms = std::sqrt(swd / sw);
+  // The weighted mean and rms of one velocity of the accepted windows (METHOD 4).
+  const auto moments = [&](double AwccWindow::*velocity) {
+    double weights = 0, sum = 0;
+    for (const auto& w : windows) {
+      if (w.fate != WindowFate::accepted) continue;
+      const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
+      weights += weight;
+      sum += weight * w.*velocity;
+    }
+    const double m = sum / weights;
+    double squares = 0;
+    for (const auto& w : windows) {
+      if (w.fate != WindowFate::accepted) continue;
+      const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
+      squares += weight * (w.*velocity - m) * (w.*velocity - m);
+    }
+    return std::pair{m, std::sqrt(squares / weights)};
+  };
+  const auto [mean, rms] = moments(&AwccWindow::velocity);
   const double n = static_cast<double>(result.windows_accepted);
   result.status = AwccStatus::ok;
   result.message.clear();
@@ -651,21 +657,10 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   const double ht = 1.96 * std::sqrt(tu * tu * (tu * tu / n + 1.0 / (2.0 * n)));
   if (result.probe_corrected) {
     // The measured moments over the same windows, for comparison.
-    double mw = 0;
-    for (const auto& w : windows) {
-      if (w.fate != WindowFate::accepted) continue;
-      mw += (options.weighting == Weighting::duration ? w.duration : 1.0) * w.measured_velocity;
-    }
-    const double measured_mean = mw / sw;
-    double md = 0;
-    for (const auto& w : windows) {
-      if (w.fate != WindowFate::accepted) continue;
-      const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
-      md += weight * (w.measured_velocity - measured_mean) * (w.measured_velocity - measured_mean);
-    }
+    const auto [measured_mean, measured_rms] = moments(&AwccWindow::measured_velocity);
     result.velocity_measured = measured_mean;
-    result.velocity_rms_measured = std::sqrt(md / sw);
-    result.turbulence_intensity_measured = result.velocity_rms_measured / measured_mean;
+    result.velocity_rms_measured = measured_rms;
+    result.turbulence_intensity_measured = measured_rms / measured_mean;
   }
   result.velocity_ci95 = {mean - hu, mean + hu};
   result.velocity_rms_ci95 = {rms - hr, rms + hr};
