@@ -327,7 +327,9 @@ std::string profile_csv_header() {
          "awcc_quality_reason,void_fraction_ci95_lower,void_fraction_ci95_upper,bubble_count_rate_ci95_lower,"
          "bubble_count_rate_ci95_upper,awcc_velocity_ci95_lower,awcc_velocity_ci95_upper,awcc_velocity_rms_ci95_lower,"
          "awcc_velocity_rms_ci95_upper,awcc_turbulence_intensity_ci95_lower,awcc_turbulence_intensity_ci95_upper,"
-         "chord_velocity_source,pdp_version,warnings";
+         "chord_velocity_source,pdp_version,warnings,awcc_probe_corrected,awcc_velocity_measured,"
+         "awcc_velocity_rms_measured,awcc_turbulence_intensity_measured,velocity_integral_time_scale,"
+         "velocity_time_scale_ratio";
 }
 
 std::string profile_csv_row(const ProcessResult& r, const std::optional<double>& position) {
@@ -380,6 +382,14 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
     for (const auto& w : f->warnings) warnings += (warnings.empty() ? "" : "; ") + w;
   }
   out += "," + csv_cell(warnings);
+  const bool corrected = awcc_ok && a->probe_corrected;
+  out += fmt::format(",{},{},{},{}", a ? (a->probe_corrected ? "on" : "off") : "",
+                     csv_number(corrected ? std::optional(a->velocity_measured) : std::nullopt),
+                     csv_number(corrected ? std::optional(a->velocity_rms_measured) : std::nullopt),
+                     csv_number(corrected ? std::optional(a->turbulence_intensity_measured) : std::nullopt));
+  const bool series = r.spectrum && r.spectrum->status == SpectrumStatus::ok;
+  out += fmt::format(",{},{}", csv_number(series ? r.spectrum->integral_time_scale : std::nullopt),
+                     csv_number(series ? r.spectrum->time_scale_ratio : std::nullopt));
   return out;
 }
 
