@@ -1,6 +1,6 @@
 // Every reader and the whole processing chain (binarisation, phase
 // statistics, FSCC, AWCC) on arbitrary bytes. The first byte picks the
-// container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV),
+// container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV, TDMS),
 // the rest is the file.
 #include "awcc/json_text.hpp"
 #include "awcc/serialise.hpp"
@@ -11,9 +11,9 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  static const char* extensions[] = {".wav", ".flac", ".dat", ".raw", ".csv", ".tsv", ".w64", ".aiff"};
+  static const char* extensions[] = {".wav", ".flac", ".dat", ".raw", ".csv", ".tsv", ".w64", ".aiff", ".tdms"};
   const std::uint8_t selector = data[0];
-  const auto path = fuzz::scratch(std::string("input") + extensions[selector % 8]);
+  const auto path = fuzz::scratch(std::string("input") + extensions[selector % 9]);
   fuzz::write(path, data + 1, size - 1);
   awcc::ProcessOptions o;
   o.reader.fs = 10000.0;
@@ -23,7 +23,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.dx = 5e-3;
   o.awcc = true;
   o.fscc_options.max_lag = 0.01;
-  o.binarisation.rule = static_cast<awcc::ThresholdRule>((selector >> 2) % 4 == 2 ? 0 : (selector >> 2) % 4);
+  // Every rule but fixed (which needs a voltage).
+  static const awcc::ThresholdRule rules[] = {awcc::ThresholdRule::histogram, awcc::ThresholdRule::felder,
+                                              awcc::ThresholdRule::kramer, awcc::ThresholdRule::hysteresis};
+  o.binarisation.rule = rules[(selector >> 2) % 4];
   o.block_frames = 1 + (selector % 7) * 1000;
   try {
     const auto r = awcc::process_recording(path, o);

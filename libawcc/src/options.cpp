@@ -47,9 +47,9 @@ std::pair<std::string_view, std::string_view> pair_of(std::string_view text, con
   return {text.substr(0, comma), text.substr(comma + 1)};
 }
 
-constexpr std::array<std::pair<const char*, InputFormat>, 5> kFormats{
+constexpr std::array<std::pair<const char*, InputFormat>, 6> kFormats{
     {{"auto", InputFormat::automatic}, {"sndfile", InputFormat::sndfile}, {"dat", InputFormat::uq_dat},
-     {"raw", InputFormat::raw}, {"csv", InputFormat::csv}}};
+     {"raw", InputFormat::raw}, {"csv", InputFormat::csv}, {"tdms", InputFormat::tdms}}};
 constexpr std::array<std::pair<const char*, SampleType>, 4> kTypes{{{"int16", SampleType::int16},
                                                                     {"int32", SampleType::int32},
                                                                     {"float32", SampleType::float32},
@@ -75,7 +75,7 @@ constexpr std::array<std::pair<const char*, CorrelationPath>, 3> kPaths{{{"auto"
 
 using R = ReaderOptions;
 const OptionField<R> kReader[] = {
-    {"format", "", "recording format: auto | sndfile | dat | raw | csv (auto: from content and extension)",
+    {"format", "", "recording format: auto | sndfile | dat | raw | csv | tdms (auto: from content and extension)",
      [](R& o, std::string_view t) { o.format = choice(t, kFormats); },
      [](const R& o) { return name_of(o.format, kFormats); }},
     {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; must agree with a file's own)",
@@ -105,6 +105,13 @@ const OptionField<R> kReader[] = {
      [](R& o, std::string_view t) { o.volts_per_count = o.raw.volts_per_count = quantity(t, Dimension::voltage); },
      [](const R& o) {
        return o.volts_per_count > 0.0 ? format_quantity(o.volts_per_count, Dimension::voltage) : std::string("the file's");
+     }},
+    {"tdms-channels", "", "TDMS: the channels to read, 'group/channel' or 'channel', comma-separated (default: every numeric channel)",
+     [](R& o, std::string_view t) { o.tdms_channels = split_cells(t); },
+     [](const R& o) {
+       std::string out;
+       for (const auto& c : o.tdms_channels) out += (out.empty() ? "" : ",") + c;
+       return out.empty() ? std::string("all") : out;
      }},
     {"csv-header", "", "CSV header row: auto | yes | no",
      [](R& o, std::string_view t) {

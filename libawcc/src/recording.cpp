@@ -16,8 +16,30 @@
 #include "awcc/errors.hpp"
 #include "awcc/order_statistics.hpp"
 #include "awcc/units.hpp"
+#include "reader_support.hpp"
 
 namespace awcc {
+
+namespace detail {
+
+void reader_fail(const std::filesystem::path& path, std::string_view what, std::string quantity) {
+  throw InputError(fmt::format("{}: {}", path.string(), what), std::move(quantity));
+}
+
+// To 1e-6 by default: a CSV's time stamps are rounded.
+double stated_rate(const std::filesystem::path& path, const ReaderOptions& options, double recorded,
+                   const std::string& where, double tolerance) {
+  if (!(options.fs > 0.0)) return recorded;
+  if (options.override_fs || std::fabs(options.fs - recorded) <= tolerance * recorded) return options.fs;
+  reader_fail(path,
+              fmt::format("{} records a sampling rate of {} but {} was stated; leave the rate out, or force the "
+                          "stated one",
+                          where, format_quantity(recorded, Dimension::frequency),
+                          format_quantity(options.fs, Dimension::frequency)),
+              "override_fs");
+}
+
+}  // namespace detail
 
 std::string_view to_string(InputFormat format) {
   switch (format) {
@@ -26,6 +48,7 @@ std::string_view to_string(InputFormat format) {
     case InputFormat::uq_dat: return "dat";
     case InputFormat::raw: return "raw";
     case InputFormat::csv: return "csv";
+    case InputFormat::tdms: return "tdms";
   }
   return "?";
 }
@@ -48,21 +71,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using detail::stated_rate;
+
 // `quantity` names the reader setting that fixes the problem (InputError::quantity).
 [[noreturn]] void fail(const fs::path& path, std::string_view what, std::string quantity = {}) {
-  throw InputError(fmt::format("{}: {}", path.string(), what), std::move(quantity));
-}
-
-// The sampling rate of a file that records its own: the stated one must
-// agree with it (to 1e-6, a CSV's time stamps being rounded) unless forced.
-double stated_rate(const fs::path& path, const ReaderOptions& options, double recorded, const std::string& where,
-                   double tolerance = 1e-6) {
-  if (!(options.fs > 0.0)) return recorded;
-  if (options.override_fs || std::fabs(options.fs - recorded) <= tolerance * recorded) return options.fs;
-  fail(path,
-       fmt::format("{} records a sampling rate of {} but {} was stated; leave the rate out, or force the stated one",
-                   where, format_quantity(recorded, Dimension::frequency), format_quantity(options.fs, Dimension::frequency)),
-       "override_fs");
+  detail::reader_fail(path, what, std::move(quantity));
 }
 
 template <class T>
@@ -904,18 +917,20 @@ std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOpti
       fail(path, fmt::format("a {} file is not a recording", ext), "not_a_recording");
     }
     if (ext == ".dat") format = InputFormat::uq_dat;
+    else if (ext == ".tdms" || detail::tdms_magic(path)) format = InputFormat::tdms;
     else if (audio_magic(path) || std::find(std::begin(audio_ext), std::end(audio_ext), ext) != std::end(audio_ext))
       format = InputFormat::sndfile;
     else if (ext == ".raw" || ext == ".bin" || ext == ".pcm") format = InputFormat::raw;
     else if (ext == ".csv" || ext == ".tsv" || ext == ".txt" || ext == ".lvm" || looks_like_text(path))
       format = InputFormat::csv;
-    else fail(path, "cannot tell the recording's format from its name or content; state the format (sndfile, dat, raw or csv)", "format");
+    else fail(path, "cannot tell the recording's format from its name or content; state the format (sndfile, dat, raw, csv or tdms)", "format");
   }
   switch (format) {
     case InputFormat::sndfile: return std::make_unique<SndfileRecording>(path, options);
     case InputFormat::uq_dat: return open_uq_dat(path, options, size);
     case InputFormat::raw: return open_raw(path, options, size);
     case InputFormat::csv: return std::make_unique<CsvRecording>(path, options);
+    case InputFormat::tdms: return detail::open_tdms(path, options);
     case InputFormat::automatic: break;
   }
   fail(path, "unknown format");

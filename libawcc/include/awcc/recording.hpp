@@ -9,7 +9,12 @@
 //    channels, header bytes, volts per count);
 //  - column files (CSV, TSV, semicolon-separated with decimal commas, LabVIEW
 //    .lvm text; header row optional, a time column found by name or by its
-//    values).
+//    values);
+//  - NI TDMS (LabVIEW's binary logger), written from NI's published format:
+//    segments of lead-in, metadata and raw data, interleaved or not, int16,
+//    int32, float32 and float64 channels with linear scaling properties,
+//    wf_increment as 1 / fs; the channels are every numeric channel in file
+//    order, or those named (`tdms_channels`).
 // Every reader hands out interleaved float volts (frames x channels) in
 // blocks, so memory does not depend on the file's length; rewind() starts
 // again for a second pass. Damaged input is refused with a message naming the
@@ -26,7 +31,7 @@
 
 namespace awcc {
 
-enum class InputFormat { automatic, sndfile, uq_dat, raw, csv };
+enum class InputFormat { automatic, sndfile, uq_dat, raw, csv, tdms };
 enum class SampleType { int16, int32, float32, float64 };
 enum class ByteOrder { little, big };
 
@@ -62,6 +67,8 @@ struct ReaderOptions {
   /// with a warning in the recording's info; refused otherwise.
   bool allow_truncated = false;
   double volts_per_count = 0.0;    ///< overrides the file's scale when > 0 (sndfile integer data, .dat)
+  /// TDMS: the channels to read, by "group/channel" or "channel" (empty: every numeric channel).
+  std::vector<std::string> tdms_channels;
 };
 
 struct RecordingInfo {
