@@ -498,9 +498,17 @@ FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording&
     if (n == 0) break;
     xs.resize(static_cast<std::size_t>(n));
     ys.resize(static_cast<std::size_t>(n));
-    for (std::size_t f = 0; f < static_cast<std::size_t>(n); ++f) {
-      xs[f] = counts ? block16[f * stride + lead] * quantum : block[f * stride + lead];
-      ys[f] = counts ? block16[f * stride + trail] * quantum : block[f * stride + trail];
+    const auto frames = static_cast<std::size_t>(n);
+    if (counts) {
+      for (std::size_t f = 0; f < frames; ++f) {
+        xs[f] = block16[f * stride + lead] * quantum;
+        ys[f] = block16[f * stride + trail] * quantum;
+      }
+    } else {
+      for (std::size_t f = 0; f < frames; ++f) {
+        xs[f] = block[f * stride + lead];
+        ys[f] = block[f * stride + trail];
+      }
     }
     correlation.feed(position, xs, ys);
     position += n;

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "awcc/chords.hpp"
+#include "awcc/probe_correction.hpp"
+#include "awcc/structure.hpp"
+#include "awcc/velocity_series.hpp"
 
 namespace {
 
@@ -93,6 +96,41 @@ TEST(ChordPdf, FeldersNormalisesByHisBubbleCount) {
   EXPECT_DOUBLE_EQ(p.air_fraction[0], static_cast<double>(3.0f / 4.0f));
   EXPECT_DOUBLE_EQ(p.water_fraction[48], 1.0);  // 98 samples = 4.9 ms: bin (4.8, 4.9], all 3 of n_pdf - 1
   EXPECT_EQ(p.lower_edge(84), static_cast<double>(84.0f * 0.1f) * 1e-3);  // his float32 label, printed 8.400001
+}
+
+// The options added with the structure, the probe correction and the
+// spectrum refuse values that cannot be meant, at and around their limits.
+TEST(NewOptions, ValidationRefusesWhatCannotBeMeant) {
+  awcc::StructureOptions s;
+  EXPECT_TRUE(s.validate().empty());
+  s.clusters.median_fraction = 0.0;
+  EXPECT_FALSE(s.validate().empty());
+  s = {};
+  s.chord_time.max = 0.5 * s.chord_time.bin_width;  // less than one bin
+  EXPECT_FALSE(s.validate().empty());
+  s = {};
+  s.arrivals.length_classes = {3e-3, 1e-3};  // not increasing
+  EXPECT_FALSE(s.validate().empty());
+  s.arrivals.length_classes = {};
+  EXPECT_TRUE(s.validate().empty());  // one class: every particle
+  awcc::ProbeCorrectionOptions p;
+  EXPECT_TRUE(p.validate().empty());
+  p.needle_diameter = 0.0;
+  EXPECT_FALSE(p.validate().empty());
+  p = {};
+  p.air_density = p.water_density;
+  EXPECT_FALSE(p.validate().empty());
+  p = {};
+  p.contact_factor = -0.1;
+  EXPECT_FALSE(p.validate().empty());
+  p = {};
+  p.max_steps = 99;
+  EXPECT_FALSE(p.validate().empty());
+  awcc::SpectrumOptions sp;
+  sp.segment_length = 7;
+  EXPECT_FALSE(sp.validate().empty());
+  sp.segment_length = 8;
+  EXPECT_TRUE(sp.validate().empty());
 }
 
 }  // namespace

@@ -86,21 +86,18 @@ def main():
         # Correlation scales and velocity.
         tu = rows(os.path.join(ref, "Tu_V_summary.txt"))
         row = tu[block_of(tu, label)][1:]
-        w = f"{label} Tu_V_summary"
-        check.number(w + " T0.5", row[0], fs["t05"])
-        check.sentinel(w + " T(Rxx=0)", row[1], fs["t_r11_zero"], 99)
-        check.number(w + " T(Min(Rxx))", row[2], fs["t_r11_min"])
-        check.number(w + " Min(Rxx)", row[3], fs["r11_min"])
-        check.number(w + " Txx", row[4], fs["txx"])
-        check.number(w + " (Rxz)max", row[5], fs["r12_max"])
-        check.number(w + " T(Rxz)max", row[6], fs["lag"])
-        check.sentinel(w + " T(Rxz=0)", row[7], fs["t_r12_zero"], 98)
-        check.number(w + " T(Min(Rxz))", row[8], fs["t_r12_min"])
-        check.number(w + " Min(Rxz)", row[9], fs["r12_min"])
-        check.number(w + " T(0.5(Rxz)max)", row[10], fs["t_half"])
-        check.number(w + " Txz", row[11], fs["txy"])
-        check.sentinel(w + " Tu", row[12], fs["turbulence_intensity_chanson"], 97)
-        check.number(w + " V", row[13], fs["velocity"])
+        # His columns in order: (name, our key, his sentinel for "not reached" or None).
+        columns = [("T0.5", "t05", None), ("T(Rxx=0)", "t_r11_zero", 99), ("T(Min(Rxx))", "t_r11_min", None),
+                   ("Min(Rxx)", "r11_min", None), ("Txx", "txx", None), ("(Rxz)max", "r12_max", None),
+                   ("T(Rxz)max", "lag", None), ("T(Rxz=0)", "t_r12_zero", 98), ("T(Min(Rxz))", "t_r12_min", None),
+                   ("Min(Rxz)", "r12_min", None), ("T(0.5(Rxz)max)", "t_half", None), ("Txz", "txy", None),
+                   ("Tu", "turbulence_intensity_chanson", 97), ("V", "velocity", None)]
+        for token, (column, key, sentinel) in zip(row, columns):
+            where = f"{label} Tu_V_summary {column}"
+            if sentinel is None:
+                check.number(where, token, fs[key])
+            else:
+                check.sentinel(where, token, fs[key], sentinel)
         # C and F of both tips.
         basics = rows(os.path.join(ref, "basics_summary.txt"))
         row = basics[block_of(basics, label)][1:]
@@ -149,14 +146,14 @@ def main():
                 c = clusters["criteria"][criterion]
                 row = table[i][1:]
                 check.number(w + " C", row[0], s["felder_counts"][0]["void_fraction"])
-                check.number(w + " No_in_cluster", row[1], c["n_in_clusters"])
-                check.number(w + " %", row[2], c["pct_in_clusters"])
-                check.number(w + " No_of_clusters", row[3], c["n_clusters"])
-                check.number(w + " per_s", row[4], c["clusters_per_s"])
-                check.number(w + " ave_no", row[5], c["mean_particles_per_cluster"])
-                check.number(w + " ave_size", row[6], c["mean_chord_in_cluster"], 1e3)
-                check.number(w + " ratio", row[7], c["ratio_cluster_chord_to_mean_chord"])
-                check.number(w + " lead", row[8], c["ratio_lead_to_cluster_mean_chord"])
+                # His nine values after C: (name, our key, scale to his units).
+                summary = [("No_in_cluster", "n_in_clusters", 1), ("%", "pct_in_clusters", 1),
+                           ("No_of_clusters", "n_clusters", 1), ("per_s", "clusters_per_s", 1),
+                           ("ave_no", "mean_particles_per_cluster", 1), ("ave_size", "mean_chord_in_cluster", 1e3),
+                           ("ratio", "ratio_cluster_chord_to_mean_chord", 1),
+                           ("lead", "ratio_lead_to_cluster_mean_chord", 1)]
+                for token, (column, key, scale) in zip(row[1:], summary):
+                    check.number(f"{w} {column}", token, c[key], scale)
                 pdf_stem = stem.replace("cluster_summary", "cluster_no_PDF")
                 table = rows(os.path.join(ref, pdf_stem + suffix + ".txt"))
                 i = block_of(table, label)
