@@ -14,16 +14,18 @@
 #include "awcc/errors.hpp"
 #include "awcc/process.hpp"
 #include "awcc/recording.hpp"
+#include "test_paths.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
+// ctest runs each test in its own process, in parallel: several tests build the
+// same file, so the name carries the test's own name to keep them apart.
 fs::path scratch(const std::string& name) {
-  const char* env = std::getenv("PDP_TEST_TMP");
-  fs::path dir = env ? fs::path(env) : fs::temp_directory_path();
-  fs::create_directories(dir);
-  return dir / name;
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string owner = test ? std::string(test->test_suite_name()) + "." + test->name() + "." : "";
+  return pdp_test::temp_dir() / (owner + name);
 }
 
 // A little-endian byte builder.
