@@ -1,6 +1,7 @@
 // Every reader and the whole processing chain (binarisation, phase
 // statistics, FSCC, AWCC) on arbitrary bytes. The first byte picks the
-// container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV, TDMS),
+// container (by extension: libsndfile, UQ .dat, raw of each sample type, CSV, TDMS,
+// HDF5, MATLAB .mat),
 // the rest is the file.
 #include "awcc/json_text.hpp"
 #include "awcc/serialise.hpp"
@@ -11,9 +12,10 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  static const char* extensions[] = {".wav", ".flac", ".dat", ".raw", ".csv", ".tsv", ".w64", ".aiff", ".tdms"};
+  static const char* extensions[] = {".wav", ".flac", ".dat", ".raw", ".csv", ".tsv",
+                                     ".w64", ".aiff", ".tdms", ".h5", ".mat"};
   const std::uint8_t selector = data[0];
-  const auto path = fuzz::scratch(std::string("input") + extensions[selector % 9]);
+  const auto path = fuzz::scratch(std::string("input") + extensions[selector % 11]);
   fuzz::write(path, data + 1, size - 1);
   awcc::ProcessOptions o;
   o.reader.fs = 10000.0;

@@ -4,10 +4,13 @@
 
 #include <array>
 #include <cmath>
+#include <optional>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/units.hpp"
 
 namespace awcc {
@@ -47,9 +50,17 @@ std::pair<std::string_view, std::string_view> pair_of(std::string_view text, con
   return {text.substr(0, comma), text.substr(comma + 1)};
 }
 
-constexpr std::array<std::pair<const char*, InputFormat>, 6> kFormats{
+/// Names written back as one comma-separated cell, or what an empty list means.
+std::string cells_or(const std::vector<std::string>& names, const char* empty) {
+  std::string out;
+  for (const auto& c : names) out += (out.empty() ? "" : ",") + c;
+  return out.empty() ? std::string(empty) : out;
+}
+
+constexpr std::array<std::pair<const char*, InputFormat>, 8> kFormats{
     {{"auto", InputFormat::automatic}, {"sndfile", InputFormat::sndfile}, {"dat", InputFormat::uq_dat},
-     {"raw", InputFormat::raw}, {"csv", InputFormat::csv}, {"tdms", InputFormat::tdms}}};
+     {"raw", InputFormat::raw}, {"csv", InputFormat::csv}, {"tdms", InputFormat::tdms}, {"hdf5", InputFormat::hdf5},
+     {"mat", InputFormat::matlab}}};
 constexpr std::array<std::pair<const char*, SampleType>, 4> kTypes{{{"int16", SampleType::int16},
                                                                     {"int32", SampleType::int32},
                                                                     {"float32", SampleType::float32},
@@ -75,7 +86,7 @@ constexpr std::array<std::pair<const char*, CorrelationPath>, 3> kPaths{{{"auto"
 
 using R = ReaderOptions;
 const OptionField<R> kReader[] = {
-    {"format", "", "recording format: auto | sndfile | dat | raw | csv | tdms (auto: from content and extension)",
+    {"format", "", "recording format: auto | sndfile | dat | raw | csv | tdms | hdf5 | mat (auto: from content and extension)",
      [](R& o, std::string_view t) { o.format = choice(t, kFormats); },
      [](const R& o) { return name_of(o.format, kFormats); }},
     {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; must agree with a file's own)",
@@ -108,11 +119,16 @@ const OptionField<R> kReader[] = {
      }},
     {"tdms-channels", "", "TDMS: the channels to read, 'group/channel' or 'channel', comma-separated (default: every numeric channel)",
      [](R& o, std::string_view t) { o.tdms_channels = split_cells(t); },
-     [](const R& o) {
-       std::string out;
-       for (const auto& c : o.tdms_channels) out += (out.empty() ? "" : ",") + c;
-       return out.empty() ? std::string("all") : out;
-     }},
+     [](const R& o) { return cells_or(o.tdms_channels, "all"); }},
+    {"dataset", "", "HDF5: the dataset(s) holding the channels, by path ('/run/volts'), comma-separated: one 2-D "
+                    "dataset samples x channels or one 1-D dataset per channel (default: pdp-sim's 'signal', or the "
+                    "only numeric dataset)",
+     [](R& o, std::string_view t) { o.datasets = split_cells(t); },
+     [](const R& o) { return cells_or(o.datasets, "found"); }},
+    {"variable", "", "MATLAB .mat: the variable(s) holding the channels, comma-separated: one matrix samples x "
+                     "channels or one vector per channel (default: the only numeric matrix with two or more columns)",
+     [](R& o, std::string_view t) { o.variables = split_cells(t); },
+     [](const R& o) { return cells_or(o.variables, "found"); }},
     {"csv-header", "", "CSV header row: auto | yes | no",
      [](R& o, std::string_view t) {
        if (t == "auto") o.csv.header.reset();
@@ -347,7 +363,7 @@ const OptionField<A> kAwcc[] = {
 };
 
 using P = ProcessOptions;
-constexpr std::array<std::pair<const char*, int>, 3> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}}};
+constexpr std::array<std::pair<const char*, int>, 4> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}, {"none", 0}}};
 const OptionField<P> kProcess[] = {
     {"dx", "m", "streamwise tip separation (e.g. 7.15mm); 0 = no velocity",
      [](P& o, std::string_view t) { o.dx = quantity(t, Dimension::length); },
@@ -361,7 +377,7 @@ const OptionField<P> kProcess[] = {
     {"trailing-channel", "-", "channel of the trailing tip (from 0)",
      [](P& o, std::string_view t) { o.trailing_channel = static_cast<int>(whole(t, 0, 1023)); },
      [](const P& o) { return std::to_string(o.trailing_channel); }},
-    {"method", "", "velocity methods: both | awcc | fscc",
+    {"method", "", "velocity methods: both | awcc | fscc | none (phase statistics only)",
      [](P& o, std::string_view t) {
        const int m = choice(t, kMethods);
        o.fscc = (m & 1) != 0;
@@ -394,6 +410,65 @@ std::span<const OptionField<StructureOptions>> structure_option_fields() { retur
 std::span<const PresetSetting> preset_settings(std::string_view name) {
   if (name == "felder") return kFelder;
   throw std::invalid_argument(fmt::format("'{}' is not a preset; the presets are: felder", name));
+}
+
+namespace {
+
+// Applies the given (else the preset's) value of each field, in declaration order.
+template <class T>
+void apply_settings(std::span<const OptionField<T>> fields, std::span<const OptionSetting> settings,
+                    std::span<const PresetSetting> preset, std::string_view preset_name, T& target,
+                    std::vector<bool>& used) {
+  for (const auto& f : fields) {
+    std::optional<std::string_view> text;
+    bool from_preset = false;
+    for (std::size_t i = 0; i < settings.size(); ++i) {
+      if (settings[i].name != f.name) continue;
+      text = settings[i].value;  // the last given wins
+      used[i] = true;
+    }
+    if (!text) {
+      for (const auto& p : preset) {
+        if (p.name == f.name) text = p.value, from_preset = true;
+      }
+    }
+    if (!text) continue;
+    try {
+      f.parse(target, *text);
+    } catch (const std::invalid_argument& e) {
+      throw OptionError(from_preset ? fmt::format("preset {}: {} = {}: {}", preset_name, f.name, *text, e.what())
+                                    : fmt::format("{} = {}: {}", f.name, *text, e.what()),
+                        std::string(f.name));
+    }
+  }
+}
+
+}  // namespace
+
+ProcessOptions process_options(std::span<const OptionSetting> settings, std::string_view preset) {
+  const auto preset_values = preset.empty() ? std::span<const PresetSetting>() : preset_settings(preset);
+  std::vector<bool> used(settings.size(), false);
+  ProcessOptions p;
+  apply_settings(process_option_fields(), settings, preset_values, preset, p, used);
+  apply_settings(reader_option_fields(), settings, preset_values, preset, p.reader, used);
+  apply_settings(binarisation_option_fields(), settings, preset_values, preset, p.binarisation, used);
+  apply_settings(fscc_option_fields(), settings, preset_values, preset, p.fscc_options, used);
+  apply_settings(awcc_option_fields(), settings, preset_values, preset, p.awcc_options, used);
+  apply_settings(structure_option_fields(), settings, preset_values, preset, p.structure, used);
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    if (!used[i]) {
+      throw OptionError(fmt::format("'{}' is not an option of a processing run; the options are listed by "
+                                    "`pdp process --help` (names without the leading --)",
+                                    settings[i].name),
+                        settings[i].name);
+    }
+  }
+  p.fscc_options.subsample = p.awcc_options.subsample;  // FSCC refines its peak as AWCC does (header above)
+  if (!p.allow_unusual) {
+    if (auto why = p.implausible(); !why.empty()) throw OptionError(why, "allow-unusual");
+  }
+  if (auto why = p.validate(); !why.empty()) throw std::invalid_argument(why);
+  return p;
 }
 
 }  // namespace awcc

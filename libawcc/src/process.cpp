@@ -421,14 +421,20 @@ std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOpt
 }
 
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
+  auto recording = open_recording(path, options.reader);
+  return awcc_raw(*recording, b, options);
+}
+
+AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options) {
+  const std::filesystem::path& path = recording.info().path;
+  recording.rewind();
   const AwccOptions& ao = options.awcc_options;
   if (auto why = ao.validate(); !why.empty()) throw std::invalid_argument(why);
   AwccResult result;
   result.np = ao.np;
   result.options = ao;
   result.windows = awcc_windows(b.leading, ao.np);
-  auto recording = open_recording(path, options.reader);
-  const auto stride = static_cast<std::size_t>(recording->info().channels);
+  const auto stride = static_cast<std::size_t>(recording.info().channels);
   const auto lead = static_cast<std::size_t>(options.leading_channel);
   const auto trail = static_cast<std::size_t>(options.trailing_channel);
   std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
@@ -442,7 +448,7 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
     AwccWindow& window = result.windows[w];
     if (position >= block_start + in_block) {
       block_start += in_block;
-      in_block = recording->read(block, options.block_frames);
+      in_block = recording.read(block, options.block_frames);
       if (in_block == 0) {
         throw InputError(fmt::format("{}: the recording ended at frame {} while reading it again for AWCC",
                                              path.string(), position));
@@ -478,7 +484,13 @@ AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording&
 
 FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
   auto recording = open_recording(path, options.reader);
-  const auto stride = static_cast<std::size_t>(recording->info().channels);
+  return fscc_raw(*recording, b, options);
+}
+
+FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options) {
+  const std::filesystem::path& path = recording.info().path;
+  recording.rewind();
+  const auto stride = static_cast<std::size_t>(recording.info().channels);
   const auto lead = static_cast<std::size_t>(options.leading_channel);
   const auto trail = static_cast<std::size_t>(options.trailing_channel);
   // Plans are built once per thread and serve every record processed on it
@@ -486,15 +498,15 @@ FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording&
   thread_local FftPlanCache plans;
   RawCorrelation correlation(b.info.frames, b.info.fs, options.fscc_options, plans);
   // 16-bit counts are read as they are stored (volts = count x quantum, exact in double).
-  const bool counts = recording->has_int16() && recording->info().quantum > 0.0;
-  const double quantum = recording->info().quantum;
+  const bool counts = recording.has_int16() && recording.info().quantum > 0.0;
+  const double quantum = recording.info().quantum;
   std::vector<float> block(counts ? 0 : static_cast<std::size_t>(options.block_frames) * stride);
   std::vector<std::int16_t> block16(counts ? static_cast<std::size_t>(options.block_frames) * stride : 0);
   std::vector<double> xs, ys;
   std::int64_t position = 0;
   for (;;) {
-    const std::int64_t n = counts ? recording->read_int16(block16, options.block_frames)
-                                  : recording->read(block, options.block_frames);
+    const std::int64_t n = counts ? recording.read_int16(block16, options.block_frames)
+                                  : recording.read(block, options.block_frames);
     if (n == 0) break;
     xs.resize(static_cast<std::size_t>(n));
     ys.resize(static_cast<std::size_t>(n));
@@ -522,8 +534,15 @@ FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording&
 }
 
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
+  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  auto recording = open_recording(path, options.reader);
+  return process_recording(*recording, options);
+}
+
+ProcessResult process_recording(Recording& recording, const ProcessOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const auto binarised = binarise_recording(path, options);
+  recording.rewind();
+  const auto binarised = binarise_recording(recording, options);
   ProcessResult out;
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     out = process_binarised(binarised, options);
@@ -532,8 +551,8 @@ ProcessResult process_recording(const std::filesystem::path& path, const Process
     out.info = binarised.info;
     out.dx = options.dx;
     out.dy = options.dy;
-    if (options.fscc) out.fscc = fscc_raw(path, binarised, options);
-    if (options.awcc) out.awcc = awcc_raw(path, binarised, options);
+    if (options.fscc) out.fscc = fscc_raw(recording, binarised, options);
+    if (options.awcc) out.awcc = awcc_raw(recording, binarised, options);
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
     add_structure(out, binarised, options);

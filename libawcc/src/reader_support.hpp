@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -22,5 +23,22 @@ double stated_rate(const std::filesystem::path& path, const ReaderOptions& optio
 std::unique_ptr<Recording> open_tdms(const std::filesystem::path& path, const ReaderOptions& options);
 /// True when the file starts with a TDMS lead-in ("TDSm").
 bool tdms_magic(const std::filesystem::path& path);
+
+/// libhdf5 may be built without its thread-safety option (Debian 12's
+/// 1.10.8 has it; other builds do not), matio keeps global log state and
+/// reads v7.3 files through libhdf5: every call into either holds this lock
+/// (awcc::pdpsim::hdf5_mutex, shared with libsynth's writer), so recordings
+/// may be opened, read and written from several threads at once.
+std::mutex& hdf5_library_mutex();
+
+/// HDF5 (awcc/recording.hpp).
+std::unique_ptr<Recording> open_hdf5(const std::filesystem::path& path, const ReaderOptions& options);
+/// True when the file carries the HDF5 signature (at 0 or a user-block offset).
+bool hdf5_magic(const std::filesystem::path& path);
+
+/// MATLAB .mat, v5 and v7.3 (awcc/recording.hpp).
+std::unique_ptr<Recording> open_matlab(const std::filesystem::path& path, const ReaderOptions& options);
+/// True when the file starts with a MAT-file's text header ("MATLAB 5.0 MAT-file", "MATLAB 7.3 MAT-file").
+bool matlab_magic(const std::filesystem::path& path);
 
 }  // namespace awcc::detail

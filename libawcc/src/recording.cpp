@@ -11,10 +11,12 @@
 #include <optional>
 #include <sndfile.h>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "awcc/errors.hpp"
 #include "awcc/order_statistics.hpp"
+#include "awcc/pdpsim_layout.hpp"
 #include "awcc/units.hpp"
 #include "reader_support.hpp"
 
@@ -49,6 +51,8 @@ std::string_view to_string(InputFormat format) {
     case InputFormat::raw: return "raw";
     case InputFormat::csv: return "csv";
     case InputFormat::tdms: return "tdms";
+    case InputFormat::hdf5: return "hdf5";
+    case InputFormat::matlab: return "mat";
   }
   return "?";
 }
@@ -899,6 +903,97 @@ bool audio_magic(const fs::path& path) {
 
 }  // namespace
 
+namespace {
+
+// Samples already in memory: read() copies the next frames out.
+template <class Sample>
+class MemoryRecording final : public Recording {
+ public:
+  MemoryRecording(std::vector<Sample> samples, int channels, double fs, double quantum, bool volts_known,
+                  std::string name)
+      : samples_(std::move(samples)) {
+    const fs::path path(name);
+    if (channels < 1) fail(path, "no channel: give at least one array", "channels");
+    const auto c = static_cast<std::size_t>(channels);
+    if (samples_.size() % c != 0) {
+      fail(path, fmt::format("{} samples are not whole frames of {} channels; give arrays of one length",
+                             samples_.size(), channels), "channels");
+    }
+    if (samples_.empty()) fail(path, "no sample: the arrays are empty");
+    if (!(fs > 0.0) || !std::isfinite(fs)) fail(path, fmt::format("sampling rate {} Hz: give a positive rate", fs), "fs");
+    if constexpr (std::is_floating_point_v<Sample>) {
+      for (std::size_t i = 0; i < samples_.size(); ++i) {
+        if (!std::isfinite(samples_[i])) {
+          fail(path, fmt::format("sample {} of channel {} is {}; remove or fill non-finite values first", i / c, i % c,
+                                 samples_[i]), "volts");
+        }
+      }
+    }
+    info_.path = path;
+    info_.format = InputFormat::automatic;
+    info_.description = std::is_floating_point_v<Sample> ? "array, float volts" : "array, 16-bit counts";
+    info_.channels = channels;
+    info_.fs = fs;
+    info_.frames = static_cast<std::int64_t>(samples_.size() / c);
+    info_.quantum = quantum;
+    info_.volts_known = volts_known;
+  }
+
+  std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
+    const auto [from, n] = next(max_frames);
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(samples_[from + i] * scale());
+    return advance(n);
+  }
+  void rewind() override { position_ = 0; }
+  [[nodiscard]] bool has_int16() const override { return std::is_same_v<Sample, std::int16_t>; }
+  std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
+    if constexpr (std::is_same_v<Sample, std::int16_t>) {
+      const auto [from, n] = next(max_frames);
+      std::copy_n(samples_.begin() + static_cast<std::ptrdiff_t>(from), n, out.begin());
+      return advance(n);
+    } else {
+      return Recording::read_int16(out, max_frames);
+    }
+  }
+
+ private:
+  [[nodiscard]] double scale() const { return std::is_floating_point_v<Sample> ? 1.0 : info_.quantum; }
+  // The first sample and the number of samples of the next max_frames frames.
+  std::pair<std::size_t, std::size_t> next(std::int64_t max_frames) const {
+    const auto frames = std::min<std::int64_t>(max_frames, info_.frames - position_);
+    const auto c = static_cast<std::size_t>(info_.channels);
+    return {static_cast<std::size_t>(position_) * c, static_cast<std::size_t>(std::max<std::int64_t>(frames, 0)) * c};
+  }
+  std::int64_t advance(std::size_t samples) {
+    const auto frames = static_cast<std::int64_t>(samples / static_cast<std::size_t>(info_.channels));
+    position_ += frames;
+    return frames;
+  }
+
+  std::vector<Sample> samples_;
+  std::int64_t position_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Recording> memory_recording(std::vector<float> interleaved, int channels, double fs, std::string name) {
+  return std::make_unique<MemoryRecording<float>>(std::move(interleaved), channels, fs, 0.0, true, std::move(name));
+}
+
+std::unique_ptr<Recording> memory_recording(std::vector<std::int16_t> interleaved, int channels, double fs,
+                                            double quantum, bool volts_known, std::string name) {
+  if (!(quantum > 0.0) || !std::isfinite(quantum)) {
+    fail(name, fmt::format("{} V per count: give a positive scale", quantum), "volts_per_count");
+  }
+  return std::make_unique<MemoryRecording<std::int16_t>>(std::move(interleaved), channels, fs, quantum, volts_known,
+                                                         std::move(name));
+}
+
+namespace detail {
+// The writer in libsynth takes the same lock (libcore owns it).
+std::mutex& hdf5_library_mutex() { return pdpsim::hdf5_mutex(); }
+}  // namespace detail
+
 std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOptions& options) {
   std::error_code ec;
   if (!fs::exists(path, ec)) fail(path, "no such file");
@@ -918,12 +1013,16 @@ std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOpti
     }
     if (ext == ".dat") format = InputFormat::uq_dat;
     else if (ext == ".tdms" || detail::tdms_magic(path)) format = InputFormat::tdms;
+    // A v7.3 MAT-file is an HDF5 file behind a MATLAB header: ask the header first.
+    else if (ext == ".mat" || detail::matlab_magic(path)) format = InputFormat::matlab;
+    else if (ext == ".h5" || ext == ".hdf5" || ext == ".hdf" || ext == ".he5" || detail::hdf5_magic(path))
+      format = InputFormat::hdf5;
     else if (audio_magic(path) || std::find(std::begin(audio_ext), std::end(audio_ext), ext) != std::end(audio_ext))
       format = InputFormat::sndfile;
     else if (ext == ".raw" || ext == ".bin" || ext == ".pcm") format = InputFormat::raw;
     else if (ext == ".csv" || ext == ".tsv" || ext == ".txt" || ext == ".lvm" || looks_like_text(path))
       format = InputFormat::csv;
-    else fail(path, "cannot tell the recording's format from its name or content; state the format (sndfile, dat, raw, csv or tdms)", "format");
+    else fail(path, "cannot tell the recording's format from its name or content; state the format (sndfile, dat, raw, csv, tdms, hdf5 or mat)", "format");
   }
   switch (format) {
     case InputFormat::sndfile: return std::make_unique<SndfileRecording>(path, options);
@@ -931,6 +1030,8 @@ std::unique_ptr<Recording> open_recording(const fs::path& path, const ReaderOpti
     case InputFormat::raw: return open_raw(path, options, size);
     case InputFormat::csv: return std::make_unique<CsvRecording>(path, options);
     case InputFormat::tdms: return detail::open_tdms(path, options);
+    case InputFormat::hdf5: return detail::open_hdf5(path, options);
+    case InputFormat::matlab: return detail::open_matlab(path, options);
     case InputFormat::automatic: break;
   }
   fail(path, "unknown format");

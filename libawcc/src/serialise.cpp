@@ -14,12 +14,51 @@
 
 namespace awcc {
 
+namespace {
+
+// Each column with its CSV number format (fmt), which keeps the table's digits as they were.
+struct WindowColumnFormat {
+  WindowColumn column;
+  std::string_view format;
+};
+constexpr WindowColumnFormat kWindowColumns[] = {
+    {{"start_time", "s", [](const AwccWindow& w) { return w.start_time; }, nullptr}, "{:.9g}"},
+    {{"duration", "s", [](const AwccWindow& w) { return w.duration; }, nullptr}, "{:.9g}"},
+    {{"particles", "-", [](const AwccWindow& w) { return static_cast<double>(w.particles); }, nullptr}, "{:.0f}"},
+    {{"lag", "s", [](const AwccWindow& w) { return w.lag; }, nullptr}, "{:.9g}"},
+    {{"velocity", "m/s", [](const AwccWindow& w) { return w.velocity; }, nullptr}, "{:.9g}"},
+    {{"r12_max", "-", [](const AwccWindow& w) { return w.r12_max; }, nullptr}, "{:.6f}"},
+    {{"spr", "-", [](const AwccWindow& w) { return w.spr; }, nullptr}, "{:.6f}"},
+    {{"void_fraction", "-", [](const AwccWindow& w) { return w.void_fraction; }, nullptr}, "{:.6f}"},
+    {{"count_rate", "1/s", [](const AwccWindow& w) { return w.count_rate; }, nullptr}, "{:.6g}"},
+    {{"fate", "", nullptr, [](const AwccWindow& w) { return to_string(w.fate); }}, "{}"},
+    {{"measured_velocity", "m/s", [](const AwccWindow& w) { return w.measured_velocity; }, nullptr}, "{:.9g}"},
+};
+
+}  // namespace
+
+std::span<const WindowColumn> awcc_window_columns() {
+  static const auto columns = [] {
+    std::vector<WindowColumn> out;
+    for (const auto& c : kWindowColumns) out.push_back(c.column);
+    return out;
+  }();
+  return columns;
+}
+
 std::string awcc_windows_csv(const AwccResult& result) {
-  std::string out = "start_time,duration,particles,lag,velocity,r12_max,spr,void_fraction,count_rate,fate,measured_velocity\n";
+  std::string out;
+  for (const auto& c : kWindowColumns) out += fmt::format("{}{}", out.empty() ? "" : ",", c.column.name);
+  out += '\n';
   for (const auto& w : result.windows) {
-    out += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.9g},{:.6f},{:.6f},{:.6f},{:.6g},{},{:.9g}\n", w.start_time, w.duration,
-                       w.particles, w.lag, w.velocity, w.r12_max, w.spr, w.void_fraction, w.count_rate,
-                       to_string(w.fate), w.measured_velocity);
+    bool first = true;
+    for (const auto& c : kWindowColumns) {
+      if (!first) out += ',';
+      first = false;
+      if (c.column.text) out += c.column.text(w);
+      else out += fmt::format(fmt::runtime(c.format), c.column.value(w));
+    }
+    out += '\n';
   }
   return out;
 }
@@ -184,6 +223,18 @@ json to_json(const StructureResult& r) {
               {"felder_counts", felder_counts(r)}};
 }
 
+json to_json(const Threshold& t) {
+  json out{{"threshold", t.threshold},
+           {"threshold_rule", std::string(to_string(t.rule))},
+           {"threshold_lower", t.lower},
+           {"threshold_upper", t.upper},
+           {"air_level", t.air_level},
+           {"water_level", t.water_level},
+           {"binary_input", t.binary_input}};
+  if (!t.note.empty()) out["threshold_note"] = t.note;
+  return out;
+}
+
 json to_json(const ProcessResult& r) {
   json tips = json::array();
   for (const auto& t : r.tips) {
@@ -193,13 +244,6 @@ json to_json(const ProcessResult& r) {
         {"name", t.name.empty() ? json(nullptr) : json(t.name)},
         {"status", to_string(p.status)},
         {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
-        {"threshold", t.threshold.threshold},
-        {"threshold_rule", std::string(to_string(t.threshold.rule))},
-        {"threshold_lower", t.threshold.lower},
-        {"threshold_upper", t.threshold.upper},
-        {"air_level", t.threshold.air_level},
-        {"water_level", t.threshold.water_level},
-        {"binary_input", t.threshold.binary_input},
         {"void_fraction", p.void_fraction},
         {"void_fraction_ci95", ci(p.void_fraction_ci95)},
         {"bubble_count_rate", p.bubble_count_rate},
@@ -214,7 +258,7 @@ json to_json(const ProcessResult& r) {
         {"chord_length", p.air_chord_length ? summary(*p.air_chord_length) : json(nullptr)},
         {"sauter_diameter", optional(p.sauter_diameter)},
     };
-    if (!t.threshold.note.empty()) tip["threshold_note"] = t.threshold.note;
+    tip.update(to_json(t.threshold));
     tips.push_back(tip);
   }
   json out{

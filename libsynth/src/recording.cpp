@@ -18,6 +18,7 @@ std::string_view to_string(FileFormat format) {
     case FileFormat::wav: return "wav";
     case FileFormat::w64: return "w64";
     case FileFormat::rf64: return "rf64";
+    case FileFormat::hdf5: return "h5";
   }
   return "?";
 }
@@ -31,8 +32,15 @@ std::optional<FileFormat> format_from_extension(const std::filesystem::path& pat
   if (ext == ".wav") return FileFormat::wav;
   if (ext == ".w64") return FileFormat::w64;
   if (ext == ".rf64") return FileFormat::rf64;
+  if (ext == ".h5" || ext == ".hdf5") return FileFormat::hdf5;
   return std::nullopt;
 }
+
+namespace detail {
+// hdf5_recording.cpp: writes `file` (already the temporary name); messages name `shown`.
+void write_hdf5(const std::filesystem::path& file, const std::filesystem::path& shown, const Scene& scene,
+                std::span<const awcc::AirIntervals> signals, const RecordingOptions& options);
+}  // namespace detail
 
 namespace {
 
@@ -42,6 +50,7 @@ int sf_major(FileFormat format) {
     case FileFormat::wav: return SF_FORMAT_WAV;
     case FileFormat::w64: return SF_FORMAT_W64;
     case FileFormat::rf64: return SF_FORMAT_RF64;
+    case FileFormat::hdf5: break;
   }
   return SF_FORMAT_WAV;
 }
@@ -49,6 +58,8 @@ int sf_major(FileFormat format) {
 }  // namespace
 
 std::string check_recordable(const Scene& scene, std::size_t channels, FileFormat format) {
+  // HDF5 stores the rate as a float64 time base and any number of tips.
+  if (format == FileFormat::hdf5) return {};
   if (scene.fs != std::floor(scene.fs) || scene.fs > 2.0e9) {
     return fmt::format("fs = {} Hz: audio containers store a whole number of hertz up to 2 GHz; choose such an fs",
                        scene.fs);
@@ -100,6 +111,12 @@ void write_recording(const std::filesystem::path& path, const Scene& scene,
   if (channels == 0) throw std::runtime_error(fmt::format("{}: no signal to write", path.string()));
   if (const auto why = check_recordable(scene, channels, options.format); !why.empty()) {
     throw std::runtime_error(fmt::format("{}: {}", path.string(), why));
+  }
+  if (options.format == FileFormat::hdf5) {
+    awcc::write_atomically(path, [&](const std::filesystem::path& temporary) {
+      detail::write_hdf5(temporary, path, scene, signals, options);
+    });
+    return;
   }
   const std::int64_t frames = signals.front().sample_count;
   awcc::write_atomically(path, [&](const std::filesystem::path& temporary) {

@@ -102,6 +102,9 @@ std::string flag_for(const std::string& quantity) {
   static const std::map<std::string, std::string> flags{
       {"fs", "--fs"},
       {"format", "--format"},
+      {"datasets", "--dataset"},
+      {"variables", "--variable"},
+      {"tdms_channels", "--tdms-channels"},
       {"raw_layout", "--raw-channels, --raw-type and --raw-header"},
       {"time_column", "--time-column"},
       {"channels", "--leading-channel/--trailing-channel"},

@@ -18,12 +18,15 @@ void setup_synth(CLI::App& app, Command& command, SynthOptions& options) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      cmd->add_option("-o,--output", options.output, "recording to write (.flac, .wav, .w64, .rf64)"));
+      cmd->add_option("-o,--output", options.output,
+                      "recording to write (.flac, .wav, .w64, .rf64; .h5 or .hdf5: pdp-sim's layout, datasets "
+                      "'signal' (samples x tips, uint8 0/1, or int16 counts with 'volts_per_count' for --signal "
+                      "voltage, which pdp-sim itself does not write) and 'time')"));
   cmd->add_option("--signal", options.signal, "binary (0 water, 1 air) or voltage (raw int16 counts)")
       ->check(CLI::IsMember({"binary", "voltage"}))
       ->capture_default_str();
-  cmd->add_option("--format", options.format, "flac | wav | w64 | rf64 [default: from the extension]")
-      ->check(CLI::IsMember({"flac", "wav", "w64", "rf64"}));
+  cmd->add_option("--format", options.format, "flac | wav | w64 | rf64 | h5 [default: from the extension]")
+      ->check(CLI::IsMember({"flac", "wav", "w64", "rf64", "h5"}));
   cmd->add_option("--flac-compression", options.flac_compression, "FLAC compression level, 0 fastest to 1 smallest")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
@@ -48,7 +51,7 @@ int run_synth(const SynthOptions& options) {
   } else if (auto f = synth::format_from_extension(options.output)) {
     recording.format = *f;
   } else {
-    spdlog::error("{}: unknown recording extension; use .flac, .wav, .w64 or .rf64, or give --format",
+    spdlog::error("{}: unknown recording extension; use .flac, .wav, .w64, .rf64 or .h5, or give --format",
                   options.output);
     return exit_bad_usage;
   }

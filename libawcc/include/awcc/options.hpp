@@ -37,4 +37,17 @@ struct PresetSetting {
 /// The settings of a preset; throws std::invalid_argument for an unknown name.
 std::span<const PresetSetting> preset_settings(std::string_view name);
 
+/// A setting as a user types it: {"dx", "7.15mm"}, {"method", "awcc"}.
+struct OptionSetting {
+  std::string name;
+  std::string value;
+};
+/// The options of a processing run from settings by their declared names, a
+/// preset's values first for the options not given (as `pdp process`
+/// applies them, in the same order), then checked: implausible values unless
+/// allow-unusual, then validate(). Throws OptionError naming the option
+/// (quantity() = its name) for an unknown name, a bad value or an
+/// implausible one, std::invalid_argument for a combination that cannot work.
+ProcessOptions process_options(std::span<const OptionSetting> settings, std::string_view preset = {});
+
 }  // namespace awcc

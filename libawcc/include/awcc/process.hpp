@@ -107,14 +107,20 @@ ProcessResult process_binarised(const BinarisedRecording& recording, const Proce
 /// binarised leading tip (reads the file once more, block by block).
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
                     const ProcessOptions& options);
+/// The same from the open recording the signals came from (read again from its start).
+AwccResult awcc_raw(Recording& recording, const BinarisedRecording& binarised, const ProcessOptions& options);
 
 /// FSCC correlating the raw voltages of the recording (reads the file once
 /// more, block by block; fscc_options.segments segments, S = 1 the whole record).
 FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
                     const ProcessOptions& options);
+/// The same from the open recording the signals came from (read again from its start).
+FsccResult fscc_raw(Recording& recording, const BinarisedRecording& binarised, const ProcessOptions& options);
 
 /// All of the above, as the options ask (awcc_options.signal chooses what
 /// both FSCC and AWCC correlate).
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options);
+/// The same for an open recording (a file or arrays in memory), read from its start.
+ProcessResult process_recording(Recording& recording, const ProcessOptions& options);
 
 }  // namespace awcc

@@ -14,7 +14,14 @@
 //    segments of lead-in, metadata and raw data, interleaved or not, int16,
 //    int32, float32 and float64 channels with linear scaling properties,
 //    wf_increment as 1 / fs; the channels are every numeric channel in file
-//    order, or those named (`tdms_channels`).
+//    order, or those named (`tdms_channels`);
+//  - HDF5: pdp-sim's signal layout (dataset `signal`, samples x sensors, a
+//    `time` dataset, attribute `sensor_id`) or any layout with the datasets
+//    named (`datasets`: one 2-D dataset samples x channels, or one 1-D
+//    dataset per channel), the rate from an attribute, a time dataset or fs;
+//  - MATLAB .mat, v5 and v7.3: the variables named (`variables`: one matrix
+//    samples x channels or one vector per channel), or the single numeric
+//    matrix with two or more columns.
 // Every reader hands out interleaved float volts (frames x channels) in
 // blocks, so memory does not depend on the file's length; rewind() starts
 // again for a second pass. Damaged input is refused with a message naming the
@@ -31,7 +38,7 @@
 
 namespace awcc {
 
-enum class InputFormat { automatic, sndfile, uq_dat, raw, csv, tdms };
+enum class InputFormat { automatic, sndfile, uq_dat, raw, csv, tdms, hdf5, matlab };
 enum class SampleType { int16, int32, float32, float64 };
 enum class ByteOrder { little, big };
 
@@ -69,6 +76,14 @@ struct ReaderOptions {
   double volts_per_count = 0.0;    ///< overrides the file's scale when > 0 (sndfile integer data, .dat)
   /// TDMS: the channels to read, by "group/channel" or "channel" (empty: every numeric channel).
   std::vector<std::string> tdms_channels;
+  /// HDF5: the dataset(s) holding the channels, by path in the file ("/run/volts"):
+  /// one 2-D dataset samples x channels, or one 1-D dataset per channel
+  /// (empty: pdp-sim's `signal`, or the file's only numeric dataset).
+  std::vector<std::string> datasets;
+  /// MATLAB: the variable(s) holding the channels: one matrix samples x
+  /// channels or one vector per channel (empty: the file's only numeric
+  /// matrix with two or more columns).
+  std::vector<std::string> variables;
 };
 
 struct RecordingInfo {
@@ -107,5 +122,17 @@ class Recording {
 /// Opens a recording (detecting the format by content and extension unless
 /// told). Throws std::runtime_error naming the file, the problem and the fix.
 std::unique_ptr<Recording> open_recording(const std::filesystem::path& path, const ReaderOptions& options = {});
+
+/// A recording held in memory (the Python module's arrays): frames x channels
+/// interleaved volts. `name` stands for the file in messages. Throws
+/// InputError for no channel, a length that is not whole frames, no frame, a
+/// non-finite sample or a rate that is not positive.
+std::unique_ptr<Recording> memory_recording(std::vector<float> interleaved, int channels, double fs,
+                                            std::string name = "array");
+/// The same from 16-bit counts, volts = count x quantum; `volts_known` says
+/// whether quantum makes them volts (a binary 0/1 signal: quantum 1, unknown).
+/// Its samples go through the int16 fast path, as a 16-bit file's do.
+std::unique_ptr<Recording> memory_recording(std::vector<std::int16_t> interleaved, int channels, double fs,
+                                            double quantum, bool volts_known, std::string name = "array");
 
 }  // namespace awcc

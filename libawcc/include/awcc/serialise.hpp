@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,8 @@ namespace awcc {
 nlohmann::json to_json(const ProcessResult& result);
 nlohmann::json to_json(const AwccOptions& options);
 nlohmann::json to_json(const StructureResult& result);
+/// A tip's threshold: the keys its entry of the process JSON's "tips" holds.
+nlohmann::json to_json(const Threshold& threshold);
 
 /// Every effective option of a processing run, defaults included, by its
 /// declared name (awcc/options.hpp) as text with its unit.
@@ -24,6 +28,16 @@ nlohmann::json options_json(const ProcessOptions& options);
 /// (options_json), "inputs": [{"file", "bytes", "sha256"}], "utc_time"}.
 nlohmann::json provenance_json(const ProcessOptions& options, const std::vector<std::string>& inputs,
                                const std::string& command_line);
+
+/// A column of the AWCC window table: the CSV's and the Python module's.
+struct WindowColumn {
+  std::string_view name;
+  std::string_view unit;                       ///< "s", "m/s", "1/s", "-", "" (text)
+  double (*value)(const AwccWindow&);          ///< numeric columns
+  std::string_view (*text)(const AwccWindow&); ///< the text column (fate); null for numeric ones
+};
+/// The columns of the window table, in order.
+std::span<const WindowColumn> awcc_window_columns();
 
 /// The per-window table of AWCC as CSV.
 std::string awcc_windows_csv(const AwccResult& result);

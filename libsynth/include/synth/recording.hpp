@@ -1,6 +1,11 @@
 #pragma once
-// Recordings of the synthetic probe: one multi-channel file per recording
-// through libsndfile, one channel per tip in tip order, 16-bit integer samples.
+// Recordings of the synthetic probe: one multi-channel file per recording,
+// one channel per tip in tip order: an audio container through libsndfile
+// (16-bit integer samples), or pdp-sim's HDF5 layout (awcc/pdpsim_layout.hpp:
+// `signal` samples x tips, uint8 0/1 for binary signals as pdp-sim writes
+// them, int16 counts with a `volts_per_count` attribute for raw voltages, a
+// form pdp-sim itself does not produce; `time` in seconds; `sensor_id` and
+// `fs` attributes on `signal`).
 //
 // Binary signals hold 0 (water) and 1 (air) as integer sample values. Raw
 // voltage signals render each tip as a conductivity/optical probe would see it:
@@ -23,12 +28,12 @@
 
 namespace synth {
 
-enum class FileFormat { flac, wav, w64, rf64 };
+enum class FileFormat { flac, wav, w64, rf64, hdf5 };
 enum class SignalKind { binary, voltage };
 
 std::string_view to_string(FileFormat format);
 std::string_view to_string(SignalKind signal);
-/// Format from a file extension (.flac, .wav, .w64, .rf64), if known.
+/// Format from a file extension (.flac, .wav, .w64, .rf64, .h5 or .hdf5), if known.
 std::optional<FileFormat> format_from_extension(const std::filesystem::path& path);
 
 struct RecordingOptions {
@@ -65,7 +70,7 @@ class VoltageRenderer {
 void write_recording(const std::filesystem::path& path, const Scene& scene,
                      std::span<const awcc::AirIntervals> signals, const RecordingOptions& options = {});
 
-/// Reads every frame of a recording back as int16 (tests and small files).
+/// Reads every frame of an audio recording back as int16 (tests and small files).
 /// Returns frames x channels interleaved and sets channels and fs.
 std::vector<std::int16_t> read_recording_int16(const std::filesystem::path& path, int& channels, double& fs);
 

@@ -1,0 +1,376 @@
+"""pdp: dual-tip phase-detection probe measurements in bubbly and self-aerated flows.
+
+Numpy in, numpy and dicts out, no file needed:
+
+    rec = pdp.read("dc157_05.dat", fs=20e3)             # channels, fs, metadata
+    r = pdp.process(rec, dx="7.15mm")                   # as `pdp process --json`
+    r.tips[0].void_fraction, r.awcc.velocity, r.windows # attribute or key access
+    a = pdp.awcc(lead, trail, fs=20e3, dx=7.15e-3, np=10)
+    s = pdp.synth(duration=10, fs=100e3)                # signals and their truth
+    c = pdp.correct(r, model="awcc.qrf")                # bias-corrected quantiles
+
+Options are the command line's, by the same declarations (``pdp process
+--help``): write ``filter_a=0.5`` for ``--filter-a 0.5``. A number is in SI
+units (m, s, Hz, V); a string may carry its unit ("7.15mm", "20kHz"); True and
+False switch flags. Results carry the JSON keys of docs/output.md. Errors
+raise pdp.InputError or pdp.OptionError (both ValueError) with the library's
+message. Use Debian's /usr/bin/python3, whose NumPy the module was built with.
+"""
+
+import json as _json
+import os as _os
+import sys as _sys
+
+import numpy as _np
+
+from . import _pdp
+from ._errors import InputError, OptionError, OutputError, PdpError
+
+__version__ = _pdp.version
+__all__ = ["read", "binarise", "phase_statistics", "fscc", "awcc", "process", "synth", "correct", "options",
+           "Result", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
+
+
+class Result(dict):
+    """A result: the JSON object of docs/output.md, with attribute access
+    (``r.awcc.velocity`` is ``r["awcc"]["velocity"]``)."""
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(f"no '{name}' in this result; it has: {', '.join(self)}") from None
+
+    def __dir__(self):
+        return list(self) + list(super().__dir__())
+
+    def to_json(self, **kwargs):
+        """The result as JSON text (array attributes such as ``windows`` are not part of it)."""
+        return _json.dumps(self, **kwargs)
+
+
+def _wrap(value):
+    if isinstance(value, dict):
+        return Result((k, _wrap(v)) for k, v in value.items())
+    if isinstance(value, list):
+        return [_wrap(v) for v in value]
+    return value
+
+
+def _table(columns):
+    """A dict of arrays as a pandas DataFrame when pandas is importable."""
+    if columns is None:
+        return None
+    try:
+        import pandas
+    except ImportError:
+        return columns
+    return pandas.DataFrame(columns)
+
+
+class Recording:
+    """Channels read from a file: ``data`` (samples x channels, float32,
+    volts when ``info.volts_known``), ``fs`` (Hz) and ``info`` (format,
+    channel names, warnings, ...)."""
+
+    def __init__(self, data, fs, info):
+        self.data, self.fs, self.info = data, fs, _wrap(info)
+
+    @property
+    def channels(self):
+        """The channels as a list of 1-D arrays (views of ``data``)."""
+        return [self.data[:, k] for k in range(self.data.shape[1])]
+
+    def __repr__(self):
+        return (f"Recording({self.info.file!r}, {self.data.shape[1]} channels x {self.data.shape[0]} samples, "
+                f"fs={self.fs:g} Hz, {self.info.format})")
+
+
+# --- options -----------------------------------------------------------------
+
+_OPTIONS = _pdp.options()
+_NAMES = {o["name"] for o in _OPTIONS if o["group"] != "scene"}
+
+
+def options(group=None):
+    """Every option with its group, name, unit, help and default (the
+    declarations the command line reads); only ``group``'s when given
+    ("probe and methods", "input", "binarisation", "fscc", "awcc",
+    "structure", "scene")."""
+    return [Result(o) for o in _OPTIONS if group is None or o["group"] == group]
+
+
+_UNITS = {o["name"]: o["unit"] for o in _OPTIONS if o["group"] != "scene"}
+
+
+def _text(value, unit=""):
+    """An option's value as a user types it; a number gets its SI unit (the
+    library refuses a quantity without one)."""
+    if isinstance(value, bool) or isinstance(value, _np.bool_):
+        return "on" if value else "off"
+    suffix = "" if unit in ("", "-", "bytes") else unit
+    if isinstance(value, (int, _np.integer)):
+        return f"{int(value)}{suffix}"
+    if isinstance(value, (float, _np.floating)):
+        return f"{float(value)!r}{suffix}"
+    if isinstance(value, (list, tuple)):
+        return ",".join(_text(v, unit) for v in value)
+    if isinstance(value, (str, _os.PathLike)):
+        return _os.fspath(value)
+    raise OptionError(f"a value of type {type(value).__name__} ({value!r}) cannot be an option; give a number, "
+                      "a string with its unit, True/False or a list")
+
+
+def _settings(kwargs):
+    """Keyword options as (declared name, text) pairs: filter_a -> filter-a."""
+    out = []
+    for key, value in kwargs.items():
+        if value is None:
+            continue
+        name = key.replace("_", "-")
+        if name not in _NAMES:
+            close = sorted(n for n in _NAMES if n.split("-")[0] == name.split("-")[0])
+            hint = f"; did you mean {', '.join(n.replace('-', '_') for n in close)}?" if close else ""
+            err = OptionError(f"'{key}' is not an option{hint} (pdp.options() lists them)")
+            err.quantity = name
+            raise err
+        out.append((name, _text(value, _UNITS[name])))
+    return out
+
+
+def _channels(lead, trail):
+    """The signals as 1-D arrays: a Recording, a 2-D array (samples x
+    channels), or one array per tip."""
+    if isinstance(lead, Recording):
+        return lead.channels, lead.fs
+    a = _np.asarray(lead)
+    if trail is None:
+        if a.ndim == 2:
+            return [a[:, k] for k in range(a.shape[1])], None
+        return [a], None
+    return [a, _np.asarray(trail)], None
+
+
+def _rate(fs, recorded):
+    if fs is None and recorded is None:
+        err = OptionError("the sampling rate is needed: give fs=... (Hz)")
+        err.quantity = "fs"
+        raise err
+    return float(recorded if fs is None else fs)
+
+
+def _arrays(lead, trail, fs, volts_per_count, kwargs, preset=""):
+    channels, recorded = _channels(lead, trail)
+    return _pdp.process_arrays(channels, _rate(fs, recorded), volts_per_count, _settings(kwargs), preset or "")
+
+
+def _call_text(name, args, kwargs):
+    shown = [repr(a) if isinstance(a, (str, _os.PathLike, list)) else "<array>" for a in args]
+    shown += [f"{k}={v!r}" for k, v in kwargs.items() if v is not None]
+    return f"python {_sys.version.split()[0]}: pdp.{name}({', '.join(shown)})"
+
+
+# --- the functions -------------------------------------------------------------
+
+
+def read(path, **options):
+    """Reads a recording: every format ``pdp process`` reads (WAV/FLAC/W64/RF64,
+    UQ .dat, raw, CSV/LabVIEW .lvm, NI TDMS, HDF5, MATLAB .mat), detected by
+    content and extension. Returns a Recording: ``data`` samples x channels
+    (float32 volts, or counts when ``info.volts_known`` is False), ``fs``
+    (Hz), ``info``. The whole file is held in memory."""
+    data, fs, info = _pdp.read(_os.fspath(path), _settings(options))
+    return Recording(data, fs, info)
+
+
+def binarise(volts, fs=None, *, output="intervals", volts_per_count=None, **options):
+    """Binarises a tip's signal (1-D array) or the two tips of a Recording or
+    2-D array (samples x channels; ``leading_channel``/``trailing_channel``
+    choose them). ``output="intervals"`` gives the air intervals as an
+    (n, 2) int64 array of [start, end) samples; ``output="binary"`` a 0/1
+    uint8 array. Float samples are volts; integer samples counts
+    (``volts_per_count`` makes them volts). Returns a Result with
+    ``threshold`` (rule, levels, value) and ``intervals`` or ``binary``; for
+    two tips, ``leading`` and ``trailing`` such Results."""
+    if output not in ("intervals", "binary"):
+        raise OptionError(f"output={output!r}: give 'intervals' or 'binary'")
+    channels, recorded = _channels(volts, None)
+    single = len(channels) == 1
+    if single:
+        channels = channels * 2  # the library binarises a pair of tips
+    b = _pdp.binarise(channels, _rate(fs, recorded), volts_per_count, _settings(options))
+
+    def tip(t):
+        r = Result(threshold=_wrap(t["threshold"]))
+        if output == "intervals":
+            r["intervals"] = t["intervals"]
+        else:
+            dense = _np.zeros(b["sample_count"], dtype=_np.uint8)
+            for start, end in t["intervals"]:
+                dense[start:end] = 1
+            r["binary"] = dense
+        r["fs"], r["sample_count"] = b["fs"], b["sample_count"]
+        return r
+
+    if single:
+        return tip(b["leading"])
+    return Result(leading=tip(b["leading"]), trailing=tip(b["trailing"]), fs=b["fs"], sample_count=b["sample_count"])
+
+
+def phase_statistics(lead, trail=None, fs=None, *, volts_per_count=None, **options):
+    """Void fraction, bubble count rate, chord times and their 95 % intervals
+    of each tip: the ``tips`` of the process JSON (a list of Results; one
+    for a single 1-D signal)."""
+    channels, recorded = _channels(lead, trail)
+    single = len(channels) == 1
+    r, _ = _pdp.process_arrays(channels * 2 if single else channels, _rate(fs, recorded), volts_per_count,
+                               _settings({**options, "method": "none"}), "")
+    tips = _wrap(r["tips"])
+    return tips[:1] if single else tips
+
+
+def fscc(lead, trail=None, fs=None, dx=None, *, volts_per_count=None, **options):
+    """Full-signal cross-correlation of the leading and trailing tips: the
+    ``fscc`` object of the process JSON (velocity, lag, r12_max, T05,
+    correlation scales, status and reason). ``dx`` is the streamwise tip
+    separation (m, or a string with its unit)."""
+    r, _ = _arrays(lead, trail, fs, volts_per_count, {**options, "dx": dx, "method": "fscc"})
+    return _wrap(r["fscc"])
+
+
+def awcc(lead, trail=None, fs=None, dx=None, np=None, *, volts_per_count=None, **options):
+    """Adaptive window cross-correlation of the leading and trailing tips
+    (``np`` particles per window): the ``awcc`` object of the process JSON
+    (velocity, turbulence intensity and their intervals, quality, status)
+    with ``windows``, the per-window table as a dict of arrays (a pandas
+    DataFrame when pandas is importable)."""
+    r, windows = _arrays(lead, trail, fs, volts_per_count, {**options, "dx": dx, "np": np, "method": "awcc"})
+    out = _wrap(r["awcc"])
+    out.windows = _table(windows)
+    return out
+
+
+def process(source, trail=None, *, fs=None, preset=None, correct=None, positions=None, volts_per_count=None,
+            **options):
+    """Processes a recording as ``pdp process --json`` does and returns the
+    same JSON as a Result: ``source`` is a file path (the result is the
+    file's JSON object, with ``provenance``), a list of paths (a profile:
+    ``{"profile": [...], "provenance": ...}``, ``positions`` in m one per
+    file), a Recording, a 2-D array samples x channels, or the leading tip's
+    array with ``trail`` the trailing tip's. ``correct`` names a correction
+    model (.qrf) that adds each result's ``correction`` (bias-corrected
+    quantiles of u and Tu). The AWCC window table of a single recording is
+    ``result.windows``."""
+    settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
+    call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
+    if isinstance(source, (str, _os.PathLike)):
+        r, windows = _pdp.process_file(_os.fspath(source), settings, preset or "")
+        inputs = [_os.fspath(source)]
+        out = r
+    elif isinstance(source, (list, tuple)):
+        paths = [_os.fspath(p) for p in source]
+        if positions is not None and len(positions) != len(paths):
+            raise OptionError(f"{len(positions)} positions for {len(paths)} files; give one per file")
+        rows, windows = [], None
+        for i, path in enumerate(paths):
+            row, _ = _pdp.process_file(path, settings, preset or "")
+            row["position"] = None if positions is None else float(positions[i])
+            rows.append(row)
+        inputs, out = paths, {"profile": rows}
+    else:
+        out, windows = _arrays(source, trail, fs, volts_per_count, options, preset)
+        inputs = []
+    if correct is not None:
+        out, warnings = _pdp.correct(_json.dumps(out), _os.fspath(correct), None, None, None)
+        for w in warnings:
+            import warnings as _warnings
+            _warnings.warn(w, stacklevel=2)
+    out["provenance"] = _pdp.provenance(inputs, settings, preset or "", call)
+    result = _wrap(out)
+    result.windows = _table(windows)
+    return result
+
+
+def synth(scene=None, *, signal="binary", **fields):
+    """Synthesises a scene with the synthetic probe (the fields of ``pdp synth``,
+    from a dict and/or keywords: ``pdp.synth(duration=10, fs=100e3,
+    mean_velocity=2.0)``). Returns a Result: ``signals`` samples x tips
+    (uint8 0/1 for ``signal="binary"``; float32 volts for ``"voltage"``, with
+    the int16 ``counts`` and ``volts_per_count``), ``fs``, ``scene`` and
+    ``truth`` (the sidecar's objects)."""
+    merged = dict(scene or {})
+    merged.update(fields)
+    s = _pdp.synthesise(_settings_scene(merged), signal)
+    out = _wrap({"fs": s["fs"], "scene": s["scene"], "truth": s["truth"], "volts_per_count": s["volts_per_count"]})
+    if signal == "voltage":
+        out["counts"] = s["signals"]
+        out["signals"] = (s["signals"] * s["volts_per_count"]).astype(_np.float32)
+    else:
+        out["signals"] = s["signals"]
+    return out
+
+
+_SCENE_UNITS = {o["name"]: o["unit"] for o in _OPTIONS if o["group"] == "scene"}
+
+
+def _settings_scene(fields):
+    names = _SCENE_UNITS
+    out = []
+    for key, value in fields.items():
+        name = key.replace("_", "-")
+        if name not in names and key in names:
+            name = key
+        if name not in names:
+            err = OptionError(f"'{key}' is not a scene field (pdp.options('scene') lists them)")
+            err.quantity = key
+            raise err
+        if isinstance(value, (list, tuple)) and value and isinstance(value[0], (list, tuple)):
+            value = ";".join(_text(v, _SCENE_UNITS[name]) for v in value)  # points: "x,y,z;x,y,z"
+        out.append((name, _text(value, _SCENE_UNITS[name])))
+    return out
+
+
+def correct(results, model, *, dx=None, dy=None, np=None):
+    """Bias-corrects AWCC's velocity and turbulence intensity with a
+    correction model (.qrf from ``pdp train``): ``results`` is what
+    ``pdp.process`` returns (one recording or a profile) or a process JSON
+    loaded as a dict. Returns the results with a ``correction`` object per
+    recording (median, 80 % and 95 % quantiles of u and Tu, or why not
+    corrected), as ``pdp correct`` writes them. ``dx``, ``dy`` (m) and ``np``
+    fill values the results lack."""
+    out, warnings = _pdp.correct(_json.dumps(results), _os.fspath(model), dx, dy, np)
+    for w in warnings:
+        import warnings as _warnings
+        _warnings.warn(w, stacklevel=2)
+    return _wrap(out)
+
+
+# --- help from the declarations ------------------------------------------------
+
+_GROUPS = {
+    read: ["input"],
+    binarise: ["binarisation"],
+    phase_statistics: ["binarisation"],
+    fscc: ["probe and methods", "binarisation", "fscc"],
+    awcc: ["probe and methods", "binarisation", "awcc"],
+    process: ["probe and methods", "input", "binarisation", "fscc", "awcc", "structure"],
+    synth: ["scene"],
+}
+
+
+def _options_doc(groups):
+    lines = ["", "Options (keyword = value; unit; default):"]
+    for group in groups:
+        lines.append(f"  {group}:")
+        for o in _OPTIONS:
+            if o["group"] != group:
+                continue
+            unit = "" if o["unit"] in ("", "-") else f"; {o['unit']}"
+            lines.append(f"    {o['name'].replace('-', '_')}{unit}; default {o['default']}")
+            lines.append(f"        {o['help']}")
+    return "\n".join(lines)
+
+
+for _function, _groups in _GROUPS.items():
+    _function.__doc__ = (_function.__doc__ or "") + "\n" + _options_doc(_groups)
+del _function, _groups

@@ -1,0 +1,399 @@
+// pdp._pdp: the compiled core of the Python module (python/pdp/__init__.py
+// is the documented interface). Every computation is the libraries': options
+// are applied from their declarations (awcc::process_options), results are
+// their JSON forms (awcc/serialise.hpp) turned into Python objects by the
+// json module, so a dict from Python equals the JSON `pdp process` writes.
+// Long calls release the GIL; library errors become pdp.InputError and
+// pdp.OptionError (ValueError subclasses) carrying the library's message and
+// the setting that fixes them.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "awcc/errors.hpp"
+#include "awcc/json_text.hpp"
+#include "awcc/options.hpp"
+#include "awcc/process.hpp"
+#include "awcc/serialise.hpp"
+#include "awcc/version.hpp"
+#include "correction/model.hpp"
+#include "correction/rows.hpp"
+#include "synth/recording.hpp"
+#include "synth/scene.hpp"
+#include "synth/sidecar.hpp"
+#include "synth/synthesiser.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+using Settings = std::vector<std::pair<std::string, std::string>>;
+
+std::vector<awcc::OptionSetting> option_settings(const Settings& settings) {
+  std::vector<awcc::OptionSetting> out;
+  for (const auto& [name, value] : settings) out.push_back({name, value});
+  return out;
+}
+
+py::object python_of(const nlohmann::json& j) {
+  return py::module_::import("json").attr("loads")(awcc::json_text(j));
+}
+
+// --- arrays in -------------------------------------------------------------
+
+// How a channel's dtype is read: 16-bit counts (bool, int8, uint8, int16),
+// other integers as counts in floats, floating values as volts.
+enum class SampleKind { counts16, counts, volts };
+
+SampleKind kind_of(const py::array& a, std::size_t k) {
+  const char kind = a.dtype().kind();
+  const auto size = a.dtype().itemsize();
+  if (kind == 'f') return SampleKind::volts;
+  if (kind == 'b' || (kind == 'i' && size <= 2) || (kind == 'u' && size == 1)) return SampleKind::counts16;
+  if (kind == 'i' || kind == 'u') return SampleKind::counts;
+  throw awcc::OptionError(fmt::format("channel {}: samples of dtype {} cannot be read; give float (volts) or integer "
+                                      "(counts) samples",
+                                      k, py::str(a.dtype()).cast<std::string>()),
+                          "channels");
+}
+
+// The channels (1-D arrays of one length) as an in-memory recording.
+// Integer counts are volts x volts_per_count when it is given, else counts of
+// unknown scale (a 0/1 binary signal).
+std::unique_ptr<awcc::Recording> recording_of(const std::vector<py::array>& channels, double fs,
+                                              std::optional<double> volts_per_count) {
+  if (channels.empty()) throw awcc::OptionError("no channel: give the tips' signals", "channels");
+  std::vector<SampleKind> kinds;
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    if (channels[k].ndim() != 1) {
+      throw awcc::OptionError(fmt::format("channel {} has {} dimensions; give 1-D arrays, one per tip (or a 2-D "
+                                          "array samples x channels)",
+                                          k, channels[k].ndim()),
+                              "channels");
+    }
+    if (channels[k].shape(0) != channels[0].shape(0)) {
+      throw awcc::OptionError(fmt::format("channel {} has {} samples but channel 0 has {}; give arrays of one length",
+                                          k, channels[k].shape(0), channels[0].shape(0)),
+                              "channels");
+    }
+    kinds.push_back(kind_of(channels[k], k));
+  }
+  if (volts_per_count && !(*volts_per_count > 0.0)) {
+    throw awcc::OptionError(fmt::format("volts_per_count = {}: give a positive scale", *volts_per_count),
+                            "volts-per-count");
+  }
+  const auto n = static_cast<std::size_t>(channels[0].shape(0));
+  const auto c = channels.size();
+  const bool all16 = std::all_of(kinds.begin(), kinds.end(), [](SampleKind k) { return k == SampleKind::counts16; });
+  const bool any_counts = std::any_of(kinds.begin(), kinds.end(), [](SampleKind k) { return k != SampleKind::volts; });
+  const double quantum = volts_per_count.value_or(1.0);
+  const bool volts_known = volts_per_count.has_value() || !any_counts;
+  if (all16) {
+    std::vector<std::int16_t> interleaved(n * c);
+    for (std::size_t k = 0; k < c; ++k) {
+      // forcecast copies a slice or another dtype into a contiguous int16 array.
+      const auto a = py::array_t<std::int16_t, py::array::c_style | py::array::forcecast>::ensure(channels[k]);
+      const auto* p = a.data();
+      for (std::size_t i = 0; i < n; ++i) interleaved[i * c + k] = p[i];
+    }
+    return awcc::memory_recording(std::move(interleaved), static_cast<int>(c), fs, quantum, volts_known);
+  }
+  std::vector<float> interleaved(n * c);
+  for (std::size_t k = 0; k < c; ++k) {
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(channels[k]);
+    const auto* p = a.data();
+    const double scale = kinds[k] == SampleKind::volts ? 1.0 : quantum;
+    for (std::size_t i = 0; i < n; ++i) interleaved[i * c + k] = static_cast<float>(p[i] * scale);
+  }
+  return awcc::memory_recording(std::move(interleaved), static_cast<int>(c), fs);
+}
+
+// --- arrays out ------------------------------------------------------------
+
+py::array_t<std::int64_t> intervals_array(const awcc::AirIntervals& s) {
+  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(s.intervals.size()), py::ssize_t{2}});
+  auto m = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < s.intervals.size(); ++i) {
+    m(static_cast<py::ssize_t>(i), 0) = s.intervals[i].start;
+    m(static_cast<py::ssize_t>(i), 1) = s.intervals[i].stop;
+  }
+  return out;
+}
+
+// The window table (awcc::awcc_window_columns) as a dict of arrays.
+py::dict windows_of(const awcc::AwccResult& r) {
+  py::dict out;
+  for (const auto& column : awcc::awcc_window_columns()) {
+    if (column.text) {
+      py::list cells;
+      for (const auto& w : r.windows) cells.append(py::str(std::string(column.text(w))));
+      out[py::str(std::string(column.name))] = py::module_::import("numpy").attr("array")(cells);
+    } else {
+      py::array_t<double> values(static_cast<py::ssize_t>(r.windows.size()));
+      auto m = values.mutable_unchecked<1>();
+      for (std::size_t i = 0; i < r.windows.size(); ++i) m(static_cast<py::ssize_t>(i)) = column.value(r.windows[i]);
+      out[py::str(std::string(column.name))] = values;
+    }
+  }
+  return out;
+}
+
+py::tuple result_of(const awcc::ProcessResult& r) {
+  return py::make_tuple(python_of(awcc::to_json(r)), r.awcc ? py::object(windows_of(*r.awcc)) : py::none());
+}
+
+// --- the functions ---------------------------------------------------------
+
+template <class T>
+void describe(py::list& out, const char* group, std::span<const awcc::OptionField<T>> fields, const T& defaults) {
+  for (const auto& f : fields) {
+    py::dict d;
+    d["group"] = group;
+    d["name"] = std::string(f.name);
+    d["unit"] = std::string(f.unit);
+    d["help"] = std::string(f.help);
+    d["default"] = f.format(defaults);
+    d["flag"] = f.flag;
+    out.append(d);
+  }
+}
+
+py::list options() {
+  py::list out;
+  const awcc::ProcessOptions p;
+  describe(out, "probe and methods", awcc::process_option_fields(), p);
+  describe(out, "input", awcc::reader_option_fields(), p.reader);
+  describe(out, "binarisation", awcc::binarisation_option_fields(), p.binarisation);
+  describe(out, "fscc", awcc::fscc_option_fields(), p.fscc_options);
+  describe(out, "awcc", awcc::awcc_option_fields(), p.awcc_options);
+  describe(out, "structure", awcc::structure_option_fields(), p.structure);
+  const synth::Scene scene;
+  for (const auto& f : synth::scene_fields()) {
+    py::dict d;
+    d["group"] = "scene";
+    d["name"] = std::string(f.name);
+    d["unit"] = std::string(awcc::si_unit(f.dimension));
+    d["help"] = std::string(f.help);
+    d["default"] = f.format(scene);
+    d["flag"] = false;
+    out.append(d);
+  }
+  return out;
+}
+
+py::tuple read_recording(const std::filesystem::path& path, const Settings& settings) {
+  const auto o = awcc::process_options(option_settings(settings));
+  std::vector<float> samples;
+  awcc::RecordingInfo info;
+  {
+    py::gil_scoped_release unlocked;
+    auto recording = awcc::open_recording(path, o.reader);
+    info = recording->info();
+    const auto c = static_cast<std::size_t>(info.channels);
+    if (info.frames > 0) samples.reserve(static_cast<std::size_t>(info.frames) * c);
+    std::vector<float> block(static_cast<std::size_t>(o.block_frames) * c);
+    for (;;) {
+      const auto n = recording->read(block, o.block_frames);
+      if (n == 0) break;
+      samples.insert(samples.end(), block.begin(), block.begin() + n * static_cast<std::int64_t>(c));
+    }
+  }
+  const auto c = static_cast<py::ssize_t>(info.channels);
+  const auto frames = static_cast<py::ssize_t>(samples.size()) / std::max<py::ssize_t>(c, 1);
+  py::array_t<float> data({frames, c});
+  std::copy(samples.begin(), samples.end(), data.mutable_data());
+  py::dict meta;
+  meta["file"] = info.path.string();
+  meta["format"] = info.description;
+  meta["channels"] = info.channels;
+  meta["fs"] = info.fs;
+  meta["samples"] = frames;
+  meta["quantum"] = info.quantum;
+  meta["volts_known"] = info.volts_known;
+  meta["warnings"] = info.warnings;
+  meta["channel_names"] = info.channel_names;
+  return py::make_tuple(data, info.fs, meta);
+}
+
+py::dict binarise(const std::vector<py::array>& channels, double fs, std::optional<double> volts_per_count,
+                  const Settings& settings) {
+  const auto o = awcc::process_options(option_settings(settings));
+  auto recording = recording_of(channels, fs, volts_per_count);
+  awcc::BinarisedRecording b;
+  {
+    py::gil_scoped_release unlocked;
+    b = awcc::binarise_recording(*recording, o);
+  }
+  py::dict out;
+  out["sample_count"] = b.leading.sample_count;
+  out["fs"] = b.info.fs;
+  out["leading"] = py::dict(py::arg("intervals") = intervals_array(b.leading),
+                            py::arg("threshold") = python_of(awcc::to_json(b.leading_threshold)));
+  out["trailing"] = py::dict(py::arg("intervals") = intervals_array(b.trailing),
+                             py::arg("threshold") = python_of(awcc::to_json(b.trailing_threshold)));
+  return out;
+}
+
+py::tuple process_arrays(const std::vector<py::array>& channels, double fs, std::optional<double> volts_per_count,
+                         const Settings& settings, const std::string& preset) {
+  const auto o = awcc::process_options(option_settings(settings), preset);
+  auto recording = recording_of(channels, fs, volts_per_count);
+  awcc::ProcessResult r;
+  {
+    py::gil_scoped_release unlocked;
+    r = awcc::process_recording(*recording, o);
+  }
+  return result_of(r);
+}
+
+// One recording as `pdp process FILE --json` gives it (provenance added by the caller).
+py::tuple process_file(const std::filesystem::path& path, const Settings& settings, const std::string& preset) {
+  auto o = awcc::process_options(option_settings(settings), preset);
+  awcc::ProcessResult r;
+  {
+    py::gil_scoped_release unlocked;
+    // A synthetic recording's sidecar states its volts per count, as for pdp process.
+    if (!(o.reader.volts_per_count > 0.0)) {
+      if (const auto vpc = synth::sidecar_volts_per_count(path)) o.reader.volts_per_count = *vpc;
+    }
+    r = awcc::process_recording(path, o);
+  }
+  return result_of(r);
+}
+
+py::object provenance(const std::vector<std::string>& inputs, const Settings& settings, const std::string& preset,
+                      const std::string& call) {
+  const auto o = awcc::process_options(option_settings(settings), preset);
+  nlohmann::json j;
+  {
+    py::gil_scoped_release unlocked;
+    j = awcc::provenance_json(o, inputs, call);
+  }
+  return python_of(j);
+}
+
+py::tuple correct(const std::string& json, const std::filesystem::path& model_path, std::optional<double> dx,
+                  std::optional<double> dy, std::optional<int> np) {
+  correction::RowDefaults defaults;
+  defaults.dx = dx;
+  defaults.dy = dy;
+  defaults.np = np;
+  correction::FileCorrection fc;
+  {
+    py::gil_scoped_release unlocked;
+    const auto model = correction::CorrectionModel::load(model_path);
+    fc = correction::correct_process_json(model, json, defaults, "results", model_path.filename().string());
+  }
+  return py::make_tuple(py::module_::import("json").attr("loads")(fc.text), fc.warnings);
+}
+
+py::dict synthesise(const Settings& settings, const std::string& signal) {
+  synth::Scene scene;
+  for (const auto& [name, value] : settings) {
+    try {
+      synth::set_scene_field(scene, name, value);
+    } catch (const std::invalid_argument& e) {
+      throw awcc::OptionError(fmt::format("{} = {}: {}", name, value, e.what()), name);
+    }
+  }
+  if (const auto errors = scene.validate(); !errors.empty()) {
+    std::string all;
+    for (const auto& e : errors) all += "\n  " + e;
+    throw awcc::OptionError("invalid scene:" + all, "scene");
+  }
+  if (signal != "binary" && signal != "voltage") {
+    throw awcc::OptionError(fmt::format("signal = {}: give binary or voltage", signal), "signal");
+  }
+  synth::Synthesis s;
+  {
+    py::gil_scoped_release unlocked;
+    s = synth::synthesise(scene);
+  }
+  const auto tips = s.signals.size();
+  const std::int64_t n = tips ? s.signals[0].sample_count : 0;
+  py::dict out;
+  out["fs"] = scene.fs;
+  out["scene"] = python_of(synth::scene_to_json(scene));
+  out["truth"] = python_of(synth::truth_to_json(s.truth));
+  if (signal == "binary") {
+    py::array_t<std::uint8_t> data({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(tips)});
+    auto* p = data.mutable_data();
+    {
+      py::gil_scoped_release unlocked;
+      std::vector<std::uint8_t> column(static_cast<std::size_t>(n));
+      for (std::size_t j = 0; j < tips; ++j) {
+        s.signals[j].render(0, column);
+        for (std::size_t i = 0; i < column.size(); ++i) p[i * tips + j] = column[i];
+      }
+    }
+    out["signals"] = data;
+    out["volts_per_count"] = py::none();
+  } else {
+    py::array_t<std::int16_t> data({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(tips)});
+    synth::VoltageRenderer renderer(scene, tips);
+    {
+      py::gil_scoped_release unlocked;
+      // Rendered block by block as the recording writer does: the same counts.
+      const std::int64_t block = synth::RecordingOptions{}.block_frames;
+      std::vector<std::vector<std::uint8_t>> air(tips, std::vector<std::uint8_t>(static_cast<std::size_t>(block)));
+      for (std::int64_t first = 0; first < n; first += block) {
+        const auto m = static_cast<std::size_t>(std::min(block, n - first));
+        std::vector<std::span<const std::uint8_t>> spans;
+        for (std::size_t j = 0; j < tips; ++j) {
+          s.signals[j].render(first, std::span<std::uint8_t>(air[j].data(), m));
+          spans.emplace_back(air[j].data(), m);
+        }
+        renderer.render(spans, std::span<std::int16_t>(data.mutable_data() + first * static_cast<std::int64_t>(tips),
+                                                       m * tips));
+      }
+    }
+    out["signals"] = data;
+    out["volts_per_count"] = renderer.volts_per_count();
+  }
+  return out;
+}
+
+// Library errors as Python exceptions with the library's message and the
+// setting that fixes them (`quantity`).
+void translate(const char* type, const std::string& message, const std::string& quantity) {
+  const auto error = py::module_::import("pdp._errors").attr(type)(message);
+  error.attr("quantity") = quantity.empty() ? py::object(py::none()) : py::object(py::str(quantity));
+  PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error.ptr())), error.ptr());
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_pdp, m) {
+  m.doc() = "The compiled core of pdp (use the pdp package, whose functions are documented)";
+  m.attr("version") = awcc::version;
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const awcc::InputError& e) {
+      translate("InputError", e.what(), e.quantity());
+    } catch (const awcc::OptionError& e) {
+      translate("OptionError", e.what(), e.quantity());
+    } catch (const awcc::OutputError& e) {
+      translate("OutputError", e.what(), {});
+    }
+  });
+  m.def("options", &options);
+  m.def("read", &read_recording, py::arg("path"), py::arg("settings"));
+  m.def("binarise", &binarise, py::arg("channels"), py::arg("fs"), py::arg("volts_per_count"), py::arg("settings"));
+  m.def("process_arrays", &process_arrays, py::arg("channels"), py::arg("fs"), py::arg("volts_per_count"),
+        py::arg("settings"), py::arg("preset"));
+  m.def("process_file", &process_file, py::arg("path"), py::arg("settings"), py::arg("preset"));
+  m.def("provenance", &provenance, py::arg("inputs"), py::arg("settings"), py::arg("preset"), py::arg("call"));
+  m.def("correct", &correct, py::arg("json"), py::arg("model"), py::arg("dx"), py::arg("dy"), py::arg("np"));
+  m.def("synthesise", &synthesise, py::arg("settings"), py::arg("signal"));
+}
