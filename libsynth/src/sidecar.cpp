@@ -109,7 +109,10 @@ json sidecar_json(const Truth& truth, const RecordingOptions& options, const std
                       {"format", std::string(to_string(options.format))},
                       {"signal", std::string(to_string(options.signal))},
                       {"channels", truth.tips.size()},
-                      {"sample_type", "int16"},
+                      // The .h5 writer stores a binary signal as uint8 (hdf5_recording.cpp).
+                      {"sample_type", options.format == FileFormat::hdf5 && options.signal == SignalKind::binary
+                                          ? "uint8"
+                                          : "int16"},
                       {"volts_per_count", options.signal == SignalKind::voltage
                                               ? json(truth.imposed.voltage_full_scale / 32768.0)
                                               : json(nullptr)}};

@@ -27,11 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // ctest runs each test in its own process, in parallel: the name carries the test's own name.
-fs::path scratch(const std::string& name) {
-  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::string owner = test ? std::string(test->test_suite_name()) + "." + test->name() + "." : "";
-  return pdp_test::temp_dir() / (owner + name);
-}
+fs::path scratch(const std::string& name) { return pdp_test::test_file(name); }
 
 // A file being written (closed at the end of the scope). Groups on the way
 // to a dataset are created.

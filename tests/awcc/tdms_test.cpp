@@ -22,11 +22,7 @@ namespace fs = std::filesystem;
 
 // ctest runs each test in its own process, in parallel: several tests build the
 // same file, so the name carries the test's own name to keep them apart.
-fs::path scratch(const std::string& name) {
-  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::string owner = test ? std::string(test->test_suite_name()) + "." + test->name() + "." : "";
-  return pdp_test::temp_dir() / (owner + name);
-}
+fs::path scratch(const std::string& name) { return pdp_test::test_file(name); }
 
 // A little-endian byte builder.
 struct Bytes {

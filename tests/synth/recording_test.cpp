@@ -173,6 +173,14 @@ TEST(Sidecar, HoldsTheDocumentedKeys) {
   EXPECT_EQ(r["bubbles_pierced"].size(), 2u);
   EXPECT_DOUBLE_EQ(r["void_fraction"][1].get<double>(), synthesis.signals[1].void_fraction());
   EXPECT_EQ(synth::sidecar_path("dir/rec.flac"), fs::path("dir/rec.truth.json"));
+  // The stored sample type follows the writer: uint8 only for a binary .h5.
+  EXPECT_EQ(j["recording"]["sample_type"], "int16");
+  synth::RecordingOptions h5;
+  h5.format = synth::FileFormat::hdf5;
+  h5.signal = synth::SignalKind::binary;
+  EXPECT_EQ(synth::sidecar_json(synthesis.truth, h5, "rec.h5")["recording"]["sample_type"], "uint8");
+  h5.signal = synth::SignalKind::voltage;
+  EXPECT_EQ(synth::sidecar_json(synthesis.truth, h5, "rec.h5")["recording"]["sample_type"], "int16");
 }
 
 }  // namespace
