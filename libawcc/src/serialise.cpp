@@ -362,18 +362,72 @@ json to_json(const ProcessResult& r) {
   return out;
 }
 
+std::span<const ProfileColumn> profile_csv_columns() {
+  static constexpr ProfileColumn columns[] = {
+      {"file", "", "/file", "the recording's file name"},
+      {"position", "m", "/position", "position of the probe in the profile"},
+      {"void_fraction", "-", "/tips/0/void_fraction", "void fraction c, leading tip"},
+      {"bubble_count_rate", "1/s", "/tips/0/bubble_count_rate", "bubble count rate F, leading tip"},
+      {"chord_time_mean", "s", "/tips/0/chord_time_mean", "mean air chord time, leading tip"},
+      {"chord_time_median", "s", "/tips/0/chord_time_median", "median air chord time, leading tip"},
+      {"threshold", "V", "/tips/0/threshold", "binarisation threshold, leading tip"},
+      {"void_fraction_trailing", "-", "/tips/1/void_fraction", "void fraction c, trailing tip"},
+      {"bubble_count_rate_trailing", "1/s", "/tips/1/bubble_count_rate", "bubble count rate F, trailing tip"},
+      {"fscc_velocity", "m/s", "/fscc/velocity", "FSCC velocity dx / lag"},
+      {"fscc_lag", "s", "/fscc/lag", "lag of the R12 peak"},
+      {"fscc_r12_max", "-", "/fscc/r12_max", "peak cross-correlation R12max"},
+      {"fscc_t05", "s", "/fscc/t05", "T05: R11 first at or below 0.5"},
+      {"fscc_tau05", "s", "/fscc/tau05", "tau05: half-width of R12 right of its peak"},
+      {"fscc_turbulence_intensity_chanson", "-", "/fscc/turbulence_intensity_chanson", "Chanson's Tu from T05 and tau05"},
+      {"sauter_diameter", "m", "/tips/0/sauter_diameter", "Sauter diameter d32 = 1.5 u c / F"},
+      {"fscc_reason", "", "/fscc/reason", "why FSCC has no velocity"},
+      {"awcc_velocity", "m/s", "/awcc/velocity", "AWCC mean interfacial velocity"},
+      {"awcc_velocity_rms", "m/s", "/awcc/velocity_rms", "AWCC velocity fluctuation u_rms"},
+      {"awcc_turbulence_intensity", "-", "/awcc/turbulence_intensity", "AWCC turbulence intensity Tu = u_rms / u"},
+      {"awcc_windows_accepted", "-", "/awcc/windows_accepted", "AWCC windows accepted"},
+      {"awcc_windows_total", "-", "/awcc/windows_total", "AWCC windows formed"},
+      {"awcc_reason", "", "/awcc/reason", "why AWCC has no figures"},
+      {"fscc_status", "", "/fscc/status", "FSCC status"},
+      {"awcc_status", "", "/awcc/status", "AWCC status"},
+      {"dx", "m", "/dx", "streamwise tip separation"},
+      {"dy", "m", "/dy", "lateral tip separation"},
+      {"np", "-", "/awcc/options/np", "particles per AWCC window"},
+      {"awcc_filter_a", "-", "/awcc/options/filter_a", "AWCC correlation/SPR filter A"},
+      {"awcc_roc", "", "/awcc/options/roc", "AWCC robust outlier cutoff"},
+      {"awcc_weighting", "", "/awcc/options/weighting", "AWCC window weighting"},
+      {"awcc_signal", "", "/awcc/options/signal", "signal AWCC correlated"},
+      {"awcc_subsample", "", "/awcc/options/subsample", "AWCC peak refinement"},
+      {"fs", "Hz", "/fs", "sampling rate"},
+      {"duration", "s", "/duration", "record duration"},
+      {"awcc_quality", "", "/awcc/quality", "AWCC quality level: ok, low or insufficient"},
+      {"awcc_quality_reason", "", "/awcc/quality_reason", "why the quality is not ok"},
+      {"void_fraction_ci95_lower", "-", "/tips/0/void_fraction_ci95/0", "void fraction, 95 % interval, lower"},
+      {"void_fraction_ci95_upper", "-", "/tips/0/void_fraction_ci95/1", "void fraction, 95 % interval, upper"},
+      {"bubble_count_rate_ci95_lower", "1/s", "/tips/0/bubble_count_rate_ci95/0", "bubble count rate, 95 % interval, lower"},
+      {"bubble_count_rate_ci95_upper", "1/s", "/tips/0/bubble_count_rate_ci95/1", "bubble count rate, 95 % interval, upper"},
+      {"awcc_velocity_ci95_lower", "m/s", "/awcc/velocity_ci95/0", "AWCC velocity, 95 % interval, lower"},
+      {"awcc_velocity_ci95_upper", "m/s", "/awcc/velocity_ci95/1", "AWCC velocity, 95 % interval, upper"},
+      {"awcc_velocity_rms_ci95_lower", "m/s", "/awcc/velocity_rms_ci95/0", "u_rms, 95 % interval, lower"},
+      {"awcc_velocity_rms_ci95_upper", "m/s", "/awcc/velocity_rms_ci95/1", "u_rms, 95 % interval, upper"},
+      {"awcc_turbulence_intensity_ci95_lower", "-", "/awcc/turbulence_intensity_ci95/0", "AWCC Tu, 95 % interval, lower"},
+      {"awcc_turbulence_intensity_ci95_upper", "-", "/awcc/turbulence_intensity_ci95/1", "AWCC Tu, 95 % interval, upper"},
+      {"chord_velocity_source", "", "/chord_velocity_source", "the velocity of the chord lengths and d32"},
+      {"pdp_version", "", "", "pdp version (the provenance's)"},
+      {"warnings", "", "/warnings", "what the reader accepted but you must know; FSCC's plausibility warnings"},
+      {"awcc_probe_corrected", "", "/awcc/probe_corrected", "bubble-probe interaction correction applied"},
+      {"awcc_velocity_measured", "m/s", "/awcc/velocity_measured", "AWCC velocity before the probe correction"},
+      {"awcc_velocity_rms_measured", "m/s", "/awcc/velocity_rms_measured", "u_rms before the probe correction"},
+      {"awcc_turbulence_intensity_measured", "-", "/awcc/turbulence_intensity_measured", "Tu before the probe correction"},
+      {"velocity_integral_time_scale", "s", "/velocity_spectrum/integral_time_scale", "integral time scale T_u of AWCC's velocity series"},
+      {"velocity_time_scale_ratio", "-", "/velocity_spectrum/time_scale_ratio", "T_u / T_W (below 2: AWCC's Tu underestimated)"},
+  };
+  return columns;
+}
+
 std::string profile_csv_header() {
-  return "file,position,void_fraction,bubble_count_rate,chord_time_mean,chord_time_median,threshold,"
-         "void_fraction_trailing,bubble_count_rate_trailing,fscc_velocity,fscc_lag,fscc_r12_max,fscc_t05,fscc_tau05,"
-         "fscc_turbulence_intensity_chanson,sauter_diameter,fscc_reason,awcc_velocity,awcc_velocity_rms,"
-         "awcc_turbulence_intensity,awcc_windows_accepted,awcc_windows_total,awcc_reason,fscc_status,awcc_status,dx,dy,"
-         "np,awcc_filter_a,awcc_roc,awcc_weighting,awcc_signal,awcc_subsample,fs,duration,awcc_quality,"
-         "awcc_quality_reason,void_fraction_ci95_lower,void_fraction_ci95_upper,bubble_count_rate_ci95_lower,"
-         "bubble_count_rate_ci95_upper,awcc_velocity_ci95_lower,awcc_velocity_ci95_upper,awcc_velocity_rms_ci95_lower,"
-         "awcc_velocity_rms_ci95_upper,awcc_turbulence_intensity_ci95_lower,awcc_turbulence_intensity_ci95_upper,"
-         "chord_velocity_source,pdp_version,warnings,awcc_probe_corrected,awcc_velocity_measured,"
-         "awcc_velocity_rms_measured,awcc_turbulence_intensity_measured,velocity_integral_time_scale,"
-         "velocity_time_scale_ratio";
+  std::string out;
+  for (const auto& c : profile_csv_columns()) out += (out.empty() ? "" : ",") + std::string(c.name);
+  return out;
 }
 
 std::string profile_csv_row(const ProcessResult& r, const std::optional<double>& position) {

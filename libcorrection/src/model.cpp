@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
@@ -381,13 +382,36 @@ CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
   return parse(bytes, path.string());
 }
 
+std::span<const awcc::ProfileColumn> correction_csv_columns() {
+  // Built once from the levels; the strings live as long as the program.
+  static const auto columns = [] {
+    static std::deque<std::string> text;
+    auto keep = [](std::string s) -> std::string_view { return text.emplace_back(std::move(s)); };
+    std::vector<awcc::ProfileColumn> out{
+        {"correction_in_range", "", "/correction/in_range", "1 when the row was corrected"},
+        {"correction_reason", "", "/correction/reason", "why the row was not corrected"}};
+    for (const char* q : {"velocity", "turbulence_intensity"}) {
+      const bool u = std::string_view(q) == "velocity";
+      const char* unit = u ? "m/s" : "-";
+      const char* what = u ? "velocity" : "turbulence intensity";
+      out.push_back({keep(fmt::format("corrected_{}", q)), unit, keep(fmt::format("/correction/{}/median", q)),
+                     keep(fmt::format("corrected {} (median of the truth given the measurement)", what))});
+      for (const char* l : correction_level_names) {
+        out.push_back({keep(fmt::format("corrected_{}_q{}", q, l)), unit,
+                       keep(fmt::format("/correction/{}/quantiles/{}", q, l)),
+                       keep(fmt::format("quantile {} of the true {}", l, what))});
+      }
+    }
+    out.push_back({"correction_status", "", "/correction/status", "corrected, or why not"});
+    return out;
+  }();
+  return columns;
+}
+
 std::string correction_csv_header() {
-  std::string out = "correction_in_range,correction_reason";
-  for (const char* q : {"velocity", "turbulence_intensity"}) {
-    out += fmt::format(",corrected_{}", q);
-    for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
-  }
-  return out + ",correction_status";
+  std::string out;
+  for (const auto& c : correction_csv_columns()) out += (out.empty() ? "" : ",") + std::string(c.name);
+  return out;
 }
 
 std::string correction_csv_cells(const Correction& c) {

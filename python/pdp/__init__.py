@@ -28,6 +28,7 @@ from ._errors import InputError, OptionError, OutputError, PdpError
 
 __version__ = _pdp.version
 __all__ = ["read", "binarise", "phase_statistics", "fscc", "awcc", "process", "synth", "correct", "options",
+           "profile_columns",
            "Result", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
 
 
@@ -98,6 +99,14 @@ def options(group=None):
     ("probe and methods", "input", "binarisation", "fscc", "awcc",
     "structure", "scene")."""
     return [Result(o) for o in _OPTIONS if group is None or o["group"] == group]
+
+
+def profile_columns():
+    """The profile CSV's columns, then the correction's: ``name``, ``unit``
+    ("" for text, "-" when dimensionless), ``pointer`` (RFC 6901: where the
+    same value is in a recording's result; "" for the version, which is in the
+    provenance) and ``meaning``, as the libraries declare them."""
+    return [Result(c) for c in _pdp.profile_columns()]
 
 
 _UNITS = {o["name"]: o["unit"] for o in _OPTIONS if o["group"] != "scene"}
@@ -223,7 +232,7 @@ def phase_statistics(lead, trail=None, fs=None, *, volts_per_count=None, **optio
     for a single 1-D signal)."""
     channels, recorded = _channels(lead, trail)
     single = len(channels) == 1
-    r, _ = _pdp.process_arrays(channels * 2 if single else channels, _rate(fs, recorded), volts_per_count,
+    r, _, _ = _pdp.process_arrays(channels * 2 if single else channels, _rate(fs, recorded), volts_per_count,
                                _settings({**options, "method": "none"}), "")
     tips = _wrap(r["tips"])
     return tips[:1] if single else tips
@@ -234,7 +243,7 @@ def fscc(lead, trail=None, fs=None, dx=None, *, volts_per_count=None, **options)
     ``fscc`` object of the process JSON (velocity, lag, r12_max, T05,
     correlation scales, status and reason). ``dx`` is the streamwise tip
     separation (m, or a string with its unit)."""
-    r, _ = _arrays(lead, trail, fs, volts_per_count, {**options, "dx": dx, "method": "fscc"})
+    r, _, _ = _arrays(lead, trail, fs, volts_per_count, {**options, "dx": dx, "method": "fscc"})
     return _wrap(r["fscc"])
 
 
@@ -244,7 +253,7 @@ def awcc(lead, trail=None, fs=None, dx=None, np=None, *, volts_per_count=None, *
     (velocity, turbulence intensity and their intervals, quality, status)
     with ``windows``, the per-window table as a dict of arrays (a pandas
     DataFrame when pandas is importable)."""
-    r, windows = _arrays(lead, trail, fs, volts_per_count, {**options, "dx": dx, "np": np, "method": "awcc"})
+    r, windows, _ = _arrays(lead, trail, fs, volts_per_count, {**options, "dx": dx, "np": np, "method": "awcc"})
     out = _wrap(r["awcc"])
     out.windows = _table(windows)
     return out
@@ -259,26 +268,29 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     file), a Recording, a 2-D array samples x channels, or the leading tip's
     array with ``trail`` the trailing tip's. ``correct`` names a correction
     model (.qrf) that adds each result's ``correction`` (bias-corrected
-    quantiles of u and Tu). The AWCC window table of a single recording is
-    ``result.windows``."""
+    quantiles of u and Tu). For a single recording, ``result.windows`` is the
+    AWCC window table, ``result.correlation`` R11 and R12 (``lag`` in s,
+    ``r11``, ``r12``; NaN outside a function's lags) and ``result.spectrum``
+    Welch's PSD of AWCC's velocity series (``frequency`` Hz, ``density``
+    (m/s)^2/Hz, ``resolvable_frequency``), or None."""
     settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
     if isinstance(source, (str, _os.PathLike)):
-        r, windows = _pdp.process_file(_os.fspath(source), settings, preset or "")
+        r, windows, detail = _pdp.process_file(_os.fspath(source), settings, preset or "")
         inputs = [_os.fspath(source)]
         out = r
     elif isinstance(source, (list, tuple)):
         paths = [_os.fspath(p) for p in source]
         if positions is not None and len(positions) != len(paths):
             raise OptionError(f"{len(positions)} positions for {len(paths)} files; give one per file")
-        rows, windows = [], None
+        rows, windows, detail = [], None, None
         for i, path in enumerate(paths):
-            row, _ = _pdp.process_file(path, settings, preset or "")
+            row, _, _ = _pdp.process_file(path, settings, preset or "")
             row["position"] = None if positions is None else float(positions[i])
             rows.append(row)
         inputs, out = paths, {"profile": rows}
     else:
-        out, windows = _arrays(source, trail, fs, volts_per_count, options, preset)
+        out, windows, detail = _arrays(source, trail, fs, volts_per_count, options, preset)
         inputs = []
     if correct is not None:
         out, warnings = _pdp.correct(_json.dumps(out), _os.fspath(correct), None, None, None)
@@ -288,6 +300,8 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     out["provenance"] = _pdp.provenance(inputs, settings, preset or "", call)
     result = _wrap(out)
     result.windows = _table(windows)
+    result.correlation = None if detail is None else detail["correlation"]
+    result.spectrum = None if detail is None else detail["spectrum"]
     return result
 
 

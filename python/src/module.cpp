@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -148,8 +149,48 @@ py::dict windows_of(const awcc::AwccResult& r) {
   return out;
 }
 
+py::array_t<double> array_of(const std::vector<double>& v) {
+  py::array_t<double> out(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), out.mutable_data());
+  return out;
+}
+
+// The functions behind the JSON's scales, as --correlation-functions and
+// --spectrum write them: R11 and R12 against the lag (s; NaN where a
+// function has no value) and Welch's PSD of AWCC's velocity series.
+py::dict detail_of(const awcc::ProcessResult& r) {
+  py::dict out;
+  out["correlation"] = py::none();
+  out["spectrum"] = py::none();
+  if (r.fscc && !(r.fscc->r11.empty() && r.fscc->r12.empty())) {
+    const auto& f = *r.fscc;
+    const auto n11 = static_cast<std::int64_t>(f.r11.size()), n12 = static_cast<std::int64_t>(f.r12.size());
+    const std::int64_t first = std::min(f.r11_first_lag, f.r12_first_lag);
+    const std::int64_t last = std::max(f.r11_first_lag + n11, f.r12_first_lag + n12) - 1;
+    std::vector<double> lag, r11, r12;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (std::int64_t k = first; k <= last; ++k) {
+      lag.push_back(static_cast<double>(k) / r.info.fs);
+      const std::int64_t j11 = k - f.r11_first_lag, j12 = k - f.r12_first_lag;
+      r11.push_back(j11 >= 0 && j11 < n11 ? f.r11[static_cast<std::size_t>(j11)] : nan);
+      r12.push_back(j12 >= 0 && j12 < n12 ? f.r12[static_cast<std::size_t>(j12)] : nan);
+    }
+    out["correlation"] = py::dict(py::arg("lag") = array_of(lag), py::arg("r11") = array_of(r11),
+                                  py::arg("r12") = array_of(r12));
+  }
+  if (r.spectrum && r.spectrum->status == awcc::SpectrumStatus::ok) {
+    const auto& v = *r.spectrum;
+    out["spectrum"] = py::dict(py::arg("frequency") = array_of(v.psd.frequency),
+                               py::arg("density") = array_of(v.psd.density),
+                               py::arg("resolvable_frequency") = v.resolvable_frequency);
+  }
+  return out;
+}
+
+// (JSON object, window table or None, detail arrays).
 py::tuple result_of(const awcc::ProcessResult& r) {
-  return py::make_tuple(python_of(awcc::to_json(r)), r.awcc ? py::object(windows_of(*r.awcc)) : py::none());
+  return py::make_tuple(python_of(awcc::to_json(r)), r.awcc ? py::object(windows_of(*r.awcc)) : py::none(),
+                        detail_of(r));
 }
 
 // --- the functions ---------------------------------------------------------
@@ -386,6 +427,19 @@ PYBIND11_MODULE(_pdp, m) {
     } catch (const awcc::OutputError& e) {
       translate("OutputError", e.what(), {});
     }
+  });
+  m.def("profile_columns", [] {
+    // The profile CSV's columns and then the correction's, as the libraries declare them.
+    py::list out;
+    auto add = [&](std::span<const awcc::ProfileColumn> columns) {
+      for (const auto& c : columns) {
+        out.append(py::dict(py::arg("name") = std::string(c.name), py::arg("unit") = std::string(c.unit),
+                            py::arg("pointer") = std::string(c.json_pointer), py::arg("meaning") = std::string(c.meaning)));
+      }
+    };
+    add(awcc::profile_csv_columns());
+    add(correction::correction_csv_columns());
+    return out;
   });
   m.def("options", &options);
   m.def("read", &read_recording, py::arg("path"), py::arg("settings"));

@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <fmt/format.h>
 #include <fstream>
 #include <random>
 
+#include "awcc/csv.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -237,6 +239,30 @@ TEST(Correction, JsonHasTheDocumentedKeys) {
     ASSERT_EQ(quantiles.size(), 7u);
     for (const char* key : {"0.025", "0.1", "0.25", "0.5", "0.75", "0.9", "0.975"}) ASSERT_TRUE(quantiles.contains(key)) << key;
     EXPECT_EQ(j[q]["median"], quantiles["0.5"]);
+  }
+}
+
+// The correction's profile CSV cells equal its JSON at each declared pointer
+// (the report's table reads the JSON through them), corrected or not.
+TEST(Correction, CsvCellsEqualTheJsonAtTheirPointers) {
+  const auto m = small_model();
+  auto outside = inside();
+  outside.void_fraction = 0.9;
+  for (const auto& c : {m.correct(inside()), m.correct(outside)}) {
+    const nlohmann::json row = {{"correction", correction::to_json(c)}};
+    const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
+    const auto columns = correction::correction_csv_columns();
+    ASSERT_EQ(cells.size(), columns.size());
+    EXPECT_EQ(awcc::split_cells(correction::correction_csv_header()).size(), columns.size());
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      const nlohmann::json::json_pointer p{std::string(columns[k].json_pointer)};
+      const auto value = row.contains(p) ? row.at(p) : nlohmann::json(nullptr);
+      std::string expected;
+      if (value.is_boolean()) expected = value.get<bool>() ? "1" : "0";
+      else if (value.is_number()) expected = fmt::format("{:.10g}", value.get<double>());
+      else if (value.is_string()) expected = value.get<std::string>();
+      EXPECT_EQ(cells[k], expected) << columns[k].name << " (" << c.message << ")";
+    }
   }
 }
 

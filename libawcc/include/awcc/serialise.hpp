@@ -42,8 +42,25 @@ std::span<const WindowColumn> awcc_window_columns();
 /// The per-window table of AWCC as CSV.
 std::string awcc_windows_csv(const AwccResult& result);
 
-/// Profile CSV: the header (no line break) and one row per recording at an
-/// optional position (m).
+/// A profile CSV column: its name, its unit ("" for text, "-" for a
+/// dimensionless number), where the same value is in the recording's JSON
+/// object (an RFC 6901 pointer; "" when it is not: the version lives in the
+/// provenance) and what it is. A JSON true/false is written on/off (1/0 for
+/// correction_in_range), a JSON list of warnings joined by "; ", a file by
+/// its name. The report's table reads these declarations; a test checks
+/// every cell of profile_csv_row against the JSON at its pointer.
+struct ProfileColumn {
+  std::string_view name;
+  std::string_view unit;
+  std::string_view json_pointer;
+  std::string_view meaning;
+};
+
+/// The columns of profile_csv_header, in order.
+std::span<const ProfileColumn> profile_csv_columns();
+
+/// Profile CSV: the header (no line break, from profile_csv_columns) and one
+/// row per recording at an optional position (m).
 std::string profile_csv_header();
 std::string profile_csv_row(const ProcessResult& result, const std::optional<double>& position);
 

@@ -41,9 +41,11 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "awcc/serialise.hpp"
 #include "correction/features.hpp"
 #include "correction/quantile_forest.hpp"
 
@@ -117,6 +119,8 @@ double from_target(TargetForm form, double target, double measured);
 /// correction_reason, corrected_velocity (median), corrected_velocity_q0.025 ..
 /// _q0.975, the same for turbulence_intensity, and correction_status.
 std::string correction_csv_header();
+/// The same columns declared as the profile CSV's (awcc::ProfileColumn).
+std::span<const awcc::ProfileColumn> correction_csv_columns();
 std::string correction_csv_cells(const Correction& c);
 
 /// {"status", "in_range", "reason", "velocity": {"measured", "median", "quantiles": {"0.025": ...}}, "turbulence_intensity": ...}
