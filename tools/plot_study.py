@@ -22,41 +22,37 @@ Every figure carries the command line that made it in its footer.
 """
 import csv
 import math
+import os
 import sys
 from collections import defaultdict
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-T975 = [0, 12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145,
-        2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045,
-        2.042]
+# One plotting layer: the style, palette, Student t and footer are pdp.plotting's
+# (python/pdp/plotting.py), imported as a plain file so no compiled module is needed.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python", "pdp"))
+import plotting  # noqa: E402
+from plotting import number, t975  # noqa: E402
 
 
-def t975(df):
-    return T975[df] if 0 < df <= 30 else 1.96 + 2.4 / max(df, 1)
-
-
-def number(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return None
+def subplots(rows=1, cols=1, figsize=(7, 4.5)):
+    fig, axes = plotting.figure(width=figsize[0], height=figsize[1], rows=rows, cols=cols)
+    if rows == 1 and cols == 1:
+        return fig, axes[0][0]
+    if rows == 1 or cols == 1:
+        return fig, [a for row in axes for a in row]
+    return fig, axes
 
 
 def footer(fig):
-    fig.text(0.01, 0.005, "made by: " + " ".join(["tools/plot_study.py"] + sys.argv[1:]), fontsize=6, color="grey")
+    plotting.footer(fig, "made by: " + " ".join(["tools/plot_study.py"] + sys.argv[1:]))
 
 
 def bench(path, out):
     rows = list(csv.DictReader(open(path)))
     if not rows:
         raise SystemExit(f"{path}: no rows")
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, axes = subplots(1, 2, figsize=(11, 4.5))
     methods = sorted({r["method"] for r in rows})
-    colours = dict(zip(methods, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+    colours = {m: plotting.PALETTE[i % len(plotting.PALETTE)] for i, m in enumerate(methods)}
     for ax, column, label in ((axes[0], "velocity_error", "|mean velocity error|"),
                               (axes[1], "turbulence_intensity_error", "|turbulence intensity error|")):
         for m in methods:
@@ -85,7 +81,7 @@ def sweep(path, parameter, out, title):
         raise SystemExit(f"{path}: no column '{parameter}'")
     series = {"AWCC mean velocity": "awcc_velocity_error", "FSCC mean velocity": "fscc_velocity_error",
               "AWCC turbulence intensity": "awcc_turbulence_intensity_error"}
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = subplots(figsize=(7, 4.5))
     for label, column in series.items():
         groups = defaultdict(list)
         for r in rows:
@@ -121,7 +117,7 @@ def windows(path, out):
         if a is not None and t and tu is not None:
             xs.append(tu)
             ys.append(a / t)
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = subplots(figsize=(7, 4.5))
     ax.scatter(xs, ys, s=10)
     ax.set_xlabel("true turbulence intensity")
     ax.set_ylabel("fraction of AWCC windows accepted")
@@ -135,7 +131,7 @@ def correction(path, out):
     rows = [r for r in csv.DictReader(open(path)) if r["in_range"] == "1"]
     if not rows:
         raise SystemExit(f"{path}: no corrected rows")
-    fig, axes = plt.subplots(2, 2, figsize=(11, 9))
+    fig, axes = subplots(2, 2, figsize=(11, 9))
     for col, (q, label) in enumerate((("velocity", "velocity"), ("turbulence_intensity", "turbulence intensity"))):
         truth = [float(r["true_" + q]) for r in rows]
         raw = [float(r[q]) for r in rows]
@@ -180,7 +176,7 @@ def learning(path, out):
     if not rows:
         raise SystemExit(f"{path}: no points (too few training runs)")
     n = [int(r["training_runs"]) for r in rows]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axes = subplots(1, 2, figsize=(11, 4.2))
     for ax, (key, label) in zip(axes, (("velocity", "velocity (relative)"), ("tu", "turbulence intensity"))):
         ax.plot(n, [float(r[f"{key}_pinball"]) for r in rows], "o-", label="pinball loss (quantiles)")
         ax.plot(n, [float(r[f"{key}_rmse_corrected"]) for r in rows], "s-", label="RMSE of the median")

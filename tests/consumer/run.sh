@@ -12,3 +12,12 @@ test -f "$scratch/prefix/include/awcc/version.hpp"
 "$scratch/build/consumer" "$scratch"
 test ! -e "$scratch/prefix/include/awcc/detail" || { echo "detail headers were installed"; exit 1; }
 "$scratch/prefix/bin/pdp" --version
+# pdp report finds the installed Python module beside the installed pdp
+# (not in a sanitizer build, whose module the interpreter cannot load).
+if [[ -z "$flags" ]] && find "$scratch/prefix" -path '*/pdp/report.py' | grep -q .; then
+  "$scratch/prefix/bin/pdp" --log-level error synth -o "$scratch/scene.flac" --duration 2s --fs 50kHz -q
+  "$scratch/prefix/bin/pdp" --log-level error process "$scratch/scene.flac" --dx 5mm --json "$scratch/scene.json" \
+    >/dev/null
+  (cd "$scratch" && env -u PYTHONPATH "$scratch/prefix/bin/pdp" report scene.json -o scene.html 2>/dev/null)
+  grep -q 'data-figure="velocity"' "$scratch/scene.html"
+fi

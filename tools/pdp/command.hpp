@@ -20,6 +20,7 @@ enum ExitCode : int {
   exit_bad_usage = 2,     ///< bad options or arguments, including a missing or unreadable config file
   exit_output_failed = 3, ///< an output could not be written
   exit_internal = 4,      ///< a defect of pdp: please report it
+  exit_missing_helper = 5,  ///< a program or package pdp runs is missing (pdp report: Python, matplotlib, Jinja2)
 };
 
 struct Command {

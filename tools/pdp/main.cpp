@@ -12,6 +12,7 @@
 #include "command.hpp"
 #include "compare_command.hpp"
 #include "correct_command.hpp"
+#include "report_command.hpp"
 #include "process_command.hpp"
 #include "sweep_command.hpp"
 #include "synth_command.hpp"
@@ -41,7 +42,7 @@ int main(int argc, char** argv) {
     pdp::Command command;
     std::function<int()> run;
   };
-  std::vector<Entry> commands(8);
+  std::vector<Entry> commands(9);
   pdp::SynthOptions synth_options;
   pdp::setup_synth(app, commands[0].command, synth_options);
   commands[0].run = [&] { return pdp::run_synth(synth_options); };
@@ -66,6 +67,9 @@ int main(int argc, char** argv) {
   pdp::CorrectOptions correct_options;
   pdp::setup_correct(app, commands[7].command, correct_options);
   commands[7].run = [&] { return pdp::run_correct(correct_options); };
+  pdp::ReportOptions report_options;
+  pdp::setup_report(app, commands[8].command, report_options);
+  commands[8].run = [&] { return pdp::run_report(report_options); };
 
   try {
     app.parse(argc, argv);

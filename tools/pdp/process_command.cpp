@@ -3,6 +3,12 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 
@@ -15,6 +21,7 @@
 #include "awcc/units.hpp"
 #include "correction/model.hpp"
 #include "hints.hpp"
+#include "report_command.hpp"
 #include "synth/sidecar.hpp"
 #include "terminal.hpp"
 
@@ -49,6 +56,10 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
       ->group(out);
   cmd->add_option("--correlation-functions", o.correlation_functions,
                   "FSCC's auto- and cross-correlation functions as CSV: file, lag_s, r11, r12")
+      ->group(out);
+  cmd->add_option("--report", o.report,
+                  "also write the HTML report of the results (pdp report: figures, table, provenance; needs "
+                  "python3-matplotlib and python3-jinja2)")
       ->group(out);
   cmd->add_option("--positions", o.positions, "profile positions, one per file: '2mm,8mm,...'")->group(out);
   cmd->add_option("--manifest", o.manifest, "profile manifest CSV with columns file,position")
@@ -146,6 +157,24 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
   return out;
 }
 
+// The report is drawn from the JSON: the --json file, or the same text in a
+// hidden scratch file beside the report, removed afterwards.
+int report_of(const ProcessCommandOptions& o, const std::string& json_text) {
+  if (!o.json.empty()) return write_report(o.json, o.report, true);
+  const auto folder = std::filesystem::absolute(o.report).parent_path();
+  std::string scratch = (folder / ".pdp-report-XXXXXX.json").string();
+  const int fd = mkstemps(scratch.data(), 5);
+  if (fd < 0) throw awcc::OutputError(fmt::format("{}: cannot create a scratch file for the report's JSON: {}",
+                                                  folder.string(), std::strerror(errno)));
+  ::close(fd);
+  struct Remove {
+    std::string path;
+    ~Remove() { std::error_code ec; std::filesystem::remove(path, ec); }
+  } remove{scratch};
+  awcc::write_text_atomically(scratch, json_text);
+  return write_report(scratch, o.report, true);
+}
+
 std::string correction_report(const correction::Correction& c) {
   if (!c.corrected()) return fmt::format("  correction: not corrected: {}\n", c.message);
   const auto& u = *c.velocity;
@@ -175,7 +204,7 @@ int run_process(ProcessCommandOptions& o) {
                                   "on synthetic records without bubble-probe interaction; use one of them");
     }
     // Inputs are never modified: refuse an output that is one of them.
-    for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum}) {
+    for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum, o.report}) {
       if (output.empty() || !std::filesystem::exists(output)) continue;
       for (const auto& input : o.files) {
         if (std::filesystem::equivalent(output, input)) {
@@ -262,8 +291,8 @@ int run_process(ProcessCommandOptions& o) {
     // Every output is rendered and its folder checked before any is written:
     // a run fails whole or writes all.
     std::vector<std::pair<std::string, std::string>> outputs;
-    std::string stdout_text;
-    if (!o.json.empty()) {
+    std::string stdout_text, json_for_report;
+    if (!o.json.empty() || !o.report.empty()) {
       nlohmann::json j;
       if (results.size() == 1 && o.files.size() == 1) {
         j = awcc::to_json(results[0]);
@@ -280,7 +309,8 @@ int run_process(ProcessCommandOptions& o) {
       }
       // Hashing the inputs costs a read of each: only for the JSON, which records it.
       j["provenance"] = awcc::provenance_json(options, inputs, command_line());
-      outputs.emplace_back(o.json, awcc::json_text(j));
+      if (!o.json.empty()) outputs.emplace_back(o.json, awcc::json_text(j));
+      else json_for_report = awcc::json_text(j);
     }
     if (!o.windows.empty() && results[0].awcc) outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
     std::vector<const awcc::ProcessResult*> all;
@@ -310,8 +340,11 @@ int run_process(ProcessCommandOptions& o) {
       else outputs.emplace_back(o.csv, table);
     }
     for (const auto& [path, text] : outputs) awcc::check_output_folder(path);
+    if (!o.report.empty()) awcc::check_output_folder(o.report);
     for (const auto& [path, text] : outputs) awcc::write_text_atomically(path, text);
     fmt::print("{}", stdout_text);
+    std::fflush(stdout);
+    if (!o.report.empty()) return report_of(o, json_for_report);
   } catch (const std::exception& e) {
     return report_error(e);
   }

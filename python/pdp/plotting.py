@@ -1,0 +1,491 @@
+"""pdp's one plotting layer (matplotlib): the style every figure shares, the
+profile report's figures (pdp.report) and the study figures
+(tools/plot_study.py).
+
+Pure Python over matplotlib and NumPy: it does not need the compiled core,
+so tools/plot_study.py imports this file on its own. Figures take the JSON
+objects of docs/output.md (a recording's result, its ``structure``, ...) and
+return matplotlib Figures; ``svg`` turns one into inline SVG text.
+
+Conventions, for print and for colour-blind readers: the Okabe-Ito palette,
+each series also told apart by marker or line style; positions in mm on the
+vertical axis (a profile is read bottom to top); times in ms; velocities in
+m/s; never metres in scientific notation.
+"""
+
+import io
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+from matplotlib.figure import Figure  # noqa: E402
+
+# Okabe & Ito (2008): distinguishable with every common colour-vision deficiency.
+BLACK, ORANGE, SKY, GREEN, YELLOW, BLUE, VERMILION, PURPLE, GREY = (
+    "#000000", "#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#D55E00", "#CC79A7", "#999999")
+PALETTE = [BLUE, ORANGE, GREEN, VERMILION, PURPLE, SKY, YELLOW, BLACK]
+QUALITY_STYLE = {"ok": (GREEN, "o"), "low": (ORANGE, "s"), "insufficient": (VERMILION, "X"), None: (GREY, "_")}
+
+STYLE = {
+    "font.size": 9, "axes.titlesize": 9.5, "axes.labelsize": 9, "legend.fontsize": 7.5, "xtick.labelsize": 8,
+    "ytick.labelsize": 8, "axes.grid": True, "grid.alpha": 0.3, "lines.linewidth": 1.3, "lines.markersize": 5,
+    "axes.prop_cycle": matplotlib.cycler(color=PALETTE), "svg.fonttype": "none", "axes.formatter.useoffset": False,
+    "axes.formatter.limits": (-4, 5), "figure.dpi": 100,
+    # A fixed title height: matplotlib otherwise lays out every tick label again to place each title.
+    "axes.titley": 1.0,
+}
+matplotlib.rcParams.update(STYLE)
+
+# Student t 97.5 % quantiles for 1..30 degrees of freedom.
+T975 = [0, 12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145,
+        2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045,
+        2.042]
+
+
+def t975(df):
+    return T975[df] if 0 < df <= 30 else 1.96 + 2.4 / max(df, 1)
+
+
+def number(value):
+    """A finite float, or None (CSV text, JSON null, NaN)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def _gaps(values):
+    """Values for a line: null and NaN become gaps."""
+    return [math.nan if number(v) is None else float(v) for v in values]
+
+
+def figure(width=4.6, height=3.4, rows=1, cols=1, margins=None):
+    """A figure of rows x cols axes. ``margins`` (left, bottom, right, top, in
+    inches) fix the layout: much faster than tight_layout or a tight bounding
+    box, which lay every tick label out again (most of a report's time)."""
+    fig = Figure(figsize=(width, height))
+    axes = fig.subplots(rows, cols, squeeze=False)
+    if margins:
+        left, bottom, right, top = margins
+        fig.subplots_adjust(left=left / width, bottom=bottom / height, right=1 - right / width, top=1 - top / height,
+                            wspace=0.3, hspace=0.5)
+    return fig, axes
+
+
+PROFILE_MARGINS = (0.62, 0.5, 0.12, 0.28)
+
+
+def footer(fig, text):
+    fig.text(0.01, 0.003, text, fontsize=6, color=GREY)
+
+
+def svg(fig, salt="pdp"):
+    """The figure as inline SVG text (no XML prologue). ``salt`` seeds the SVG's
+    element ids: the same figure gives the same text, and figures with
+    different salts can share one HTML page without clashing ids."""
+    buf = io.StringIO()
+    with matplotlib.rc_context({"svg.hashsalt": salt}):
+        fig.savefig(buf, format="svg", metadata={"Date": None})
+    text = buf.getvalue()
+    return text[text.index("<svg"):]
+
+
+def note(ax, text):
+    """A panel that has nothing to plot says why."""
+    ax.set_axis_off()
+    ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True, fontsize=8, color=BLACK, transform=ax.transAxes)
+
+
+def get(obj, *path):
+    for key in path:
+        if obj is None:
+            return None
+        if isinstance(key, int):
+            obj = obj[key] if isinstance(obj, list) and len(obj) > key else None
+        else:
+            obj = obj.get(key) if isinstance(obj, dict) else None
+    return obj
+
+
+# --- profile figures: one value per row against position ---------------------
+
+
+def positions_mm(rows):
+    """Each row's position in mm (its index when the profile has none)."""
+    have = all(number(r.get("position")) is not None for r in rows)
+    if have:
+        return [1e3 * float(r["position"]) for r in rows], "position (mm)"
+    return list(range(1, len(rows) + 1)), "row (no positions given)"
+
+
+def _series(ax, y, rows, value, interval=None, scale=1.0, **style):
+    """Points with horizontal error bars; rows without a value are left out."""
+    xs, ys, lo, hi = [], [], [], []
+    for yi, r in zip(y, rows):
+        v = number(value(r))
+        if v is None:
+            continue
+        xs.append(v * scale)
+        ys.append(yi)
+        if interval:
+            a, b = (number(x) for x in (interval(r) or (None, None)))
+            lo.append(max(0.0, v * scale - a * scale) if a is not None else 0.0)
+            hi.append(max(0.0, b * scale - v * scale) if b is not None else 0.0)
+    if xs:
+        ax.errorbar(xs, ys, xerr=[lo, hi] if interval else None, capsize=2.5, **style)
+    return len(xs)
+
+
+def _finish(ax, ylabel, xlabel, title):
+    ax.set_ylabel(ylabel)
+    ax.set_xlabel(xlabel)
+    ax.set_title(title)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best")
+
+
+def profile_void_fraction(rows):
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    _series(ax, y, rows, lambda r: get(r, "tips", 0, "void_fraction"), lambda r: get(r, "tips", 0, "void_fraction_ci95"),
+            color=BLUE, marker="o", ls="-", label="leading tip, 95 % interval")
+    _series(ax, y, rows, lambda r: get(r, "tips", 1, "void_fraction"), lambda r: get(r, "tips", 1, "void_fraction_ci95"),
+            color=ORANGE, marker="s", ls="--", label="trailing tip, 95 % interval")
+    ax.set_xlim(left=0)
+    _finish(ax, ylabel, "void fraction c (-)", "Void fraction")
+    return fig
+
+
+def profile_count_rate(rows):
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    _series(ax, y, rows, lambda r: get(r, "tips", 0, "bubble_count_rate"),
+            lambda r: get(r, "tips", 0, "bubble_count_rate_ci95"), color=BLUE, marker="o", ls="-",
+            label="leading tip, 95 % interval")
+    _series(ax, y, rows, lambda r: get(r, "tips", 1, "bubble_count_rate"),
+            lambda r: get(r, "tips", 1, "bubble_count_rate_ci95"), color=ORANGE, marker="s", ls="--",
+            label="trailing tip, 95 % interval")
+    ax.set_xlim(left=0)
+    _finish(ax, ylabel, "bubble count rate F (1/s)", "Bubble count rate")
+    return fig
+
+
+def _quantiles(r, q, a, b):
+    qs = get(r, "correction", q, "quantiles")
+    return (qs.get(a), qs.get(b)) if qs else None
+
+
+def profile_velocity(rows):
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    _series(ax, y, rows, lambda r: get(r, "fscc", "velocity"), color=BLACK, marker="D", ls=":", mfc="none",
+            label="FSCC")
+    _series(ax, y, rows, lambda r: get(r, "awcc", "velocity"), lambda r: get(r, "awcc", "velocity_ci95"),
+            color=BLUE, marker="o", ls="-", label="AWCC, 95 % interval")
+    corrected = lambda r: get(r, "correction", "velocity", "median")  # noqa: E731
+    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "velocity", "0.025", "0.975"), color=VERMILION,
+            marker=None, ls="none", elinewidth=1.0, label="corrected, 95 % band")
+    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "velocity", "0.1", "0.9"), color=VERMILION, marker="^",
+            ls="none", elinewidth=3.0, label="corrected median, 80 % band")
+    _finish(ax, ylabel, "mean interfacial velocity (m/s)", "Velocity")
+    return fig
+
+
+def profile_turbulence(rows):
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    _series(ax, y, rows, lambda r: get(r, "awcc", "turbulence_intensity"),
+            lambda r: get(r, "awcc", "turbulence_intensity_ci95"), color=BLUE, marker="o", ls="-",
+            label="AWCC measured, 95 % interval")
+    corrected = lambda r: get(r, "correction", "turbulence_intensity", "median")  # noqa: E731
+    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "turbulence_intensity", "0.025", "0.975"),
+            color=VERMILION, marker=None, ls="none", elinewidth=1.0, label="corrected, 95 % band")
+    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "turbulence_intensity", "0.1", "0.9"), color=VERMILION,
+            marker="^", ls="none", elinewidth=3.0, label="corrected median, 80 % band")
+    ax.set_xlim(left=0)
+    _finish(ax, ylabel, "turbulence intensity Tu (-)", "Turbulence intensity (AWCC)")
+    return fig
+
+
+def profile_chanson(rows):
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    _series(ax, y, rows, lambda r: get(r, "fscc", "turbulence_intensity_chanson"), color=BLACK, marker="D",
+            ls=":", mfc="none", label="0.851 sqrt(tau05^2 - T05^2) / lag")
+    ax.set_xlim(left=0)
+    _finish(ax, ylabel, "Tu from FSCC (-); not comparable to AWCC's", "Chanson's turbulence intensity")
+    return fig
+
+
+def profile_sauter(rows):
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    _series(ax, y, rows, lambda r: get(r, "tips", 0, "sauter_diameter"), scale=1e3, color=GREEN, marker="o",
+            ls="-", label="d32 = 1.5 u c / F")
+    ax.set_xlim(left=0)
+    _finish(ax, ylabel, "Sauter diameter d32 (mm)", "Sauter diameter")
+    return fig
+
+
+def profile_yield(rows):
+    """Accepted / total AWCC windows, each row marked with its quality level."""
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    y, ylabel = positions_mm(rows)
+    seen = set()
+    for yi, r in zip(y, rows):
+        quality = get(r, "awcc", "quality")
+        colour, marker = QUALITY_STYLE.get(quality, QUALITY_STYLE[None])
+        total, accepted = get(r, "awcc", "windows_total"), get(r, "awcc", "windows_accepted")
+        value = accepted / total if total else 0.0
+        label = quality or "AWCC not run"
+        ax.plot([value], [yi], marker=marker, color=colour, ls="none", markersize=7,
+                label=None if label in seen else label)
+        seen.add(label)
+        ax.annotate(f"{accepted}/{total}" if total is not None else "not run", (value, yi), fontsize=7,
+                    va="center", textcoords="offset points", xytext=(6, 0))
+    ax.set_xlim(0, 1.15)
+    _finish(ax, ylabel, "AWCC data yield: accepted / total windows (-)", "Data yield and quality level")
+    return fig
+
+
+PROFILE_FIGURES = [
+    ("void-fraction", "Void fraction", profile_void_fraction),
+    ("count-rate", "Bubble count rate", profile_count_rate),
+    ("velocity", "Velocity", profile_velocity),
+    ("turbulence", "Turbulence intensity", profile_turbulence),
+    ("chanson", "Chanson's FSCC turbulence intensity", profile_chanson),
+    ("sauter", "Sauter diameter", profile_sauter),
+    ("yield", "Data yield and quality", profile_yield),
+]
+
+
+# --- per-position figures --------------------------------------------------------
+
+
+def _steps(ax, edges_lower, width, fractions, scale, **style):
+    """A PDF as steps over bins (lower, lower + width]; the last (overflow) bin drawn one width wide."""
+    xs = [scale * e for e in edges_lower] + [scale * (edges_lower[-1] + width)]
+    ax.stairs([number(f) or 0.0 for f in fractions], xs, **style)  # null: a phase without chords
+
+
+def chord_pdf(ax, pdf, basis):
+    if not pdf or not any(number(f) for f in pdf["air_fraction"] + pdf["water_fraction"]):
+        note(ax, "no chord lengths: no velocity to convert chord times" if basis == "length" and not pdf
+             else "no chords")
+        return
+    scale, unit = (1e3, "ms") if basis == "time" else (1e3, "mm")
+    edges, width = pdf["lower_edges"], pdf["bin_width"]
+    _steps(ax, edges, width, pdf["air_fraction"], scale, color=BLUE, lw=1.4, label="air chords")
+    _steps(ax, edges, width, pdf["water_fraction"], scale, color=ORANGE, lw=1.2, ls="--", label="water chords")
+    ax.set_xlabel(f"chord {basis} ({unit}); last bin: above {scale * pdf['max']:g} {unit}")
+    ax.set_ylabel("fraction of chords (-)")
+    ax.set_title(f"Chord-{basis} PDF")
+    ax.legend()
+
+
+def voltage_pdf(ax, structure, tips):
+    pdfs = get(structure, "voltage_pdf") or {}
+    if not pdfs.get("leading"):
+        note(ax, "binary input: no voltage PDF")
+        return
+    for name, colour, ls, tip in (("leading", BLUE, "-", tips[0]), ("trailing", ORANGE, "--", tips[1])):
+        p = pdfs.get(name)
+        if not p:
+            continue
+        lower = [u - (p["upper"][1] - p["lower"][1]) if lo is None else lo for lo, u in zip(p["lower"], p["upper"])]
+        ax.stairs(p["fraction"], lower + [p["upper"][-1]], color=colour, ls=ls, label=f"{name} tip")
+        ax.axvline(tip["threshold"], color=colour, ls=":", lw=1.2)
+        for level, marker in ((tip.get("air_level"), "v"), (tip.get("water_level"), "^")):
+            if number(level) is not None:  # at the axis' foot: a log axis has no 0
+                ax.plot([level], [0.04], marker=marker, color=colour, ls="none", ms=7,
+                        transform=ax.get_xaxis_transform())
+    ax.set_yscale("log")
+    ax.minorticks_off()  # a third of the panel's drawing time, for no reading
+    ax.plot([], [], color=GREY, ls=":", label="threshold")
+    ax.plot([], [], color=GREY, marker="v", ls="none", label="air mode")
+    ax.plot([], [], color=GREY, marker="^", ls="none", label="water mode")
+    ax.set_xlabel("voltage (V)")
+    ax.set_ylabel("fraction of samples (-)")
+    ax.set_title("Voltage PDF")
+    ax.legend()
+
+
+def correlation(ax, functions, fscc):
+    if functions is None:
+        note(ax, "correlation functions not available")
+        return
+    lag = [1e3 * t for t in functions["lag"]]
+    ax.plot(lag, functions["r11"], color=BLUE, label="R11 (leading tip)")
+    ax.plot(lag, functions["r12"], color=ORANGE, ls="--", label="R12 (cross)")
+    if fscc and number(fscc.get("lag")) is not None and number(fscc.get("r12_max")) is not None:
+        ax.plot([1e3 * fscc["lag"]], [fscc["r12_max"]], marker="o", color=VERMILION, ls="none",
+                label=f"peak: {1e3 * fscc['lag']:.3g} ms, {fscc['r12_max']:.3g}")
+        if number(fscc.get("t_half")) is not None:
+            ax.annotate("", xy=(1e3 * fscc["t_half"], fscc["r12_max"] / 2), xytext=(1e3 * fscc["lag"], fscc["r12_max"] / 2),
+                        arrowprops=dict(arrowstyle="<->", color=VERMILION, lw=1))
+            ax.plot([], [], color=VERMILION, lw=1, label=f"tau05 = {1e3 * fscc['tau05']:.3g} ms")
+    if fscc and number(fscc.get("t05")) is not None:
+        ax.annotate("", xy=(1e3 * fscc["t05"], 0.5), xytext=(0, 0.5), arrowprops=dict(arrowstyle="<->", color=GREEN, lw=1))
+        ax.plot([], [], color=GREEN, lw=1, label=f"T05 = {1e3 * fscc['t05']:.3g} ms")
+    ax.axhline(0, color=BLACK, lw=0.6)
+    ax.set_xlim(min(lag[0], 0), lag[-1])
+    ax.set_xlabel("lag (ms)")
+    ax.set_ylabel("correlation (-)")
+    ax.set_title("Auto- and cross-correlation")
+    ax.legend()
+
+
+def window_series(ax, windows, awcc):
+    if windows is None or not len(windows["velocity"]):
+        note(ax, "no AWCC windows" if awcc else "AWCC not run")
+        return
+    t, v, fate = windows["start_time"], windows["velocity"], windows["fate"]
+    acc = [i for i in range(len(v)) if fate[i] == "accepted"]
+    rej = [i for i in range(len(v)) if fate[i] != "accepted" and v[i] > 0]
+    ax.plot([t[i] for i in rej], [v[i] for i in rej], ls="none", marker="x", color=GREY, ms=3.5,
+            label=f"rejected ({len(v) - len(acc)}; {len(rej)} with a velocity)", rasterized=len(rej) > 2000)
+    ax.plot([t[i] for i in acc], [v[i] for i in acc], ls="none", marker="o", color=BLUE, ms=3,
+            label=f"accepted ({len(acc)})", rasterized=len(acc) > 2000)
+    if awcc and number(awcc.get("velocity")) is not None:
+        ax.axhline(awcc["velocity"], color=VERMILION, lw=1.2, label=f"mean {awcc['velocity']:.3g} m/s")
+    if acc:
+        hi = max(v[i] for i in acc)
+        ax.set_ylim(0, 2.0 * hi)
+    ax.set_xlabel("window start (s)")
+    ax.set_ylabel("window velocity (m/s)")
+    ax.set_title("AWCC window velocities")
+    ax.legend()
+
+
+def window_histogram(ax, windows, awcc):
+    if windows is None or not len(windows["velocity"]):
+        note(ax, "no AWCC windows" if awcc else "AWCC not run")
+        return
+    v, fate = windows["velocity"], windows["fate"]
+    acc = [v[i] for i in range(len(v)) if fate[i] == "accepted"]
+    if not acc:
+        note(ax, "no accepted window")
+        return
+    lo, hi = min(acc), max(acc)
+    rej = [v[i] for i in range(len(v)) if fate[i] != "accepted" and 0 < v[i] <= 2 * hi]
+    bins = max(8, min(40, int(math.sqrt(len(acc)) * 2)))
+    edges = [lo + (2 * hi - lo) * k / bins for k in range(bins + 1)] if hi > lo else bins
+    ax.hist([acc, rej], bins=edges, stacked=True, color=[BLUE, GREY], label=["accepted", "rejected"])
+    ax.set_xlabel("window velocity (m/s)")
+    ax.set_ylabel("windows")
+    ax.set_title("Window velocity histogram")
+    ax.legend()
+
+
+def cluster_sizes(ax, clusters):
+    if not clusters or clusters.get("status") != "ok":
+        note(ax, "cluster sizes: " + ((clusters or {}).get("reason") or "not computed"))
+        return
+    sizes = list(range(2, 21)) + [21]
+    width = 0.27
+    largest = 2
+    for k, (name, colour) in enumerate((("median", BLUE), ("constant", ORANGE), ("near_wake", GREEN))):
+        c = clusters["criteria"][name]
+        label = f"{name.replace('_', '-')}: {c['n_clusters']} clusters"
+        if not c["n_clusters"]:  # its PDF is 0/0
+            ax.bar([], [], color=colour, label=label, hatch=["", "//", ".."][k])
+            continue
+        ax.bar([s + (k - 1) * width for s in sizes], c["size_pdf"], width=width, color=colour, label=label,
+               hatch=["", "//", ".."][k])
+        largest = max([largest] + [s for s, f in zip(sizes, c["size_pdf"]) if f])
+    ax.set_xlim(1.4, max(largest, 6) + 0.6)
+    ticks = [t for t in (2, 3, 4, 5, 6, 8, 10, 12, 15, 18, 21) if t <= max(largest, 6)]
+    ax.set_xticks(ticks, [">20" if t == 21 else str(t) for t in ticks])
+    ax.set_xlabel(f"particles per cluster ({clusters['basis']} criteria)")
+    ax.set_ylabel("fraction of clusters (-)")
+    ax.set_title("Cluster sizes")
+    ax.legend()
+
+
+def arrival_pdf(ax, arrivals):
+    if not arrivals or arrivals.get("status") != "ok":
+        note(ax, "arrival times: " + ((arrivals or {}).get("reason") or "not computed"))
+        return
+    w = arrivals["bin_width"]
+    unit = "mm" if arrivals.get("basis") == "length" else "ms"
+    shown = 0
+    for k, cls in enumerate(arrivals["classes"]):
+        if not cls.get("pdf") or not cls.get("intervals"):
+            continue
+        n = min(30, len(cls["pdf"]) - 1)  # the first 30 bins; the last is the overflow
+        x = [1e3 * w * (i + 0.5) for i in range(n)]
+        colour = PALETTE[k % len(PALETTE)]
+        lo, hi = cls.get("lower"), cls.get("upper")
+        name = (f"{'' if lo is None else f'{1e3 * lo:g}-'}{'' if hi is None else f'{1e3 * hi:g}'} {unit}"
+                if lo is not None or hi is not None else "all")
+        if lo is None and hi is not None:
+            name = f"<= {1e3 * hi:g} {unit}"
+        elif hi is None and lo is not None:
+            name = f"> {1e3 * lo:g} {unit}"
+        ax.plot(x, _gaps(cls["pdf"][:n]), color=colour, marker="o", ms=2.5, label=f"{name} (N={cls['particles']})")
+        ax.plot(x, _gaps(cls["reference"][:n]), color=colour, ls=":", lw=1.0)
+        shown += 1
+    if not shown:
+        note(ax, "no class has intervals")
+        return
+    ax.plot([], [], color=GREY, ls=":", label="Poisson reference")
+    ax.set_xlabel("inter-particle arrival time (ms)")
+    ax.set_ylabel("fraction of intervals (-)")
+    ax.set_title("Inter-particle arrival times")
+    ax.legend(fontsize=6.5)
+
+
+def velocity_spectrum(ax, spectrum, series):
+    if spectrum is None:
+        note(ax, "velocity spectrum: " + ((series or {}).get("reason") or "not available"))
+        return
+    f = [x for x in spectrum["frequency"] if x > 0]
+    p = [d for x, d in zip(spectrum["frequency"], spectrum["density"]) if x > 0]
+    if not f:
+        note(ax, "velocity spectrum: no frequency above 0")
+        return
+    ax.loglog(f, p, color=BLUE, label="Welch PSD of AWCC's series")
+    # A -5/3 line through the PSD's middle, for the inertial subrange.
+    mid = len(f) // 2
+    ref = [p[mid] * (x / f[mid]) ** (-5.0 / 3.0) for x in f]
+    ax.loglog(f, ref, color=BLACK, ls="--", lw=1.0, label="-5/3")
+    fr = spectrum.get("resolvable_frequency")
+    if number(fr) is not None:
+        ax.axvline(fr, color=VERMILION, ls=":", label=f"1/(2 T_W) = {fr:.3g} Hz")
+    ax.minorticks_off()
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("PSD ((m/s)^2/Hz)")
+    ax.set_title("Velocity spectrum")
+    ax.legend()
+
+
+def position_figure(row, detail, gid_prefix=""):
+    """Every per-position panel of one recording in one figure (3 x 3); each
+    panel's SVG group is named gid_prefix + its POSITION_PANELS key."""
+    fig, axes = figure(width=13.5, height=10.5, rows=3, cols=3, margins=(0.62, 0.5, 0.12, 0.3))
+    s = row.get("structure") or {}
+    chord_pdf(axes[0][0], s.get("chord_time_pdf"), "time")
+    chord_pdf(axes[0][1], s.get("chord_length_pdf"), "length")
+    voltage_pdf(axes[0][2], s, row["tips"])
+    correlation(axes[1][0], detail.get("correlation"), row.get("fscc"))
+    window_series(axes[1][1], detail.get("windows"), row.get("awcc"))
+    window_histogram(axes[1][2], detail.get("windows"), row.get("awcc"))
+    clusters = get(s, "clusters", "length")
+    if not clusters or clusters.get("status") != "ok":
+        clusters = get(s, "clusters", "time") or clusters
+    cluster_sizes(axes[2][0], clusters)
+    arrival_pdf(axes[2][1], get(s, "arrivals", "time"))
+    velocity_spectrum(axes[2][2], detail.get("spectrum"), row.get("velocity_spectrum"))
+    for ax, (key, _) in zip((a for r in axes for a in r), POSITION_PANELS):
+        ax.set_gid(gid_prefix + key)
+    return fig
+
+
+# (SVG group key, title) of each per-position panel, in reading order.
+POSITION_PANELS = [("chord-time-pdf", "chord-time PDF"), ("chord-length-pdf", "chord-length PDF"),
+                   ("voltage-pdf", "voltage PDF"), ("correlation", "R11 and R12"),
+                   ("window-velocities", "AWCC window velocities"), ("window-histogram", "window velocity histogram"),
+                   ("cluster-sizes", "cluster sizes"), ("arrival-pdf", "arrival-time PDF"),
+                   ("velocity-spectrum", "velocity spectrum")]

@@ -1,0 +1,384 @@
+"""pdp's profile report: one self-contained HTML page showing a whole
+measurement and how far to trust it.
+
+    python3 -m pdp.report PROFILE.json -o report.html     (or: pdp report ...)
+
+The page holds the profile figures (pdp.plotting), one collapsible panel of
+figures per position, a table of every profile-CSV column with its unit and
+meaning (pdp.profile_columns(), the libraries' one declaration), the warnings
+and reasons with every gap explained, and the provenance of the profile and
+of the report. Figures are inline SVG: no network, no external file.
+
+The per-position figures need what the JSON does not keep (the AWCC window
+table, R11/R12, the velocity spectrum): each recording named in the
+provenance is found (as written, then beside the JSON), its SHA-256 checked,
+and processed again with the provenance's options through the Python module;
+the report uses it only when the re-processed FSCC and AWCC velocities equal
+the JSON's. Otherwise the position says why its detail is missing.
+
+Exit status as pdp's (README, "Exit status"): 1 bad input, 2 bad usage,
+3 output not written, 4 internal error, 5 a package is missing.
+"""
+
+import argparse
+import datetime
+import hashlib
+import json
+import math
+import os
+import shlex
+import sys
+import tempfile
+
+EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_OUTPUT_FAILED, EXIT_INTERNAL, EXIT_MISSING_PACKAGE = 1, 2, 3, 4, 5
+MISSING_PACKAGE_HELP = ("pdp report draws with matplotlib and writes the page with Jinja2: install Debian's "
+                        "python3-matplotlib and python3-jinja2 (sudo apt install python3-matplotlib python3-jinja2)")
+
+
+class InputProblem(Exception):
+    """A JSON file that is not a pdp result."""
+
+
+# --- reading the profile ---------------------------------------------------------
+
+
+def load(path):
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except OSError as e:
+        raise InputProblem(f"{path}: cannot read: {e.strerror}") from None
+    try:
+        data = json.loads(raw)
+    except ValueError as e:
+        raise InputProblem(f"{path}: not JSON ({e}); give the file pdp process --json wrote") from None
+    if not isinstance(data, dict):
+        raise InputProblem(f"{path}: not a pdp result (a JSON object); give the file pdp process --json wrote")
+    rows = data.get("profile") if "profile" in data else [data]
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) and isinstance(r.get("tips"), list)
+                                                          for r in rows):
+        raise InputProblem(f"{path}: field 'profile' (or a recording's 'tips') missing or empty: not a pdp "
+                           "process result; give the file pdp process --json wrote")
+    return data, rows, hashlib.sha256(raw).hexdigest()
+
+
+def pointer_value(obj, pointer):
+    """The value at an RFC 6901 pointer, or None where the path does not exist."""
+    if pointer == "":
+        return None
+    for token in pointer.split("/")[1:]:
+        token = token.replace("~1", "/").replace("~0", "~")
+        if isinstance(obj, list):
+            obj = obj[int(token)] if token.isdigit() and int(token) < len(obj) else None
+        elif isinstance(obj, dict):
+            obj = obj.get(token)
+        else:
+            return None
+    return obj
+
+
+def cell_value(row, column, provenance):
+    if column["name"] == "pdp_version":
+        return provenance.get("pdp_version")
+    return pointer_value(row, column["pointer"])
+
+
+def display(value, unit):
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return str(value)
+        if unit in ("m", "s") and value != 0 and abs(value) < 1:
+            return f"{1e3 * value:.4g} m{unit}"
+        if value == int(value) and abs(value) < 1e12:
+            return str(int(value))
+        return f"{value:.4g}"
+    if isinstance(value, list):
+        return "; ".join(str(v) for v in value)
+    return str(value)
+
+
+def gap_reason(row, pointer, have_positions):
+    """Why the value at `pointer` is missing from a row, in the user's words."""
+    section = pointer.split("/")[1] if pointer.count("/") >= 1 else ""
+    if section == "position":
+        return "no positions given (pdp process --positions)"
+    if section == "awcc":
+        awcc = row.get("awcc")
+        if awcc is None:
+            return "AWCC not run (pdp process --method fscc)"
+        return "AWCC: " + (awcc.get("reason") or awcc.get("quality_reason") or f"status {awcc.get('status')}")
+    if section == "fscc":
+        fscc = row.get("fscc")
+        if fscc is None:
+            return "FSCC not run (pdp process --method awcc)"
+        return "FSCC: " + (fscc.get("reason") or fscc.get("note") or f"status {fscc.get('status')}")
+    if section == "correction":
+        c = row.get("correction")
+        if c is None:
+            return "not corrected: no model given (pdp process --correct MODEL.qrf)"
+        return "not corrected: " + (c.get("reason") or str(c.get("status")))
+    if section == "velocity_spectrum":
+        s = row.get("velocity_spectrum")
+        if s is None:
+            return "no velocity spectrum: AWCC not run"
+        return "velocity spectrum: " + (s.get("reason") or str(s.get("status")))
+    if pointer.endswith("sauter_diameter"):
+        return "d32 = 1.5 u c / F needs a velocity and bubbles: " + (
+            f"velocity from {row.get('chord_velocity_source')}" if row.get("chord_velocity") else "no velocity")
+    if section == "dy" or section == "dx":
+        return "no tip separation given (--dx, --dy)"
+    return "not defined for this recording"
+
+
+# --- per-position detail: the recording processed again ---------------------------
+
+
+def _sha256_of(path):
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _same(a, b):
+    a, b = (None if v is None or (isinstance(v, float) and math.isnan(v)) else v for v in (a, b))
+    return a == b
+
+
+def process_options(provenance, pdp):
+    """The provenance's options that differ from their declared defaults, as keywords of pdp.process."""
+    defaults = {o["name"]: str(o["default"]) for o in pdp.options() if o["group"] != "scene"}
+    return {k.replace("-", "_"): v for k, v in (provenance.get("options") or {}).items()
+            if k in defaults and defaults[k] != v}
+
+
+def detail_for(index, row, data, json_dir, pdp, options):
+    """(detail dict, None) or (None, why not)."""
+    provenance = data.get("provenance") or {}
+    inputs = provenance.get("inputs") or []
+    rows = data.get("profile", [data])
+    if len(inputs) != len(rows):
+        return None, ("the provenance names no recording for each row (a JSON from pdp correct or edited by "
+                      "hand): process the recordings again with pdp process --report")
+    entry = inputs[index]
+    written = entry.get("file", "")
+    candidates = [written] if os.path.isabs(written) else [written, os.path.join(json_dir, written),
+                                                            os.path.join(json_dir, os.path.basename(written))]
+    path = next((p for p in candidates if os.path.isfile(p)), None)
+    if path is None:
+        return None, (f"recording {written} not found (looked in the working folder and beside the JSON): run the "
+                      "report from the folder pdp process ran in")
+    if entry.get("sha256") and _sha256_of(path) != entry["sha256"]:
+        return None, f"{path} is not the recording processed (its SHA-256 differs from the provenance's)"
+    try:
+        r = pdp.process(path, **options)
+    except pdp.PdpError as e:
+        return None, f"{path} could not be processed again: {e}"
+    for section in ("fscc", "awcc"):
+        if not _same((row.get(section) or {}).get("velocity"), (r.get(section) or {}).get("velocity")):
+            return None, (f"processed again, {path} gives a different {section.upper()} velocity than the JSON "
+                          f"(pdp {provenance.get('pdp_version')} wrote it, this is pdp {pdp.__version__})")
+    windows = None if r.windows is None else {k: list(r.windows[k]) for k in
+                                              ("start_time", "velocity", "fate")}
+    correlation = None if r.correlation is None else {k: [float(x) for x in r.correlation[k]] for k in
+                                                      ("lag", "r11", "r12")}
+    spectrum = None if r.spectrum is None else {
+        "frequency": [float(x) for x in r.spectrum["frequency"]],
+        "density": [float(x) for x in r.spectrum["density"]],
+        "resolvable_frequency": r.spectrum.get("resolvable_frequency")}
+    return {"windows": windows, "correlation": correlation, "spectrum": spectrum}, None
+
+
+# --- figures ------------------------------------------------------------------------
+
+
+def _profile_svgs(rows):
+    from pdp import plotting
+    return [(key, title, plotting.svg(make(rows), salt=key)) for key, title, make in plotting.PROFILE_FIGURES]
+
+
+def _position_svg(args):
+    from pdp import plotting
+    index, row, detail = args
+    return plotting.svg(plotting.position_figure(row, detail or {}, gid_prefix=f"p{index}-"), salt=f"p{index}")
+
+
+class _Serial:
+    """The pool's interface, run in this process (--jobs 1)."""
+
+    class _Done:
+        def __init__(self, value):
+            self.value = value
+
+        def get(self):
+            return self.value
+
+    def apply_async(self, function, args):
+        return self._Done(function(*args))
+
+
+def figures(rows, detail_of, jobs):
+    """(profile SVGs, per-position SVGs, per-position notes). Workers draw
+    while this process reads and processes the recordings again (detail_of(i)
+    -> (detail, note)); they are forked before any processing, so no thread
+    of the core library is copied half-way."""
+    pool = None
+    if jobs > 1 and len(rows) > 1:
+        import multiprocessing
+        pool = multiprocessing.get_context("fork").Pool(min(jobs, len(rows) + 1))
+    try:
+        runner = pool or _Serial()
+        profile = runner.apply_async(_profile_svgs, (rows,))
+        positions, notes = [], []
+        for i, row in enumerate(rows):
+            detail, note = detail_of(i)
+            notes.append(note)
+            positions.append(runner.apply_async(_position_svg, ((i, row, detail),)))
+        return profile.get(), [p.get() for p in positions], notes
+    finally:
+        if pool:
+            pool.close()
+            pool.join()
+
+
+# --- the page -----------------------------------------------------------------------
+
+
+def build(json_path, detail=True, jobs=1, command_line=None):
+    from pdp import plotting
+    import jinja2
+    import pdp
+
+    data, rows, digest = load(json_path)
+    provenance = data.get("provenance") or {}
+    have_positions = all(plotting.number(r.get("position")) is not None for r in rows)
+    ys, _ = plotting.positions_mm(rows)
+    labels = [f"{y:g} mm" if have_positions else f"row {y}" for y in ys]
+
+    if detail:
+        options = process_options(provenance, pdp)
+        json_dir = os.path.dirname(os.path.abspath(json_path))
+
+        def detail_of(i):
+            return detail_for(i, rows[i], data, json_dir, pdp, options)
+    else:
+        def detail_of(i):
+            return None, "left out (--no-detail)"
+    profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs)
+
+    columns = pdp.profile_columns()
+    text_columns = [c for c in columns if c["name"].endswith("reason") or c["name"] == "warnings"]
+    gaps, table = {}, []
+    for c in columns:
+        cells = []
+        for i, row in enumerate(rows):
+            value = cell_value(row, c, provenance)
+            cell = {"value": json.dumps(value), "text": display(value, c["unit"]), "gap": None, "note": False}
+            if c in text_columns and value:  # long text: told below the table, linked from here
+                cell["text"], cell["note"] = "see note", True
+            if value is None or value == []:
+                if c not in text_columns:  # an empty reason or warning is no gap
+                    cell["gap"] = gaps.setdefault(gap_reason(row, c["pointer"], have_positions), len(gaps) + 1)
+            cells.append(cell)
+        table.append({"name": c["name"], "unit": c["unit"], "meaning": c["meaning"], "pointer": c["pointer"],
+                      "cells": cells})
+
+    positions = []
+    for i, row in enumerate(rows):
+        notes = []  # (name, text, anchor): the table links a column's first note
+        for c in text_columns:
+            value = cell_value(row, c, provenance)
+            for k, v in enumerate(v for v in (value if isinstance(value, list) else [value]) if v):
+                notes.append((c["name"], v, f"note-{i}-{c['name']}" if k == 0 else None))
+        spectrum_warning = (row.get("velocity_spectrum") or {}).get("warning")
+        if spectrum_warning:
+            notes.append(("velocity_spectrum.warning", spectrum_warning, None))
+        positions.append({"index": i, "label": labels[i], "file": row.get("file"), "svg": position_svgs[i],
+                          "quality": (row.get("awcc") or {}).get("quality"), "notes": notes,
+                          "detail_note": detail_notes[i]})
+
+    made = {"pdp_version": pdp.__version__, "utc_time": datetime.datetime.now(datetime.timezone.utc)
+            .strftime("%Y-%m-%dT%H:%M:%SZ"), "command_line": command_line or " ".join(
+                ["python3 -m pdp.report"] + [shlex.quote(a) for a in sys.argv[1:]]),
+            "input": json_path, "sha256": digest}
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(os.path.dirname(os.path.abspath(__file__))),
+                             autoescape=True, trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
+    return env.get_template("report.html.j2").render(
+        title=os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
+        positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
+        provenance=provenance, made=made, panels=plotting.POSITION_PANELS, single="profile" not in data)
+
+
+def write_atomically(text, out):
+    folder = os.path.dirname(os.path.abspath(out))
+    fd, tmp = tempfile.mkstemp(prefix=".pdp-report-", suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, out)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="pdp report", description="One self-contained HTML page for a pdp "
+                                     "process JSON (a profile or one recording): figures, table, provenance.")
+    parser.add_argument("json", metavar="PROFILE.json", help="the file pdp process --json wrote")
+    parser.add_argument("-o", "--output", required=True, metavar="REPORT.html", help="the page to write")
+    parser.add_argument("--no-detail", action="store_true",
+                        help="leave out the per-position figures (no recording is read again)")
+    parser.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4), metavar="N",
+                        help="processes drawing the figures (the page is the same for any N)")
+    parser.add_argument("--command-line", default=None, help=argparse.SUPPRESS)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:
+        return EXIT_BAD_USAGE if e.code else 0
+    if args.jobs < 1:
+        print("pdp report: --jobs must be at least 1", file=sys.stderr)
+        return EXIT_BAD_USAGE
+    try:
+        import jinja2  # noqa: F401
+        import matplotlib  # noqa: F401
+        import numpy  # noqa: F401
+    except ImportError as e:
+        print(f"pdp report: {e.name} is missing: {MISSING_PACKAGE_HELP}", file=sys.stderr)
+        return EXIT_MISSING_PACKAGE
+    try:
+        import pdp  # noqa: F401
+    except ImportError as e:
+        print(f"pdp report: the pdp module cannot be loaded ({e}): build pdp with its Python module or install it "
+              "(cmake --install), and run Debian's /usr/bin/python3", file=sys.stderr)
+        return EXIT_MISSING_PACKAGE
+    try:
+        page = build(args.json, detail=not args.no_detail, jobs=args.jobs, command_line=args.command_line)
+    except InputProblem as e:
+        print(f"pdp report: {e}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except Exception:  # a defect: Python's own exit status 1 would read as bad input
+        import traceback
+        traceback.print_exc()
+        print("pdp report: internal error; please report it with the command line", file=sys.stderr)
+        return EXIT_INTERNAL
+    try:
+        write_atomically(page, args.output)
+    except OSError as e:
+        print(f"pdp report: {args.output}: cannot write: {e.strerror}; choose a writable folder with -o",
+              file=sys.stderr)
+        return EXIT_OUTPUT_FAILED
+    print(f"pdp report: wrote {args.output}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
