@@ -330,22 +330,69 @@ def write_atomically(text, out):
         raise
 
 
-def main(argv=None):
+def _parser():
+    """The report's options: their one declaration (pdp report hands its arguments here)."""
     parser = argparse.ArgumentParser(prog="pdp report", description="One self-contained HTML page for a pdp "
                                      "process JSON (a profile or one recording): figures, table, provenance.")
-    parser.add_argument("json", metavar="PROFILE.json", help="the file pdp process --json wrote")
-    parser.add_argument("-o", "--output", required=True, metavar="REPORT.html", help="the page to write")
+    parser.add_argument("input", nargs="?", metavar="PROFILE.json", help="the file pdp process --json wrote")
+    parser.add_argument("-o", "--output", metavar="REPORT.html", help="the page to write (required)")
     parser.add_argument("--no-detail", action="store_true",
                         help="leave out the per-position figures (no recording is read again)")
     parser.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4), metavar="N",
-                        help="processes drawing the figures (the page is the same for any N)")
+                        help="processes drawing the figures; the page is the same for any N (default: the "
+                        "cores, at most 4)")
+    parser.add_argument("--config", metavar="FILE.toml",
+                        help="settings file (TOML): keys are these options' names without --, at the top level or "
+                        "in a [report] table; the command line overrides it")
     parser.add_argument("--command-line", default=None, help=argparse.SUPPRESS)
+    return parser
+
+
+def _apply_config(parser, args, argv):
+    """Settings from --config for the options not given on the command line."""
+    import tomllib
+    try:
+        with open(args.config, "rb") as f:
+            table = tomllib.load(f)
+    except OSError as e:
+        raise ValueError(f"{args.config}: cannot read: {e.strerror}; give an existing settings file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ValueError(f"{args.config}: not TOML ({e}); fix the file") from None
+    settings = dict(table.get("report", {}), **{k: v for k, v in table.items() if not isinstance(v, dict)})
+    known = {a.dest.replace("_", "-"): a for a in parser._actions if a.dest not in ("help", "config", "command_line")}
+    given = {a.dest for a in parser._actions for opt in a.option_strings if opt in argv}
+    for key, value in settings.items():
+        action = known.get(key)
+        if action is None:
+            raise ValueError(f"{args.config}: unknown setting '{key}'; pdp report's settings are "
+                             f"{', '.join(sorted(known))}")
+        if action.dest in given or (action.dest == "input" and args.input is not None):
+            continue
+        expected = bool if isinstance(action, argparse._StoreTrueAction) else action.type or str
+        if not isinstance(value, expected) or (expected is int and isinstance(value, bool)):
+            kind = {bool: "true or false", int: "a whole number", str: "a string"}[expected]
+            raise ValueError(f"{args.config}: setting '{key}' is {value!r}; give {kind}")
+        setattr(args, action.dest, value)
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = _parser()
     try:
         args = parser.parse_args(argv)
     except SystemExit as e:
         return EXIT_BAD_USAGE if e.code else 0
-    if args.jobs < 1:
-        print("pdp report: --jobs must be at least 1", file=sys.stderr)
+    try:
+        if args.config:
+            _apply_config(parser, args, argv)
+        if args.input is None or args.output is None:
+            raise ValueError("give the profile JSON and the page to write: pdp report PROFILE.json -o REPORT.html")
+        if args.jobs < 1:
+            raise ValueError(f"--jobs {args.jobs}: give at least 1")
+        if os.path.exists(args.output) and os.path.exists(args.input) and os.path.samefile(args.output, args.input):
+            raise ValueError(f"{args.output} is the input; choose another output file with -o")
+    except ValueError as e:
+        print(f"pdp report: {e}", file=sys.stderr)
         return EXIT_BAD_USAGE
     try:
         import jinja2  # noqa: F401
@@ -361,7 +408,7 @@ def main(argv=None):
               "(cmake --install), and run Debian's /usr/bin/python3", file=sys.stderr)
         return EXIT_MISSING_PACKAGE
     try:
-        page = build(args.json, detail=not args.no_detail, jobs=args.jobs, command_line=args.command_line)
+        page = build(args.input, detail=not args.no_detail, jobs=args.jobs, command_line=args.command_line)
     except InputProblem as e:
         print(f"pdp report: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT

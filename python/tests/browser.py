@@ -154,9 +154,11 @@ def _png_pixels(png, row_step=4):
     return w, h, out[::row_step].reshape(-1, w, bpp)
 
 
-def render(html_path, width=1280, timeout=60):
+def render(html_path, width=1280, timeout=60, media="screen"):
     """Opens html_path in headless Chromium; returns console, document size,
-    device pixel ratio, a full-page PNG and how blank it is (see module doc)."""
+    device pixel ratio, a full-page PNG and how blank it is (see module doc).
+    media="print" lays the page out as printed: print CSS, and the page's
+    beforeprint handlers run."""
     url = pathlib.Path(html_path).resolve().as_uri()
     chromium = _binary("PDP_CHROMIUM", "chromium", "chromium-browser")
     driver = _binary("PDP_CHROMEDRIVER", "chromedriver")
@@ -210,6 +212,9 @@ def render(html_path, width=1280, timeout=60):
         call("POST", "/execute/async", {"args": [], "script": (
             "const done = arguments[arguments.length - 1];"
             "document.fonts.ready.then(() => requestAnimationFrame(() => requestAnimationFrame(done)));")})
+        if media == "print":
+            call("POST", "/goog/cdp/execute", {"cmd": "Emulation.setEmulatedMedia", "params": {"media": "print"}})
+            js("window.dispatchEvent(new Event('beforeprint'));")
         size = js("const e = document.documentElement;"
                   "return [e.scrollWidth, e.scrollHeight, window.devicePixelRatio];")
         doc_w, doc_h, dpr = size

@@ -285,6 +285,20 @@ def test_usage_and_output_errors_have_their_exit_status(synthetic, tmp_path):
     assert done.returncode == 2
 
 
+def test_a_settings_file_gives_what_the_command_line_does_not(synthetic, tmp_path):
+    (tmp_path / "r.toml").write_text(f'[report]\ninput = "{synthetic / "profile.json"}"\noutput = "from-file.html"\n'
+                                     'no-detail = true\njobs = 1\n')
+    made("report", "--config", tmp_path / "r.toml", "-o", "given.html", cwd=tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["given.html", "r.toml"]
+    assert (tmp_path / "given.html").read_text().count("left out (--no-detail)") == 3
+    for text, message in (('jobs = "2"', "give a whole number"), ("job = 2", "unknown setting 'job'"),
+                          ("jobs = [", "not TOML")):
+        (tmp_path / "bad.toml").write_text(text + "\n")
+        done = run("report", synthetic / "profile.json", "-o", tmp_path / "x.html", "--config", tmp_path / "bad.toml")
+        assert done.returncode == 2 and message in done.stderr and "bad.toml" in done.stderr
+    assert not (tmp_path / "x.html").exists()
+
+
 def test_a_missing_python_or_package_says_what_to_install(synthetic, tmp_path):
     env = dict(os.environ, PDP_PYTHON=str(tmp_path / "no-python"))
     done = run("report", synthetic / "profile.json", "-o", tmp_path / "r.html", env=env)
@@ -313,3 +327,15 @@ def test_the_real_report_renders_in_headless_chromium(real):
     assert shot["document_height"] > 3 * 300 + 75 * 18
     if os.environ.get("PDP_UPDATE_SCREENSHOT"):
         (SOURCE / "docs" / "figures" / "report-real-profile.png").write_bytes(shot["png"])
+
+
+def test_printing_opens_every_position_in_print_layout(real):
+    """As printed (print CSS, beforeprint), every position's figures are in
+    the page: it grows by at least ten 3 x 3 panels' height (each ~700 px at
+    the print layout's width) over the screen's, without a console error."""
+    from browser import render
+
+    screen = render(real / "report.html", width=1000, timeout=120)
+    printed = render(real / "report.html", width=1000, timeout=120, media="print")
+    assert not [e for e in printed["console"] if e.get("level") in ("SEVERE", "WARNING")]
+    assert printed["document_height"] > screen["document_height"] + 10 * 500

@@ -160,7 +160,7 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
 // The report is drawn from the JSON: the --json file, or the same text in a
 // hidden scratch file beside the report, removed afterwards.
 int report_of(const ProcessCommandOptions& o, const std::string& json_text) {
-  if (!o.json.empty()) return write_report(o.json, o.report, true);
+  if (!o.json.empty()) return write_report({o.json, "-o", o.report});
   const auto folder = std::filesystem::absolute(o.report).parent_path();
   std::string scratch = (folder / ".pdp-report-XXXXXX.json").string();
   const int fd = mkstemps(scratch.data(), 5);
@@ -172,7 +172,7 @@ int report_of(const ProcessCommandOptions& o, const std::string& json_text) {
     ~Remove() { std::error_code ec; std::filesystem::remove(path, ec); }
   } remove{scratch};
   awcc::write_text_atomically(scratch, json_text);
-  return write_report(scratch, o.report, true);
+  return write_report({scratch, "-o", o.report});
 }
 
 std::string correction_report(const correction::Correction& c) {

@@ -58,7 +58,7 @@ std::vector<fs::path> module_candidates() {
 
 }  // namespace
 
-int write_report(const std::string& json, const std::string& html, bool detail) {
+int write_report(std::vector<std::string> arguments) {
   const auto python = find_python();
   if (!python) {
     spdlog::error("no python3 found (PDP_PYTHON, /usr/bin/python3, PATH): {}", install_help);
@@ -82,9 +82,9 @@ int write_report(const std::string& json, const std::string& html, bool detail) 
   }
   // Run as a script, not -m: its own first lines check the packages and say
   // what to install before anything imports them.
-  std::vector<std::string> args = {*python, (*module_dir / "pdp" / "report.py").string(), json, "-o", html,
-                                   "--command-line", command_line()};
-  if (!detail) args.emplace_back("--no-detail");
+  std::vector<std::string> args = {*python, (*module_dir / "pdp" / "report.py").string(), "--command-line",
+                                   command_line()};
+  args.insert(args.end(), arguments.begin(), arguments.end());
   std::vector<std::string> env;
   std::string pythonpath = "PYTHONPATH=" + module_dir->string();
   for (char** e = environ; *e; ++e) {
@@ -127,23 +127,15 @@ int write_report(const std::string& json, const std::string& html, bool detail) 
 void setup_report(CLI::App& app, Command& command, ReportOptions& o) {
   auto* cmd = app.add_subcommand("report",
                                  "One self-contained HTML page for a pdp process JSON: profile figures, per-position "
-                                 "figures, the profile table with units, warnings, gaps and provenance");
+                                 "figures, the profile table with units, warnings, gaps and provenance (pdp report "
+                                 "--help lists its options)");
   command.app = cmd;
-  add_config_option(command);
-  command.required.push_back(
-      cmd->add_option("input", o.input, "pdp process JSON (a profile or one recording)")->check(CLI::ExistingFile));
-  command.required.push_back(cmd->add_option("-o,--output", o.output, "the HTML page to write"));
-  cmd->add_flag("--no-detail", o.no_detail,
-                "leave out the per-position figures (no recording is read again; faster)");
+  // Every argument, --help included, goes to pdp.report, which declares them.
+  cmd->prefix_command();
+  cmd->set_help_flag();
+  cmd->callback([cmd, &o] { o.arguments = cmd->remaining(); });
 }
 
-int run_report(const ReportOptions& o) {
-  std::error_code ec;
-  if (fs::exists(o.output, ec) && fs::equivalent(o.output, o.input, ec)) {
-    spdlog::error("{} is the input; choose another output file with -o", o.output);
-    return exit_bad_usage;
-  }
-  return write_report(o.input, o.output, !o.no_detail);
-}
+int run_report(const ReportOptions& o) { return write_report(o.arguments); }
 
 }  // namespace pdp
