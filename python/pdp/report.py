@@ -224,13 +224,13 @@ class _Serial:
         return self._Done(function(*args))
 
 
-def figures(rows, detail_of, jobs):
+def figures(rows, detail_of, jobs, per_position=True):
     """(profile SVGs, per-position SVGs, per-position notes). Workers draw
     while this process reads and processes the recordings again (detail_of(i)
     -> (detail, note)); they are forked before any processing, so no thread
     of the core library is copied half-way."""
     pool = None
-    if jobs > 1 and len(rows) > 1:
+    if jobs > 1 and len(rows) > 1 and per_position:
         import multiprocessing
         pool = multiprocessing.get_context("fork").Pool(min(jobs, len(rows) + 1))
     try:
@@ -240,7 +240,8 @@ def figures(rows, detail_of, jobs):
         for i, row in enumerate(rows):
             detail, note = detail_of(i)
             notes.append(note)
-            positions.append(runner.apply_async(_position_svg, ((i, row, detail),)))
+            positions.append(runner.apply_async(_position_svg, ((i, row, detail),)) if per_position
+                             else _Serial._Done(None))
         return profile.get(), [p.get() for p in positions], notes
     finally:
         if pool:
@@ -270,8 +271,8 @@ def build(json_path, detail=True, jobs=1, command_line=None):
             return detail_for(i, rows[i], data, json_dir, pdp, options)
     else:
         def detail_of(i):
-            return None, "left out (--no-detail)"
-    profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs)
+            return None, None
+    profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs, per_position=detail)
 
     columns = pdp.profile_columns()
     text_columns = [c for c in columns if c["name"].endswith("reason") or c["name"] == "warnings"]

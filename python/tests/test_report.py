@@ -290,7 +290,9 @@ def test_a_settings_file_gives_what_the_command_line_does_not(synthetic, tmp_pat
                                      'no-detail = true\njobs = 1\n')
     made("report", "--config", tmp_path / "r.toml", "-o", "given.html", cwd=tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["given.html", "r.toml"]
-    assert (tmp_path / "given.html").read_text().count("left out (--no-detail)") == 3
+    page = Page((tmp_path / "given.html").read_text())
+    assert page.positions == [0, 1, 2] and not any(g.startswith("p0-") for g in page.gids)
+    assert (tmp_path / "given.html").read_text().count("Figures left out (pdp report --no-detail)") == 3
     for text, message in (('jobs = "2"', "give a whole number"), ("job = 2", "unknown setting 'job'"),
                           ("jobs = [", "not TOML")):
         (tmp_path / "bad.toml").write_text(text + "\n")
