@@ -110,6 +110,17 @@ def get(obj, *path):
 
 
 # --- profile figures: one value per row against position ---------------------
+# Each takes the rows of a profile (pdp process JSON's "profile", or
+# pdp.process(files).profile) and draws in ``ax`` when given (to compose
+# figures), else in a figure of its own; it returns the figure.
+
+
+def _profile_axes(ax):
+    """The axes to draw a profile figure in: the caller's, or a new figure's."""
+    if ax is not None:
+        return ax.figure, ax
+    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    return fig, ax
 
 
 def positions_mm(rows):
@@ -146,8 +157,8 @@ def _finish(ax, ylabel, xlabel, title):
         ax.legend(loc="best")
 
 
-def profile_void_fraction(rows):
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+def profile_void_fraction(rows, ax=None):
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "tips", 0, "void_fraction"), lambda r: get(r, "tips", 0, "void_fraction_ci95"),
             color=BLUE, marker="o", ls="-", label="leading tip, 95 % interval")
@@ -158,8 +169,8 @@ def profile_void_fraction(rows):
     return fig
 
 
-def profile_count_rate(rows):
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+def profile_count_rate(rows, ax=None):
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "tips", 0, "bubble_count_rate"),
             lambda r: get(r, "tips", 0, "bubble_count_rate_ci95"), color=BLUE, marker="o", ls="-",
@@ -177,8 +188,8 @@ def _quantiles(r, q, a, b):
     return (qs.get(a), qs.get(b)) if qs else None
 
 
-def profile_velocity(rows):
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+def profile_velocity(rows, ax=None):
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "fscc", "velocity"), color=BLACK, marker="D", ls=":", mfc="none",
             label="FSCC")
@@ -193,8 +204,8 @@ def profile_velocity(rows):
     return fig
 
 
-def profile_turbulence(rows):
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+def profile_turbulence(rows, ax=None):
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "awcc", "turbulence_intensity"),
             lambda r: get(r, "awcc", "turbulence_intensity_ci95"), color=BLUE, marker="o", ls="-",
@@ -209,8 +220,8 @@ def profile_turbulence(rows):
     return fig
 
 
-def profile_chanson(rows):
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+def profile_chanson(rows, ax=None):
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "fscc", "turbulence_intensity_chanson"), color=BLACK, marker="D",
             ls=":", mfc="none", label="0.851 sqrt(tau05^2 - T05^2) / lag")
@@ -219,8 +230,8 @@ def profile_chanson(rows):
     return fig
 
 
-def profile_sauter(rows):
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+def profile_sauter(rows, ax=None):
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "tips", 0, "sauter_diameter"), scale=1e3, color=GREEN, marker="o",
             ls="-", label="d32 = 1.5 u c / F")
@@ -229,9 +240,9 @@ def profile_sauter(rows):
     return fig
 
 
-def profile_yield(rows):
+def profile_yield(rows, ax=None):
     """Accepted / total AWCC windows, each row marked with its quality level."""
-    fig, ((ax,),) = figure(margins=PROFILE_MARGINS)
+    fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     seen = set()
     for yi, r in zip(y, rows):
