@@ -149,20 +149,30 @@ def _series(ax, y, rows, value, interval=None, scale=1.0, **style):
     return len(xs)
 
 
-def _finish(ax, ylabel, xlabel, title):
+def _finish(ax, ylabel, xlabel, title, legend_size=None):
     ax.set_ylabel(ylabel)
     ax.set_xlabel(xlabel)
     ax.set_title(title)
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="best")
+        ax.legend(loc="best", fontsize=legend_size)
+
+
+def _not_ok(ax, what, result):
+    """True, said in the panel, when a structure result (clusters, arrivals) has nothing to draw."""
+    if result and result.get("status") == "ok":
+        return False
+    note(ax, f"{what}: " + ((result or {}).get("reason") or "not computed"))
+    return True
 
 
 def profile_void_fraction(rows, ax=None):
     fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
-    _series(ax, y, rows, lambda r: get(r, "tips", 0, "void_fraction"), lambda r: get(r, "tips", 0, "void_fraction_ci95"),
+    _series(ax, y, rows, lambda r: get(r, "tips", 0, "void_fraction"),
+            lambda r: get(r, "tips", 0, "void_fraction_ci95"),
             color=BLUE, marker="o", ls="-", label="leading tip, 95 % interval")
-    _series(ax, y, rows, lambda r: get(r, "tips", 1, "void_fraction"), lambda r: get(r, "tips", 1, "void_fraction_ci95"),
+    _series(ax, y, rows, lambda r: get(r, "tips", 1, "void_fraction"),
+            lambda r: get(r, "tips", 1, "void_fraction_ci95"),
             color=ORANGE, marker="s", ls="--", label="trailing tip, 95 % interval")
     ax.set_xlim(left=0)
     _finish(ax, ylabel, "void fraction c (-)", "Void fraction")
@@ -290,10 +300,8 @@ def chord_pdf(ax, pdf, basis):
     edges, width = pdf["lower_edges"], pdf["bin_width"]
     _steps(ax, edges, width, pdf["air_fraction"], scale, color=BLUE, lw=1.4, label="air chords")
     _steps(ax, edges, width, pdf["water_fraction"], scale, color=ORANGE, lw=1.2, ls="--", label="water chords")
-    ax.set_xlabel(f"chord {basis} ({unit}); last bin: above {scale * pdf['max']:g} {unit}")
-    ax.set_ylabel("fraction of chords (-)")
-    ax.set_title(f"Chord-{basis} PDF")
-    ax.legend()
+    _finish(ax, "fraction of chords (-)", f"chord {basis} ({unit}); last bin: above {scale * pdf['max']:g} {unit}",
+            f"Chord-{basis} PDF")
 
 
 def voltage_pdf(ax, structure, tips):
@@ -317,10 +325,7 @@ def voltage_pdf(ax, structure, tips):
     ax.plot([], [], color=GREY, ls=":", label="threshold")
     ax.plot([], [], color=GREY, marker="v", ls="none", label="air mode")
     ax.plot([], [], color=GREY, marker="^", ls="none", label="water mode")
-    ax.set_xlabel("voltage (V)")
-    ax.set_ylabel("fraction of samples (-)")
-    ax.set_title("Voltage PDF")
-    ax.legend()
+    _finish(ax, "fraction of samples (-)", "voltage (V)", "Voltage PDF")
 
 
 def correlation(ax, functions, fscc):
@@ -334,27 +339,35 @@ def correlation(ax, functions, fscc):
         ax.plot([1e3 * fscc["lag"]], [fscc["r12_max"]], marker="o", color=VERMILION, ls="none",
                 label=f"peak: {1e3 * fscc['lag']:.3g} ms, {fscc['r12_max']:.3g}")
         if number(fscc.get("t_half")) is not None:
-            ax.annotate("", xy=(1e3 * fscc["t_half"], fscc["r12_max"] / 2), xytext=(1e3 * fscc["lag"], fscc["r12_max"] / 2),
+            half = fscc["r12_max"] / 2
+            ax.annotate("", xy=(1e3 * fscc["t_half"], half), xytext=(1e3 * fscc["lag"], half),
                         arrowprops=dict(arrowstyle="<->", color=VERMILION, lw=1))
             ax.plot([], [], color=VERMILION, lw=1, label=f"tau05 = {1e3 * fscc['tau05']:.3g} ms")
     if fscc and number(fscc.get("t05")) is not None:
-        ax.annotate("", xy=(1e3 * fscc["t05"], 0.5), xytext=(0, 0.5), arrowprops=dict(arrowstyle="<->", color=GREEN, lw=1))
+        ax.annotate("", xy=(1e3 * fscc["t05"], 0.5), xytext=(0, 0.5),
+                    arrowprops=dict(arrowstyle="<->", color=GREEN, lw=1))
         ax.plot([], [], color=GREEN, lw=1, label=f"T05 = {1e3 * fscc['t05']:.3g} ms")
     ax.axhline(0, color=BLACK, lw=0.6)
     ax.set_xlim(min(lag[0], 0), lag[-1])
-    ax.set_xlabel("lag (ms)")
-    ax.set_ylabel("correlation (-)")
-    ax.set_title("Auto- and cross-correlation")
-    ax.legend()
+    _finish(ax, "correlation (-)", "lag (ms)", "Auto- and cross-correlation")
+
+
+def _window_fates(ax, windows, awcc):
+    """The windows' velocities with the indices of the accepted ones and of the
+    rejected ones that have a velocity; None, said in the panel, without windows."""
+    if windows is None or not len(windows["velocity"]):
+        note(ax, "no AWCC windows" if awcc else "AWCC not run")
+        return None
+    v, fate = windows["velocity"], windows["fate"]
+    return (v, [i for i in range(len(v)) if fate[i] == "accepted"],
+            [i for i in range(len(v)) if fate[i] != "accepted" and v[i] > 0])
 
 
 def window_series(ax, windows, awcc):
-    if windows is None or not len(windows["velocity"]):
-        note(ax, "no AWCC windows" if awcc else "AWCC not run")
+    fates = _window_fates(ax, windows, awcc)
+    if fates is None:
         return
-    t, v, fate = windows["start_time"], windows["velocity"], windows["fate"]
-    acc = [i for i in range(len(v)) if fate[i] == "accepted"]
-    rej = [i for i in range(len(v)) if fate[i] != "accepted" and v[i] > 0]
+    (v, acc, rej), t = fates, windows["start_time"]
     ax.plot([t[i] for i in rej], [v[i] for i in rej], ls="none", marker="x", color=GREY, ms=3.5,
             label=f"rejected ({len(v) - len(acc)}; {len(rej)} with a velocity)", rasterized=len(rej) > 2000)
     ax.plot([t[i] for i in acc], [v[i] for i in acc], ls="none", marker="o", color=BLUE, ms=3,
@@ -364,35 +377,28 @@ def window_series(ax, windows, awcc):
     if acc:
         hi = max(v[i] for i in acc)
         ax.set_ylim(0, 2.0 * hi)
-    ax.set_xlabel("window start (s)")
-    ax.set_ylabel("window velocity (m/s)")
-    ax.set_title("AWCC window velocities")
-    ax.legend()
+    _finish(ax, "window velocity (m/s)", "window start (s)", "AWCC window velocities")
 
 
 def window_histogram(ax, windows, awcc):
-    if windows is None or not len(windows["velocity"]):
-        note(ax, "no AWCC windows" if awcc else "AWCC not run")
+    fates = _window_fates(ax, windows, awcc)
+    if fates is None:
         return
-    v, fate = windows["velocity"], windows["fate"]
-    acc = [v[i] for i in range(len(v)) if fate[i] == "accepted"]
-    if not acc:
+    v, accepted, rejected = fates
+    if not accepted:
         note(ax, "no accepted window")
         return
+    acc = [v[i] for i in accepted]
     lo, hi = min(acc), max(acc)
-    rej = [v[i] for i in range(len(v)) if fate[i] != "accepted" and 0 < v[i] <= 2 * hi]
+    rej = [v[i] for i in rejected if v[i] <= 2 * hi]
     bins = max(8, min(40, int(math.sqrt(len(acc)) * 2)))
     edges = [lo + (2 * hi - lo) * k / bins for k in range(bins + 1)] if hi > lo else bins
     ax.hist([acc, rej], bins=edges, stacked=True, color=[BLUE, GREY], label=["accepted", "rejected"])
-    ax.set_xlabel("window velocity (m/s)")
-    ax.set_ylabel("windows")
-    ax.set_title("Window velocity histogram")
-    ax.legend()
+    _finish(ax, "windows", "window velocity (m/s)", "Window velocity histogram")
 
 
 def cluster_sizes(ax, clusters):
-    if not clusters or clusters.get("status") != "ok":
-        note(ax, "cluster sizes: " + ((clusters or {}).get("reason") or "not computed"))
+    if _not_ok(ax, "cluster sizes", clusters):
         return
     sizes = list(range(2, 21)) + [21]
     width = 0.27
@@ -409,15 +415,12 @@ def cluster_sizes(ax, clusters):
     ax.set_xlim(1.4, max(largest, 6) + 0.6)
     ticks = [t for t in (2, 3, 4, 5, 6, 8, 10, 12, 15, 18, 21) if t <= max(largest, 6)]
     ax.set_xticks(ticks, [">20" if t == 21 else str(t) for t in ticks])
-    ax.set_xlabel(f"particles per cluster ({clusters['basis']} criteria)")
-    ax.set_ylabel("fraction of clusters (-)")
-    ax.set_title("Cluster sizes")
-    ax.legend()
+    _finish(ax, "fraction of clusters (-)", f"particles per cluster ({clusters['basis']} criteria)",
+            "Cluster sizes")
 
 
 def arrival_pdf(ax, arrivals):
-    if not arrivals or arrivals.get("status") != "ok":
-        note(ax, "arrival times: " + ((arrivals or {}).get("reason") or "not computed"))
+    if _not_ok(ax, "arrival times", arrivals):
         return
     w = arrivals["bin_width"]
     unit = "mm" if arrivals.get("basis") == "length" else "ms"
@@ -442,10 +445,8 @@ def arrival_pdf(ax, arrivals):
         note(ax, "no class has intervals")
         return
     ax.plot([], [], color=GREY, ls=":", label="Poisson reference")
-    ax.set_xlabel("inter-particle arrival time (ms)")
-    ax.set_ylabel("fraction of intervals (-)")
-    ax.set_title("Inter-particle arrival times")
-    ax.legend(fontsize=6.5)
+    _finish(ax, "fraction of intervals (-)", "inter-particle arrival time (ms)", "Inter-particle arrival times",
+            legend_size=6.5)
 
 
 def velocity_spectrum(ax, spectrum, series):
@@ -466,10 +467,7 @@ def velocity_spectrum(ax, spectrum, series):
     if number(fr) is not None:
         ax.axvline(fr, color=VERMILION, ls=":", label=f"1/(2 T_W) = {fr:.3g} Hz")
     ax.minorticks_off()
-    ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("PSD ((m/s)^2/Hz)")
-    ax.set_title("Velocity spectrum")
-    ax.legend()
+    _finish(ax, "PSD ((m/s)^2/Hz)", "frequency (Hz)", "Velocity spectrum")
 
 
 def position_figure(row, detail, gid_prefix=""):
