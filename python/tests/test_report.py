@@ -343,3 +343,11 @@ def test_printing_opens_every_position_in_print_layout(real):
     printed = render(real / "report.html", width=1000, timeout=120, media="print")
     assert not [e for e in printed["console"] if e.get("level") in ("SEVERE", "WARNING")]
     assert printed["document_height"] > screen["document_height"] + 10 * 500
+
+
+def test_a_felder_preset_profile_is_drawn_from_its_recordings(real_files, tmp_path):
+    """The preset's options are in the provenance as values: processing again
+    with those that differ from the defaults gives the JSON's velocities."""
+    made("process", *real_files[2:4], "--fs", "20kHz", "--dx", "7.15mm", "--preset", "felder", "--json",
+         tmp_path / "profile.json", "--csv", tmp_path / "profile.csv", "--report", tmp_path / "report.html")
+    assert "are not shown" not in check_report(tmp_path)
