@@ -1,0 +1,88 @@
+// One study run end to end (docs/performance.md, issue 17): synthesis, FSCC
+// and AWCC of the base case (METHOD 5) as pdp sweep runs it, on one thread.
+//
+//   run_bench [--duration SECONDS] [--repeat N] [--seed S]
+//
+// Prints the median (and range) of each stage over N runs, and a fingerprint
+// of the results: every estimate and the truth written with 17 significant
+// digits, then a hash of them, so that a faster build can be checked to give
+// bit-identical numbers for the same seed.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "awcc/sha256.hpp"
+#include "bench_util.hpp"
+#include "study.hpp"
+
+namespace {
+
+struct Stage {
+  const char* name;
+  std::vector<double> seconds;
+};
+
+void show(const Stage& s) {
+  auto v = s.seconds;
+  std::sort(v.begin(), v.end());
+  std::printf("  %-10s median %.3f s  (%.3f-%.3f)\n", s.name, v[v.size() / 2], v.front(), v.back());
+}
+
+std::string fingerprint(const pdp::RunResult& r) {
+  std::string text = fmt::format("truth u {:.17g} Tu {:.17g} c {:.17g} F {:.17g}\n", r.truth_velocity,
+                                 r.truth_turbulence_intensity, r.truth_void_fraction, r.truth_count_rate);
+  text += fmt::format("phase c {:.17g} F {:.17g}\n", r.void_fraction, r.count_rate);
+  if (r.fscc) text += fmt::format("fscc u {:.17g} lag {:.17g} r12 {:.17g}\n", r.fscc->velocity, r.fscc->lag,
+                                  r.fscc->r12_max);
+  if (r.awcc) {
+    text += fmt::format("awcc u {:.17g} Tu {:.17g} windows {} accepted {}\n", r.awcc->velocity,
+                        r.awcc->turbulence_intensity, r.awcc->windows_total, r.awcc->windows_accepted);
+  }
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double duration = 300.0;
+  int repeat = 5;
+  std::uint64_t seed = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
+  }
+  synth::Scene scene;
+  scene.duration = duration;
+  scene.seed = seed;
+  pdp::StudyOptions options;  // as pdp sweep: FSCC and AWCC, window truth kept
+  Stage synth{"synthesis", {}}, fscc{"FSCC", {}}, awcc{"AWCC", {}}, total{"total", {}};
+  std::string first;
+  for (int k = 0; k < repeat; ++k) {
+    const double t0 = bench::now();
+    const auto r = pdp::run_scene(scene, options);
+    total.seconds.push_back(bench::now() - t0);
+    synth.seconds.push_back(r.seconds_synth);
+    fscc.seconds.push_back(r.seconds_fscc);
+    awcc.seconds.push_back(r.seconds_awcc);
+    const auto text = fingerprint(r);
+    if (k == 0) first = text;
+    else if (text != first) {
+      std::fprintf(stderr, "run %d differs from run 0 with the same seed:\n%s%s", k, first.c_str(), text.c_str());
+      return 1;
+    }
+  }
+  std::printf("base case, %.0f s at %.0f kHz, seed %llu, %d runs (one thread):\n", duration, scene.fs / 1e3,
+              static_cast<unsigned long long>(seed), repeat);
+  for (const auto* s : {&synth, &fscc, &awcc, &total}) show(*s);
+  awcc::Sha256 hash;
+  hash.update({reinterpret_cast<const std::uint8_t*>(first.data()), first.size()});
+  std::printf("results:\n%sfingerprint %s\n", first.c_str(), hash.hex().substr(0, 16).c_str());
+  std::printf("peak memory %.0f MB\n", bench::peak_mb());
+  return 0;
+}
