@@ -5,6 +5,7 @@
 #include "overlap_impulses.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <fmt/format.h>
@@ -127,14 +128,27 @@ void clip(const AirIntervals& s, std::int64_t start, std::int64_t length, std::v
 
 namespace {
 
-// Air samples of intervals `iv` (sorted, relative) in [0, m).
-double air_below(const std::vector<AirInterval>& iv, const std::vector<double>& cumulative, std::int64_t m) {
-  const auto it = std::partition_point(iv.begin(), iv.end(), [m](const AirInterval& a) { return a.stop <= m; });
-  const auto i = static_cast<std::size_t>(it - iv.begin());
-  double total = cumulative[i];
-  if (it != iv.end() && it->start < m) total += static_cast<double>(m - it->start);
-  return total;
-}
+// Air samples of intervals `iv` (sorted, relative) in [0, m), for a sweep
+// whose m moves a little at a time: the first interval ending after m is
+// found by walking from where the last call left off (the same interval a
+// binary search finds, without its dozen unpredictable branches per call).
+class AirBelow {
+ public:
+  AirBelow(const std::vector<AirInterval>& iv, const std::vector<double>& cumulative)
+      : iv_(iv), cumulative_(cumulative) {}
+  double operator()(std::int64_t m) {
+    while (i_ > 0 && iv_[i_ - 1].stop > m) --i_;
+    while (i_ < iv_.size() && iv_[i_].stop <= m) ++i_;
+    double total = cumulative_[i_];
+    if (i_ < iv_.size() && iv_[i_].start < m) total += static_cast<double>(m - iv_[i_].start);
+    return total;
+  }
+
+ private:
+  const std::vector<AirInterval>& iv_;
+  const std::vector<double>& cumulative_;
+  std::size_t i_ = 0;
+};
 
 }  // namespace
 
@@ -164,12 +178,21 @@ std::vector<double> PiecewiseCorrelation::expand() const {
 PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
                                                   std::int64_t length, std::int64_t k_min, std::int64_t k_max,
                                                   AwccWorkspace& workspace) {
+  PiecewiseCorrelation out;
+  window_correlation_piecewise(x, y, start, length, k_min, k_max, workspace, out);
+  return out;
+}
+
+void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max,
+                                  AwccWorkspace& workspace, PiecewiseCorrelation& out) {
   auto& scratch = workspace.scratch();
   auto& a = scratch.clipped_x;
   auto& b = scratch.clipped_y;
   auto& ca = scratch.air_x;
   auto& cb = scratch.air_y;
-  PiecewiseCorrelation out;
+  out.lags.clear();
+  out.values.clear();
   clip(x, start, length, a);
   clip(y, start, length, b);
   const double L = static_cast<double>(length);
@@ -180,7 +203,7 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
   const double ax = ca.back(), ay = cb.back();
   const double mx = ax / L, my = ay / L;
   const double qx = L * mx * (1 - mx), qy = L * my * (1 - my);
-  if (!(qx > 0.0) || !(qy > 0.0) || k_max < k_min) return out;
+  if (!(qx > 0.0) || !(qy > 0.0) || k_max < k_min) return;
 
   // Overlap sums from the pairs of air intervals (overlap_impulses.hpp).
   // Impulses and every other kink (the mean terms' kinks at
@@ -221,6 +244,7 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
   //   k >= 0: sx = air of x in [0, L - k), sy = air of y in [k, L);
   //   k <  0: sx = air of x in [-k, L),    sy = air of y in [0, L + k).
   const double norm = 1.0 / std::sqrt(qx * qy);
+  AirBelow air_a(a, ca), air_b(b, cb);
   std::int64_t at = k_min;
   for (std::size_t i = 0; i < lags;) {
     std::uint64_t word;
@@ -229,20 +253,22 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
       i += 8;
       continue;
     }
-    if (!mark[i]) {
-      ++i;
-      continue;
+    // The first marked byte of the word (bytes are 0 or 1; the padding is 0).
+    if constexpr (std::endian::native == std::endian::little) {
+      i += static_cast<std::size_t>(std::countr_zero(word)) / 8;
+    } else {
+      while (!mark[i]) ++i;
     }
     const std::int64_t k = k_min + static_cast<std::int64_t>(i);
     value += slope * (k - at);  // slope is constant on [at, k)
     at = k;
     double sx, sy;
     if (k >= 0) {
-      sx = air_below(a, ca, length - k);
-      sy = ay - air_below(b, cb, k);
+      sx = air_a(length - k);
+      sy = ay - air_b(k);
     } else {
-      sx = ax - air_below(a, ca, -k);
-      sy = air_below(b, cb, length + k);
+      sx = ax - air_a(-k);
+      sy = air_b(length + k);
     }
     const double n = static_cast<double>(length - (k >= 0 ? k : -k));
     out.lags.push_back(k);
@@ -250,7 +276,6 @@ PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const A
     slope += impulse[i];
     ++i;
   }
-  return out;
 }
 
 std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
@@ -707,6 +732,7 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   const bool use_fft = options.path == CorrelationPath::fft;
   std::vector<std::uint8_t> dense_x, dense_y;
   std::vector<double> xs, ys;
+  PiecewiseCorrelation piecewise;  // reused: its buffers outlive the windows
   for (auto& w : result.windows) {
     const auto [k_min, k_max] = awcc_lag_range(w.length, dx, fs, options);
     if (k_max < k_min) {
@@ -723,7 +749,8 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
       ys.assign(dense_y.begin(), dense_y.end());
       analyse_window(w, window_correlation_fft(xs, ys, k_min, k_max, workspace), k_min, dx, fs, options, workspace);
     } else {
-      const auto r = window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max, workspace);
+      auto& r = piecewise;
+      window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max, workspace, r);
       const CorrelationPeak p = r.empty() ? CorrelationPeak{}
                                           : analyse_correlation(r, options.subsample, options.prominence_fraction,
                                                                 workspace);

@@ -1,6 +1,7 @@
 #include "synth/synthesiser.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <fmt/format.h>
@@ -78,6 +79,11 @@ struct ActiveBubble {
   double t_entry;
   std::uint64_t serial;
   std::uint64_t pierced_mask = 0;
+  std::uint64_t open_mask = 0;  // tips inside this bubble at the end of the last step (in open_)
+  // Per tip (the first few): the probe's lateral path length below which
+  // the tip cannot reach this bubble (Synthesiser::pierce_tip).
+  static constexpr std::size_t cached_tips = 4;
+  std::array<double, cached_tips> clear_until{};
 };
 
 // Active bubbles sorted by key.x: a vector with a moving head, so that the
@@ -93,8 +99,20 @@ class BubbleQueue {
   void pop_front() {
     if (++head_ >= 4096 && 2 * head_ >= items_.size()) {
       items_.erase(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(head_));
+      erased_ += head_;
       head_ = 0;
     }
+  }
+  /// The first bubble whose key.x is not below `key` (std::partition_point's
+  /// answer), found by walking from where the last search with this `hint`
+  /// ended: keys move a little from one step to the next, so the walk is a
+  /// step or two where a binary search is a dozen unpredictable branches.
+  iterator first_not_below(double key, std::size_t& hint) {
+    std::size_t i = hint >= erased_ ? std::clamp(hint - erased_, head_, items_.size()) : head_;
+    while (i > head_ && items_[i - 1].key.x >= key) --i;
+    while (i < items_.size() && items_[i].key.x < key) ++i;
+    hint = i + erased_;
+    return items_.begin() + static_cast<std::ptrdiff_t>(i);
   }
   void insert_sorted(const ActiveBubble& b) {
     auto pos = end();
@@ -105,6 +123,14 @@ class BubbleQueue {
  private:
   std::vector<ActiveBubble> items_;
   std::size_t head_ = 0;
+  std::size_t erased_ = 0;  // items erased from the front so far: hints survive the compaction
+};
+
+// A neighbour of a bubble being placed, as every placement attempt tests it.
+struct Neighbour {
+  double sx2, r2;                 // squared streamwise separation and squared sum of radii
+  double entry_y, key_dy;         // its entry y, and key_b.y - key_o.y
+  double entry_z, key_dz;
 };
 
 struct Pending {
@@ -267,6 +293,7 @@ class Synthesiser {
     record_steps_ = static_cast<std::int64_t>(std::ceil(duration_ / dt_));
 
     open_.resize(tips_.size());
+    pierce_hint_.assign(tips_.size(), 0);
     pierces_.resize(tips_.size());
     pair_counts_.assign(tips_.size() * tips_.size(), 0);
     tip_counts_.assign(tips_.size(), 0);
@@ -363,10 +390,12 @@ class Synthesiser {
   // One velocity step [t, t + dt) at constant velocity u.
   void advance(double t, const Vec3& u) {
     const Vec3 d_next{d_.x + u.x * dt_, d_.y + u.y * dt_, d_.z + u.z * dt_};
+    lateral_path_next_ = lateral_path_ + std::sqrt(u.y * u.y + u.z * u.z) * dt_;
     arrivals(t, u, d_next);
     pierce(t, u, d_next);
     retire(d_next);
     d_ = d_next;
+    lateral_path_ = lateral_path_next_;
   }
 
   // Arrivals and retries of waiting bubbles during the step, in time order.
@@ -429,6 +458,13 @@ class Synthesiser {
     }
   }
 
+  // A lateral separation in the sphere-mapped space. Spherical bubbles (the
+  // usual case) skip the division: x / 1 is x, and a division is the slowest
+  // step of the placement test.
+  [[nodiscard]] double to_sphere(double lateral) const {
+    return spherical_ ? lateral : lateral / sizes_.lateral_factor;
+  }
+
   bool try_place(double diameter, double t_entry, const Vec3& key, bool must_place) {
     ActiveBubble b;
     b.key = key;
@@ -445,20 +481,35 @@ class Synthesiser {
     // away from the tips, and the tips would see a void fraction well below c
     // (0.19 instead of 0.25 in the base case).
     const double reach = 2.0 * a_x_max_;
-    auto lo = std::partition_point(bubbles_.begin(), bubbles_.end(),
-                                   [&](const ActiveBubble& o) { return o.key.x < key.x - reach; });
-    auto hi = std::partition_point(lo, bubbles_.end(), [&](const ActiveBubble& o) { return o.key.x <= key.x + reach; });
+    const auto lo = bubbles_.first_not_below(key.x - reach, place_hint_lo_);
+    // partition_point(o.key.x <= key.x + reach): the first key above it.
+    const auto hi = bubbles_.first_not_below(std::nextafter(key.x + reach, HUGE_VAL), place_hint_hi_);
+    // What the attempts share, once: each neighbour's streamwise separation
+    // and the parts of its lateral ones that do not depend on the entry
+    // drawn. Neighbours streamwise too far for any lateral position drop out
+    // (sx^2 >= r^2: the sum below cannot fall under r^2 either).
+    auto& near = neighbours_;
+    near.clear();
+    for (auto it = lo; it != hi; ++it) {
+      // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
+      const double sx = (it->key.x - key.x) / sizes_.x_factor;
+      const double r = b.radius + it->radius;
+      if (sx * sx >= r * r) continue;
+      near.push_back({sx * sx, r * r, it->entry.y, key.y - it->key.y, it->entry.z, key.z - it->key.z});
+    }
     bool placed = false;
     for (int attempt = 0; attempt <= scene_.overlap_retries; ++attempt) {
       b.entry = {entry_x_, (bubble_rng_.uniform() - 0.5) * length_[1], (bubble_rng_.uniform() - 0.5) * length_[2]};
       bool overlaps = false;
-      for (auto it = lo; it != hi && !overlaps; ++it) {
-        // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
-        const double sx = (it->key.x - key.x) / sizes_.x_factor;
-        const double sy = wrap(b.entry.y - it->entry.y - (key.y - it->key.y), length_[1]) / sizes_.lateral_factor;
-        const double sz = wrap(b.entry.z - it->entry.z - (key.z - it->key.z), length_[2]) / sizes_.lateral_factor;
-        const double r = b.radius + it->radius;
-        overlaps = sx * sx + sy * sy + sz * sz < r * r;
+      for (const auto& o : near) {
+        const double sy = to_sphere(wrap(b.entry.y - o.entry_y - o.key_dy, length_[1]));
+        const double sxy = o.sx2 + sy * sy;
+        if (sxy >= o.r2) continue;  // adding sz^2 cannot bring it under r^2
+        const double sz = to_sphere(wrap(b.entry.z - o.entry_z - o.key_dz, length_[2]));
+        if (sxy + sz * sz < o.r2) {
+          overlaps = true;
+          break;
+        }
       }
       if (!overlaps) {
         placed = true;
@@ -485,8 +536,7 @@ class Synthesiser {
     for (std::size_t j = 0; j < tips_.size(); ++j) {
       const double key_lo = entry_x_ + d_lo - tips_[j].x - a_x_max_;
       const double key_hi = entry_x_ + d_hi - tips_[j].x + a_x_max_;
-      auto it = std::partition_point(bubbles_.begin(), bubbles_.end(),
-                                     [&](const ActiveBubble& b) { return b.key.x < key_lo; });
+      auto it = bubbles_.first_not_below(key_lo, pierce_hint_[j]);
       for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
         const double s0 = std::max(0.0, it->t_entry - t);
         pierce_tip(*it, j, t, s0, u);
@@ -494,12 +544,39 @@ class Synthesiser {
     }
   }
 
+  // Whether the tip stays outside the bubble for the whole step by one
+  // coordinate alone: |q + v s| >= |q| - |v| dt > 1 for s in [0, dt]. The
+  // margin (1e-9 of the unit form) is far above the rounding of the roots
+  // below, so a skipped bubble is one whose roots lie outside the step
+  // whichever way they are rounded: skipping changes no output.
+  [[nodiscard]] bool outside_all_step(double q, double v) const {
+    return std::fabs(q) - std::fabs(v) * dt_ > 1.0 + 1e-9;
+  }
+
+  // Most candidates pass the tip at a lateral distance: the bubble moves
+  // with the flow, the tip with it laterally by at most the lateral path
+  // length of the probe (the minimum-image distance is 1-Lipschitz). A
+  // bubble found at lateral distance D at the start of a step cannot hold
+  // the tip until that path has grown by D - a_lat; until then it is
+  // skipped. The margin (1e-3 a_lat) is orders of magnitude above the
+  // rounding of the path sum and of the positions over a bubble's passage,
+  // so a skipped bubble is one that the full test would pass over too:
+  // skipping changes no output.
+  static constexpr double lateral_margin = 1e-3;
+
   void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
     const Vec3& p = tips_[j];
+    const bool was_inside = (b.open_mask >> j) & 1u;
+    const bool cached = j < ActiveBubble::cached_tips;
+    if (cached && !was_inside && lateral_path_next_ < b.clear_until[j]) return;
     const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
-    const double qy = (wrap(b.entry.y + d_.y - b.key.y, length_[1]) - p.y) * b.inv_axes.y;
-    const double qz = (wrap(b.entry.z + d_.z - b.key.z, length_[2]) - p.z) * b.inv_axes.z;
-    const double vx = u.x * b.inv_axes.x, vy = u.y * b.inv_axes.y, vz = u.z * b.inv_axes.z;
+    const double vx = u.x * b.inv_axes.x;
+    const double lateral_y = wrap(b.entry.y + d_.y - b.key.y, length_[1]) - p.y;
+    const double lateral_z = wrap(b.entry.z + d_.z - b.key.z, length_[2]) - p.z;
+    const double qy = lateral_y * b.inv_axes.y;
+    const double vy = u.y * b.inv_axes.y;
+    const double qz = lateral_z * b.inv_axes.z;
+    const double vz = u.z * b.inv_axes.z;
     const double a = vx * vx + vy * vy + vz * vz;
     const double bh = qx * vx + qy * vy + qz * vz;
     const double c = qx * qx + qy * qy + qz * qz - 1.0;
@@ -524,23 +601,38 @@ class Synthesiser {
     }
 
     auto& open = open_[j];
-    auto found = std::find_if(open.begin(), open.end(), [&](const OpenPierce& o) { return o.serial == b.serial; });
-    if (found != open.end()) {
+    if (was_inside) {
+      auto found = std::find_if(open.begin(), open.end(), [&](const OpenPierce& o) { return o.serial == b.serial; });
       if (!crosses || r2 <= s0) {
         emit(j, b, found->t_in, t + s0);
         open.erase(found);
+        b.open_mask &= ~(std::uint64_t{1} << j);
       } else if (r2 < dt_) {
         emit(j, b, found->t_in, t + r2);
         open.erase(found);
+        b.open_mask &= ~(std::uint64_t{1} << j);
       }
       return;
     }
-    if (!crosses || r2 <= s0 || r1 >= dt_) return;
+    if (!crosses || r2 <= s0 || r1 >= dt_) {
+      if (cached) {
+        // The distance to the tip's nearest periodic image: lateral_y is one
+        // image of the tip's offset (the bubble's image is chosen before the
+        // tip's offset is taken), the other is length - |lateral_y|. Lateral
+        // semi-axes are equal (try_place): a_lat = 1 / inv_axes.y.
+        const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
+        const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
+        const double distance = std::sqrt(ny * ny + nz * nz);
+        b.clear_until[j] = lateral_path_ + distance - (1.0 + lateral_margin) / b.inv_axes.y;
+      }
+      return;
+    }
     const double t_in = t + std::max(r1, s0);
     if (r2 < dt_) {
       emit(j, b, t_in, t + r2);
     } else {
       open.push_back({b.serial, t_in});
+      b.open_mask |= std::uint64_t{1} << j;
     }
   }
 
@@ -588,6 +680,7 @@ class Synthesiser {
   const Scene& scene_;
   const SynthesisOptions& options_;
   SizeModel sizes_;
+  bool spherical_ = sizes_.lateral_factor == 1.0;
   Rng bubble_rng_;
   double dt_ = 0.0, fs_ = 0.0, duration_ = 0.0;
   std::int64_t samples_ = 0;
@@ -604,12 +697,18 @@ class Synthesiser {
   double next_time_ = 0.0, next_key_ = 0.0;
 
   Vec3 d_{};  // common displacement at the current step start
+  // Lateral path length of the flow past the probe, sum of |u_lat| dt, at
+  // the current step's start and end (pierce_tip's lateral skip).
+  double lateral_path_ = 0.0, lateral_path_next_ = 0.0;
   BubbleQueue bubbles_;
+  std::vector<Neighbour> neighbours_;  // scratch of try_place
   std::deque<Pending> pending_;
   std::vector<BubbleRecord> records_;
   std::uint64_t serial_ = 0;
   double max_retired_key_ = -std::numeric_limits<double>::infinity();
   std::vector<std::vector<OpenPierce>> open_;
+  std::vector<std::size_t> pierce_hint_;  // per tip: where the last candidate search ended
+  std::size_t place_hint_lo_ = 0, place_hint_hi_ = 0;
   std::vector<std::vector<awcc::AirInterval>> pierces_;
   std::vector<std::int64_t> pair_counts_;
   std::vector<std::int64_t> tip_counts_;

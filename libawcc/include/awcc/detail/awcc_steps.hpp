@@ -30,6 +30,10 @@ struct PiecewiseCorrelation {
 PiecewiseCorrelation window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
                                                   std::int64_t length, std::int64_t k_min, std::int64_t k_max,
                                                   AwccWorkspace& workspace);
+/// The same into the caller's `out`, whose buffers are reused (no allocation per window).
+void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
+                                  std::int64_t length, std::int64_t k_min, std::int64_t k_max,
+                                  AwccWorkspace& workspace, PiecewiseCorrelation& out);
 
 /// The normalised cross-correlation of a window, lags [k_min, k_max].
 /// Binary signals, interval path (exact): the piecewise form expanded.
