@@ -1,7 +1,7 @@
 // One study run end to end (docs/performance.md, issue 17): synthesis, FSCC
 // and AWCC of the base case (METHOD 5) as pdp sweep runs it, on one thread.
 //
-//   run_bench [--duration SECONDS] [--repeat N] [--seed S]
+//   run_bench [--scene FILE.toml] [--duration SECONDS] [--repeat N] [--seed S]
 //
 // Prints the median (and range) of each stage over N runs, and a fingerprint
 // of the results: every estimate and the truth written with 17 significant
@@ -52,12 +52,15 @@ int main(int argc, char** argv) {
   double duration = 300.0;
   int repeat = 5;
   std::uint64_t seed = 1;
+  const char* scene_file = nullptr;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--scene") && i + 1 < argc) scene_file = argv[++i];
+    else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
   }
   synth::Scene scene;
+  if (scene_file) synth::load_scene_toml(scene_file, scene);
   scene.duration = duration;
   scene.seed = seed;
   pdp::StudyOptions options;  // as pdp sweep: FSCC and AWCC, window truth kept
@@ -77,7 +80,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::printf("base case, %.0f s at %.0f kHz, seed %llu, %d runs (one thread):\n", duration, scene.fs / 1e3,
+  std::printf("%s, %.0f s at %.0f kHz, seed %llu, %d runs (one thread):\n", scene_file ? scene_file : "base case",
+              duration, scene.fs / 1e3,
               static_cast<unsigned long long>(seed), repeat);
   for (const auto* s : {&synth, &fscc, &awcc, &total}) show(*s);
   awcc::Sha256 hash;

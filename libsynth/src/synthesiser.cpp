@@ -59,12 +59,18 @@ struct SizeModel {
 
 // Minimum-image separation on a periodic interval of the given length.
 // Separations are rarely more than one period off (bubbles live for a few
-// milliseconds), so a loop beats a call to nearbyint on this hot path.
+// milliseconds), so one conditional shift beats a call to nearbyint on this
+// hot path. Both shift conditions are read off the input (after a shift
+// down the value cannot be below -half, so this is what testing the shifted
+// value gave), which keeps them off each other's latency; a separation
+// within one length needs no more (the shift lands in [-half, half]).
 inline double wrap(double separation, double length) {
   const double half = 0.5 * length;
-  separation -= length * static_cast<double>(separation > half);
-  separation += length * static_cast<double>(separation < -half);
-  if (separation > half || separation < -half) [[unlikely]] {
+  const double above = length * static_cast<double>(separation > half);
+  const double below = length * static_cast<double>(separation < -half);
+  const bool far = std::fabs(separation) > length;
+  separation = (separation - above) + below;
+  if (far && (separation > half || separation < -half)) [[unlikely]] {
     separation -= length * std::nearbyint(separation / length);
   }
   return separation;
