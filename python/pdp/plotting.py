@@ -165,32 +165,36 @@ def _not_ok(ax, what, result):
     return True
 
 
-def profile_void_fraction(rows, ax=None):
+def _both_tips(rows, ax, key, xlabel, title):
+    """A phase quantity of both tips (``key`` and ``key_ci95`` in each tip) against position."""
     fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
-    _series(ax, y, rows, lambda r: get(r, "tips", 0, "void_fraction"),
-            lambda r: get(r, "tips", 0, "void_fraction_ci95"),
-            color=BLUE, marker="o", ls="-", label="leading tip, 95 % interval")
-    _series(ax, y, rows, lambda r: get(r, "tips", 1, "void_fraction"),
-            lambda r: get(r, "tips", 1, "void_fraction_ci95"),
-            color=ORANGE, marker="s", ls="--", label="trailing tip, 95 % interval")
+    for tip, colour, marker, ls, name in ((0, BLUE, "o", "-", "leading"), (1, ORANGE, "s", "--", "trailing")):
+        _series(ax, y, rows, lambda r: get(r, "tips", tip, key), lambda r: get(r, "tips", tip, key + "_ci95"),
+                color=colour, marker=marker, ls=ls, label=f"{name} tip, 95 % interval")
     ax.set_xlim(left=0)
-    _finish(ax, ylabel, "void fraction c (-)", "Void fraction")
+    _finish(ax, ylabel, xlabel, title)
     return fig
+
+
+def profile_void_fraction(rows, ax=None):
+    return _both_tips(rows, ax, "void_fraction", "void fraction c (-)", "Void fraction")
 
 
 def profile_count_rate(rows, ax=None):
-    fig, ax = _profile_axes(ax)
-    y, ylabel = positions_mm(rows)
-    _series(ax, y, rows, lambda r: get(r, "tips", 0, "bubble_count_rate"),
-            lambda r: get(r, "tips", 0, "bubble_count_rate_ci95"), color=BLUE, marker="o", ls="-",
-            label="leading tip, 95 % interval")
-    _series(ax, y, rows, lambda r: get(r, "tips", 1, "bubble_count_rate"),
-            lambda r: get(r, "tips", 1, "bubble_count_rate_ci95"), color=ORANGE, marker="s", ls="--",
-            label="trailing tip, 95 % interval")
-    ax.set_xlim(left=0)
-    _finish(ax, ylabel, "bubble count rate F (1/s)", "Bubble count rate")
-    return fig
+    return _both_tips(rows, ax, "bubble_count_rate", "bubble count rate F (1/s)", "Bubble count rate")
+
+
+def _awcc_and_corrected(ax, y, rows, quantity, measured_label):
+    """AWCC's value of a quantity with its 95 % interval, and the corrected
+    median with its 95 % (thin) and 80 % (thick) bands."""
+    _series(ax, y, rows, lambda r: get(r, "awcc", quantity), lambda r: get(r, "awcc", quantity + "_ci95"),
+            color=BLUE, marker="o", ls="-", label=measured_label)
+    corrected = lambda r: get(r, "correction", quantity, "median")  # noqa: E731
+    for low, high, marker, width, label in (("0.025", "0.975", None, 1.0, "corrected, 95 % band"),
+                                            ("0.1", "0.9", "^", 3.0, "corrected median, 80 % band")):
+        _series(ax, y, rows, corrected, lambda r: _quantiles(r, quantity, low, high), color=VERMILION,
+                marker=marker, ls="none", elinewidth=width, label=label)
 
 
 def _quantiles(r, q, a, b):
@@ -203,13 +207,7 @@ def profile_velocity(rows, ax=None):
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "fscc", "velocity"), color=BLACK, marker="D", ls=":", mfc="none",
             label="FSCC")
-    _series(ax, y, rows, lambda r: get(r, "awcc", "velocity"), lambda r: get(r, "awcc", "velocity_ci95"),
-            color=BLUE, marker="o", ls="-", label="AWCC, 95 % interval")
-    corrected = lambda r: get(r, "correction", "velocity", "median")  # noqa: E731
-    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "velocity", "0.025", "0.975"), color=VERMILION,
-            marker=None, ls="none", elinewidth=1.0, label="corrected, 95 % band")
-    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "velocity", "0.1", "0.9"), color=VERMILION, marker="^",
-            ls="none", elinewidth=3.0, label="corrected median, 80 % band")
+    _awcc_and_corrected(ax, y, rows, "velocity", "AWCC, 95 % interval")
     _finish(ax, ylabel, "mean interfacial velocity (m/s)", "Velocity")
     return fig
 
@@ -217,14 +215,7 @@ def profile_velocity(rows, ax=None):
 def profile_turbulence(rows, ax=None):
     fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
-    _series(ax, y, rows, lambda r: get(r, "awcc", "turbulence_intensity"),
-            lambda r: get(r, "awcc", "turbulence_intensity_ci95"), color=BLUE, marker="o", ls="-",
-            label="AWCC measured, 95 % interval")
-    corrected = lambda r: get(r, "correction", "turbulence_intensity", "median")  # noqa: E731
-    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "turbulence_intensity", "0.025", "0.975"),
-            color=VERMILION, marker=None, ls="none", elinewidth=1.0, label="corrected, 95 % band")
-    _series(ax, y, rows, corrected, lambda r: _quantiles(r, "turbulence_intensity", "0.1", "0.9"), color=VERMILION,
-            marker="^", ls="none", elinewidth=3.0, label="corrected median, 80 % band")
+    _awcc_and_corrected(ax, y, rows, "turbulence_intensity", "AWCC measured, 95 % interval")
     ax.set_xlim(left=0)
     _finish(ax, ylabel, "turbulence intensity Tu (-)", "Turbulence intensity (AWCC)")
     return fig
