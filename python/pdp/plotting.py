@@ -15,6 +15,7 @@ m/s; never metres in scientific notation.
 
 import io
 import math
+import re
 
 import matplotlib
 
@@ -82,14 +83,19 @@ def footer(fig, text):
 
 
 def svg(fig, salt="pdp"):
-    """The figure as inline SVG text (no XML prologue). ``salt`` seeds the SVG's
-    element ids: the same figure gives the same text, and figures with
-    different salts can share one HTML page without clashing ids."""
+    """The figure as inline SVG text (no XML prologue). Every element id, and
+    every reference to one, is prefixed with ``salt`` + "-": figures with
+    different salts share one HTML page without clashing ids (matplotlib
+    numbers its groups figure_1, axes_1, ... in every figure), and the same
+    figure gives the same text."""
     buf = io.StringIO()
     with matplotlib.rc_context({"svg.hashsalt": salt}):
         fig.savefig(buf, format="svg", metadata={"Date": None})
     text = buf.getvalue()
-    return text[text.index("<svg"):]
+    text = text[text.index("<svg"):]
+    text = re.sub(r'\bid="([^"]+)"', rf'id="{salt}-\1"', text)
+    text = re.sub(r'url\(#([^)]+)\)', rf'url(#{salt}-\1)', text)
+    return re.sub(r'href="#([^"]+)"', rf'href="#{salt}-\1"', text)
 
 
 def note(ax, text):
@@ -124,29 +130,35 @@ def _profile_axes(ax):
 
 
 def positions_mm(rows):
-    """Each row's position in mm (its index when the profile has none)."""
-    have = all(number(r.get("position")) is not None for r in rows)
-    if have:
+    """Each row's position in mm, or its number (from 1) when any row has no position."""
+    missing = [i + 1 for i, r in enumerate(rows) if number(r.get("position")) is None]
+    if not missing:
         return [1e3 * float(r["position"]) for r in rows], "position (mm)"
-    return list(range(1, len(rows) + 1)), "row (no positions given)"
+    if len(missing) == len(rows):
+        return list(range(1, len(rows) + 1)), "row (no positions given)"
+    return list(range(1, len(rows) + 1)), f"row (no position for row {', '.join(map(str, missing))})"
 
 
 def _series(ax, y, rows, value, interval=None, scale=1.0, **style):
-    """Points with horizontal error bars; rows without a value are left out."""
+    """Points with horizontal error bars, joined in order of position; a row
+    without a value breaks the line (a gap is not bridged). Returns how many
+    rows have a value."""
+    order = sorted(range(len(rows)), key=lambda i: y[i])
     xs, ys, lo, hi = [], [], [], []
-    for yi, r in zip(y, rows):
-        v = number(value(r))
-        if v is None:
-            continue
-        xs.append(v * scale)
-        ys.append(yi)
-        if interval:
-            a, b = (number(x) for x in (interval(r) or (None, None)))
-            lo.append(max(0.0, v * scale - a * scale) if a is not None else 0.0)
-            hi.append(max(0.0, b * scale - v * scale) if b is not None else 0.0)
-    if xs:
+    for i in order:
+        v = number(value(rows[i]))
+        ys.append(y[i])
+        xs.append(math.nan if v is None else v * scale)
+        a, b = (number(x) for x in ((interval(rows[i]) if interval else None) or (None, None)))
+        lo.append(max(0.0, v * scale - a * scale) if v is not None and a is not None else 0.0)
+        hi.append(max(0.0, b * scale - v * scale) if v is not None and b is not None else 0.0)
+    shown = sum(1 for x in xs if not math.isnan(x))
+    if shown:
         ax.errorbar(xs, ys, xerr=[lo, hi] if interval else None, capsize=2.5, **style)
-    return len(xs)
+    if ys:  # every row's position on the axis, drawn or not
+        pad = 0.04 * (max(ys) - min(ys)) or 1.0
+        ax.set_ylim(min(ys) - pad, max(ys) + pad)
+    return shown
 
 
 def _finish(ax, ylabel, xlabel, title, legend_size=None):
@@ -186,8 +198,13 @@ def profile_count_rate(rows, ax=None):
 
 
 def _awcc_and_corrected(ax, y, rows, quantity, measured_label):
-    """AWCC's value of a quantity with its 95 % interval, and the corrected
-    median with its 95 % (thin) and 80 % (thick) bands."""
+    """AWCC's value of a quantity with its 95 % interval (and, under the
+    bubble-probe correction, the value measured before it), and the
+    corrected median with its 95 % (thin) and 80 % (thick) bands."""
+    if any(get(r, "awcc", "probe_corrected") for r in rows):
+        _series(ax, y, rows, lambda r: get(r, "awcc", quantity + "_measured"), color=SKY, marker="v", ls=":",
+                label="AWCC before the probe correction")
+        measured_label = "AWCC probe-corrected, 95 % interval"
     _series(ax, y, rows, lambda r: get(r, "awcc", quantity), lambda r: get(r, "awcc", quantity + "_ci95"),
             color=BLUE, marker="o", ls="-", label=measured_label)
     corrected = lambda r: get(r, "correction", quantity, "median")  # noqa: E731
@@ -215,7 +232,7 @@ def profile_velocity(rows, ax=None):
 def profile_turbulence(rows, ax=None):
     fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
-    _awcc_and_corrected(ax, y, rows, "turbulence_intensity", "AWCC measured, 95 % interval")
+    _awcc_and_corrected(ax, y, rows, "turbulence_intensity", "AWCC, 95 % interval")
     ax.set_xlim(left=0)
     _finish(ax, ylabel, "turbulence intensity Tu (-)", "Turbulence intensity (AWCC)")
     return fig
@@ -321,7 +338,7 @@ def voltage_pdf(ax, structure, tips):
 
 def correlation(ax, functions, fscc):
     if functions is None:
-        note(ax, "correlation functions not available")
+        note(ax, "R11 and R12 not available: see this position's note")
         return
     lag = [1e3 * t for t in functions["lag"]]
     ax.plot(lag, functions["r11"], color=BLUE, label="R11 (leading tip)")
@@ -347,7 +364,12 @@ def _window_fates(ax, windows, awcc):
     """The windows' velocities with the indices of the accepted ones and of the
     rejected ones that have a velocity; None, said in the panel, without windows."""
     if windows is None or not len(windows["velocity"]):
-        note(ax, "no AWCC windows" if awcc else "AWCC not run")
+        if not awcc:
+            note(ax, "AWCC not run")
+        elif windows is None:
+            note(ax, "window table not available: see this position's note")
+        else:
+            note(ax, "no AWCC windows")
         return None
     v, fate = windows["velocity"], windows["fate"]
     return (v, [i for i in range(len(v)) if fate[i] == "accepted"],
@@ -366,8 +388,11 @@ def window_series(ax, windows, awcc):
     if awcc and number(awcc.get("velocity")) is not None:
         ax.axhline(awcc["velocity"], color=VERMILION, lw=1.2, label=f"mean {awcc['velocity']:.3g} m/s")
     if acc:
-        hi = max(v[i] for i in acc)
-        ax.set_ylim(0, 2.0 * hi)
+        top = 2.0 * max(v[i] for i in acc)
+        ax.set_ylim(0, top)
+        above = sum(1 for i in rej if v[i] > top)
+        if above:
+            ax.plot([], [], ls="none", label=f"{above} rejected above {top:.3g} m/s not shown")
     _finish(ax, "window velocity (m/s)", "window start (s)", "AWCC window velocities")
 
 
@@ -380,11 +405,13 @@ def window_histogram(ax, windows, awcc):
         note(ax, "no accepted window")
         return
     acc = [v[i] for i in accepted]
-    lo, hi = min(acc), max(acc)
-    rej = [v[i] for i in rejected if v[i] <= 2 * hi]
+    top = 2.0 * max(acc)
+    rej = [v[i] for i in rejected if v[i] <= top]
     bins = max(8, min(40, int(math.sqrt(len(acc)) * 2)))
-    edges = [lo + (2 * hi - lo) * k / bins for k in range(bins + 1)] if hi > lo else bins
-    ax.hist([acc, rej], bins=edges, stacked=True, color=[BLUE, GREY], label=["accepted", "rejected"])
+    edges = [top * k / bins for k in range(bins + 1)]
+    above = len(rejected) - len(rej)
+    ax.hist([acc, rej], bins=edges, stacked=True, color=[BLUE, GREY],
+            label=["accepted", f"rejected ({above} above {top:.3g} m/s not shown)" if above else "rejected"])
     _finish(ax, "windows", "window velocity (m/s)", "Window velocity histogram")
 
 
@@ -422,6 +449,7 @@ def arrival_pdf(ax, arrivals):
         n = min(30, len(cls["pdf"]) - 1)  # the first 30 bins; the last is the overflow
         x = [1e3 * w * (i + 0.5) for i in range(n)]
         colour = PALETTE[k % len(PALETTE)]
+        marker = "osD^vP*X"[k % 8]
         lo, hi = cls.get("lower"), cls.get("upper")
         name = (f"{'' if lo is None else f'{1e3 * lo:g}-'}{'' if hi is None else f'{1e3 * hi:g}'} {unit}"
                 if lo is not None or hi is not None else "all")
@@ -429,7 +457,7 @@ def arrival_pdf(ax, arrivals):
             name = f"<= {1e3 * hi:g} {unit}"
         elif hi is None and lo is not None:
             name = f"> {1e3 * lo:g} {unit}"
-        ax.plot(x, _gaps(cls["pdf"][:n]), color=colour, marker="o", ms=2.5, label=f"{name} (N={cls['particles']})")
+        ax.plot(x, _gaps(cls["pdf"][:n]), color=colour, marker=marker, ms=3, label=f"{name} (N={cls['particles']})")
         ax.plot(x, _gaps(cls["reference"][:n]), color=colour, ls=":", lw=1.0)
         shown += 1
     if not shown:
@@ -437,12 +465,13 @@ def arrival_pdf(ax, arrivals):
         return
     ax.plot([], [], color=GREY, ls=":", label="Poisson reference")
     _finish(ax, "fraction of intervals (-)", "inter-particle arrival time (ms)", "Inter-particle arrival times",
-            legend_size=6.5)
+            legend_size=0.8 * matplotlib.rcParams["legend.fontsize"])
 
 
 def velocity_spectrum(ax, spectrum, series):
     if spectrum is None:
-        note(ax, "velocity spectrum: " + ((series or {}).get("reason") or "not available"))
+        reason = (series or {}).get("reason")
+        note(ax, f"velocity spectrum: {reason}" if reason else "velocity spectrum not available: see this position's note")
         return
     f = [x for x in spectrum["frequency"] if x > 0]
     p = [d for x, d in zip(spectrum["frequency"], spectrum["density"]) if x > 0]
@@ -461,10 +490,25 @@ def velocity_spectrum(ax, spectrum, series):
     _finish(ax, "PSD ((m/s)^2/Hz)", "frequency (Hz)", "Velocity spectrum")
 
 
+# The per-position figure is printed at about half its size: its text is
+# drawn larger, to stay legible (about 6.5 pt on A4).
+POSITION_FONTS = {"font.size": 13, "axes.titlesize": 14, "axes.labelsize": 13, "legend.fontsize": 11,
+                  "xtick.labelsize": 12, "ytick.labelsize": 12}
+
+
+def position_svg(row, detail, salt):
+    """The per-position figure as SVG; each panel is the group ``salt-KEY``
+    (KEY of POSITION_PANELS)."""
+    with matplotlib.rc_context(POSITION_FONTS):
+        return svg(position_figure(row, detail), salt=salt)
+
+
 def position_figure(row, detail, gid_prefix=""):
     """Every per-position panel of one recording in one figure (3 x 3); each
-    panel's SVG group is named gid_prefix + its POSITION_PANELS key."""
-    fig, axes = figure(width=13.5, height=10.5, rows=3, cols=3, margins=(0.62, 0.5, 0.12, 0.3))
+    panel's SVG group is named gid_prefix + its POSITION_PANELS key. ``detail``
+    holds what the JSON does not (windows, correlation, spectrum); a key that
+    is None is said missing in its panel."""
+    fig, axes = figure(width=13.5, height=10.5, rows=3, cols=3, margins=(0.8, 0.6, 0.12, 0.4))
     s = row.get("structure") or {}
     chord_pdf(axes[0][0], s.get("chord_time_pdf"), "time")
     chord_pdf(axes[0][1], s.get("chord_length_pdf"), "length")

@@ -56,9 +56,21 @@ def load(path):
         raise InputProblem(f"{path}: not a pdp result (a JSON object); give the file pdp process --json wrote")
     rows = data.get("profile") if "profile" in data else [data]
     if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) and isinstance(r.get("tips"), list)
-                                                          for r in rows):
+                                                          and r["tips"] for r in rows):
         raise InputProblem(f"{path}: field 'profile' (or a recording's 'tips') missing or empty: not a pdp "
                            "process result; give the file pdp process --json wrote")
+    where = "profile[{}]" if "profile" in data else "the recording{}"
+    for i, row in enumerate(rows):
+        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum"):
+            if row.get(key) is not None and not isinstance(row[key], dict):
+                raise InputProblem(f"{path}: field '{key}' of {where.format(f'[{i}]' if 'profile' in data else '')} "
+                                   "is not an object: not what pdp process writes; give the file pdp process "
+                                   "--json wrote")
+        if not all(isinstance(t, dict) for t in row["tips"]):
+            raise InputProblem(f"{path}: field 'tips' of {where.format(f'[{i}]' if 'profile' in data else '')} "
+                               "holds something other than objects: not what pdp process writes")
+    if not isinstance(data.get("provenance", {}), dict):
+        raise InputProblem(f"{path}: field 'provenance' is not an object: not what pdp process writes")
     return data, rows, hashlib.sha256(raw).hexdigest()
 
 
@@ -112,12 +124,16 @@ def gap_reason(row, pointer, have_positions):
         awcc = row.get("awcc")
         if awcc is None:
             return "AWCC not run (pdp process --method fscc)"
-        return "AWCC: " + (awcc.get("reason") or awcc.get("quality_reason") or f"status {awcc.get('status')}")
+        if pointer.endswith("_measured") and not awcc.get("probe_corrected"):
+            return "no bubble-probe correction (--probe-correction off): the measured values are AWCC's own columns"
+        why = awcc.get("reason") or (awcc.get("quality_reason") if awcc.get("quality") != "ok" else None)
+        return f"AWCC: {why}" if why else "not defined for this recording"
     if section == "fscc":
         fscc = row.get("fscc")
         if fscc is None:
             return "FSCC not run (pdp process --method awcc)"
-        return "FSCC: " + (fscc.get("reason") or fscc.get("note") or f"status {fscc.get('status')}")
+        why = fscc.get("reason") or fscc.get("note")
+        return f"FSCC: {why}" if why else "not defined for this recording"
     if section == "correction":
         c = row.get("correction")
         if c is None:
@@ -175,7 +191,11 @@ def detail_for(index, row, data, json_dir, pdp, options):
     if path is None:
         return None, (f"recording {written} not found (looked in the working folder and beside the JSON): run the "
                       "report from the folder pdp process ran in")
-    if entry.get("sha256") and _sha256_of(path) != entry["sha256"]:
+    try:
+        changed = entry.get("sha256") and _sha256_of(path) != entry["sha256"]
+    except OSError as e:
+        return None, f"{path} cannot be read: {e.strerror}"
+    if changed:
         return None, f"{path} is not the recording processed (its SHA-256 differs from the provenance's)"
     try:
         r = pdp.process(path, **options)
@@ -207,7 +227,9 @@ def _profile_svgs(rows):
 def _position_svg(args):
     from pdp import plotting
     index, row, detail = args
-    return plotting.svg(plotting.position_figure(row, detail or {}, gid_prefix=f"p{index}-"), salt=f"p{index}")
+    if detail is None:  # not recomputed: each panel that needs it says so
+        detail = {"windows": None, "correlation": None, "spectrum": None}
+    return plotting.position_svg(row, detail, salt=f"p{index}")
 
 
 class _Serial:
@@ -252,7 +274,7 @@ def figures(rows, detail_of, jobs, per_position=True):
 # --- the page -----------------------------------------------------------------------
 
 
-def build(json_path, detail=True, jobs=1, command_line=None):
+def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     from pdp import plotting
     import jinja2
     import pdp
@@ -308,11 +330,11 @@ def build(json_path, detail=True, jobs=1, command_line=None):
     made = {"pdp_version": pdp.__version__, "utc_time": datetime.datetime.now(datetime.timezone.utc)
             .strftime("%Y-%m-%dT%H:%M:%SZ"), "command_line": command_line or " ".join(
                 ["python3 -m pdp.report"] + [shlex.quote(a) for a in sys.argv[1:]]),
-            "input": json_path, "sha256": digest}
+            "input": input_name or json_path, "sha256": digest}
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(os.path.dirname(os.path.abspath(__file__))),
                              autoescape=True, trim_blocks=True, lstrip_blocks=True, undefined=jinja2.StrictUndefined)
     return env.get_template("report.html.j2").render(
-        title=os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
+        title=input_name or os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
         positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
         provenance=provenance, made=made, panels=plotting.POSITION_PANELS, single="profile" not in data)
 
@@ -346,6 +368,8 @@ def _parser():
                         help="settings file (TOML): keys are these options' names without --, at the top level or "
                         "in a [report] table; the command line overrides it")
     parser.add_argument("--command-line", default=None, help=argparse.SUPPRESS)
+    # pdp process --report: the JSON is a scratch file; the page names what made it instead.
+    parser.add_argument("--input-name", default=None, help=argparse.SUPPRESS)
     return parser
 
 
@@ -360,8 +384,14 @@ def _apply_config(parser, args, argv):
     except tomllib.TOMLDecodeError as e:
         raise ValueError(f"{args.config}: not TOML ({e}); fix the file") from None
     settings = dict(table.get("report", {}), **{k: v for k, v in table.items() if not isinstance(v, dict)})
-    known = {a.dest.replace("_", "-"): a for a in parser._actions if a.dest not in ("help", "config", "command_line")}
-    given = {a.dest for a in parser._actions for opt in a.option_strings if opt in argv}
+    known = {a.dest.replace("_", "-"): a for a in parser._actions
+             if a.dest not in ("help", "config", "command_line", "input_name")}
+    # What the command line gave, however it was spelt (--output=X, -oX, --out X):
+    # a second parse in which nothing has a default.
+    bare = _parser()
+    for action in bare._actions:
+        action.default = argparse.SUPPRESS
+    given = set(vars(bare.parse_args(argv)))
     for key, value in settings.items():
         action = known.get(key)
         if action is None:
@@ -409,7 +439,8 @@ def main(argv=None):
               "(cmake --install), and run Debian's /usr/bin/python3", file=sys.stderr)
         return EXIT_MISSING_PACKAGE
     try:
-        page = build(args.input, detail=not args.no_detail, jobs=args.jobs, command_line=args.command_line)
+        page = build(args.input, detail=not args.no_detail, jobs=args.jobs, command_line=args.command_line,
+                     input_name=args.input_name)
     except InputProblem as e:
         print(f"pdp report: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -28,7 +28,9 @@ class Page(html.parser.HTMLParser):
         super().__init__()
         self.figures, self.positions, self.gids, self.links, self.scripts = [], [], set(), [], []
         self.columns = {}  # column name -> {row index: (data-value, data-gap)}
-        self.ids, self._column, self._open_ids = {}, None, []
+        self.texts = {}  # column name -> {row index: the cell's visible text}
+        self.ids, self._column, self._open_ids, self._cell = {}, None, [], None
+        self.all_ids, self.references = [], []
         self.feed(text)
 
     def handle_starttag(self, tag, attrs):
@@ -46,8 +48,18 @@ class Page(html.parser.HTMLParser):
             self.scripts.append(a)
         if tag == "tr" and "data-column" in a:
             self._column = self.columns.setdefault(a["data-column"], {})
+            self._column_name = a["data-column"]
         if tag == "td" and "data-row" in a and self._column is not None:
             self._column[int(a["data-row"])] = (json.loads(a["data-value"]), a.get("data-gap"))
+            self._cell = (self._column_name, int(a["data-row"]))
+            self.texts.setdefault(self._column_name, {})[int(a["data-row"])] = ""
+        if "id" in a:
+            self.all_ids.append(a["id"])
+        for name, target in a.items():
+            if name in ("href", "xlink:href") and target.startswith("#"):
+                self.references.append(target[1:])
+            if target and "url(#" in target:
+                self.references.extend(t.split(")")[0] for t in target.split("url(#")[1:])
         if "id" in a and tag != "g":
             self._open_ids.append([a["id"], tag, ""])
             self.ids[a["id"]] = ""
@@ -55,6 +67,8 @@ class Page(html.parser.HTMLParser):
     def handle_endtag(self, tag):
         if tag == "tr":
             self._column = None
+        if tag == "td":
+            self._cell = None
         if self._open_ids and self._open_ids[-1][1] == tag:
             name, _, text = self._open_ids.pop()
             self.ids[name] = text
@@ -62,6 +76,8 @@ class Page(html.parser.HTMLParser):
     def handle_data(self, data):
         for entry in self._open_ids:
             entry[2] += data
+        if self._cell:
+            self.texts[self._cell[0]][self._cell[1]] += data
 
 
 def run(*args, env=None, cwd=None):
@@ -154,11 +170,23 @@ def check_table(page, folder):
                 assert text == os.path.basename(value)
             else:
                 assert text == value, (c["name"], i)
-    # Every gap's note exists and says something.
+    # Every gap's note exists and gives a reason, not a status.
     for cells in page.columns.values():
         for _, gap in cells.values():
             if gap:
-                assert len(page.ids.get(f"gap-{gap}", "").strip()) > 10, gap
+                reason = page.ids.get(f"gap-{gap}", "")
+                assert len(reason.strip()) > 10 and "status ok" not in reason, (gap, reason)
+    # The visible numbers are the values, in mm and ms below 1 m and 1 s, to 4 digits.
+    for c in columns:
+        for i, (value, gap) in page.columns[c["name"]].items():
+            text = page.texts[c["name"]][i].strip()
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or gap:
+                continue
+            shown = value
+            if c["unit"] in ("m", "s") and value != 0 and abs(value) < 1:
+                assert text.endswith(" m" + c["unit"]), (c["name"], text)
+                text, shown = text[:-len(c["unit"]) - 2], 1e3 * value
+            assert float(text) == pytest.approx(shown, rel=5e-4), (c["name"], i, text, value)
 
 
 def pointer(obj, path):
@@ -170,10 +198,13 @@ def pointer(obj, path):
 
 
 def check_self_contained(page, text):
+    """Nothing fetched; every id unique (the SVGs of one page included) and every reference resolved."""
     for tag, target in page.links:
         assert target.startswith("#") or target.startswith("data:"), (tag, target)
     assert all("src" not in s for s in page.scripts)
     assert "<link" not in text and "@import" not in text and "url(http" not in text
+    assert len(page.all_ids) == len(set(page.all_ids)), "duplicate ids"
+    assert set(page.references) <= set(page.all_ids), set(page.references) - set(page.all_ids)
 
 
 def check_report(folder):
@@ -211,6 +242,8 @@ def test_an_insufficient_row_is_a_gap_with_its_reason(real):
     assert "windows accepted" in page.ids[f"gap-{gap}"]
     _, gap = page.columns["corrected_velocity"][0]
     assert "not corrected" in page.ids[f"gap-{gap}"]
+    _, gap = page.columns["awcc_velocity_measured"][9]
+    assert "no bubble-probe correction" in page.ids[f"gap-{gap}"]
 
 
 def test_the_synthetic_profile_report_holds_every_figure_and_number(synthetic):
@@ -241,7 +274,7 @@ def test_a_changed_or_missing_recording_is_named_not_drawn(synthetic, tmp_path):
     text = (tmp_path / "report.html").read_text()
     positions = text.split('id="position-')
     assert "are not shown" not in positions[1] and "are not shown" not in positions[3]
-    assert "SHA-256 differs" in positions[2]
+    assert "SHA-256 differs" in positions[2] and "window table not available" in positions[2]
     # Moved away from its recordings: each position says where it looked.
     os.mkdir(tmp_path / "away")
     shutil.copy(synthetic / "profile.json", tmp_path / "away")
@@ -263,6 +296,11 @@ def test_the_page_is_the_same_for_any_number_of_drawing_processes(synthetic, tmp
 def test_process_report_without_json_leaves_no_scratch_file(real_files, tmp_path):
     made("process", real_files[8], "--fs", "20kHz", "--dx", "7.15mm", "--report", tmp_path / "one.html")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["one.html"]
+    assert "the results of pdp process (no --json written)" in (tmp_path / "one.html").read_text()
+    done = run("process", real_files[8], "--fs", "20kHz", "--dx", "7.15mm", "--csv", tmp_path / "x.out", "--report",
+               tmp_path / "x.out")
+    assert done.returncode == 2 and "--csv and --report both name" in done.stderr
+    assert not (tmp_path / "x.out").exists()
     check_figures(Page((tmp_path / "one.html").read_text()), [0])
 
 
@@ -295,6 +333,9 @@ def test_a_settings_file_gives_what_the_command_line_does_not(synthetic, tmp_pat
     page = Page((tmp_path / "given.html").read_text())
     assert page.positions == [0, 1, 2] and not any(g.startswith("p0-") for g in page.gids)
     assert (tmp_path / "given.html").read_text().count("Figures left out (pdp report --no-detail)") == 3
+    # The command line wins however it spells the option.
+    made("report", "--config", tmp_path / "r.toml", "--output=eq.html", cwd=tmp_path)
+    assert (tmp_path / "eq.html").exists() and not (tmp_path / "from-file.html").exists()
     for text, message in (('jobs = "2"', "give a whole number"), ("job = 2", "unknown setting 'job'"),
                           ("jobs = [", "not TOML")):
         (tmp_path / "bad.toml").write_text(text + "\n")

@@ -172,7 +172,7 @@ int report_of(const ProcessCommandOptions& o, const std::string& json_text) {
     ~Remove() { std::error_code ec; std::filesystem::remove(path, ec); }
   } remove{scratch};
   awcc::write_text_atomically(scratch, json_text);
-  return write_report({scratch, "-o", o.report});
+  return write_report({scratch, "-o", o.report, "--input-name", "the results of pdp process (no --json written)"});
 }
 
 std::string correction_report(const correction::Correction& c) {
@@ -202,6 +202,25 @@ int run_process(ProcessCommandOptions& o) {
     if (!o.correct.empty() && options.awcc_options.probe_correction.enabled) {
       throw std::invalid_argument("--correct and --probe-correction both correct AWCC's velocity: the model was trained "
                                   "on synthetic records without bubble-probe interaction; use one of them");
+    }
+    // Two outputs into one file would leave only the last.
+    {
+      const std::vector<std::pair<const char*, const std::string*>> named = {
+          {"--json", &o.json},       {"--csv", &o.csv},
+          {"--windows", &o.windows}, {"--correlation-functions", &o.correlation_functions},
+          {"--spectrum", &o.spectrum}, {"--report", &o.report}};
+      for (std::size_t a = 0; a < named.size(); ++a) {
+        for (std::size_t b = a + 1; b < named.size(); ++b) {
+          const auto& x = *named[a].second;
+          const auto& y = *named[b].second;
+          if (x.empty() || y.empty()) continue;
+          std::error_code ec;
+          if (x == y || (std::filesystem::exists(x) && std::filesystem::equivalent(x, y, ec))) {
+            throw std::invalid_argument(fmt::format("{} and {} both name {}: give each output its own file",
+                                                    named[a].first, named[b].first, x));
+          }
+        }
+      }
     }
     // Inputs are never modified: refuse an output that is one of them.
     for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum, o.report}) {
