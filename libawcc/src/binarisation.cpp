@@ -75,6 +75,11 @@ void VoltageHistogram::add(std::span<const float> values, std::size_t first, std
   const double inv = 1.0 / width_;
   for (std::size_t i = first; i < values.size(); i += stride) {
     const float v = values[i];
+    // Readers refuse non-finite samples; one that slips through is named, not cast (undefined behaviour).
+    if (!std::isfinite(v)) [[unlikely]] {
+      throw InputError(fmt::format("sample {} of a channel is {}: the recording is damaged", (i - first) / stride,
+                                   std::isnan(v) ? "NaN" : "infinite"));
+    }
     const auto index = static_cast<std::int64_t>(std::floor(static_cast<double>(v) * inv + 0.5));
     std::int64_t k = index - offset_;
     if (k < 0 || k >= static_cast<std::int64_t>(counts_.size())) [[unlikely]] {

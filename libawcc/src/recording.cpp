@@ -755,6 +755,11 @@ class CsvRecording final : public Recording {
         if (!std::isfinite(v)) {
           fail(info_.path, fmt::format("line {}, column {}: the value is not finite; the recording is damaged", line_, c + 1));
         }
+        // Samples are 32-bit floats: a larger magnitude would become infinite.
+        if (std::fabs(v) > static_cast<double>(std::numeric_limits<float>::max())) {
+          fail(info_.path, fmt::format("line {}, column {}: {:g} lies beyond the range of a sample (+/- 3.4e38); the "
+                                       "recording is damaged: fix the cell or remove the line", line_, c + 1, v));
+        }
         out[static_cast<std::size_t>(n * info_.channels + k++)] = static_cast<float>(v);
       }
       ++n;

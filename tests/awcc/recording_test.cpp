@@ -193,6 +193,18 @@ TEST(Csv, TextCellInADataRowIsRefusedWithItsLine) {
   EXPECT_NE(e.find("'oops'"), std::string::npos) << e;
 }
 
+TEST(Csv, AValueBeyondTheSampleRangeIsRefusedWithItsLine) {
+  // Found by fuzz_recording: 1e113 parses, but as a 32-bit sample it is infinite.
+  const auto p = scratch("huge.csv");
+  {
+    std::ofstream f(p);
+    f << "time,lead,trail\n0,4.1,4.2\n0.0001,1e113,4.1\n0.0002,-3.5e38,0.2\n";
+  }
+  const auto e = error_of(p, {});
+  EXPECT_NE(e.find("line 3, column 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("beyond the range of a sample"), std::string::npos) << e;
+}
+
 TEST(Sndfile, ReadsIntegerAudioAsCountsTimesScale) {
   const auto p = scratch("pcm.wav");
   SF_INFO info{};
