@@ -4,8 +4,12 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <stdexcept>
+#include <thread>
+#include <type_traits>
 
 #include "awcc/detail/awcc_steps.hpp"
+#include "awcc/detail/read_ahead.hpp"
+#include "awcc/detail/two_level_scan.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/units.hpp"
 
@@ -54,20 +58,33 @@ struct ChannelSelection {
   std::size_t stride, lead, trail;
 };
 
+// Blocks of a recording in order, read one ahead on a second thread where the
+// options allow it and a second core exists (same blocks either way).
+template <class Sample>
+detail::ReadAhead<Sample> blocks(Recording& recording, const ProcessOptions& options, const ChannelSelection& ch) {
+  static const bool two_cores = std::thread::hardware_concurrency() >= 2;
+  typename detail::ReadAhead<Sample>::ReadFn read;
+  if constexpr (std::is_same_v<Sample, float>) {
+    read = [&recording](std::span<float> out, std::int64_t n) { return recording.read(out, n); };
+  } else {
+    read = [&recording](std::span<std::int16_t> out, std::int64_t n) { return recording.read_int16(out, n); };
+  }
+  return detail::ReadAhead<Sample>(std::move(read), options.block_frames, ch.stride, options.read_ahead && two_cores);
+}
+
 // Two passes over floating (or non-16-bit) samples: histograms, then thresholds.
 void binarise_two_pass(Recording& recording, const ProcessOptions& options, const BinarisationOptions& bopt,
                        const ChannelSelection& ch, BinarisedRecording& out) {
   const auto& path = recording.info().path;
-  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * ch.stride);
   VoltageHistogram h_lead(recording.info().quantum), h_trail(recording.info().quantum);
   std::int64_t frames = 0;
-  for (;;) {
-    const std::int64_t n = recording.read(block, options.block_frames);
-    if (n == 0) break;
-    const auto used = std::span<const float>(block.data(), static_cast<std::size_t>(n) * ch.stride);
-    h_lead.add(used, ch.lead, ch.stride);
-    h_trail.add(used, ch.trail, ch.stride);
-    frames += n;
+  {
+    auto reader = blocks<float>(recording, options, ch);
+    for (auto used = reader.next(); !used.empty(); used = reader.next()) {
+      h_lead.add(used, ch.lead, ch.stride);
+      h_trail.add(used, ch.trail, ch.stride);
+      frames += static_cast<std::int64_t>(used.size() / ch.stride);
+    }
   }
   if (frames == 0) throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
   out.leading_threshold = choose_threshold(h_lead, bopt);
@@ -76,12 +93,12 @@ void binarise_two_pass(Recording& recording, const ProcessOptions& options, cons
   out.trailing_histogram = std::move(h_trail);
   recording.rewind();
   Binariser b_lead(out.leading_threshold, recording.info().fs), b_trail(out.trailing_threshold, recording.info().fs);
-  for (;;) {
-    const std::int64_t n = recording.read(block, options.block_frames);
-    if (n == 0) break;
-    const auto used = std::span<const float>(block.data(), static_cast<std::size_t>(n) * ch.stride);
-    b_lead.feed(used, ch.lead, ch.stride);
-    b_trail.feed(used, ch.trail, ch.stride);
+  {
+    auto reader = blocks<float>(recording, options, ch);
+    for (auto used = reader.next(); !used.empty(); used = reader.next()) {
+      b_lead.feed(used, ch.lead, ch.stride);
+      b_trail.feed(used, ch.trail, ch.stride);
+    }
   }
   out.leading = b_lead.finish();
   out.trailing = b_trail.finish();
@@ -270,26 +287,47 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
   try {
     bool done = false;
     if (options.single_pass && recording->has_int16() && info.quantum > 0.0) {
-      std::vector<std::int16_t> block(static_cast<std::size_t>(options.block_frames) * ch.stride);
-      std::int64_t n = recording->read_int16(block, options.block_frames);
-      const auto band_lead = band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.lead, info.quantum, bopt);
-      const auto band_trail =
-          band_from(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail, info.quantum, bopt.for_trailing_tip());
-      if (n > 0 && band_lead && band_trail) {
-        BandRecorder lead(band_lead->first, band_lead->second), trail(band_trail->first, band_trail->second);
-        while (n > 0) {
-          lead.feed(block.data(), static_cast<std::size_t>(n), ch.stride, ch.lead);
-          trail.feed(block.data(), static_cast<std::size_t>(n), ch.stride, ch.trail);
-          n = recording->read_int16(block, options.block_frames);
+      // A binary recording (two levels per tip): its level changes only.
+      {
+        auto reader = blocks<std::int16_t>(*recording, options, ch);
+        detail::TwoLevelScan binary(ch.stride, ch.lead, ch.trail);
+        bool two_levels = true;
+        for (auto used = reader.next(); two_levels && !used.empty(); used = reader.next()) {
+          two_levels = binary.feed(used.data(), used.size() / ch.stride);
         }
-        out.leading_histogram = lead.histogram(info.quantum);
-        out.trailing_histogram = trail.histogram(info.quantum);
-        out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
-        out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt.for_trailing_tip());
-        if (lead.covers(out.leading_threshold, info.quantum) && trail.covers(out.trailing_threshold, info.quantum)) {
-          out.leading = lead.resolve(out.leading_threshold, info.quantum, info.fs);
-          out.trailing = trail.resolve(out.trailing_threshold, info.quantum, info.fs);
+        if (two_levels && binary.samples() > 0) {
+          out.leading_histogram = binary.histogram(0, info.quantum);
+          out.trailing_histogram = binary.histogram(1, info.quantum);
+          out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
+          out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt.for_trailing_tip());
+          out.leading = binary.intervals(0, out.leading_threshold, info.quantum, info.fs);
+          out.trailing = binary.intervals(1, out.trailing_threshold, info.quantum, info.fs);
           done = true;
+        }
+      }
+      if (!done) {
+        // Not binary: a band of candidate thresholds from the first block, then one pass.
+        recording->rewind();
+        auto reader = blocks<std::int16_t>(*recording, options, ch);
+        auto used = reader.next();
+        const std::size_t n = used.size() / ch.stride;
+        const auto band_lead = band_from(used.data(), n, ch.stride, ch.lead, info.quantum, bopt);
+        const auto band_trail = band_from(used.data(), n, ch.stride, ch.trail, info.quantum, bopt.for_trailing_tip());
+        if (n > 0 && band_lead && band_trail) {
+          BandRecorder lead(band_lead->first, band_lead->second), trail(band_trail->first, band_trail->second);
+          for (; !used.empty(); used = reader.next()) {
+            lead.feed(used.data(), used.size() / ch.stride, ch.stride, ch.lead);
+            trail.feed(used.data(), used.size() / ch.stride, ch.stride, ch.trail);
+          }
+          out.leading_histogram = lead.histogram(info.quantum);
+          out.trailing_histogram = trail.histogram(info.quantum);
+          out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
+          out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt.for_trailing_tip());
+          if (lead.covers(out.leading_threshold, info.quantum) && trail.covers(out.trailing_threshold, info.quantum)) {
+            out.leading = lead.resolve(out.leading_threshold, info.quantum, info.fs);
+            out.trailing = trail.resolve(out.trailing_threshold, info.quantum, info.fs);
+            done = true;
+          }
         }
       }
       if (!done) recording->rewind();

@@ -337,6 +337,61 @@ TEST(ProcessSynthetic, OnePassFallsBackWhenTheFirstBlockMisleads) {
   EXPECT_GT(one.leading.intervals.size(), 100u);
 }
 
+TEST(ProcessSynthetic, BinaryScanReadAheadAndTwoPassAgreeWithTheSynthesisedSignals) {
+  // A binary W64 (int16 0/1) goes through the two-level scan; its intervals
+  // must be the synthesised ones exactly, and equal to the general two-pass
+  // path's, with or without the read-ahead thread and for any block size.
+  synth::Scene s;
+  s.duration = 3.0;
+  s.fs = 100e3;
+  const auto w = write_scene(s, synth::SignalKind::binary, "binary_scan.w64");
+  for (std::int64_t block : {std::int64_t{1} << 18, std::int64_t{777}}) {
+    for (bool read_ahead : {true, false}) {
+      awcc::ProcessOptions o;
+      o.block_frames = block;
+      o.read_ahead = read_ahead;
+      const auto fast = awcc::binarise_recording(w.path, o);
+      EXPECT_EQ(fast.leading.intervals, w.synthesis.signals[0].intervals);
+      EXPECT_EQ(fast.trailing.intervals, w.synthesis.signals[1].intervals);
+      o.single_pass = false;
+      const auto two = awcc::binarise_recording(w.path, o);
+      EXPECT_EQ(fast.leading.intervals, two.leading.intervals);
+      EXPECT_EQ(fast.trailing.intervals, two.trailing.intervals);
+      EXPECT_EQ(fast.leading.sample_count, two.leading.sample_count);
+      EXPECT_EQ(fast.leading_threshold.threshold, two.leading_threshold.threshold);
+      EXPECT_EQ(fast.leading_threshold.air_level, two.leading_threshold.air_level);
+      EXPECT_EQ(fast.trailing_threshold.water_level, two.trailing_threshold.water_level);
+      EXPECT_EQ(fast.leading_histogram->values(), two.leading_histogram->values());
+      EXPECT_EQ(fast.trailing_histogram->values(), two.trailing_histogram->values());
+      EXPECT_TRUE(fast.leading_threshold.binary_input);
+    }
+  }
+}
+
+TEST(ProcessSynthetic, ARecordingThatStopsBeingBinaryIsBinarisedTheGeneralWay) {
+  // Two levels for most of the record, then a third value in the trailing tip
+  // long after the first block: the scan gives up and the result equals the
+  // two-pass path's (a threshold between the modes, not "binary input").
+  std::vector<std::int16_t> data;
+  for (int i = 0; i < 200000; ++i) {
+    const bool air = (i / 37) % 5 == 0;
+    data.push_back(static_cast<std::int16_t>(air ? 2000 : 27000));
+    const bool air2 = (i / 41) % 4 == 0;
+    data.push_back(static_cast<std::int16_t>(i == 150000 ? 14000 : (air2 ? 3000 : 26000)));
+  }
+  awcc::ProcessOptions o;
+  o.block_frames = 10000;
+  auto one = awcc::binarise_recording(*awcc::memory_recording(data, 2, 20e3, 5.0 / 32768.0, true), o);
+  o.single_pass = false;
+  auto two = awcc::binarise_recording(*awcc::memory_recording(data, 2, 20e3, 5.0 / 32768.0, true), o);
+  EXPECT_TRUE(one.leading_threshold.binary_input);
+  EXPECT_FALSE(one.trailing_threshold.binary_input);
+  EXPECT_EQ(one.leading.intervals, two.leading.intervals);
+  EXPECT_EQ(one.trailing.intervals, two.trailing.intervals);
+  EXPECT_EQ(one.trailing_threshold.threshold, two.trailing_threshold.threshold);
+  EXPECT_GT(one.trailing.intervals.size(), 1000u);
+}
+
 // --- Bad input and edge cases -----------------------------------------------
 
 std::string process_error(const fs::path& p, const awcc::ProcessOptions& o) {

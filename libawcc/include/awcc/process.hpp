@@ -41,8 +41,14 @@ struct ProcessOptions {
   /// Accept values outside the plausible ranges of the instrument (below):
   /// off, because a value out of them is nearly always a unit slip.
   bool allow_unusual = false;
-  std::int64_t block_frames = 1 << 16;  ///< frames read at a time
+  /// Frames read at a time: large enough that handing blocks between the
+  /// reading and the binarising thread costs little, small enough to stay in cache.
+  std::int64_t block_frames = 1 << 18;
   bool single_pass = true;            ///< allow the one-pass path for 16-bit data (same result, faster)
+  /// Read the next block on a second thread while one is binarised, where a
+  /// second core exists (same result; decoding FLAC or copying from the page
+  /// cache then overlaps with the work on the samples).
+  bool read_ahead = true;
 
   /// Empty when valid, else what is wrong; includes implausible() unless allow_unusual.
   [[nodiscard]] std::string validate() const;

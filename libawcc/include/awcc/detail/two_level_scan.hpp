@@ -1,0 +1,61 @@
+#pragma once
+// Binary recordings read as 16-bit counts (METHOD.md 2: a channel holding at
+// most two distinct values is binary input, its higher value air). For the
+// library's own use and its tests; not installed, not a stable interface.
+//
+// A binary channel needs neither a histogram of every sample nor a threshold
+// test per sample: its level changes say everything. The scan compares every
+// sample with the one a frame earlier (all channels at once, eight counts per
+// vector comparison), keeps the changes of the two tips, and stops as soon as
+// either tip shows a third value (then the recording is not binary and the
+// caller binarises it the general way). The levels' counts follow from the
+// run lengths, so the histogram, the threshold and the air intervals equal
+// those of the general path on the same counts.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "awcc/air_intervals.hpp"
+#include "awcc/binarisation.hpp"
+
+namespace awcc::detail {
+
+class TwoLevelScan {
+ public:
+  /// Frames of `stride` interleaved channels; the tips are channels `lead` and `trail`.
+  TwoLevelScan(std::size_t stride, std::size_t lead, std::size_t trail);
+
+  /// Scans the next `frames` frames. False once a tip has shown a third
+  /// distinct value: the recording is not binary, and the scan is spent.
+  [[nodiscard]] bool feed(const std::int16_t* data, std::size_t frames);
+
+  [[nodiscard]] std::int64_t samples() const { return position_; }
+
+  /// Histogram of tip 0 (lead) or 1 (trail) at `quantum` volts per count.
+  [[nodiscard]] VoltageHistogram histogram(int tip, double quantum) const;
+  /// The air intervals of tip 0 or 1 under `threshold` (chosen on histogram(tip)).
+  [[nodiscard]] AirIntervals intervals(int tip, const Threshold& threshold, double quantum, double fs) const;
+
+ private:
+  struct Change {
+    std::int64_t index;  // first sample at the new value
+    std::int16_t value;
+  };
+  struct Tip {
+    std::size_t channel = 0;
+    std::int16_t level[2] = {0, 0};
+    int levels = 0;
+    std::vector<Change> changes;  // the first at sample 0
+  };
+  [[nodiscard]] bool change(Tip& tip, std::int64_t index, std::int16_t value);
+
+  std::size_t stride_;
+  Tip tips_[2];
+  std::vector<signed char> tip_of_channel_;  // -1 for channels that are not a tip
+  std::vector<std::int16_t> last_frame_;
+  std::vector<std::uint32_t> offsets_;  // scratch: changed counts of one block
+  std::int64_t position_ = 0;
+};
+
+}  // namespace awcc::detail
