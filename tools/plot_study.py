@@ -2,8 +2,12 @@
 """Figures from pdp's study CSVs (Debian's python3 with matplotlib).
 
   plot_study.py bench BENCH.csv OUT.png
-      error against run time: |velocity error| and |Tu error| of every method
-      and setting, log-log, one colour per method.
+      error against cost, per scene: the RMS error over the seeds of u and of
+      Tu of every method and setting against its processing cost, the Pareto
+      front drawn and labelled, the goals (5 % in u, 10 % in Tu) marked; prints
+      per scene the shortest record and the cheapest setting reaching each goal.
+  plot_study.py bench-bias BENCH.csv OUT.png
+      the duration series split into bias and spread against record length.
   plot_study.py sweep RUNS.csv PARAMETER OUT.png [--title TEXT]
       the relative errors of the AWCC and FSCC mean velocity and of the AWCC
       turbulence intensity against one swept parameter (a CSV column), as
@@ -23,6 +27,7 @@ Every figure carries the command line that made it in its footer.
 import csv
 import math
 import os
+import statistics
 import sys
 from collections import defaultdict
 
@@ -30,6 +35,7 @@ from collections import defaultdict
 # (python/pdp/plotting.py), imported as a plain file so no compiled module is needed.
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python", "pdp"))
 import plotting  # noqa: E402
+from matplotlib import ticker  # noqa: E402
 from plotting import number, t975  # noqa: E402
 
 
@@ -46,33 +52,175 @@ def footer(fig):
     plotting.footer(fig, "made by: " + " ".join(["tools/plot_study.py"] + sys.argv[1:]))
 
 
+METHOD_LABELS = {
+    "fscc": "FSCC",
+    "awcc-intervals": "AWCC",
+    "awcc-fft": "AWCC FFT",
+    "awcc-raw": "AWCC raw",
+    "awcc-intervals+qrf": "AWCC+QRF",
+}
+MARKERS = {"fscc": "s", "awcc-intervals": "o", "awcc-fft": "D", "awcc-raw": "^", "awcc-intervals+qrf": "*"}
+GOALS = {"velocity": 0.05, "turbulence_intensity": 0.10}
+
+
+def setting_label(s):
+    """Short name of a setting: method, then what differs from Np = 10, 500 kHz."""
+    parts = [METHOD_LABELS.get(s["method"], s["method"])]
+    if s["method"] != "fscc" and s["np"] != 10:
+        parts.append(f"Np {s['np']}")
+    if s["fs"] != 500e3:
+        parts.append(f"{s['fs'] / 1e3:g} kHz")
+    parts.append(f"{s['duration']:g} s")
+    return " ".join(parts)
+
+
+def bench_summary(rows):
+    """Per scene and setting (method, Np, fs, duration): over the seeds, the
+    relative errors' RMS, mean (bias) and standard deviation (spread, n - 1),
+    the median cost, and how many seeds gave a value. RMS^2 = bias^2 +
+    spread^2 (n - 1)/n, so a bias that does not shrink with the record length
+    shows as an RMS floor."""
+    groups = defaultdict(list)
+    for r in rows:
+        key = (r["scene"], r["method"], int(r["np"]), float(r["fs"]), float(r["duration"]))
+        groups[key].append(r)
+    out = []
+    for (scene, method, np_, fs, duration), rs in groups.items():
+        s = {"scene": scene, "method": method, "np": np_, "fs": fs, "duration": duration, "seeds": len(rs),
+             "cost": statistics.median(float(r["seconds"]) for r in rs)}
+        for q in ("velocity", "turbulence_intensity"):
+            e = [number(r[q + "_error"]) for r in rs]
+            e = [x for x in e if x is not None]
+            s[q + "_n"] = len(e)
+            if e:
+                s[q + "_rms"] = math.sqrt(sum(x * x for x in e) / len(e))
+                s[q + "_bias"] = sum(e) / len(e)
+                s[q + "_spread"] = statistics.stdev(e) if len(e) > 1 else 0.0
+        out.append(s)
+    return out
+
+
+def complete(s, q):
+    """A setting counts only when every seed gave a value."""
+    return s.get(q + "_n", 0) == s["seeds"] and s["seeds"] > 0
+
+
+def pareto_front(settings, q):
+    """The settings no other beats in both cost and RMS error, cheapest first."""
+    front, best = [], math.inf
+    for s in sorted((s for s in settings if complete(s, q)), key=lambda s: (s["cost"], s[q + "_rms"])):
+        if s[q + "_rms"] < best:
+            front.append(s)
+            best = s[q + "_rms"]
+    return front
+
+
+def decision(settings, q):
+    """The shortest record that reaches the goal (any method), and the cheapest
+    setting that does; None when none does."""
+    ok = [s for s in settings if complete(s, q) and s[q + "_rms"] <= GOALS[q]]
+    if not ok:
+        return None
+    shortest = min(ok, key=lambda s: (s["duration"], s["cost"]))
+    cheapest = min(ok, key=lambda s: (s["cost"], s["duration"]))
+    return shortest, cheapest
+
+
+def bench_table(summary, scenes):
+    lines = ["| scene | u: RMS <= 5 %: shortest record | u: cheapest | Tu: RMS <= 10 %: shortest record | Tu: cheapest |",
+             "|---|---|---|---|---|"]
+    for scene in scenes:
+        cells = [scene]
+        for q in ("velocity", "turbulence_intensity"):
+            d = decision([s for s in summary if s["scene"] == scene], q)
+            if d is None:
+                cells += ["none reaches it", "none"]
+                continue
+            for s in d:
+                cells.append(f"{setting_label(s)} ({100 * s[q + '_rms']:.1f} %, {s['cost']:.3g} s)")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def bench(path, out):
     rows = list(csv.DictReader(open(path)))
     if not rows:
         raise SystemExit(f"{path}: no rows")
-    fig, axes = subplots(1, 2, figsize=(11, 4.5))
-    methods = sorted({r["method"] for r in rows})
+    summary = bench_summary(rows)
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    methods = [m for m in METHOD_LABELS if any(s["method"] == m for s in summary)]
     colours = {m: plotting.PALETTE[i % len(plotting.PALETTE)] for i, m in enumerate(methods)}
-    for ax, column, label in ((axes[0], "velocity_error", "|mean velocity error|"),
-                              (axes[1], "turbulence_intensity_error", "|turbulence intensity error|")):
-        for m in methods:
-            xs, ys = [], []
-            for r in rows:
-                e, t = number(r[column]), number(r["seconds"])
-                if r["method"] == m and e is not None and t:
-                    xs.append(t)
-                    ys.append(max(abs(e), 1e-4))
-            ax.scatter(xs, ys, label=m, color=colours[m], s=18)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("run time per record (s)")
-        ax.set_ylabel(label)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8)
-    fig.suptitle("Error against run time (pdp bench)")
+    seeds = max(s["seeds"] for s in summary)
+    fig, axes = plotting.figure(width=10.5, height=2.6 * len(scenes) + 0.6, rows=len(scenes), cols=2,
+                                margins=(0.75, 0.6, 0.15, 0.35))
+    for i, scene in enumerate(scenes):
+        mine = [s for s in summary if s["scene"] == scene]
+        for j, (q, name) in enumerate((("velocity", "mean velocity"), ("turbulence_intensity", "Tu"))):
+            ax = axes[i][j]
+            for m in methods:
+                pts = [s for s in mine if s["method"] == m and complete(s, q)]
+                ax.scatter([s["cost"] for s in pts], [100 * s[q + "_rms"] for s in pts], marker=MARKERS[m],
+                           color=colours[m], s=22, label=METHOD_LABELS[m], alpha=0.85, linewidths=0)
+            front = pareto_front(mine, q)
+            if front:
+                ax.step([s["cost"] for s in front], [100 * s[q + "_rms"] for s in front], where="post",
+                        color=plotting.BLACK, lw=1.0, ls="--", label="Pareto front")
+                for s in front:
+                    ax.annotate(setting_label(s), (s["cost"], 100 * s[q + "_rms"]), fontsize=6,
+                                xytext=(3, 3), textcoords="offset points")
+            ax.axhline(100 * GOALS[q], color=plotting.VERMILION, lw=0.8, ls=":")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+            ax.set_title(f"{scene}: {name}, RMS error over {seeds} seeds", fontsize=9)
+            ax.set_ylabel(f"RMS error of {'u' if q == 'velocity' else 'Tu'} (%)")
+            if i == len(scenes) - 1:
+                ax.set_xlabel("processing cost per record (CPU s)")
+            ax.grid(True, which="major", alpha=0.3)
+    axes[0][0].legend(fontsize=7, loc="upper right")
     footer(fig)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
-    fig.savefig(out, dpi=120)
+    fig.savefig(out, dpi=110)
+    print(bench_table(summary, scenes))
+
+
+def bench_bias(path, out):
+    """Bias and spread of the duration series (500 kHz, Np = 10) against the
+    record length, per scene: the spread falls as 1/sqrt(T), the bias stays."""
+    summary = bench_summary(list(csv.DictReader(open(path))))
+    scenes = list(dict.fromkeys(s["scene"] for s in summary))
+    fig, axes = plotting.figure(width=10.5, height=2.4 * len(scenes) + 0.6, rows=len(scenes), cols=2,
+                                margins=(0.75, 0.6, 0.15, 0.35))
+    for i, scene in enumerate(scenes):
+        for j, (q, name) in enumerate((("velocity", "u"), ("turbulence_intensity", "Tu"))):
+            ax = axes[i][j]
+            for k, m in enumerate(("awcc-intervals", "fscc", "awcc-intervals+qrf")):
+                pts = sorted((s for s in summary if s["scene"] == scene and s["method"] == m and s["fs"] == 500e3
+                              and s["np"] in (0, 10) and complete(s, q)), key=lambda s: s["duration"])
+                if not pts:
+                    continue
+                c = plotting.PALETTE[k]
+                d = [s["duration"] for s in pts]
+                ax.plot(d, [100 * abs(s[q + "_bias"]) for s in pts], "-o", color=c, ms=3,
+                        label=f"{METHOD_LABELS[m]} |bias|")
+                ax.plot(d, [100 * s[q + "_spread"] for s in pts], "--s", color=c, ms=3,
+                        label=f"{METHOD_LABELS[m]} spread")
+                if m == "awcc-intervals":
+                    ref = pts[0][q + "_spread"] * 100
+                    ax.plot(d, [ref * math.sqrt(d[0] / x) for x in d], ":", color=plotting.BLACK, lw=0.8,
+                            label="1/sqrt(T)")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+            ax.set_title(f"{scene}: {name}", fontsize=9)
+            ax.set_ylabel("error (%)")
+            if i == len(scenes) - 1:
+                ax.set_xlabel("record duration (s)")
+            ax.grid(True, which="major", alpha=0.3)
+    axes[0][1].legend(fontsize=6, ncol=2)
+    footer(fig)
+    fig.savefig(out, dpi=110)
 
 
 def sweep(path, parameter, out, title):
@@ -196,6 +344,8 @@ def learning(path, out):
 def main(argv):
     if len(argv) >= 4 and argv[1] == "bench":
         bench(argv[2], argv[3])
+    elif len(argv) >= 4 and argv[1] == "bench-bias":
+        bench_bias(argv[2], argv[3])
     elif len(argv) >= 5 and argv[1] == "sweep":
         title = argv[argv.index("--title") + 1] if "--title" in argv else None
         sweep(argv[2], argv[3], argv[4], title)

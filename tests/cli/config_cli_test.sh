@@ -86,7 +86,7 @@ expect 2 "--np 4 conflicts with np set in" "$pdp" sweep "$dir/study-np.toml" -o 
 [[ -e $dir/conflict.csv ]] && fail "sweep wrote a CSV on a conflict"
 
 # bench
-printf 'quick = true\nrepeat = 1\nscenes = "base"\nduration = "0.5s"\noutput = "%s"\n' "$dir/bench.csv" >"$dir/bench.toml"
+printf 'quick = true\nseeds = 1\nscenes = "base"\nduration = "0.5s"\noutput = "%s"\n' "$dir/bench.csv" >"$dir/bench.toml"
 "$pdp" --log-level warn bench --config "$dir/bench.toml" || fail "bench with config"
 [[ -s $dir/bench.csv ]] || fail "bench: no output from the config's path"
 

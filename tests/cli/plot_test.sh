@@ -12,9 +12,15 @@ failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 png() { [[ -s $1 && $(head -c 8 "$1" | od -An -c | tr -d ' ') == '211PNG\r\n032\n' ]]; }
 
-"$pdp" --log-level warn bench --quick --repeat 1 --scenes base -o "$dir/bench.csv" || fail "pdp bench --quick"
-/usr/bin/python3 "$src/tools/plot_study.py" bench "$dir/bench.csv" "$dir/bench.png" || fail "bench figure"
+"$pdp" --log-level warn bench --quick --scenes base,low-c -o "$dir/bench.csv" || fail "pdp bench --quick"
+/usr/bin/python3 "$src/tools/plot_study.py" bench "$dir/bench.csv" "$dir/bench.png" >"$dir/bench.md" || fail "bench figure"
 png "$dir/bench.png" || fail "bench figure is not a PNG"
+grep -q '^| low-c |' "$dir/bench.md" || fail "bench: no decision line for the low-c scene"
+/usr/bin/python3 "$src/tools/plot_study.py" bench-bias "$dir/bench.csv" "$dir/bench-bias.png" || fail "bench-bias figure"
+png "$dir/bench-bias.png" || fail "bench-bias figure is not a PNG"
+# Same seeds, same numbers, whatever the thread count (the cost column aside).
+"$pdp" --log-level warn bench --quick --scenes base,low-c --threads 1 -o "$dir/bench1.csv" || fail "pdp bench --threads 1"
+[[ $(cut -d, -f1-6,8- "$dir/bench.csv") == $(cut -d, -f1-6,8- "$dir/bench1.csv") ]] || fail "bench: numbers depend on threads"
 
 cat >"$dir/grid.toml" <<'TOML'
 [sweep]
