@@ -74,6 +74,14 @@ def setting_label(s):
     return " ".join(parts)
 
 
+def log_percent_axis(axis):
+    """Ticks at 1, 2 and 5 of each decade, written as plain numbers (a range
+    within one decade still gets labels)."""
+    axis.set_major_locator(ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(ticker.NullFormatter())
+
+
 def bench_summary(rows):
     """Per scene and setting (method, Np, fs, duration): over the seeds, the
     relative errors' RMS, mean (bias) and standard deviation (spread, n - 1),
@@ -171,8 +179,7 @@ def bench(path, out):
             ax.axhline(100 * GOALS[q], color=plotting.VERMILION, lw=0.8, ls=":")
             ax.set_xscale("log")
             ax.set_yscale("log")
-            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+            log_percent_axis(ax.yaxis)
             ax.set_title(f"{scene}: {name}, RMS error over {seeds} seeds", fontsize=9)
             ax.set_ylabel(f"RMS error of {'u' if q == 'velocity' else 'Tu'} (%)")
             if i == len(scenes) - 1:
@@ -211,8 +218,7 @@ def bench_bias(path, out):
                             label="1/sqrt(T)")
             ax.set_xscale("log")
             ax.set_yscale("log")
-            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+            log_percent_axis(ax.yaxis)
             ax.set_title(f"{scene}: {name}", fontsize=9)
             ax.set_ylabel("error (%)")
             if i == len(scenes) - 1:
