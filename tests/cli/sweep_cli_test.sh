@@ -189,6 +189,7 @@ fs = "100kHz"
 [ranges]
 velocity = ["2m/s", "20m/s"]
 bubble-diameter = ["1mm", "5mm"]
+fs = ["10kHz", "1MHz", "log"]
 TOML
 "$pdp" --log-level warn sweep "$dir/mc.toml" -o "$dir/mc1.csv" --threads 2 || fail "monte-carlo"
 "$pdp" --log-level warn sweep "$dir/mc.toml" -o "$dir/mc2.csv" --threads 1 || fail "monte-carlo again"
@@ -202,7 +203,28 @@ for r in rows:
     assert 1e-3 <= float(r["bubble_diameter"]) <= 5e-3, r["bubble_diameter"]
     assert 1e-3 <= float(r["time_scale"]) <= 1.0, r["time_scale"]
     assert 0.005 <= float(r["void_fraction"]) <= 0.4
+    assert 1e4 <= float(r["fs"]) <= 1e6, r["fs"]
 PY
+# Log-uniform: of 400 draws over 10 kHz-1 MHz, half lie below 100 kHz (the
+# geometric middle); uniform would put 9 %. Binomial sd 2.5 %: 35-65 % is 6 sd.
+printf '[sweep]\nmode = "monte-carlo"\nruns = 400\nseed = 4\n[base]\nduration = "0.05s"\n[ranges]\nfs = ["10kHz", "1MHz", "log"]\n' >"$dir/log.toml"
+"$pdp" --log-level error sweep "$dir/log.toml" -o "$dir/log.csv" || fail "log-uniform sweep"
+python3 - "$dir/log.csv" <<'PY' || fail "fs not log-uniform"
+import csv, sys
+fs = [float(r["fs"]) for r in csv.DictReader(open(sys.argv[1]))]
+assert len(fs) == 400 and all(1e4 <= f <= 1e6 for f in fs)
+below = sum(f < 1e5 for f in fs) / len(fs)
+assert 0.35 <= below <= 0.65, below
+PY
+bad() {  # bad TOML-ranges-line expected-message
+  printf '[sweep]\nmode = "monte-carlo"\nruns = 4\n[ranges]\n%s\n' "$1" >"$dir/bad.toml"
+  local out
+  out=$("$pdp" sweep "$dir/bad.toml" -o "$dir/bad.csv" 2>&1) && fail "accepted: $1"
+  [[ $out == *"$2"* ]] || fail "$1: message lacks '$2': $out"
+  [[ -e $dir/bad.csv ]] && fail "$1: wrote a CSV"
+}
+bad 'fs = ["10kHz", "1MHz", "lin"]' 'or [min, max, "log"]'
+bad 'fs = ["0Hz", "1MHz", "log"]' 'needs min > 0'
 
 if ((failures)); then
   echo "$failures failures"

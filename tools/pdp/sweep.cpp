@@ -116,7 +116,8 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
   }
   for (const auto& s : table("ranges")) {
     if (!is_field(s.key)) fail("[ranges] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
-    if (s.items.size() != 2) fail("[ranges] " + s.key, "must be [min, max]");
+    const bool log = s.items.size() == 3 && s.items[2] == "log";
+    if (s.items.size() != 2 && !log) fail("[ranges] " + s.key, "must be [min, max], or [min, max, \"log\"] for a log-uniform draw");
     double ends[2];
     for (std::size_t i = 0; i < 2; ++i) {
       try {
@@ -126,7 +127,10 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
       }
     }
     if (!(ends[0] <= ends[1])) fail("[ranges] " + s.key, "min must not exceed max");
+    if (log && !(ends[0] > 0.0)) fail("[ranges] " + s.key, "a log-uniform range needs min > 0");
+    if (log && s.key == "time-scale") fail("[ranges] " + s.key, "the time scale is drawn log-normally already; drop \"log\"");
     d.ranges[s.key] = {ends[0], ends[1]};
+    if (log) d.log_ranges.insert(s.key);
   }
   if (d.mode == "grid" && d.grid.empty()) fail("[grid]", "a grid sweep needs at least one list of values");
   // Canonical text: every setting, sorted.
@@ -138,7 +142,9 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
     c += ";";
   }
   if (d.mode == "monte-carlo") {
-    for (const auto& [k, v] : d.ranges) c += fmt::format("ranges.{}={:.17g},{:.17g};", k, v.first, v.second);
+    // Uniform ranges keep the text they had before log ranges existed (studies resume).
+    for (const auto& [k, v] : d.ranges)
+      c += fmt::format("ranges.{}={:.17g},{:.17g}{};", k, v.first, v.second, d.log_ranges.count(k) ? ",log" : "");
   }
   d.canonical = c;
   return d;
@@ -187,6 +193,8 @@ std::vector<SweepRun> SweepDefinition::expand() const {
           double z;
           do z = rng.normal(); while (std::fabs(z) > 2.0);
           v = std::exp(mid + sd * z);
+        } else if (log_ranges.count(k)) {
+          v = std::exp(std::log(range.first) + (std::log(range.second) - std::log(range.first)) * rng.uniform());
         } else {
           v = range.first + (range.second - range.first) * rng.uniform();
         }

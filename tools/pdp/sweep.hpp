@@ -44,6 +44,9 @@ struct SweepDefinition {
   std::map<std::string, std::string> base, grid_text;
   std::map<std::string, std::vector<std::string>> grid;
   std::map<std::string, std::pair<double, double>> ranges;  ///< SI
+  /// Ranges drawn log-uniformly ([min, max, "log"]); the others uniformly
+  /// (time-scale: log-normal, see expand).
+  std::set<std::string> log_ranges;
 };
 
 /// Reads and checks a sweep file; throws std::runtime_error naming the file,
