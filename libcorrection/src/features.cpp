@@ -1,6 +1,7 @@
 #include "correction/features.hpp"
 
 #include <fmt/format.h>
+#include <stdexcept>
 
 namespace correction {
 
@@ -11,6 +12,7 @@ std::string_view to_string(CorrectionStatus status) {
     case CorrectionStatus::no_awcc_velocity: return "no_awcc_velocity";
     case CorrectionStatus::low_quality: return "low_quality";
     case CorrectionStatus::no_bubbles: return "no_bubbles";
+    case CorrectionStatus::missing_feature: return "missing_feature";
     case CorrectionStatus::too_few_windows: return "too_few_windows";
     case CorrectionStatus::outside_training_range: return "outside_training_range";
     case CorrectionStatus::probe_corrected: return "probe_corrected";
@@ -46,7 +48,36 @@ FeatureResult make_features(const Measurement& m) {
   f.dy = m.dy;
   f.np = m.np;
   f.windows_accepted = m.windows_accepted;
+  f.fs = m.fs;
+  f.duration = m.duration;
   return r;
+}
+
+std::optional<double> Features::value(std::string_view name) const {
+  const auto measured = vector();
+  for (std::size_t j = 0; j < names.size(); ++j)
+    if (name == names[j]) return measured[j];
+  if (name == "fs" && fs > 0.0) return fs;
+  if (name == "duration" && duration > 0.0) return duration;
+  if (name == "windows_accepted" && windows_accepted >= 0) return static_cast<double>(windows_accepted);
+  return std::nullopt;
+}
+
+std::vector<std::string> feature_set_names(std::string_view set) {
+  if (set != "measured" && set != "extended") {
+    throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7) or extended (with "
+                                            "fs, duration and accepted windows)",
+                                            set));
+  }
+  std::vector<std::string> out(Features::names.begin(), Features::names.end());
+  if (set == "extended") out.insert(out.end(), Features::record_names.begin(), Features::record_names.end());
+  return out;
+}
+
+std::string feature_set_of(const std::vector<std::string>& names) {
+  for (const char* set : {"measured", "extended"})
+    if (names == feature_set_names(set)) return set;
+  return {};
 }
 
 MeasurementResult measurement_of(const awcc::ProcessResult& r) {
@@ -82,6 +113,8 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   m.dy = r.dy;
   m.np = r.awcc->np;
   m.windows_accepted = r.awcc->windows_accepted;
+  m.fs = r.info.fs;
+  m.duration = r.info.fs > 0.0 ? static_cast<double>(r.info.frames) / r.info.fs : 0.0;
   return out;
 }
 

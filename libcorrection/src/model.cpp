@@ -138,13 +138,13 @@ void write_forest(Writer& w, const std::string& name, TargetForm form, const Qua
   }
 }
 
-QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& form) {
+QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& form, std::uint32_t expected_features) {
   if (const auto name = r.text(); name != expected) r.damaged(fmt::format("forest '{}' where '{}' belongs", name, expected));
   const auto f = r.u8();
   if (f > 2) r.damaged(fmt::format("unknown target form {}", f));
   form = static_cast<TargetForm>(f);
   const auto features = r.u32();
-  if (features != Features::count) r.damaged(fmt::format("{} features, expected {}", features, Features::count));
+  if (features != expected_features) r.damaged(fmt::format("{} features, expected {}", features, expected_features));
   std::vector<double> targets(r.count(r.u64(), 8));
   for (auto& y : targets) y = r.f64();
   std::vector<RegressionTree> trees(r.count(r.u32(), 12));
@@ -239,8 +239,18 @@ Correction CorrectionModel::correct(const Features& f) const {
                          fmt::format("{} accepted windows; the model was trained on runs with at least {}",
                                      f.windows_accepted, min_windows));
   }
-  const auto x = f.vector();
-  for (std::size_t j = 0; j < ranges.size() && j < x.size(); ++j) {
+  std::vector<double> x(ranges.size());
+  for (std::size_t j = 0; j < ranges.size(); ++j) {
+    const auto v = f.value(ranges[j].name);
+    if (!v) {
+      return not_corrected(CorrectionStatus::missing_feature,
+                           fmt::format("the model takes the record's {} as a feature, and it is not known for this row; "
+                                       "give it (e.g. a CSV column '{}')",
+                                       ranges[j].name, ranges[j].name));
+    }
+    x[j] = *v;
+  }
+  for (std::size_t j = 0; j < ranges.size(); ++j) {
     const auto& r = ranges[j];
     const double pad = range_margin * (r.max - r.min);
     if (!(x[j] >= r.min - pad && x[j] <= r.max + pad)) {
@@ -327,15 +337,15 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
   CorrectionModel m;
   m.provenance = r.text();
   m.ranges.resize(r.count(r.u32(), 20));
-  if (m.ranges.size() != Features::count) r.damaged(fmt::format("{} feature ranges", m.ranges.size()));
+  // Format 1 and 2 models take the measured features; format 3 also the extended set.
+  const auto names = feature_set_names(m.ranges.size() == Features::count || version < 3 ? "measured" : "extended");
+  if (m.ranges.size() != names.size()) r.damaged(fmt::format("{} feature ranges", m.ranges.size()));
   for (std::size_t j = 0; j < m.ranges.size(); ++j) {
     auto& fr = m.ranges[j];
     fr.name = r.text();
     fr.min = r.f64();
     fr.max = r.f64();
-    if (fr.name != Features::names[j]) {
-      r.damaged(fmt::format("feature {} is '{}', expected '{}'", j, fr.name, Features::names[j]));
-    }
+    if (fr.name != names[j]) r.damaged(fmt::format("feature {} is '{}', expected '{}'", j, fr.name, names[j]));
     if (!(std::isfinite(fr.min) && std::isfinite(fr.max) && fr.min <= fr.max)) r.damaged("a feature range is not finite");
   }
   m.range_margin = r.f64();
@@ -355,8 +365,9 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
     m.processing.subsample = flag("peak refinement") ? awcc::Subsample::parabolic : awcc::Subsample::none;
   }
   if (r.u32() != 2) r.damaged("the model holds other than two forests");
-  m.velocity = read_forest(r, "velocity", m.velocity_form);
-  m.turbulence_intensity = read_forest(r, "turbulence_intensity", m.turbulence_form);
+  const auto p = static_cast<std::uint32_t>(m.ranges.size());
+  m.velocity = read_forest(r, "velocity", m.velocity_form, p);
+  m.turbulence_intensity = read_forest(r, "turbulence_intensity", m.turbulence_form, p);
   if (!r.done()) r.damaged("bytes after the last forest");
   return m;
 }

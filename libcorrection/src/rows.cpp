@@ -110,6 +110,8 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
   m.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
   m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
   m.np = static_cast<int>(need(number(a, "np"), default_np(d), file, "np", "particles per window"));
+  m.fs = number(r, "fs").value_or(0.0);
+  m.duration = number(r, "duration").value_or(0.0);
   return model.correct(m);
 }
 
@@ -181,6 +183,11 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     m.dx = need(std::nullopt, d.dx, where, "dx", "streamwise tip separation");
     m.dy = need(std::nullopt, d.dy, where, "dy", "lateral tip separation");
     m.np = static_cast<int>(need(std::nullopt, default_np(d), where, "np", "particles per window"));
+    // The record's features, where the tool's CSV has columns of pdp's names.
+    auto optional = [&](const char* name) { return col.count(name) ? value(name) : std::nullopt; };
+    m.fs = optional("fs").value_or(0.0);
+    m.duration = optional("duration").value_or(0.0);
+    if (const auto w = optional("awcc_windows_accepted")) m.windows_accepted = static_cast<std::int64_t>(*w);
     const auto c = c_value ? model.correct(m)
                            : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
     out.text += row;
@@ -290,6 +297,8 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
       m.np = static_cast<int>(need(value("np"), default_np(d), where, "np", "particles per window"));
       m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
+      m.fs = value("fs").value_or(0.0);
+      m.duration = value("duration").value_or(0.0);
       c = model.correct(m);
     }
     out.text += row + "," + correction_csv_cells(c) + "\n";

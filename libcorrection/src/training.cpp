@@ -1,6 +1,7 @@
 #include "correction/training.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <atomic>
@@ -34,13 +35,27 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 std::vector<double> levels() { return {correction_levels.begin(), correction_levels.end()}; }
 
-TrainingData data_of(const std::vector<TrainingRow>& rows, bool velocity, TargetForm form) {
+// A training row's feature vector in the order of `names` (every value is
+// there: load_training_set reads them all).
+std::vector<double> vector_of(const Features& f, const std::vector<std::string>& names) {
+  std::vector<double> x;
+  x.reserve(names.size());
+  for (const auto& n : names) {
+    const auto v = f.value(n);
+    if (!v) throw std::runtime_error(fmt::format("a training row has no {}", n));
+    x.push_back(*v);
+  }
+  return x;
+}
+
+TrainingData data_of(const std::vector<TrainingRow>& rows, bool velocity, TargetForm form,
+                     const std::vector<std::string>& names) {
   TrainingData d;
-  d.features = Features::count;
-  d.x.reserve(rows.size() * 7);
+  d.features = static_cast<int>(names.size());
+  d.x.reserve(rows.size() * names.size());
   d.y.reserve(rows.size());
   for (const auto& r : rows) {
-    const auto x = r.features.vector();
+    const auto x = vector_of(r.features, names);
     d.x.insert(d.x.end(), x.begin(), x.end());
     d.y.push_back(velocity ? to_target(form, r.true_velocity, r.features.velocity)
                            : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity));
@@ -60,8 +75,9 @@ double target_pinball(const std::vector<double>& q, const TrainingRow& r, bool v
   return pinball_loss(q, lv, r.true_turbulence_intensity);
 }
 
-std::vector<double> predict(const QuantileForest& f, TargetForm form, const TrainingRow& r, bool velocity) {
-  const auto x = r.features.vector();
+std::vector<double> predict(const QuantileForest& f, TargetForm form, const TrainingRow& r, bool velocity,
+                            const std::vector<std::string>& names) {
+  const auto x = vector_of(r.features, names);
   auto q = f.quantiles(x, levels());
   const double measured = velocity ? r.features.velocity : r.features.turbulence_intensity;
   for (auto& v : q) {
@@ -110,9 +126,16 @@ const awcc::OptionField<T> kTraining[] = {
        o.min_leaf = o.min_leaf_grid.front();
      },
      [](const T& o) { return list_text(o.min_leaf_grid); }},
-    {"features-per-split", "-", "features tried per split (1-7): the values tried",
+    {"feature-set", "-",
+     "features of the model: measured (u, Tu, c, d32, dx, dy, Np) or extended (also fs, duration and accepted windows)",
      [](T& o, std::string_view t) {
-       o.features_per_split_grid = whole_list(t, 1, Features::count);
+       feature_set_names(t);  // refuses an unknown set
+       o.feature_set = std::string(t);
+     },
+     [](const T& o) { return o.feature_set; }},
+    {"features-per-split", "-", "features tried per split (1 to the feature count): the values tried",
+     [](T& o, std::string_view t) {
+       o.features_per_split_grid = whole_list(t, 1, static_cast<std::int64_t>(Features::names.size() + Features::record_names.size()));
        o.features_per_split = o.features_per_split_grid.front();
      },
      [](const T& o) { return list_text(o.features_per_split_grid); }},
@@ -135,8 +158,18 @@ std::string TrainOptions::validate() const {
   if (folds == 1 || folds < 0) return fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds);
   if (cv_trees < 1) return fmt::format("cross-validation trees {}: give at least 1", cv_trees);
   if (min_leaf < 1) return fmt::format("min leaf {}: give at least 1", min_leaf);
-  if (features_per_split < 1 || features_per_split > Features::count) {
-    return fmt::format("features per split {}: give 1 to {}", features_per_split, Features::count);
+  std::size_t features = 0;
+  try {
+    features = feature_set_names(feature_set).size();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  for (int m : features_per_split_grid) {
+    if (m < 1 || static_cast<std::size_t>(m) > features)
+      return fmt::format("features per split {}: give 1 to {} (the {} feature set)", m, features, feature_set);
+  }
+  if (features_per_split < 1 || static_cast<std::size_t>(features_per_split) > features) {
+    return fmt::format("features per split {}: give 1 to {}", features_per_split, features);
   }
   return {};
 }
@@ -237,6 +270,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         m.dy = number_of(dy_column);
         m.np = static_cast<int>(number_of("np"));
         m.windows_accepted = static_cast<std::int64_t>(number_of("awcc_windows_accepted"));
+        m.fs = number_of("fs");
+        m.duration = number_of("duration");
         return make_features(m);
       }();
       if (!features.ok()) {  // no (positive) AWCC velocity, or no bubbles: not corrected either
@@ -265,22 +300,23 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
 
 CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm velocity_form,
                                 TargetForm turbulence_form, const ForestOptions& velocity_options,
-                                const ForestOptions& turbulence_options, std::int64_t min_windows) {
+                                const ForestOptions& turbulence_options, std::int64_t min_windows,
+                                const std::vector<std::string>& names) {
   CorrectionModel m;
   m.min_windows = min_windows;
   m.velocity_form = velocity_form;
   m.turbulence_form = turbulence_form;
-  for (int j = 0; j < Features::count; ++j) {
-    FeatureRange r{Features::names[static_cast<std::size_t>(j)], 1e300, -1e300};
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    FeatureRange r{names[j], 1e300, -1e300};
     for (const auto& row : rows) {
-      const double v = row.features.vector()[static_cast<std::size_t>(j)];
+      const double v = *row.features.value(names[j]);
       r.min = std::min(r.min, v);
       r.max = std::max(r.max, v);
     }
     m.ranges.push_back(r);
   }
-  m.velocity = QuantileForest::train(data_of(rows, true, velocity_form), velocity_options);
-  m.turbulence_intensity = QuantileForest::train(data_of(rows, false, turbulence_form), turbulence_options);
+  m.velocity = QuantileForest::train(data_of(rows, true, velocity_form, names), velocity_options);
+  m.turbulence_intensity = QuantileForest::train(data_of(rows, false, turbulence_form, names), turbulence_options);
   return m;
 }
 
@@ -364,6 +400,7 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
 
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
   if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
+  const auto names = feature_set_names(o.feature_set);
   // Held-out split by a hash of the run index: independent of file order.
   std::vector<TrainingRow> rows = set.rows;
   auto key = [&](const TrainingRow& r) { return mix64(o.seed ^ mix64(static_cast<std::uint64_t>(r.run) ^ mix64(r.study))); };
@@ -416,10 +453,10 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
               fo.features_per_split = mtry;
               fo.seed = o.seed + 17 * fold + static_cast<std::uint64_t>(target);
               fo.threads = o.threads;
-              const auto forest = QuantileForest::train(data_of(fit, velocity, form), fo);
+              const auto forest = QuantileForest::train(data_of(fit, velocity, form, names), fo);
               std::vector<double> losses(test.size());
               parallel_for(test.size(), o.threads, [&](std::size_t i) {
-                losses[i] = target_pinball(predict(forest, form, test[i], velocity), test[i], velocity);
+                losses[i] = target_pinball(predict(forest, form, test[i], velocity, names), test[i], velocity);
               });
               for (double l : losses) loss += l;
             }
@@ -443,7 +480,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   result.turbulence_features_per_split = topt.features_per_split;
 
   const auto train_start = std::chrono::steady_clock::now();
-  result.model = fit_model(training, vform, tform, vopt, topt, o.min_windows);
+  result.model = fit_model(training, vform, tform, vopt, topt, o.min_windows, names);
   result.seconds_train = seconds_since(train_start);
   result.held_out = score(result.model, held_out, &result.predictions, o.threads);
   if (progress) progress(cv_share + 0.1);
@@ -463,7 +500,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     const std::size_t n = training.size() * num / den;
     if (n < 10) continue;
     const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
-    auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows);
+    auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows, names);
     // Every point scores the same held-out rows: those inside the full
     // model's ranges (a small subset's own ranges would drop the hard rows).
     m.ranges = result.model.ranges;
@@ -482,12 +519,12 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
   result.model.processing = set.processing;
   result.model.provenance = fmt::format(
-      "pdp train {}: {}; processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
+      "pdp train {}: {}; {} features ({}); processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
       "windows); trained on {}, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
       "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
       "{:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; Tu RMSE {:.4f} raw, {:.4f} corrected, 80/95 % coverage "
       "{:.1f}/{:.1f} %.",
-      awcc::version, sources, describe(set.processing),
+      awcc::version, sources, o.feature_set, fmt::join(names, ", "), describe(set.processing),
       set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
       set.excluded_windows, o.min_windows, training.size(), held_out.size(), o.seed, to_string(vform), vopt.trees,
       vopt.min_leaf, vopt.features_per_split, to_string(tform), topt.trees, topt.min_leaf,

@@ -115,8 +115,8 @@ TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "pdp-qrf\n");
-  // Format version 2 as u32 little-endian.
-  EXPECT_EQ(bytes[8], 2);
+  // Format version 3 as u32 little-endian.
+  EXPECT_EQ(bytes[8], 3);
   EXPECT_EQ(bytes[9], 0);
   EXPECT_EQ(bytes[10], 0);
   EXPECT_EQ(bytes[11], 0);
@@ -148,8 +148,8 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   const std::string text = "velocity,turbulence_intensity\n1,2\n";
   EXPECT_NE(message({text.begin(), text.end()}).find("not a pdp model file"), std::string::npos);
   auto newer = bytes;
-  newer[8] = 3;
-  EXPECT_NE(message(newer).find("version 3"), std::string::npos) << message(newer);
+  newer[8] = 4;
+  EXPECT_NE(message(newer).find("version 4"), std::string::npos) << message(newer);
   // A structural fault with a valid checksum: the reader checks the trees too.
   auto forged = bytes;
   // The first tree's root node follows the velocity targets; find it by
@@ -342,6 +342,73 @@ TEST(Correction, ModelFileKeepsTheProcessing) {
   const auto shipped = std::filesystem::path(PDP_SOURCE_DIR) / "samples" / "model" / "awcc.qrf";
   const auto v1 = CorrectionModel::load(shipped);
   EXPECT_TRUE(v1.processing == correction::Processing{});
+}
+
+TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
+  // A model whose ranges are the extended set: a row without fs is not
+  // corrected and says which feature is missing; with it, it is corrected
+  // exactly as the forests say; the file reads back bit for bit, as version 3.
+  std::mt19937_64 g(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto names = correction::feature_set_names("extended");
+  ASSERT_EQ(names.size(), 10u);
+  correction::TrainingData v, t;
+  v.features = t.features = 10;
+  CorrectionModel m;
+  for (const auto& n : names) m.ranges.push_back({n, 1e300, -1e300});
+  for (int i = 0; i < 300; ++i) {
+    Features f = inside();
+    f.velocity = 1 + 49 * u(g);
+    f.fs = 1e4 + 1e6 * u(g);
+    f.duration = 20 + 280 * u(g);
+    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * u(g));
+    std::vector<double> x;
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      x.push_back(*f.value(names[j]));
+      m.ranges[j].min = std::min(m.ranges[j].min, x.back());
+      m.ranges[j].max = std::max(m.ranges[j].max, x.back());
+    }
+    v.x.insert(v.x.end(), x.begin(), x.end());
+    t.x.insert(t.x.end(), x.begin(), x.end());
+    v.y.push_back(1.0 + 1e-7 * f.fs);
+    t.y.push_back(0.01);
+  }
+  correction::ForestOptions o;
+  o.trees = 5;
+  m.velocity = correction::QuantileForest::train(v, o);
+  m.turbulence_intensity = correction::QuantileForest::train(t, o);
+  m.min_windows = 10;
+  Features f = inside();
+  const auto missing = m.correct(f);
+  EXPECT_EQ(missing.status, correction::CorrectionStatus::missing_feature);
+  EXPECT_NE(missing.message.find("fs"), std::string::npos);
+  f.fs = 5e5;
+  f.duration = 100;
+  const auto c = m.correct(f);
+  ASSERT_TRUE(c.corrected()) << c.message;
+  std::vector<double> x;
+  for (const auto& n : names) x.push_back(*f.value(n));
+  const auto q = m.velocity.quantiles(x, correction::correction_levels);
+  EXPECT_DOUBLE_EQ(c.velocity->median(), correction::from_target(m.velocity_form, q[3], f.velocity));
+  const auto bytes = m.serialise();
+  std::uint32_t version = 0;
+  std::memcpy(&version, bytes.data() + 8, 4);
+  EXPECT_EQ(version, 3u);
+  EXPECT_EQ(CorrectionModel::parse(bytes, "x.qrf").serialise(), bytes);
+  // The unknown-record values are not features.
+  Features none;
+  EXPECT_FALSE(none.value("fs"));
+  EXPECT_FALSE(none.value("windows_accepted"));
+  EXPECT_FALSE(none.value("colour"));
+}
+
+TEST(Correction, TheShippedModelOfFormat2StillCorrects) {
+  const auto path = pdp_test::source_dir() / "samples" / "model" / "awcc.qrf";
+  const auto m = CorrectionModel::load(path);
+  EXPECT_EQ(m.ranges.size(), 7u);
+  auto f = inside();  // no fs or duration: the seven features suffice
+  const auto c = m.correct(f);
+  EXPECT_TRUE(c.corrected()) << c.message;
 }
 
 }  // namespace

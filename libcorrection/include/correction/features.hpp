@@ -10,6 +10,12 @@
 // the same way, instead of F), streamwise and lateral tip separations dx and
 // dy (m, the geometry that was processed), particles per window Np.
 //
+// Extended feature set (METHOD 7, extended domain; model files from format
+// 3): the seven above, then the record's sampling rate fs (Hz), its duration
+// (s) and AWCC's accepted windows. A model records its feature names; a
+// measurement that lacks one its model needs (a file without fs, say) is
+// not corrected, and says which.
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -23,6 +29,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "awcc/awcc.hpp"
 #include "awcc/process.hpp"
@@ -36,6 +43,7 @@ enum class CorrectionStatus {
   no_awcc_velocity,        ///< AWCC gave no (positive) velocity
   low_quality,             ///< AWCC's quality is low (METHOD 4, item 10): only ok rows are corrected
   no_bubbles,              ///< the leading tip saw no complete bubble (F = 0)
+  missing_feature,         ///< the model needs a feature the measurement does not give (e.g. fs)
   too_few_windows,         ///< fewer accepted windows than the model's training runs had
   outside_training_range,  ///< a feature outside the model's training data
   probe_corrected,         ///< AWCC was bubble-probe corrected: the model corrects uncorrected AWCC
@@ -52,19 +60,35 @@ struct Measurement {
   double dx = 0.0, dy = 0.0;                   ///< tip separations processed, m
   int np = 0;                                  ///< particles per window
   std::int64_t windows_accepted = -1;          ///< -1: not known (another tool's file)
+  double fs = 0.0;                             ///< sampling rate, Hz (0: not known)
+  double duration = 0.0;                       ///< record duration, s (0: not known)
 };
 
 /// The features of one measurement.
 struct Features {
+  /// The measured features of every model (format 1 and 2 models have these only).
   static constexpr int count = 7;
   static constexpr std::array<const char*, 7> names{"velocity", "turbulence_intensity", "void_fraction", "d32",
                                                     "dx",       "dy",                   "np"};
+  /// The record's features, which extended models (format 3) take after those.
+  static constexpr std::array<const char*, 3> record_names{"fs", "duration", "windows_accepted"};
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
-  std::int64_t windows_accepted = -1;  ///< not a feature: rows below the model's minimum are not corrected; -1 unknown
+  /// Rows below a model's minimum are not corrected; -1 unknown.
+  std::int64_t windows_accepted = -1;
+  double fs = 0.0, duration = 0.0;  ///< Hz, s; 0 = not known
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
+  /// The value of a named feature; empty when the measurement does not know it
+  /// (fs or duration 0, windows -1) or the name is not a feature.
+  [[nodiscard]] std::optional<double> value(std::string_view name) const;
 };
+
+/// The feature names of a feature set: "measured" (the seven) or "extended"
+/// (the seven and the record's three). Throws std::invalid_argument otherwise.
+std::vector<std::string> feature_set_names(std::string_view set);
+/// "measured" or "extended" for a model's names in order; empty when they are neither.
+std::string feature_set_of(const std::vector<std::string>& names);
 
 /// Features, or the status and message saying why there are none.
 struct FeatureResult {

@@ -33,6 +33,9 @@
 // right child being left + 1; a leaf: u8 0xff, u32 first held row, u32
 // count), held-row count (u64), held rows. Version 1 files (no processing)
 // were all trained with the default processing, which they are read with.
+// Version 3 has the same layout and admits the extended feature set (the
+// seven measured features, then fs, duration and windows_accepted: see
+// correction/features.hpp); versions 1 and 2 have the seven only.
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
 
@@ -82,7 +85,7 @@ struct Correction {
 Correction not_corrected(CorrectionStatus status, std::string message);
 
 struct CorrectionModel {
-  static constexpr std::uint32_t format_version = 2;
+  static constexpr std::uint32_t format_version = 3;
 
   std::string provenance;             ///< how the model was made (sweep, rows, options, held-out scores)
   std::vector<FeatureRange> ranges;   ///< training data [min, max] per feature, feature order

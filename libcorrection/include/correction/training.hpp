@@ -78,6 +78,9 @@ struct TrainOptions {
   TargetForm turbulence_form = TargetForm::difference; ///< without CV
   std::uint64_t seed = 1;
   int threads = 0;
+  /// "measured" (the seven features of METHOD 7) or "extended" (also fs,
+  /// duration and accepted windows: records of every length and rate).
+  std::string feature_set = "measured";
   [[nodiscard]] std::string validate() const;
 };
 
@@ -147,7 +150,8 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
 /// The two forests and the ranges from training rows.
 CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm velocity_form,
                                 TargetForm turbulence_form, const ForestOptions& velocity_options,
-                                const ForestOptions& turbulence_options, std::int64_t min_windows);
+                                const ForestOptions& turbulence_options, std::int64_t min_windows,
+                                const std::vector<std::string>& names = feature_set_names("measured"));
 
 /// Held-out predictions as CSV: run, features, truth, raw, quantiles.
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
