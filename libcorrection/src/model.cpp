@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <deque>
 #include <fstream>
 #include <iterator>
@@ -233,6 +234,24 @@ Correction not_corrected(CorrectionStatus status, std::string message) {
   return c;
 }
 
+int Calibration::band(std::int64_t windows) const {
+  if (windows < 0) return -1;
+  int b = 0;
+  while (b < static_cast<int>(window_edges.size()) && windows >= window_edges[static_cast<std::size_t>(b)]) ++b;
+  return b;
+}
+
+void Calibration::apply(const std::array<double, 3>& offsets, std::vector<double>& t) {
+  // Levels 0.025 0.1 0.25 0.5 0.75 0.9 0.975: pairs (2, 4), (1, 5), (0, 6).
+  for (std::size_t k = 0; k < 3; ++k) {
+    t[2 - k] -= offsets[k];
+    t[4 + k] += offsets[k];
+  }
+  // A narrowed interval may not cross a narrower one or the median.
+  for (std::size_t k = 3; k-- > 0;) t[k] = std::min(t[k], t[k + 1]);
+  for (std::size_t k = 4; k < 7; ++k) t[k] = std::max(t[k], t[k - 1]);
+}
+
 Correction CorrectionModel::correct(const Features& f) const {
   if (f.windows_accepted >= 0 && f.windows_accepted < min_windows) {
     return not_corrected(CorrectionStatus::too_few_windows,
@@ -261,18 +280,32 @@ Correction CorrectionModel::correct(const Features& f) const {
   }
   Correction c;
   c.status = CorrectionStatus::corrected;
-  auto one = [&](const QuantileForest& forest, TargetForm form, double measured, bool nonnegative) {
+  const int band = calibration.band(f.windows_accepted);
+  auto one = [&](const QuantileForest& forest, TargetForm form, double measured, bool nonnegative,
+                 const std::vector<std::array<double, 3>>& offsets) {
     CorrectedQuantity q;
     q.measured = measured;
-    const auto t = forest.quantiles(x, correction_levels);
+    auto t = forest.quantiles(x, correction_levels);
+    if (!offsets.empty()) {
+      std::array<double, 3> o{};
+      if (band >= 0) {
+        o = offsets[static_cast<std::size_t>(band)];
+      } else {  // windows not known: each interval's widest band
+        o.fill(-std::numeric_limits<double>::infinity());
+        for (const auto& b : offsets)
+          for (std::size_t k = 0; k < 3; ++k) o[k] = std::max(o[k], b[k]);
+      }
+      Calibration::apply(o, t);
+    }
     for (std::size_t k = 0; k < t.size(); ++k) {
       q.quantiles[k] = from_target(form, t[k], measured);
       if (nonnegative) q.quantiles[k] = std::max(0.0, q.quantiles[k]);
     }
     return q;
   };
-  c.velocity = one(velocity, velocity_form, f.velocity, false);
-  c.turbulence_intensity = one(turbulence_intensity, turbulence_form, f.turbulence_intensity, true);
+  c.velocity = one(velocity, velocity_form, f.velocity, false, calibration.velocity);
+  c.turbulence_intensity =
+      one(turbulence_intensity, turbulence_form, f.turbulence_intensity, true, calibration.turbulence_intensity);
   return c;
 }
 
@@ -301,6 +334,13 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
   payload.u8(processing.weighting == awcc::Weighting::none ? 1 : 0);
   payload.u8(processing.signal == awcc::CorrelationSignal::raw ? 1 : 0);
   payload.u8(processing.subsample == awcc::Subsample::parabolic ? 1 : 0);
+  payload.u32(static_cast<std::uint32_t>(calibration.velocity.size()));
+  if (!calibration.empty()) {
+    for (auto e : calibration.window_edges) payload.i64(e);
+    for (const auto* bands : {&calibration.velocity, &calibration.turbulence_intensity})
+      for (const auto& b : *bands)
+        for (double o : b) payload.f64(o);
+  }
   payload.u32(2);
   write_forest(payload, "velocity", velocity_form, velocity);
   write_forest(payload, "turbulence_intensity", turbulence_form, turbulence_intensity);
@@ -363,6 +403,25 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
     m.processing.weighting = flag("weighting") ? awcc::Weighting::none : awcc::Weighting::duration;
     m.processing.signal = flag("signal") ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
     m.processing.subsample = flag("peak refinement") ? awcc::Subsample::parabolic : awcc::Subsample::none;
+  }
+  if (version >= 3) {
+    const auto bands = r.count(r.u32(), 48);
+    if (bands > 0) {
+      auto& c = m.calibration;
+      c.window_edges.resize(bands - 1);
+      for (auto& e : c.window_edges) {
+        e = r.i64();
+        if (e < 0 || (&e != c.window_edges.data() && e <= *(&e - 1))) r.damaged("calibration band edges not increasing");
+      }
+      for (auto* b : {&c.velocity, &c.turbulence_intensity}) {
+        b->resize(bands);
+        for (auto& band : *b)
+          for (double& o : band) {
+            o = r.f64();
+            if (!std::isfinite(o)) r.damaged("a calibration offset is not finite");
+          }
+      }
+    }
   }
   if (r.u32() != 2) r.damaged("the model holds other than two forests");
   const auto p = static_cast<std::uint32_t>(m.ranges.size());

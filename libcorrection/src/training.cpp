@@ -126,6 +126,19 @@ const awcc::OptionField<T> kTraining[] = {
        o.min_leaf = o.min_leaf_grid.front();
      },
      [](const T& o) { return list_text(o.min_leaf_grid); }},
+    {"calibration", "-",
+     "fraction of the training runs set aside to calibrate the 50/80/95 % intervals (conformalised); 0 = none",
+     [](T& o, std::string_view t) { o.calibration = awcc::parse_quantity(t, awcc::Dimension::dimensionless); },
+     [](const T& o) { return fmt::format("{:g}", o.calibration); }},
+    {"calibration-bands", "-", "accepted-window counts where the calibration bands meet (each band is calibrated on its own)",
+     [](T& o, std::string_view t) {
+       o.calibration_bands.clear();
+       for (int v : whole_list(t, 1, 1 << 30)) o.calibration_bands.push_back(v);
+     },
+     [](const T& o) {
+       std::vector<int> v(o.calibration_bands.begin(), o.calibration_bands.end());
+       return list_text(v);
+     }},
     {"feature-set", "-",
      "features of the model: measured (u, Tu, c, d32, dx, dy, Np) or extended (also fs, duration and accepted windows)",
      [](T& o, std::string_view t) {
@@ -158,6 +171,9 @@ std::string TrainOptions::validate() const {
   if (folds == 1 || folds < 0) return fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds);
   if (cv_trees < 1) return fmt::format("cross-validation trees {}: give at least 1", cv_trees);
   if (min_leaf < 1) return fmt::format("min leaf {}: give at least 1", min_leaf);
+  if (!(calibration >= 0.0 && calibration < 1.0)) return fmt::format("calibration fraction {}: give a fraction in [0, 1)", calibration);
+  for (std::size_t i = 1; i < calibration_bands.size(); ++i)
+    if (calibration_bands[i] <= calibration_bands[i - 1]) return "calibration bands: give increasing window counts";
   std::size_t features = 0;
   try {
     features = feature_set_names(feature_set).size();
@@ -398,6 +414,56 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
   return s;
 }
 
+Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
+                      const std::vector<std::int64_t>& window_edges, int threads) {
+  std::vector<std::string> names;
+  for (const auto& r : model.ranges) names.push_back(r.name);
+  Calibration c;
+  c.window_edges = window_edges;
+  // Scores of each row: velocity then Tu, intervals 50, 80, 95 %.
+  std::vector<std::array<double, 6>> scores(rows.size());
+  std::vector<int> band(rows.size());
+  parallel_for(rows.size(), threads, [&](std::size_t i) {
+    const auto& r = rows[i];
+    const auto x = vector_of(r.features, names);
+    for (int f = 0; f < 2; ++f) {
+      const auto& forest = f == 0 ? model.velocity : model.turbulence_intensity;
+      const auto form = f == 0 ? model.velocity_form : model.turbulence_form;
+      const double target = f == 0 ? to_target(form, r.true_velocity, r.features.velocity)
+                                   : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity);
+      const auto t = forest.quantiles(x, correction_levels);
+      for (std::size_t k = 0; k < 3; ++k)
+        scores[i][static_cast<std::size_t>(3 * f) + k] = std::max(t[2 - k] - target, target - t[4 + k]);
+    }
+    band[i] = c.band(r.features.windows_accepted);
+  });
+  // Q = E_k, k = ceil((n + 1)(1 - alpha)): the header's guarantee.
+  constexpr std::array<double, 3> alpha{0.5, 0.2, 0.05};
+  auto offsets = [&](int b, std::size_t column0) {
+    std::array<double, 3> q{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::vector<double> e;
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        if (b < 0 || band[i] == b) e.push_back(scores[i][column0 + k]);
+      std::sort(e.begin(), e.end());
+      const auto n = static_cast<double>(e.size());
+      const auto rank = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 - alpha[k])));
+      q[k] = e[std::min(rank, e.size()) - 1];
+    }
+    return q;
+  };
+  const std::size_t bands = window_edges.size() + 1;
+  for (std::size_t b = 0; b < bands; ++b) {
+    // A band with too few calibration runs (fewer than 1/alpha for the 95 %
+    // interval, with margin) takes the pooled offsets.
+    const auto n = std::count(band.begin(), band.end(), static_cast<int>(b));
+    const int group = n >= 50 ? static_cast<int>(b) : -1;
+    c.velocity.push_back(offsets(group, 0));
+    c.turbulence_intensity.push_back(offsets(group, 3));
+  }
+  return c;
+}
+
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
   if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
   const auto names = feature_set_names(o.feature_set);
@@ -415,7 +481,16 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
                                             100 * (1 - o.held_out), 100 * o.held_out));
   }
   const std::vector<TrainingRow> held_out(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(held));
-  const std::vector<TrainingRow> training(rows.begin() + static_cast<std::ptrdiff_t>(held), rows.end());
+  // The calibration runs come next in the same order; the forests never see them.
+  const auto calibrating = static_cast<std::size_t>(std::llround(o.calibration * static_cast<double>(rows.size() - held)));
+  if (o.calibration > 0.0 && calibrating < 100) {
+    throw std::invalid_argument(fmt::format("{} calibration runs are too few to calibrate the 95 % interval of each "
+                                            "band; run a larger sweep or set calibration to 0",
+                                            calibrating));
+  }
+  const std::vector<TrainingRow> calibration_rows(rows.begin() + static_cast<std::ptrdiff_t>(held),
+                                                  rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating));
+  const std::vector<TrainingRow> training(rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating), rows.end());
 
   TrainResult result;
   result.training_rows = static_cast<std::int64_t>(training.size());
@@ -481,6 +556,10 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
 
   const auto train_start = std::chrono::steady_clock::now();
   result.model = fit_model(training, vform, tform, vopt, topt, o.min_windows, names);
+  if (!calibration_rows.empty()) {
+    result.model.calibration = calibrate(result.model, calibration_rows, o.calibration_bands, o.threads);
+  }
+  result.calibration_rows = static_cast<std::int64_t>(calibration_rows.size());
   result.seconds_train = seconds_since(train_start);
   result.held_out = score(result.model, held_out, &result.predictions, o.threads);
   if (progress) progress(cv_share + 0.1);
@@ -501,6 +580,9 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     if (n < 10) continue;
     const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
     auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows, names);
+    if (num != den && !calibration_rows.empty()) {
+      m.calibration = calibrate(m, calibration_rows, o.calibration_bands, o.threads);
+    }
     // Every point scores the same held-out rows: those inside the full
     // model's ranges (a small subset's own ranges would drop the hard rows).
     m.ranges = result.model.ranges;
@@ -520,13 +602,13 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   result.model.processing = set.processing;
   result.model.provenance = fmt::format(
       "pdp train {}: {}; {} features ({}); processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
-      "windows); trained on {}, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
+      "windows); trained on {}, {} set aside to calibrate the intervals, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
       "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
       "{:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; Tu RMSE {:.4f} raw, {:.4f} corrected, 80/95 % coverage "
       "{:.1f}/{:.1f} %.",
       awcc::version, sources, o.feature_set, fmt::join(names, ", "), describe(set.processing),
       set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
-      set.excluded_windows, o.min_windows, training.size(), held_out.size(), o.seed, to_string(vform), vopt.trees,
+      set.excluded_windows, o.min_windows, training.size(), calibration_rows.size(), held_out.size(), o.seed, to_string(vform), vopt.trees,
       vopt.min_leaf, vopt.features_per_split, to_string(tform), topt.trees, topt.min_leaf,
       topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected, 100 * h.velocity_coverage80,
       100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected, 100 * h.tu_coverage80, 100 * h.tu_coverage95);

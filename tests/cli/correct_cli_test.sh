@@ -33,7 +33,7 @@ TOML
 
 # Training: a report, a model, and the same bytes for 1 and 2 threads.
 "$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/a.qrf" --trees 20 --folds 2 --cv-trees 5 --min-leaf 3,5 \
-  --features-per-split 3,7 --min-windows 20 --threads 1 --predictions "$dir/pred.csv" --learning-curve "$dir/lc.csv" \
+  --features-per-split 3,7 --min-windows 20 --calibration 0 --threads 1 --predictions "$dir/pred.csv" --learning-curve "$dir/lc.csv" \
   >"$dir/report.txt" || fail "train"
 grep -q "Held out:" "$dir/report.txt" || fail "no held-out report"
 grep -q "coverage 80 % / 95 %" "$dir/report.txt" || fail "no coverage in the report"
@@ -41,8 +41,12 @@ grep -q "^  velocity  *ratio" "$dir/report.txt" || fail "no CV table"
 head -1 "$dir/pred.csv" | grep -q "corrected_velocity_q0.975" || fail "predictions CSV header"
 head -1 "$dir/lc.csv" | grep -q "^training_runs," || fail "learning curve header"
 "$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/b.qrf" --trees 20 --folds 2 --cv-trees 5 --min-leaf 3,5 \
-  --features-per-split 3,7 --min-windows 20 --threads 2 >/dev/null || fail "train, 2 threads"
+  --features-per-split 3,7 --min-windows 20 --calibration 0 --threads 2 >/dev/null || fail "train, 2 threads"
 cmp -s "$dir/a.qrf" "$dir/b.qrf" || fail "models differ between 1 and 2 threads"
+# Calibrating intervals (the default) needs 100 calibration runs: a small sweep is told so, and no model is written.
+out=$("$pdp" train "$dir/mc.csv" -o "$dir/c.qrf" --trees 5 --folds 0 --min-windows 20 2>&1) && fail "calibrated on a few runs"
+[[ $out == *"calibration runs are too few"*"set calibration to 0"* ]] || fail "calibration message: $out"
+[[ -e $dir/c.qrf ]] && fail "a model written despite the error"
 
 # A recording well inside the training ranges (mid-range in every feature:
 # the ranges of 30 training runs are narrow).

@@ -163,7 +163,7 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
   std::mt19937_64 g(4);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   correction::TrainingSet set;
-  for (int i = 0; i < 200; ++i) {
+  for (int i = 0; i < 700; ++i) {
     correction::TrainingRow r;
     r.run = i;
     r.features = {1 + 49 * u(g), 0.35 * u(g), 0.4 * u(g), 0.01 * u(g), 0.01 * u(g), 0.002 * u(g), 10, 500};
@@ -171,7 +171,7 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
     r.true_turbulence_intensity = r.features.turbulence_intensity + 0.05 * u(g);
     set.rows.push_back(r);
   }
-  set.total = 200;
+  set.total = 700;
   correction::TrainOptions o;
   o.trees = 10;
   o.folds = 2;
@@ -179,13 +179,15 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
   o.min_leaf_grid = {3, 8};
   o.features_per_split_grid = {2, 7};
   // Two studies with the same run indices (two sweeps combined).
-  for (int i = 0; i < 100; ++i) set.rows[static_cast<std::size_t>(i)].study = 7;
-  for (int i = 100; i < 200; ++i) set.rows[static_cast<std::size_t>(i)].run -= 100;
+  for (int i = 0; i < 350; ++i) set.rows[static_cast<std::size_t>(i)].study = 7;
+  for (int i = 350; i < 700; ++i) set.rows[static_cast<std::size_t>(i)].run -= 350;
   const auto first = correction::train_model(set, o);
   std::reverse(set.rows.begin(), set.rows.end());
   const auto second = correction::train_model(set, o);
   EXPECT_EQ(first.model.serialise(), second.model.serialise());
-  EXPECT_EQ(first.predictions.size(), 40u);
+  EXPECT_EQ(first.predictions.size(), 140u);
+  EXPECT_EQ(first.calibration_rows, 112);  // 20 % of the 560 not held out
+  EXPECT_FALSE(first.model.calibration.empty());
   EXPECT_EQ(first.cv.size(), 2u * 2u * 2u * 2u);
 }
 
@@ -196,7 +198,7 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   std::mt19937_64 g(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::string csv = kHeader + "\n";
-  for (int i = 0; i < 600; ++i) {
+  for (int i = 0; i < 800; ++i) {
     const double fs = std::exp(std::log(1e4) + (std::log(1e6) - std::log(1e4)) * u(g));
     const double measured = 1 + 49 * u(g);
     const double truth = measured * (1.0 - 0.2 * (std::log(1e6) - std::log(fs)) / (std::log(1e6) - std::log(1e4)));
@@ -206,7 +208,7 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
     csv += row(i, v);
   }
   const auto set = correction::load_training_set({write("extended.csv", csv)}, 10);
-  ASSERT_EQ(set.rows.size(), 600u);
+  ASSERT_EQ(set.rows.size(), 800u);
   EXPECT_GT(set.rows[0].features.fs, 1e4 - 1);
   EXPECT_GT(set.rows[0].features.duration, 19.9);
   correction::TrainOptions o;
@@ -243,6 +245,127 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   o.feature_set = "measured";
   o.features_per_split_grid = {8};
   EXPECT_NE(o.validate().find("give 1 to 7"), std::string::npos);
+}
+
+// A model of one varying feature (velocity 1-2 m/s) whose forest learnt
+// targets of spread `sd` (velocity in the value form: the target is the true
+// velocity; Tu in the difference form, its spread sd / 10).
+correction::CorrectionModel shifted_model(double sd, std::uint64_t seed) {
+  std::mt19937_64 g(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(1.0, 2.0);
+  correction::CorrectionModel m;
+  m.velocity_form = correction::TargetForm::value;
+  m.turbulence_form = correction::TargetForm::difference;
+  m.min_windows = 1;
+  correction::TrainingData v, t;
+  v.features = t.features = 7;
+  correction::Features f;
+  f.turbulence_intensity = 0.2, f.void_fraction = 0.2, f.d32 = 3e-3, f.dx = 5e-3, f.dy = 1e-3, f.np = 10;
+  for (int i = 0; i < 1000; ++i) {
+    f.velocity = u(g);
+    const auto x = f.vector();
+    v.x.insert(v.x.end(), x.begin(), x.end());
+    t.x.insert(t.x.end(), x.begin(), x.end());
+    v.y.push_back(10.0 + sd * n(g));
+    t.y.push_back(sd / 10.0 * n(g));
+  }
+  for (std::size_t j = 0; j < 7; ++j) m.ranges.push_back({correction::Features::names[j], j == 0 ? 1.0 : f.vector()[j], j == 0 ? 2.0 : f.vector()[j]});
+  correction::ForestOptions o;
+  o.trees = 10;
+  o.min_leaf = 100;  // leaves hold the whole spread
+  o.seed = seed;
+  m.velocity = correction::QuantileForest::train(v, o);
+  m.turbulence_intensity = correction::QuantileForest::train(t, o);
+  return m;
+}
+
+// Runs of spread 1 (Tu: 0.1) around the same centres, with their windows.
+std::vector<correction::TrainingRow> runs(int count, std::uint64_t seed, std::int64_t windows) {
+  std::mt19937_64 g(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(1.0, 2.0);
+  std::vector<correction::TrainingRow> rows(static_cast<std::size_t>(count));
+  for (auto& r : rows) {
+    r.features.velocity = u(g);
+    r.features.turbulence_intensity = 0.2, r.features.void_fraction = 0.2, r.features.d32 = 3e-3;
+    r.features.dx = 5e-3, r.features.dy = 1e-3, r.features.np = 10;
+    r.features.windows_accepted = windows;
+    r.true_velocity = 10.0 + n(g);
+    r.true_turbulence_intensity = 0.2 + 0.1 * n(g);
+  }
+  return rows;
+}
+
+TEST(Calibration, ConformalOffsetsBringCoverageToNominal) {
+  // The forest learnt a spread twice the runs' own: its 80 % interval covers
+  // P(|Z| < 2 x 1.2816) = 99 % of them. Calibrated on n = 1000 runs, the
+  // coverage of new runs is Beta-distributed around 1 - alpha with sd
+  // sqrt(alpha (1 - alpha) / n) (1.3 % at 80 %, 0.7 % at 95 %); scored on
+  // 4000 runs (sd 0.6 %, 0.3 %): 4.5 % and 2.5 % are more than 3 sd.
+  const auto model = shifted_model(2.0, 1);
+  const auto calibration_runs = runs(1000, 2, 500);
+  const auto test_runs = runs(4000, 3, 500);
+  const auto raw = correction::score(model, test_runs);
+  EXPECT_GT(raw.velocity_coverage80, 0.97);
+  auto calibrated = model;
+  calibrated.calibration = correction::calibrate(model, calibration_runs, {30, 100});
+  ASSERT_EQ(calibrated.calibration.velocity.size(), 3u);
+  // Bands 0 and 1 have no calibration runs: they take the pooled offsets, which equal band 2's.
+  EXPECT_EQ(calibrated.calibration.velocity[0], calibrated.calibration.velocity[2]);
+  EXPECT_LT(calibrated.calibration.velocity[2][1], 0.0);  // narrowed
+  const auto s = correction::score(calibrated, test_runs);
+  EXPECT_NEAR(s.velocity_coverage80, 0.80, 0.045);
+  EXPECT_NEAR(s.velocity_coverage95, 0.95, 0.025);
+  EXPECT_NEAR(s.tu_coverage80, 0.80, 0.045);
+  EXPECT_NEAR(s.tu_coverage95, 0.95, 0.025);
+  // The median is the forest's: calibration moves only the interval ends.
+  EXPECT_DOUBLE_EQ(s.velocity_rmse_corrected, raw.velocity_rmse_corrected);
+}
+
+TEST(Calibration, BandsAreCalibratedOnTheirOwnAndUnknownWindowsTakeTheWidest) {
+  // Runs with 10-29 windows spread 1, runs with 100+ spread 0.5: each band's
+  // 80 % interval is set by its own runs.
+  const auto model = shifted_model(2.0, 4);
+  auto few = runs(600, 5, 20), many = runs(600, 6, 500);
+  for (auto& r : many) r.true_velocity = 10.0 + 0.5 * (r.true_velocity - 10.0);
+  std::vector<correction::TrainingRow> both(few);
+  both.insert(both.end(), many.begin(), many.end());
+  auto m = model;
+  m.calibration = correction::calibrate(model, both, {30, 100});
+  const auto& c = m.calibration;
+  EXPECT_GT(c.velocity[0][1], c.velocity[2][1] + 0.3);  // the few-window band is wider
+  // Band 1 (30-99 windows) has no runs: the pooled offsets, between the two.
+  EXPECT_LT(c.velocity[1][1], c.velocity[0][1]);
+  EXPECT_GT(c.velocity[1][1], c.velocity[2][1]);
+  EXPECT_EQ(c.band(-1), -1);
+  EXPECT_EQ(c.band(10), 0);
+  EXPECT_EQ(c.band(30), 1);
+  EXPECT_EQ(c.band(100), 2);
+  EXPECT_NEAR(correction::score(m, runs(3000, 7, 20)).velocity_coverage80, 0.80, 0.04);
+  auto narrow = runs(3000, 8, 500);
+  for (auto& r : narrow) r.true_velocity = 10.0 + 0.5 * (r.true_velocity - 10.0);
+  EXPECT_NEAR(correction::score(m, narrow).velocity_coverage80, 0.80, 0.04);
+  // Unknown windows: each interval's widest band, so at least nominal for either kind.
+  auto unknown = runs(3000, 9, -1);
+  EXPECT_GT(correction::score(m, unknown).velocity_coverage80, 0.77);
+  // The calibration survives the file.
+  const auto again = correction::CorrectionModel::parse(m.serialise(), "m.qrf");
+  EXPECT_EQ(again.calibration.window_edges, c.window_edges);
+  EXPECT_EQ(again.calibration.velocity, c.velocity);
+  EXPECT_EQ(again.calibration.turbulence_intensity, c.turbulence_intensity);
+}
+
+TEST(Calibration, ApplyKeepsTheQuantilesInOrder) {
+  // A narrowing larger than an interval's half width stops at the median.
+  std::vector<double> t{-3, -2, -1, 0, 1, 2, 3};
+  correction::Calibration::apply({5.0, -10.0, 1.0}, t);
+  // 50 % widened to -6..6; 80 % narrowed past the median and 95 % to -4..4:
+  // both are held at least as wide as the 50 % interval.
+  EXPECT_EQ(t, (std::vector<double>{-6, -6, -6, 0, 6, 6, 6}));
+  std::vector<double> u{-3, -2, -1, 0, 1, 2, 3};
+  correction::Calibration::apply({-5.0, 0.0, 0.0}, u);
+  EXPECT_EQ(u, (std::vector<double>{-3, -2, 0, 0, 0, 2, 3}));
 }
 
 }  // namespace

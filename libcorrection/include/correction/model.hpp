@@ -33,9 +33,11 @@
 // right child being left + 1; a leaf: u8 0xff, u32 first held row, u32
 // count), held-row count (u64), held rows. Version 1 files (no processing)
 // were all trained with the default processing, which they are read with.
-// Version 3 has the same layout and admits the extended feature set (the
-// seven measured features, then fs, duration and windows_accepted: see
-// correction/features.hpp); versions 1 and 2 have the seven only.
+// Version 3 admits the extended feature set (the seven measured features,
+// then fs, duration and windows_accepted: see correction/features.hpp;
+// versions 1 and 2 have the seven only) and, after the processing, the
+// calibration: u32 band count B (0: none), B - 1 window edges (i64), then
+// B x 3 offsets (f64) for the velocity and B x 3 for Tu.
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
 
@@ -84,6 +86,32 @@ struct Correction {
 /// A row that is not corrected, with the status and reason.
 Correction not_corrected(CorrectionStatus status, std::string message);
 
+/// Calibrated intervals: split conformalised quantile regression (Romano,
+/// Patterson and Candes 2019), by group. On calibration runs the forests
+/// were not trained on, a run's score for the interval [q_lo, q_hi] of its
+/// target t (in the forest's target form) is E = max(q_lo - t, t - q_hi).
+/// With the scores E_1 <= ... <= E_n of the run's group, the interval
+/// [q_lo - Q, q_hi + Q] with Q = E_k, k = ceil((n + 1)(1 - alpha)), covers
+/// a new run of the same distribution with probability at least 1 - alpha
+/// (and at most 1 - alpha + 1/(n + 1)); Q < 0 narrows an interval that was
+/// too wide. Intervals: the central 50 %, 80 % and 95 % of the reported
+/// levels; the median is left as the forest gives it. Groups are bands of
+/// accepted windows, the feature that most changes how wide an interval
+/// must be; a row whose windows are unknown takes each interval's widest
+/// group.
+struct Calibration {
+  /// Band g holds windows in [edges[g - 1], edges[g]) (band 0 from 0, the last to infinity).
+  std::vector<std::int64_t> window_edges;
+  /// Per band: Q of the 50 %, 80 % and 95 % intervals, in target units.
+  std::vector<std::array<double, 3>> velocity, turbulence_intensity;
+  [[nodiscard]] bool empty() const { return velocity.empty(); }
+  /// The band of a row (-1 when its windows are not known).
+  [[nodiscard]] int band(std::int64_t windows) const;
+  /// Applies the offsets of `band` to the quantiles t at correction_levels
+  /// (target units), keeping them in order.
+  static void apply(const std::array<double, 3>& offsets, std::vector<double>& t);
+};
+
 struct CorrectionModel {
   static constexpr std::uint32_t format_version = 3;
 
@@ -95,6 +123,7 @@ struct CorrectionModel {
   TargetForm velocity_form = TargetForm::ratio;
   TargetForm turbulence_form = TargetForm::difference;
   QuantileForest velocity, turbulence_intensity;
+  Calibration calibration;            ///< empty: the forests' quantiles as they are (format 1, 2)
 
   /// Corrected, or too few windows / outside the training range, with the reason.
   [[nodiscard]] Correction correct(const Features& f) const;

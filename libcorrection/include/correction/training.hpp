@@ -81,6 +81,13 @@ struct TrainOptions {
   /// "measured" (the seven features of METHOD 7) or "extended" (also fs,
   /// duration and accepted windows: records of every length and rate).
   std::string feature_set = "measured";
+  /// Fraction of the non-held-out runs set aside to calibrate the intervals
+  /// (model.hpp, Calibration): the forests are trained on the rest. Without
+  /// it the forest's intervals are as wide as its leaves make them, which
+  /// was 3 points too wide for the 80 % interval of Tu.
+  double calibration = 0.2;
+  /// Accepted-window counts where the calibration bands meet: 10-30, 30-100, 100+.
+  std::vector<std::int64_t> calibration_bands{30, 100};
   [[nodiscard]] std::string validate() const;
 };
 
@@ -129,6 +136,7 @@ struct HeldOutPrediction {
 struct TrainResult {
   CorrectionModel model;
   std::int64_t training_rows = 0;
+  std::int64_t calibration_rows = 0;    ///< set aside to calibrate the intervals
   std::vector<CvEntry> cv;              ///< every grid point scored
   int velocity_min_leaf = 0, velocity_features_per_split = 0;
   int turbulence_min_leaf = 0, turbulence_features_per_split = 0;
@@ -152,6 +160,10 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
                                 TargetForm turbulence_form, const ForestOptions& velocity_options,
                                 const ForestOptions& turbulence_options, std::int64_t min_windows,
                                 const std::vector<std::string>& names = feature_set_names("measured"));
+
+/// The calibration of a model's intervals on runs its forests were not trained on (model.hpp).
+Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
+                      const std::vector<std::int64_t>& window_edges, int threads = 0);
 
 /// Held-out predictions as CSV: run, features, truth, raw, quantiles.
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
