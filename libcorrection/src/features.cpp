@@ -22,6 +22,23 @@ std::string_view to_string(CorrectionStatus status) {
 
 FeatureResult make_features(const Measurement& m) {
   FeatureResult r;
+  auto& f = r.features;
+  // What every forest shares, and FSCC's own.
+  f.void_fraction = m.void_fraction;
+  f.dx = m.dx;
+  f.dy = m.dy;
+  f.np = m.np;
+  f.windows_accepted = m.windows_accepted;
+  f.fs = m.fs;
+  f.duration = m.duration;
+  auto d32_of = [&](double u) {
+    return m.bubble_count_rate > 0.0 ? 1.5 * u * m.void_fraction / m.bubble_count_rate : m.d32.value_or(0.0);
+  };
+  if (m.fscc_velocity && *m.fscc_velocity > 0.0) {
+    f.fscc_velocity = *m.fscc_velocity;
+    f.r12_max = m.r12_max.value_or(0.0);
+    f.fscc_d32 = d32_of(f.fscc_velocity);
+  }
   if (!m.velocity || !m.turbulence_intensity) {
     r.status = CorrectionStatus::no_awcc_velocity;
     r.message = "AWCC gave no velocity";
@@ -39,18 +56,16 @@ FeatureResult make_features(const Measurement& m) {
     r.message = "no bubbles on the leading tip";
     return r;
   }
-  auto& f = r.features;
   f.velocity = *m.velocity;
   f.turbulence_intensity = *m.turbulence_intensity;
-  f.void_fraction = m.void_fraction;
-  f.d32 = m.bubble_count_rate > 0.0 ? 1.5 * f.velocity * m.void_fraction / m.bubble_count_rate : *m.d32;
-  f.dx = m.dx;
-  f.dy = m.dy;
-  f.np = m.np;
-  f.windows_accepted = m.windows_accepted;
-  f.fs = m.fs;
-  f.duration = m.duration;
+  f.d32 = d32_of(f.velocity);
   return r;
+}
+
+std::string fscc_unusable(const Features& f) {
+  if (!(f.fscc_velocity > 0.0)) return "FSCC gave no velocity";
+  if (!(f.fscc_d32 > 0.0)) return "no bubbles on the leading tip";
+  return {};
 }
 
 std::optional<double> Features::value(std::string_view name) const {
@@ -60,10 +75,14 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == "fs" && fs > 0.0) return fs;
   if (name == "duration" && duration > 0.0) return duration;
   if (name == "windows_accepted" && windows_accepted >= 0) return static_cast<double>(windows_accepted);
+  if (name == "fscc_velocity" && fscc_velocity > 0.0) return fscc_velocity;
+  if (name == "r12_max" && fscc_velocity > 0.0) return r12_max;
+  if (name == "fscc_d32" && fscc_d32 > 0.0) return fscc_d32;
   return std::nullopt;
 }
 
 std::vector<std::string> feature_set_names(std::string_view set) {
+  if (set == "fscc") return {Features::fscc_names.begin(), Features::fscc_names.end()};
   if (set != "measured" && set != "extended") {
     throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7) or extended (with "
                                             "fs, duration and accepted windows)",
@@ -82,39 +101,40 @@ std::string feature_set_of(const std::vector<std::string>& names) {
 
 MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   MeasurementResult out;
-  if (!r.awcc) {
-    out.status = CorrectionStatus::awcc_not_run;
-    out.message = "AWCC was not run";
-    return out;
-  }
-  if (!r.awcc->ok()) {
-    out.status = CorrectionStatus::no_awcc_velocity;
-    out.message = "AWCC gave no velocity: " + r.awcc->message;
-    return out;
-  }
-  if (r.awcc->probe_corrected) {
-    out.status = CorrectionStatus::probe_corrected;
-    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC";
-    return out;
-  }
-  if (r.awcc->quality != awcc::AwccQuality::ok) {
-    out.status = CorrectionStatus::low_quality;
-    out.message = "AWCC's quality is low: " + r.awcc->quality_reason;
-    return out;
-  }
+  // What every forest shares and FSCC's own, whatever AWCC gave.
   auto& m = out.measurement;
-  m.velocity = r.awcc->velocity;
-  m.turbulence_intensity = r.awcc->turbulence_intensity;
   if (!r.tips.empty()) {
     m.void_fraction = r.tips[0].phase.void_fraction;
     m.bubble_count_rate = r.tips[0].phase.bubble_count_rate;
   }
   m.dx = r.dx;
   m.dy = r.dy;
-  m.np = r.awcc->np;
-  m.windows_accepted = r.awcc->windows_accepted;
   m.fs = r.info.fs;
   m.duration = r.info.fs > 0.0 ? static_cast<double>(r.info.frames) / r.info.fs : 0.0;
+  if (r.fscc && r.fscc->ok()) {
+    m.fscc_velocity = r.fscc->velocity;
+    m.r12_max = r.fscc->r12_max;
+  }
+  if (r.awcc) {
+    m.np = r.awcc->np;
+    m.windows_accepted = r.awcc->windows_accepted;
+  }
+  if (!r.awcc) {
+    out.status = CorrectionStatus::awcc_not_run;
+    out.message = "AWCC was not run";
+  } else if (!r.awcc->ok()) {
+    out.status = CorrectionStatus::no_awcc_velocity;
+    out.message = "AWCC gave no velocity: " + r.awcc->message;
+  } else if (r.awcc->probe_corrected) {
+    out.status = CorrectionStatus::probe_corrected;
+    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC";
+  } else if (r.awcc->quality != awcc::AwccQuality::ok) {
+    out.status = CorrectionStatus::low_quality;
+    out.message = "AWCC's quality is low: " + r.awcc->quality_reason;
+  } else {
+    m.velocity = r.awcc->velocity;
+    m.turbulence_intensity = r.awcc->turbulence_intensity;
+  }
   return out;
 }
 

@@ -303,15 +303,83 @@ Correction CorrectionModel::correct(const Features& f) const {
     }
     return q;
   };
+  c.forest = "awcc";
   c.velocity = one(velocity, velocity_form, f.velocity, false, calibration.velocity);
   c.turbulence_intensity =
       one(turbulence_intensity, turbulence_form, f.turbulence_intensity, true, calibration.turbulence_intensity);
   return c;
 }
 
+namespace {
+
+// AWCC statuses after which the FSCC forest may correct the velocity.
+bool fscc_may_follow(CorrectionStatus s) {
+  switch (s) {
+    case CorrectionStatus::awcc_not_run:
+    case CorrectionStatus::no_awcc_velocity:
+    case CorrectionStatus::low_quality:
+    case CorrectionStatus::too_few_windows:
+    case CorrectionStatus::outside_training_range: return true;
+    default: return false;
+  }
+}
+
+}  // namespace
+
+Correction CorrectionModel::correct_fscc(const Features& f) const {
+  if (!fscc) return not_corrected(CorrectionStatus::no_awcc_velocity, "the model has no FSCC forest");
+  if (const auto why = fscc_unusable(f); !why.empty()) return not_corrected(CorrectionStatus::no_awcc_velocity, why);
+  std::vector<double> x(fscc->ranges.size());
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    const auto& r = fscc->ranges[j];
+    const auto v = f.value(r.name);
+    if (!v) {
+      return not_corrected(CorrectionStatus::missing_feature,
+                           fmt::format("the FSCC forest takes the record's {}, which is not known for this row", r.name));
+    }
+    const double pad = range_margin * (r.max - r.min);
+    if (!(*v >= r.min - pad && *v <= r.max + pad)) {
+      return not_corrected(CorrectionStatus::outside_training_range,
+                           fmt::format("{} = {:.6g} is outside the FSCC forest's training range [{:.6g}, {:.6g}]",
+                                       r.name, *v, r.min, r.max));
+    }
+    x[j] = *v;
+  }
+  auto t = fscc->velocity.quantiles(x, correction_levels);
+  if (!fscc->calibration.empty()) Calibration::apply(fscc->calibration.velocity.front(), t);
+  CorrectedQuantity q;
+  q.measured = f.fscc_velocity;
+  for (std::size_t k = 0; k < t.size(); ++k) q.quantiles[k] = from_target(fscc->form, t[k], f.fscc_velocity);
+  Correction c;
+  c.status = CorrectionStatus::corrected;
+  c.forest = "fscc";
+  c.velocity = q;
+  return c;
+}
+
 Correction CorrectionModel::correct(const Measurement& m) const {
   const auto f = make_features(m);
-  return f.ok() ? correct(f.features) : not_corrected(f.status, f.message);
+  Correction awcc = f.ok() ? correct(f.features) : not_corrected(f.status, f.message);
+  if (awcc.corrected() || !fscc || !fscc_may_follow(awcc.status)) return awcc;
+  auto c = correct_fscc(f.features);
+  if (!c.corrected()) {
+    // Neither forest: AWCC's status, with both reasons.
+    c.status = awcc.status;
+    c.message = fmt::format("{}; FSCC forest: {}", awcc.message, c.message);
+  }
+  return c;
+}
+
+Correction CorrectionModel::correct(const MeasurementResult& m) const {
+  if (m.status == CorrectionStatus::corrected) return correct(m.measurement);
+  Correction awcc = not_corrected(m.status, m.message);
+  if (!fscc || !fscc_may_follow(m.status)) return awcc;
+  auto c = correct_fscc(make_features(m.measurement).features);
+  if (!c.corrected()) {
+    c.status = awcc.status;
+    c.message = fmt::format("{}; FSCC forest: {}", awcc.message, c.message);
+  }
+  return c;
 }
 
 std::string CorrectionModel::mismatch(const Processing& results) const {
@@ -344,6 +412,19 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
   payload.u32(2);
   write_forest(payload, "velocity", velocity_form, velocity);
   write_forest(payload, "turbulence_intensity", turbulence_form, turbulence_intensity);
+  payload.u32(fscc ? 1 : 0);
+  if (fscc) {
+    payload.u32(static_cast<std::uint32_t>(fscc->ranges.size()));
+    for (const auto& r : fscc->ranges) {
+      payload.text(r.name);
+      payload.f64(r.min);
+      payload.f64(r.max);
+    }
+    payload.u32(fscc->calibration.empty() ? 0 : 1);
+    if (!fscc->calibration.empty())
+      for (double o : fscc->calibration.velocity.front()) payload.f64(o);
+    write_forest(payload, "fscc_velocity", fscc->form, fscc->velocity);
+  }
   Writer w;
   w.raw(magic, sizeof magic);
   w.u32(format_version);
@@ -427,6 +508,35 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
   const auto p = static_cast<std::uint32_t>(m.ranges.size());
   m.velocity = read_forest(r, "velocity", m.velocity_form, p);
   m.turbulence_intensity = read_forest(r, "turbulence_intensity", m.turbulence_form, p);
+  if (version >= 3) {
+    const auto extra = r.u32();
+    if (extra > 1) r.damaged(fmt::format("{} FSCC forests", extra));
+    if (extra == 1) {
+      FsccForest f;
+      const auto fscc_names = feature_set_names("fscc");
+      f.ranges.resize(r.count(r.u32(), 20));
+      if (f.ranges.size() != fscc_names.size()) r.damaged(fmt::format("{} FSCC feature ranges", f.ranges.size()));
+      for (std::size_t j = 0; j < f.ranges.size(); ++j) {
+        auto& fr = f.ranges[j];
+        fr.name = r.text();
+        fr.min = r.f64();
+        fr.max = r.f64();
+        if (fr.name != fscc_names[j]) r.damaged(fmt::format("FSCC feature {} is '{}', expected '{}'", j, fr.name, fscc_names[j]));
+        if (!(std::isfinite(fr.min) && std::isfinite(fr.max) && fr.min <= fr.max)) r.damaged("a feature range is not finite");
+      }
+      const auto calibrated = r.u32();
+      if (calibrated > 1) r.damaged("FSCC calibration flag");
+      if (calibrated == 1) {
+        f.calibration.velocity.resize(1);
+        for (double& o : f.calibration.velocity.front()) {
+          o = r.f64();
+          if (!std::isfinite(o)) r.damaged("a calibration offset is not finite");
+        }
+      }
+      f.velocity = read_forest(r, "fscc_velocity", f.form, static_cast<std::uint32_t>(fscc_names.size()));
+      m.fscc = std::move(f);
+    }
+  }
   if (!r.done()) r.damaged("bytes after the last forest");
   return m;
 }
@@ -459,7 +569,8 @@ std::span<const awcc::ProfileColumn> correction_csv_columns() {
     auto keep = [](std::string s) -> std::string_view { return text.emplace_back(std::move(s)); };
     std::vector<awcc::ProfileColumn> out{
         {"correction_in_range", "", "/correction/in_range", "1 when the row was corrected"},
-        {"correction_reason", "", "/correction/reason", "why the row was not corrected"}};
+        {"correction_reason", "", "/correction/reason", "why the row was not corrected"},
+        {"correction_forest", "", "/correction/forest", "the forest that corrected the row: awcc, or fscc (velocity only)"}};
     for (const char* q : {"velocity", "turbulence_intensity"}) {
       const bool u = std::string_view(q) == "velocity";
       const char* unit = u ? "m/s" : "-";
@@ -485,7 +596,8 @@ std::string correction_csv_header() {
 }
 
 std::string correction_csv_cells(const Correction& c) {
-  std::string out = fmt::format("{},{}", c.corrected() ? 1 : 0, awcc::csv_cell(c.corrected() ? std::string() : c.message));
+  std::string out = fmt::format("{},{},{}", c.corrected() ? 1 : 0,
+                                awcc::csv_cell(c.corrected() ? std::string() : c.message), c.forest);
   for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
     if (*q) {
       out += fmt::format(",{:.10g}", (*q)->median());
@@ -507,6 +619,7 @@ nlohmann::json to_json(const Correction& c) {
   };
   return json{{"status", to_string(c.status)},
               {"in_range", c.corrected()},
+              {"forest", c.forest.empty() ? json(nullptr) : json(c.forest)},
               {"reason", c.corrected() ? json(nullptr) : json(c.message)},
               {"velocity", quantity(c.velocity)},
               {"turbulence_intensity", quantity(c.turbulence_intensity)}};

@@ -59,29 +59,6 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
     return j[key].get<double>();
   };
-  if (!r.contains("awcc") || !r["awcc"].is_object()) {
-    return not_corrected(CorrectionStatus::awcc_not_run, "AWCC was not run");
-  }
-  const auto& a = r["awcc"];
-  if (!a.value("defined", false)) {
-    return not_corrected(CorrectionStatus::no_awcc_velocity,
-                         "AWCC gave no velocity: " +
-                             (a.contains("reason") && a["reason"].is_string() ? a["reason"].get<std::string>() : std::string()));
-  }
-  if (a.contains("quality") && a["quality"].is_string() && a["quality"].get<std::string>() != "ok") {
-    return not_corrected(CorrectionStatus::low_quality,
-                         "AWCC's quality is " + a["quality"].get<std::string>() +
-                             (a.contains("quality_reason") && a["quality_reason"].is_string()
-                                  ? ": " + a["quality_reason"].get<std::string>()
-                                  : std::string()));
-  }
-  if (a.value("probe_corrected", false)) {
-    // The model learnt AWCC's bias on synthetic records without the needle:
-    // a bubble-probe-corrected velocity is not what it corrects.
-    return not_corrected(CorrectionStatus::probe_corrected,
-                         "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
-                         "uncorrected AWCC; process without the probe correction to correct it");
-  }
   if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
     throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
   }
@@ -94,25 +71,60 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     }
     return *v;
   };
+  // What every forest shares and FSCC's own, whatever AWCC gave.
+  MeasurementResult result;
+  Measurement& m = result.measurement;
+  m.void_fraction = required(lead, "void_fraction", "tips[0]");
+  m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
+  m.fs = number(r, "fs").value_or(0.0);
+  m.duration = number(r, "duration").value_or(0.0);
+  if (r.contains("fscc") && r["fscc"].is_object() && r["fscc"].value("defined", false)) {
+    m.fscc_velocity = number(r["fscc"], "velocity");
+    m.r12_max = number(r["fscc"], "r12_max");
+  }
+  const bool has_awcc = r.contains("awcc") && r["awcc"].is_object();
+  const json none = json::object();
+  const auto& a = has_awcc ? r["awcc"] : none;
+  auto text = [&](const char* key) {
+    return a.contains(key) && a[key].is_string() ? a[key].get<std::string>() : std::string();
+  };
+  if (!has_awcc) {
+    result.status = CorrectionStatus::awcc_not_run;
+    result.message = "AWCC was not run";
+  } else if (!a.value("defined", false)) {
+    result.status = CorrectionStatus::no_awcc_velocity;
+    result.message = "AWCC gave no velocity: " + text("reason");
+  } else if (!text("quality").empty() && text("quality") != "ok") {
+    result.status = CorrectionStatus::low_quality;
+    result.message = "AWCC's quality is " + text("quality") + (text("quality_reason").empty() ? "" : ": " + text("quality_reason"));
+  } else if (a.value("probe_corrected", false)) {
+    // The model learnt AWCC's bias on synthetic records without the needle:
+    // a bubble-probe-corrected velocity is not what it corrects.
+    result.status = CorrectionStatus::probe_corrected;
+    result.message = "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
+                     "uncorrected AWCC; process without the probe correction to correct it";
+  }
   std::optional<Processing> processing;
   if (a.contains("options") && a["options"].is_object()) {
     const auto& o = a["options"];
     processing = parse_processing(required(o, "filter_a", "awcc.options"), o.value("roc", true) ? "on" : "off",
                                   o.value("weighting", ""), o.value("signal", ""), o.value("subsample", ""));
   }
-  check_processing(model, processing, file, warnings);
-  Measurement m;
-  m.velocity = required(a, "velocity", "awcc");
-  m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
-  m.windows_accepted = static_cast<std::int64_t>(required(a, "windows_accepted", "awcc"));
-  m.void_fraction = required(lead, "void_fraction", "tips[0]");
-  m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
+  if (result.status == CorrectionStatus::corrected) {
+    check_processing(model, processing, file, warnings);
+    m.velocity = required(a, "velocity", "awcc");
+    m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
+    m.windows_accepted = static_cast<std::int64_t>(required(a, "windows_accepted", "awcc"));
+  } else if (const auto w = number(a, "windows_accepted")) {
+    m.windows_accepted = static_cast<std::int64_t>(*w);
+  }
   m.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
   m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
-  m.np = static_cast<int>(need(number(a, "np"), default_np(d), file, "np", "particles per window"));
-  m.fs = number(r, "fs").value_or(0.0);
-  m.duration = number(r, "duration").value_or(0.0);
-  return model.correct(m);
+  // Np is a feature of the AWCC forest only.
+  m.np = result.status == CorrectionStatus::corrected
+             ? static_cast<int>(need(number(a, "np"), default_np(d), file, "np", "particles per window"))
+             : static_cast<int>(number(a, "np").value_or(0.0));
+  return model.correct(result);
 }
 
 // Calls fn(line, cells, "FILE:LINE") for every non-empty row after the
@@ -274,13 +286,15 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       if (!v) throw awcc::InputError(fmt::format("{}: column {} = '{}' is not a number", where, name, t));
       return v;
     };
-    Correction c;
+    MeasurementResult result;
+    Measurement& m = result.measurement;
     const auto u = value("awcc_velocity"), tu = value("awcc_turbulence_intensity");
     if (!u || !tu) {
-      c = not_corrected(CorrectionStatus::no_awcc_velocity, "AWCC gave no velocity");
+      result.status = CorrectionStatus::no_awcc_velocity;
+      result.message = "AWCC gave no velocity";
     } else if (!text_of("awcc_quality").empty() && text_of("awcc_quality") != "ok") {
-      c = not_corrected(CorrectionStatus::low_quality, "AWCC's quality is " + text_of("awcc_quality") + ": " +
-                                                           text_of("awcc_quality_reason"));
+      result.status = CorrectionStatus::low_quality;
+      result.message = "AWCC's quality is " + text_of("awcc_quality") + ": " + text_of("awcc_quality_reason");
     } else {
       std::optional<Processing> processing;
       if (has_processing && value("awcc_filter_a")) {
@@ -288,19 +302,23 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
                                       text_of("awcc_signal"), text_of("awcc_subsample"));
       }
       check_processing(model, processing, where, out.warnings);
-      Measurement m;
       m.velocity = u;
       m.turbulence_intensity = tu;
-      m.void_fraction = value("void_fraction").value_or(0.0);
-      m.bubble_count_rate = value("bubble_count_rate").value_or(0.0);
-      m.dx = need(value("dx"), d.dx, where, "dx", "streamwise tip separation");
-      m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
-      m.np = static_cast<int>(need(value("np"), default_np(d), where, "np", "particles per window"));
-      m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
-      m.fs = value("fs").value_or(0.0);
-      m.duration = value("duration").value_or(0.0);
-      c = model.correct(m);
     }
+    m.void_fraction = value("void_fraction").value_or(0.0);
+    m.bubble_count_rate = value("bubble_count_rate").value_or(0.0);
+    m.dx = need(value("dx"), d.dx, where, "dx", "streamwise tip separation");
+    m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
+    // Np is a feature of the AWCC forest only.
+    m.np = result.status == CorrectionStatus::corrected
+               ? static_cast<int>(need(value("np"), default_np(d), where, "np", "particles per window"))
+               : static_cast<int>(value("np").value_or(0.0));
+    m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
+    m.fs = value("fs").value_or(0.0);
+    m.duration = value("duration").value_or(0.0);
+    m.fscc_velocity = value("fscc_velocity");
+    m.r12_max = value("fscc_r12_max");
+    const Correction c = model.correct(result);
     out.text += row + "," + correction_csv_cells(c) + "\n";
   });
   return out;

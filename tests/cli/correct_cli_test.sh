@@ -80,7 +80,7 @@ sys.exit(0 if a==b else 1)" || fail "pdp correct and process --correct disagree"
 "$pdp" --log-level error process "$dir/rec.flac" "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc \
   --csv "$dir/profile.csv" || fail "profile"
 "$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" -o "$dir/corrected.csv" || fail "correct CSV"
-head -1 "$dir/corrected.csv" | grep -q ",correction_in_range,correction_reason,corrected_velocity,corrected_velocity_q0.025," ||
+head -1 "$dir/corrected.csv" | grep -q ",correction_in_range,correction_reason,correction_forest,corrected_velocity,corrected_velocity_q0.025," ||
   fail "CSV correction columns"
 [[ $(column "$dir/corrected.csv" correction_in_range | sort -u) == "1" ]] || fail "profile rows not corrected"
 [[ $(column "$dir/corrected.csv" correction_status | sort -u) == "corrected" ]] || fail "profile rows' status"

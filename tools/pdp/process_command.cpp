@@ -294,8 +294,7 @@ int run_process(ProcessCommandOptions& o) {
   if (model) {
     for (const auto& r : results) {
       const auto m = correction::measurement_of(r);
-      corrections.push_back(m.status == correction::CorrectionStatus::corrected ? model->correct(m.measurement)
-                                                                                 : correction::not_corrected(m.status, m.message));
+      corrections.push_back(model->correct(m));
       if (!corrections.back().corrected()) {
         spdlog::warn("{}: not corrected: {}", r.info.path.string(), corrections.back().message);
       }

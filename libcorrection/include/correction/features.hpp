@@ -16,6 +16,11 @@
 // measurement that lacks one its model needs (a file without fs, say) is
 // not corrected, and says which.
 //
+// FSCC feature set (the second forest of an extended model, for rows AWCC
+// cannot give a usable result for): FSCC's velocity, its correlation peak
+// R12max, c, the Sauter diameter from FSCC's velocity (1.5 u_FSCC c / F, or
+// a file's stated d32), dx, dy, fs and duration.
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -62,6 +67,8 @@ struct Measurement {
   std::int64_t windows_accepted = -1;          ///< -1: not known (another tool's file)
   double fs = 0.0;                             ///< sampling rate, Hz (0: not known)
   double duration = 0.0;                       ///< record duration, s (0: not known)
+  std::optional<double> fscc_velocity;         ///< FSCC's velocity, m/s (empty: none)
+  std::optional<double> r12_max;               ///< FSCC's correlation peak, -
 };
 
 /// The features of one measurement.
@@ -72,10 +79,15 @@ struct Features {
                                                     "dx",       "dy",                   "np"};
   /// The record's features, which extended models (format 3) take after those.
   static constexpr std::array<const char*, 3> record_names{"fs", "duration", "windows_accepted"};
+  /// The FSCC forest's features.
+  static constexpr std::array<const char*, 8> fscc_names{"fscc_velocity", "r12_max", "void_fraction", "fscc_d32",
+                                                         "dx",            "dy",      "fs",            "duration"};
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
   /// Rows below a model's minimum are not corrected; -1 unknown.
   std::int64_t windows_accepted = -1;
   double fs = 0.0, duration = 0.0;  ///< Hz, s; 0 = not known
+  /// FSCC's velocity (0: none), R12max, and d32 from FSCC's velocity (0: not known).
+  double fscc_velocity = 0.0, r12_max = 0.0, fscc_d32 = 0.0;
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
@@ -84,8 +96,9 @@ struct Features {
   [[nodiscard]] std::optional<double> value(std::string_view name) const;
 };
 
-/// The feature names of a feature set: "measured" (the seven) or "extended"
-/// (the seven and the record's three). Throws std::invalid_argument otherwise.
+/// The feature names of a feature set: "measured" (the seven), "extended"
+/// (the seven and the record's three) or "fscc" (the FSCC forest's). Throws
+/// std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// "measured" or "extended" for a model's names in order; empty when they are neither.
 std::string feature_set_of(const std::vector<std::string>& names);
@@ -98,8 +111,11 @@ struct FeatureResult {
   [[nodiscard]] bool ok() const { return status == CorrectionStatus::corrected; }
 };
 
-/// The one computation of the features (d32 = 1.5 u c / F).
+/// The one computation of the features (d32 = 1.5 u c / F). The status is
+/// about AWCC's features; FSCC's are filled whenever FSCC gave a velocity.
 FeatureResult make_features(const Measurement& m);
+/// Empty when the FSCC forest can take the features, else why not.
+std::string fscc_unusable(const Features& f);
 
 /// The measurement of a processed recording (AWCC's velocity and Tu, the
 /// leading tip's c and F, the processed dx and dy, Np); `status` says when

@@ -37,7 +37,10 @@
 // then fs, duration and windows_accepted: see correction/features.hpp;
 // versions 1 and 2 have the seven only) and, after the processing, the
 // calibration: u32 band count B (0: none), B - 1 window edges (i64), then
-// B x 3 offsets (f64) for the velocity and B x 3 for Tu.
+// B x 3 offsets (f64) for the velocity and B x 3 for Tu; after the two
+// forests, u32 0 or 1, then the FSCC forest: its feature ranges (count, then
+// name, min, max), its calibration (u32 0 or 1, then 3 offsets) and the
+// forest ("fscc_velocity").
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
 
@@ -80,6 +83,9 @@ struct Correction {
   CorrectionStatus status = CorrectionStatus::awcc_not_run;
   std::string message;                ///< why not corrected (empty when corrected)
   std::optional<CorrectedQuantity> velocity, turbulence_intensity;
+  /// Which forest corrected the row: "awcc", or "fscc" (the velocity only:
+  /// Tu stays uncorrected); empty when not corrected.
+  std::string forest;
   [[nodiscard]] bool corrected() const { return status == CorrectionStatus::corrected; }
 };
 
@@ -112,6 +118,16 @@ struct Calibration {
   static void apply(const std::array<double, 3>& offsets, std::vector<double>& t);
 };
 
+/// The second forest of an extended model: the mean velocity from FSCC's
+/// (features "fscc" of correction/features.hpp), for rows without a usable
+/// AWCC result. Its calibration has one band (velocity offsets only).
+struct FsccForest {
+  std::vector<FeatureRange> ranges;
+  TargetForm form = TargetForm::ratio;
+  QuantileForest velocity;
+  Calibration calibration;
+};
+
 struct CorrectionModel {
   static constexpr std::uint32_t format_version = 3;
 
@@ -124,11 +140,20 @@ struct CorrectionModel {
   TargetForm turbulence_form = TargetForm::difference;
   QuantileForest velocity, turbulence_intensity;
   Calibration calibration;            ///< empty: the forests' quantiles as they are (format 1, 2)
+  std::optional<FsccForest> fscc;     ///< the FSCC forest (format 3, when trained)
 
   /// Corrected, or too few windows / outside the training range, with the reason.
   [[nodiscard]] Correction correct(const Features& f) const;
   /// From a measurement: its features (make_features) or why there are none.
+  /// Rows AWCC cannot correct (no usable AWCC velocity, low quality, too few
+  /// windows, outside the AWCC forest's ranges) get the FSCC forest's
+  /// velocity where the model has one and FSCC gave a velocity.
   [[nodiscard]] Correction correct(const Measurement& m) const;
+  /// From a processed recording's measurement (measurement_of): its AWCC
+  /// status decides whether AWCC's forest may be asked.
+  [[nodiscard]] Correction correct(const MeasurementResult& m) const;
+  /// The FSCC forest alone (not_corrected when the model has none).
+  [[nodiscard]] Correction correct_fscc(const Features& f) const;
 
   /// Empty when results processed this way may be corrected, else the
   /// differences ("filter A: model 0.4, results 0.3").
