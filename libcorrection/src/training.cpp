@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "awcc/csv.hpp"
+#include "awcc/order_statistics.hpp"
 #include "awcc/parallel.hpp"
 #include "awcc/random.hpp"
 #include "awcc/units.hpp"
@@ -278,18 +279,28 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       Measurement m;
       if (!cell("awcc_velocity").empty()) m.velocity = number_of("awcc_velocity");
       if (!cell("awcc_turbulence_intensity").empty()) m.turbulence_intensity = number_of("awcc_turbulence_intensity");
-      const auto features = [&] {
-        if (!m.velocity || !m.turbulence_intensity) return make_features(m);
-        m.void_fraction = number_of("awcc_void_fraction");
-        m.bubble_count_rate = number_of("awcc_count_rate");
-        m.dx = number_of(dx_column);
-        m.dy = number_of(dy_column);
-        m.np = static_cast<int>(number_of("np"));
-        m.windows_accepted = static_cast<std::int64_t>(number_of("awcc_windows_accepted"));
-        m.fs = number_of("fs");
-        m.duration = number_of("duration");
-        return make_features(m);
-      }();
+      auto optional_number = [&](const char* name) -> std::optional<double> {
+        return col.count(name) && !cell(name).empty() ? std::optional(number_of(name)) : std::nullopt;
+      };
+      // The phase statistics and the record are there for every run that did not fail.
+      m.void_fraction = optional_number("awcc_void_fraction").value_or(0.0);
+      m.bubble_count_rate = optional_number("awcc_count_rate").value_or(0.0);
+      m.dx = number_of(dx_column);
+      m.dy = number_of(dy_column);
+      m.np = static_cast<int>(number_of("np"));
+      m.windows_accepted = static_cast<std::int64_t>(optional_number("awcc_windows_accepted").value_or(-1.0));
+      m.fs = optional_number("fs").value_or(0.0);
+      m.duration = optional_number("duration").value_or(0.0);
+      m.fscc_velocity = optional_number("fscc_velocity");
+      m.r12_max = optional_number("fscc_r12_max");
+      const auto features = make_features(m);
+      r.true_velocity = number_of("truth_velocity");
+      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
+      if (fscc_unusable(features.features).empty() && features.features.fs > 0.0 && features.features.duration > 0.0) {
+        TrainingRow f = r;
+        f.features = features.features;
+        set.fscc_rows.push_back(f);
+      }
       if (!features.ok()) {  // no (positive) AWCC velocity, or no bubbles: not corrected either
         ++set.excluded_undefined;
         continue;
@@ -299,8 +310,6 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         continue;
       }
       r.features = features.features;
-      r.true_velocity = number_of("truth_velocity");
-      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
       set.rows.push_back(r);
     }
     for (const auto& s : studies) set.sources.push_back(fmt::format("{} (study {})", path.filename().string(), s));
@@ -414,6 +423,28 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
   return s;
 }
 
+namespace {
+
+// The 50, 80 and 95 % intervals' miscoverage.
+constexpr std::array<double, 3> calibration_alpha{0.5, 0.2, 0.05};
+
+// Q = E_k, k = ceil((n + 1)(1 - alpha)) of the scores (model.hpp, Calibration).
+double conformal_offset(std::vector<double> e, double alpha) {
+  std::sort(e.begin(), e.end());
+  const auto n = static_cast<double>(e.size());
+  const auto rank = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 - alpha)));
+  return e[std::min(rank, e.size()) - 1];
+}
+
+// A row's conformity scores for the 50, 80, 95 % intervals of a forest's quantiles.
+std::array<double, 3> interval_scores(const std::vector<double>& t, double target) {
+  std::array<double, 3> e{};
+  for (std::size_t k = 0; k < 3; ++k) e[k] = std::max(t[2 - k] - target, target - t[4 + k]);
+  return e;
+}
+
+}  // namespace
+
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads) {
   std::vector<std::string> names;
@@ -431,24 +462,18 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
       const auto form = f == 0 ? model.velocity_form : model.turbulence_form;
       const double target = f == 0 ? to_target(form, r.true_velocity, r.features.velocity)
                                    : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity);
-      const auto t = forest.quantiles(x, correction_levels);
-      for (std::size_t k = 0; k < 3; ++k)
-        scores[i][static_cast<std::size_t>(3 * f) + k] = std::max(t[2 - k] - target, target - t[4 + k]);
+      const auto e = interval_scores(forest.quantiles(x, correction_levels), target);
+      for (std::size_t k = 0; k < 3; ++k) scores[i][static_cast<std::size_t>(3 * f) + k] = e[k];
     }
     band[i] = c.band(r.features.windows_accepted);
   });
-  // Q = E_k, k = ceil((n + 1)(1 - alpha)): the header's guarantee.
-  constexpr std::array<double, 3> alpha{0.5, 0.2, 0.05};
   auto offsets = [&](int b, std::size_t column0) {
     std::array<double, 3> q{};
     for (std::size_t k = 0; k < 3; ++k) {
       std::vector<double> e;
       for (std::size_t i = 0; i < rows.size(); ++i)
         if (b < 0 || band[i] == b) e.push_back(scores[i][column0 + k]);
-      std::sort(e.begin(), e.end());
-      const auto n = static_cast<double>(e.size());
-      const auto rank = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 - alpha[k])));
-      q[k] = e[std::min(rank, e.size()) - 1];
+      q[k] = conformal_offset(std::move(e), calibration_alpha[k]);
     }
     return q;
   };
@@ -463,6 +488,104 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
   }
   return c;
 }
+
+namespace {
+
+// The FSCC forest (model.hpp, FsccForest) on its own rows: the same held-out
+// and calibration fractions and split key as the AWCC forests, the velocity
+// forest's settings, target u_true / u_FSCC.
+void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptions& velocity_options,
+                const std::function<std::uint64_t(const TrainingRow&)>& key, TrainResult& result) {
+  auto rows = set.fscc_rows;
+  if (rows.size() < 500) {
+    result.fscc_note = fmt::format("no FSCC forest: {} runs with an FSCC velocity, fewer than 500", rows.size());
+    return;
+  }
+  std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
+    const auto ha = key(a), hb = key(b);
+    if (ha != hb) return ha < hb;
+    return a.study != b.study ? a.study < b.study : a.run < b.run;
+  });
+  const auto held = static_cast<std::size_t>(std::llround(o.held_out * static_cast<double>(rows.size())));
+  const auto calibrating = static_cast<std::size_t>(std::llround(o.calibration * static_cast<double>(rows.size() - held)));
+  const std::vector<TrainingRow> held_out(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(held));
+  const std::vector<TrainingRow> calibration_rows(rows.begin() + static_cast<std::ptrdiff_t>(held),
+                                                  rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating));
+  const std::vector<TrainingRow> training(rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating), rows.end());
+  const auto names = feature_set_names("fscc");
+  FsccForest f;
+  f.form = TargetForm::ratio;
+  for (const auto& n : names) {
+    FeatureRange r{n, 1e300, -1e300};
+    for (const auto& row : training) {
+      const double v = *row.features.value(n);
+      r.min = std::min(r.min, v);
+      r.max = std::max(r.max, v);
+    }
+    f.ranges.push_back(r);
+  }
+  TrainingData d;
+  d.features = static_cast<int>(names.size());
+  for (const auto& r : training) {
+    const auto x = vector_of(r.features, names);
+    d.x.insert(d.x.end(), x.begin(), x.end());
+    d.y.push_back(to_target(f.form, r.true_velocity, r.features.fscc_velocity));
+  }
+  ForestOptions fo = velocity_options;
+  fo.features_per_split = std::min(fo.features_per_split, d.features);
+  f.velocity = QuantileForest::train(d, fo);
+  if (!calibration_rows.empty()) {
+    std::vector<std::array<double, 3>> scores(calibration_rows.size());
+    parallel_for(calibration_rows.size(), o.threads, [&](std::size_t i) {
+      const auto& r = calibration_rows[i];
+      scores[i] = interval_scores(f.velocity.quantiles(vector_of(r.features, names), correction_levels),
+                                  to_target(f.form, r.true_velocity, r.features.fscc_velocity));
+    });
+    std::array<double, 3> q{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::vector<double> e;
+      for (const auto& sc : scores) e.push_back(sc[k]);
+      q[k] = conformal_offset(std::move(e), calibration_alpha[k]);
+    }
+    f.calibration.velocity = {q};
+  }
+  CorrectionModel scorer;  // the FSCC forest alone, with the model's margin
+  scorer.range_margin = result.model.range_margin;
+  scorer.fscc = f;
+  FsccScores& sc = result.fscc_held_out;
+  std::vector<double> abs_raw, abs_corrected;
+  double sq_raw = 0.0, sq_corrected = 0.0;
+  for (const auto& r : held_out) {
+    const auto c = scorer.correct_fscc(r.features);
+    if (!c.corrected()) {
+      ++sc.out_of_range;
+      continue;
+    }
+    const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
+    const double corrected = c.velocity->median() / r.true_velocity - 1.0;
+    sq_raw += raw * raw;
+    sq_corrected += corrected * corrected;
+    abs_raw.push_back(std::fabs(raw));
+    abs_corrected.push_back(std::fabs(corrected));
+    const auto& q = c.velocity->quantiles;
+    sc.coverage80 += q[1] <= r.true_velocity && r.true_velocity <= q[5];
+    sc.coverage95 += q[0] <= r.true_velocity && r.true_velocity <= q[6];
+    ++sc.rows;
+  }
+  if (sc.rows > 0) {
+    const auto n = static_cast<double>(sc.rows);
+    sc.rmse_raw = std::sqrt(sq_raw / n);
+    sc.rmse_corrected = std::sqrt(sq_corrected / n);
+    sc.median_abs_raw = awcc::median(abs_raw);
+    sc.median_abs_corrected = awcc::median(abs_corrected);
+    sc.coverage80 /= n;
+    sc.coverage95 /= n;
+  }
+  result.fscc_training_rows = static_cast<std::int64_t>(training.size());
+  result.model.fscc = std::move(f);
+}
+
+}  // namespace
 
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
   if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
@@ -560,6 +683,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     result.model.calibration = calibrate(result.model, calibration_rows, o.calibration_bands, o.threads);
   }
   result.calibration_rows = static_cast<std::int64_t>(calibration_rows.size());
+  if (o.feature_set == "extended") train_fscc(set, o, vopt, key, result);
   result.seconds_train = seconds_since(train_start);
   result.held_out = score(result.model, held_out, &result.predictions, o.threads);
   if (progress) progress(cv_share + 0.1);
@@ -612,6 +736,16 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
       vopt.min_leaf, vopt.features_per_split, to_string(tform), topt.trees, topt.min_leaf,
       topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected, 100 * h.velocity_coverage80,
       100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected, 100 * h.tu_coverage80, 100 * h.tu_coverage95);
+  if (result.model.fscc) {
+    const auto& f = result.fscc_held_out;
+    result.model.provenance += fmt::format(
+        " FSCC forest (velocity of rows without a usable AWCC result): trained on {} runs; held out: velocity RMSE "
+        "{:.2f} % raw FSCC, {:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} % ({} rows).",
+        result.fscc_training_rows, 100 * f.rmse_raw, 100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95,
+        f.rows);
+  } else if (!result.fscc_note.empty()) {
+    result.model.provenance += " " + result.fscc_note + ".";
+  }
   return result;
 }
 

@@ -138,6 +138,9 @@ def gap_reason(row, pointer, have_positions):
         c = row.get("correction")
         if c is None:
             return "not corrected: no model given (pdp process --correct MODEL.qrf)"
+        if c.get("in_range") and c.get("forest") == "fscc":
+            return ("Tu not corrected: AWCC gave no usable result, and the FSCC forest that corrected this row's "
+                    "velocity corrects the velocity only")
         return "not corrected: " + (c.get("reason") or str(c.get("status")))
     if section == "velocity_spectrum":
         s = row.get("velocity_spectrum")

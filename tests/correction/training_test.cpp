@@ -15,7 +15,7 @@ namespace {
 // The columns of a pdp sweep CSV that training reads (and a scene column).
 const std::string kHeader =
     "study,run,velocity,fs,duration,dx,dy,np,truth_velocity,truth_turbulence_intensity,awcc_velocity,awcc_turbulence_intensity,"
-    "awcc_void_fraction,awcc_count_rate,awcc_windows_accepted,reason";
+    "awcc_void_fraction,awcc_count_rate,awcc_windows_accepted,fscc_velocity,fscc_r12_max,reason";
 
 // A sweep CSV row with the columns pdp train reads set, the rest empty.
 std::string row(std::int64_t run, const std::map<std::string, std::string>& values) {
@@ -198,17 +198,22 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   std::mt19937_64 g(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::string csv = kHeader + "\n";
-  for (int i = 0; i < 800; ++i) {
+  for (int i = 0; i < 1000; ++i) {
     const double fs = std::exp(std::log(1e4) + (std::log(1e6) - std::log(1e4)) * u(g));
     const double measured = 1 + 49 * u(g);
     const double truth = measured * (1.0 - 0.2 * (std::log(1e6) - std::log(fs)) / (std::log(1e6) - std::log(1e4)));
     auto v = good(measured, truth, 10 + std::floor(1000 * u(g)));
     v["fs"] = fmt::format("{:.10g}", fs);
     v["duration"] = fmt::format("{:.10g}", 20 + 280 * u(g));
+    // FSCC reads 10 % high, and one run in four has no AWCC velocity.
+    v["fscc_velocity"] = fmt::format("{:.10g}", 1.1 * truth);
+    v["fscc_r12_max"] = "0.5";
+    if (i % 4 == 0) v["awcc_velocity"] = v["awcc_turbulence_intensity"] = "";
     csv += row(i, v);
   }
   const auto set = correction::load_training_set({write("extended.csv", csv)}, 10);
-  ASSERT_EQ(set.rows.size(), 800u);
+  ASSERT_EQ(set.rows.size(), 750u);
+  ASSERT_EQ(set.fscc_rows.size(), 1000u);  // FSCC's forest takes the runs without AWCC too
   EXPECT_GT(set.rows[0].features.fs, 1e4 - 1);
   EXPECT_GT(set.rows[0].features.duration, 19.9);
   correction::TrainOptions o;
@@ -232,6 +237,30 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
               }()),
               features);
     rmse[k++] = r.held_out.velocity_rmse_corrected;
+    EXPECT_EQ(r.model.fscc.has_value(), std::string(features) == "extended");
+    if (r.model.fscc) {
+      // FSCC's 10 % is a constant ratio: the forest removes it.
+      EXPECT_NEAR(r.fscc_held_out.rmse_raw, 0.10, 1e-9);
+      EXPECT_LT(r.fscc_held_out.rmse_corrected, 0.01);
+      EXPECT_NE(r.model.provenance.find("FSCC forest"), std::string::npos);
+      // A row without AWCC: the FSCC forest corrects its velocity, not its Tu.
+      correction::Measurement m;
+      m.void_fraction = 0.2;
+      m.bubble_count_rate = 2000;
+      m.dx = 0.005, m.dy = 0.001, m.np = 10, m.fs = 1e5, m.duration = 100, m.windows_accepted = 3;
+      m.fscc_velocity = 22.0;
+      m.r12_max = 0.5;
+      const auto c = r.model.correct(m);
+      ASSERT_TRUE(c.corrected()) << c.message;
+      EXPECT_EQ(c.forest, "fscc");
+      EXPECT_NEAR(c.velocity->median(), 20.0, 0.2);
+      EXPECT_FALSE(c.turbulence_intensity);
+      // Without FSCC either: AWCC's status, with both reasons.
+      m.fscc_velocity.reset();
+      const auto none = r.model.correct(m);
+      EXPECT_EQ(none.status, correction::CorrectionStatus::no_awcc_velocity);
+      EXPECT_NE(none.message.find("FSCC forest: FSCC gave no velocity"), std::string::npos) << none.message;
+    }
     // The file keeps the feature set.
     const auto again = correction::CorrectionModel::parse(r.model.serialise(), "m.qrf");
     EXPECT_EQ(again.serialise(), r.model.serialise());

@@ -55,6 +55,9 @@ struct TrainingSet {
   std::int64_t excluded_undefined = 0;  ///< AWCC gave no velocity
   std::int64_t excluded_windows = 0;    ///< fewer than min_windows accepted windows
   std::vector<std::string> sources;     ///< file names and study ids
+  /// Runs with an FSCC velocity, bubbles, fs and duration, whatever AWCC gave
+  /// (the FSCC forest's training set; not subject to min_windows).
+  std::vector<TrainingRow> fscc_rows;
   Processing processing;                ///< how every run was processed
   bool processing_assumed = false;      ///< the CSVs do not say: the default was assumed
 };
@@ -133,10 +136,21 @@ struct HeldOutPrediction {
   Correction correction;
 };
 
+/// Held-out scores of the FSCC forest (velocity only, relative errors).
+struct FsccScores {
+  std::int64_t rows = 0, out_of_range = 0;
+  double rmse_raw = 0.0, rmse_corrected = 0.0;
+  double median_abs_raw = 0.0, median_abs_corrected = 0.0;
+  double coverage80 = 0.0, coverage95 = 0.0;
+};
+
 struct TrainResult {
   CorrectionModel model;
   std::int64_t training_rows = 0;
   std::int64_t calibration_rows = 0;    ///< set aside to calibrate the intervals
+  std::int64_t fscc_training_rows = 0;  ///< the FSCC forest's (extended feature set)
+  FsccScores fscc_held_out;
+  std::string fscc_note;                ///< why there is no FSCC forest, when there is none
   std::vector<CvEntry> cv;              ///< every grid point scored
   int velocity_min_leaf = 0, velocity_features_per_split = 0;
   int turbulence_min_leaf = 0, turbulence_features_per_split = 0;
