@@ -186,17 +186,33 @@ QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& f
 }  // namespace
 
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size) {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
+  // Slicing by 8 (Kounavis and Berry): eight tables, eight bytes a step; the
+  // same CRC as the byte-wise table, about six times faster (most of the
+  // time of reading a model was this checksum).
+  static const auto tables = [] {
+    std::array<std::array<std::uint32_t, 256>, 8> t{};
     for (std::uint32_t i = 0; i < 256; ++i) {
       std::uint32_t c = i;
       for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xedb88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
+      t[0][i] = c;
     }
+    for (std::size_t s = 1; s < 8; ++s)
+      for (std::size_t i = 0; i < 256; ++i) t[s][i] = (t[s - 1][i] >> 8) ^ t[0][t[s - 1][i] & 0xffu];
     return t;
   }();
   std::uint32_t c = 0xffffffffu;
-  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xffu] ^ (c >> 8);
+  std::size_t i = 0;
+  for (; i + 8 <= size; i += 8) {
+    // Little-endian loads whatever the machine.
+    const std::uint32_t lo = c ^ (static_cast<std::uint32_t>(data[i]) | static_cast<std::uint32_t>(data[i + 1]) << 8 |
+                                  static_cast<std::uint32_t>(data[i + 2]) << 16 |
+                                  static_cast<std::uint32_t>(data[i + 3]) << 24);
+    const std::uint32_t hi = static_cast<std::uint32_t>(data[i + 4]) | static_cast<std::uint32_t>(data[i + 5]) << 8 |
+                             static_cast<std::uint32_t>(data[i + 6]) << 16 | static_cast<std::uint32_t>(data[i + 7]) << 24;
+    c = tables[7][lo & 0xffu] ^ tables[6][(lo >> 8) & 0xffu] ^ tables[5][(lo >> 16) & 0xffu] ^ tables[4][lo >> 24] ^
+        tables[3][hi & 0xffu] ^ tables[2][(hi >> 8) & 0xffu] ^ tables[1][(hi >> 16) & 0xffu] ^ tables[0][hi >> 24];
+  }
+  for (; i < size; ++i) c = tables[0][(c ^ data[i]) & 0xffu] ^ (c >> 8);
   return c ^ 0xffffffffu;
 }
 
