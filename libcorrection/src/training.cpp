@@ -774,6 +774,15 @@ std::string TrainResult::report() const {
   line(fmt::format("  Tu mean error          {:7.4f}     {:7.4f}", h.tu_bias_raw, h.tu_bias_corrected));
   line(fmt::format("  coverage 80 % / 95 %   velocity {:.1f} / {:.1f} %, Tu {:.1f} / {:.1f} %", 100 * h.velocity_coverage80,
                    100 * h.velocity_coverage95, 100 * h.tu_coverage80, 100 * h.tu_coverage95));
+  const auto table = coverage_by_band(predictions);
+  if (!table.empty()) {
+    line("Coverage of the held-out runs by band (nominal 80 % and 95 %):");
+    line("  band                          runs   velocity 80 %  95 %    Tu 80 %  95 %");
+    for (const auto& b : table) {
+      line(fmt::format("  {:<28} {:>6}   {:9.1f} {:5.1f}   {:7.1f} {:5.1f}", b.band, b.rows, 100 * b.velocity80,
+                       100 * b.velocity95, 100 * b.tu80, 100 * b.tu95));
+    }
+  }
   if (!learning_curve.empty()) {
     line("Learning curve (held-out scores against training runs):");
     line("  (gain: paired decrease of the pinball loss from the previous point, +/- its standard error)");
@@ -788,18 +797,66 @@ std::string TrainResult::report() const {
   return out;
 }
 
+std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>& predictions) {
+  struct Band {
+    std::string name;
+    std::function<bool(const TrainingRow&)> holds;
+  };
+  std::vector<Band> bands{{"all", [](const TrainingRow&) { return true; }}};
+  // True Tu (the bands), accepted windows, sampling rate.
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 0.35}}) {
+    bands.push_back({fmt::format("true Tu {:g}-{:g}", lo, hi), [lo, hi](const TrainingRow& r) {
+                       return r.true_turbulence_intensity >= lo && r.true_turbulence_intensity < hi;
+                     }});
+  }
+  for (const auto& [lo, hi] : std::vector<std::pair<std::int64_t, std::int64_t>>{{10, 30}, {30, 100}, {100, 1LL << 62}}) {
+    bands.push_back({hi > (1LL << 61) ? fmt::format("windows {}+", lo) : fmt::format("windows {}-{}", lo, hi - 1),
+                     [lo, hi](const TrainingRow& r) {
+                       return r.features.windows_accepted >= lo && r.features.windows_accepted < hi;
+                     }});
+  }
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0, 50e3}, {50e3, 200e3}, {200e3, 1e300}}) {
+    bands.push_back({hi > 1e299 ? fmt::format("fs {:g} kHz+", lo / 1e3) : fmt::format("fs {:g}-{:g} kHz", lo / 1e3, hi / 1e3),
+                     [lo, hi](const TrainingRow& r) { return r.features.fs > lo && r.features.fs <= hi; }});
+  }
+  std::vector<BandCoverage> out;
+  for (const auto& b : bands) {
+    BandCoverage c;
+    c.band = b.name;
+    for (const auto& p : predictions) {
+      if (!p.correction.corrected() || !p.correction.velocity || !p.correction.turbulence_intensity ||
+          !b.holds(p.row))
+        continue;
+      const auto& u = p.correction.velocity->quantiles;
+      const auto& t = p.correction.turbulence_intensity->quantiles;
+      const double uu = p.row.true_velocity, tt = p.row.true_turbulence_intensity;
+      c.velocity80 += u[1] <= uu && uu <= u[5];
+      c.velocity95 += u[0] <= uu && uu <= u[6];
+      c.tu80 += t[1] <= tt && tt <= t[5];
+      c.tu95 += t[0] <= tt && tt <= t[6];
+      ++c.rows;
+    }
+    if (c.rows == 0) continue;  // a band the runs do not reach (fs bands of a 500 kHz campaign)
+    const auto n = static_cast<double>(c.rows);
+    c.velocity80 /= n, c.velocity95 /= n, c.tu80 /= n, c.tu95 /= n;
+    out.push_back(c);
+  }
+  return out;
+}
+
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
-  std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,true_velocity,"
-                    "true_turbulence_intensity,in_range";
+  std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,fs,duration,"
+                    "true_velocity,true_turbulence_intensity,in_range";
   for (const char* q : {"velocity", "turbulence_intensity"}) {
     for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
   out += "\n";
   for (const auto& p : predictions) {
     const auto& f = p.row.features;
-    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{}", p.row.run,
-                       f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np, f.windows_accepted,
-                       p.row.true_velocity, p.row.true_turbulence_intensity, p.correction.corrected() ? 1 : 0);
+    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{}",
+                       p.row.run, f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np,
+                       f.windows_accepted, f.fs, f.duration, p.row.true_velocity, p.row.true_turbulence_intensity,
+                       p.correction.corrected() ? 1 : 0);
     for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
       for (std::size_t k = 0; k < correction_levels.size(); ++k) {
         out += *q ? fmt::format(",{:.10g}", (*q)->quantiles[k]) : std::string(",");

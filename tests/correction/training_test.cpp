@@ -397,4 +397,46 @@ TEST(Calibration, ApplyKeepsTheQuantilesInOrder) {
   EXPECT_EQ(u, (std::vector<double>{-3, -2, 0, 0, 0, 2, 3}));
 }
 
+TEST(Training, CoverageByBandCountsEachBandsRowsInsideTheirIntervals) {
+  // Four runs: Tu 0.15 with 20 windows at 20 kHz (two inside both intervals,
+  // one inside the 95 % only, one outside both) and one Tu 0.32 with 500 windows at 500 kHz.
+  auto prediction = [](double true_u, double tu, std::int64_t windows, double fs) {
+    correction::HeldOutPrediction p;
+    p.row.true_velocity = true_u;
+    p.row.true_turbulence_intensity = tu;
+    p.row.features.windows_accepted = windows;
+    p.row.features.fs = fs;
+    p.correction.status = correction::CorrectionStatus::corrected;
+    correction::CorrectedQuantity u, t;
+    u.quantiles = {7, 8, 9, 10, 11, 12, 13};
+    t.quantiles = {0.0, 0.1, 0.12, 0.15, 0.18, 0.2, 0.4};
+    p.correction.velocity = u;
+    p.correction.turbulence_intensity = t;
+    return p;
+  };
+  const std::vector<correction::HeldOutPrediction> p{prediction(10, 0.15, 20, 2e4), prediction(11.5, 0.15, 20, 2e4),
+                                                     prediction(12.5, 0.15, 20, 2e4), prediction(14, 0.15, 20, 2e4),
+                                                     prediction(10, 0.32, 500, 5e5)};
+  const auto table = correction::coverage_by_band(p);
+  auto band = [&](const std::string& name) {
+    for (const auto& b : table)
+      if (b.band == name) return b;
+    ADD_FAILURE() << "no band " << name;
+    return correction::BandCoverage{};
+  };
+  EXPECT_EQ(band("all").rows, 5);
+  EXPECT_DOUBLE_EQ(band("all").velocity80, 3.0 / 5);
+  EXPECT_DOUBLE_EQ(band("all").velocity95, 4.0 / 5);
+  EXPECT_EQ(band("true Tu 0.1-0.2").rows, 4);
+  EXPECT_DOUBLE_EQ(band("true Tu 0.1-0.2").velocity80, 2.0 / 4);
+  EXPECT_DOUBLE_EQ(band("true Tu 0.1-0.2").tu80, 1.0);
+  EXPECT_DOUBLE_EQ(band("true Tu 0.3-0.35").tu80, 0.0);  // 0.32 is above q0.9 = 0.2
+  EXPECT_DOUBLE_EQ(band("true Tu 0.3-0.35").tu95, 1.0);
+  EXPECT_EQ(band("windows 10-29").rows, 4);
+  EXPECT_EQ(band("windows 100+").rows, 1);
+  EXPECT_EQ(band("fs 0-50 kHz").rows, 4);
+  EXPECT_EQ(band("fs 200 kHz+").rows, 1);
+  for (const auto& b : table) EXPECT_NE(b.band, "windows 30-99");  // empty bands are left out
+}
+
 }  // namespace

@@ -179,6 +179,17 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads = 0);
 
+/// Coverage of the corrected rows' 80 % and 95 % intervals in one band of runs.
+struct BandCoverage {
+  std::string band;  ///< "all", "true Tu 0.1-0.2", "windows 30-99", "fs 50-200 kHz", ...
+  std::int64_t rows = 0;
+  double velocity80 = 0.0, velocity95 = 0.0, tu80 = 0.0, tu95 = 0.0;
+};
+/// The coverage table of held-out predictions: all runs, by band of the true
+/// Tu (0-0.1, 0.1-0.2, 0.2-0.3, 0.3-0.35), of accepted windows (10-29, 30-99,
+/// 100+) and of fs (up to 50 kHz, 50-200 kHz, above); empty bands left out.
+std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>& predictions);
+
 /// Held-out predictions as CSV: run, features, truth, raw, quantiles.
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
 /// The learning curve as CSV.
