@@ -207,11 +207,21 @@ def _awcc_and_corrected(ax, y, rows, quantity, measured_label):
         measured_label = "AWCC probe-corrected, 95 % interval"
     _series(ax, y, rows, lambda r: get(r, "awcc", quantity), lambda r: get(r, "awcc", quantity + "_ci95"),
             color=BLUE, marker="o", ls="-", label=measured_label)
-    corrected = lambda r: get(r, "correction", quantity, "median")  # noqa: E731
-    for low, high, marker, width, label in (("0.025", "0.975", None, 1.0, "corrected, 95 % band"),
-                                            ("0.1", "0.9", "^", 3.0, "corrected median, 80 % band")):
-        _series(ax, y, rows, corrected, lambda r: _quantiles(r, quantity, low, high), color=VERMILION,
-                marker=marker, ls="none", elinewidth=width, label=label)
+    # Rows corrected by an extended model's FSCC forest (no usable AWCC
+    # result; the velocity only) are drawn apart, so that a reader sees which
+    # forest each corrected value comes from.
+    for forest, colour, mark, what in (("awcc", VERMILION, "^", "corrected"),
+                                       ("fscc", PURPLE, "s", "corrected from FSCC (no usable AWCC)")):
+        def corrected(r, forest=forest):
+            if (get(r, "correction", "forest") or "awcc") != forest:
+                return None
+            return get(r, "correction", quantity, "median")
+        for low, high, marker, width, label in (("0.025", "0.975", None, 1.0, f"{what}, 95 % band"),
+                                                ("0.1", "0.9", mark, 3.0, f"{what} median, 80 % band")):
+            if forest == "fscc" and not any(corrected(r) is not None for r in rows):
+                continue  # no such rows: no legend entry
+            _series(ax, y, rows, corrected, lambda r, lo=low, hi=high: _quantiles(r, quantity, lo, hi), color=colour,
+                    marker=marker, ls="none", elinewidth=width, label=label)
 
 
 def _quantiles(r, q, a, b):
