@@ -250,6 +250,20 @@ Correction not_corrected(CorrectionStatus status, std::string message) {
   return c;
 }
 
+namespace {
+
+// Why a feature value is outside its training range, in the field's words
+// where the flow itself is outside what the simulator models.
+std::string out_of_range_reason(const FeatureRange& r, double v) {
+  std::string why = fmt::format("{} = {:.6g} is outside the training range [{:.6g}, {:.6g}]", r.name, v, r.min, r.max);
+  if (r.name == "void_fraction" && v > 0.6) {
+    why += ": above c = 0.6 the flow is droplets in air, which the synthetic probe the model learnt from does not model";
+  }
+  return why;
+}
+
+}  // namespace
+
 int Calibration::band(std::int64_t windows) const {
   if (windows < 0) return -1;
   int b = 0;
@@ -289,9 +303,7 @@ Correction CorrectionModel::correct(const Features& f) const {
     const auto& r = ranges[j];
     const double pad = range_margin * (r.max - r.min);
     if (!(x[j] >= r.min - pad && x[j] <= r.max + pad)) {
-      return not_corrected(CorrectionStatus::outside_training_range,
-                           fmt::format("{} = {:.6g} is outside the training range [{:.6g}, {:.6g}]", r.name, x[j],
-                                       r.min, r.max));
+      return not_corrected(CorrectionStatus::outside_training_range, out_of_range_reason(r, x[j]));
     }
   }
   Correction c;
@@ -355,9 +367,7 @@ Correction CorrectionModel::correct_fscc(const Features& f) const {
     }
     const double pad = range_margin * (r.max - r.min);
     if (!(*v >= r.min - pad && *v <= r.max + pad)) {
-      return not_corrected(CorrectionStatus::outside_training_range,
-                           fmt::format("{} = {:.6g} is outside the FSCC forest's training range [{:.6g}, {:.6g}]",
-                                       r.name, *v, r.min, r.max));
+      return not_corrected(CorrectionStatus::outside_training_range, "FSCC forest: " + out_of_range_reason(r, *v));
     }
     x[j] = *v;
   }

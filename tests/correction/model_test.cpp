@@ -421,6 +421,17 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   EXPECT_FALSE(none.value("colour"));
 }
 
+TEST(Correction, DropletFlowIsNamedAsOutsideWhatTheModelLearnt) {
+  const auto m = small_model();
+  auto f = inside();
+  f.void_fraction = 0.75;
+  const auto c = m.correct(f);
+  EXPECT_EQ(c.status, correction::CorrectionStatus::outside_training_range);
+  EXPECT_NE(c.message.find("droplets in air"), std::string::npos) << c.message;
+  f.void_fraction = 0.5;  // outside this small model's range too, but not droplet flow
+  EXPECT_EQ(m.correct(f).message.find("droplets"), std::string::npos);
+}
+
 TEST(Correction, TheShippedModelOfFormat2StillCorrects) {
   const auto path = pdp_test::source_dir() / "samples" / "model" / "awcc.qrf";
   const auto m = CorrectionModel::load(path);
