@@ -210,6 +210,8 @@ std::vector<Row> bench_one(const std::string& name, std::uint64_t seed, const Pl
         m.dy = s.dy;
         m.np = options.np;
         m.windows_accepted = res.windows_accepted;
+        m.fs = fs;  // the record's features, for an extended model
+        m.duration = duration;
         c.seconds = r.seconds + cost([&] { k = model->correct(m); });
         c.windows = res.windows_accepted;
         if (k.corrected()) {
