@@ -10,6 +10,11 @@
 #include <deque>
 #include <fstream>
 #include <iterator>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <stdexcept>
 
 #include "awcc/atomic_output.hpp"
@@ -86,6 +91,8 @@ class Reader {
     return static_cast<std::size_t>(n);
   }
   [[nodiscard]] bool done() const { return p_ == end_; }
+  /// The next n bytes, in place.
+  std::span<const std::uint8_t> bytes(std::size_t n) { return {take(n), n}; }
   [[noreturn]] void damaged(const std::string& what) const {
     throw awcc::InputError(fmt::format("{}: damaged model file ({}); retrain it with pdp train or fetch it again", name_, what));
   }
@@ -105,41 +112,32 @@ class Reader {
 void write_forest(Writer& w, const std::string& name, TargetForm form, const QuantileForest& f) {
   w.text(name);
   w.u8(static_cast<std::uint8_t>(form));
-  w.u32(static_cast<std::uint32_t>(f.features()));
-  w.u64(f.targets().size());
-  for (double y : f.targets()) w.f64(y);
-  w.u32(static_cast<std::uint32_t>(f.trees().size()));
-  // Held rows in 2 bytes when the rows are few enough, else 4.
-  const bool narrow = f.targets().size() <= 65536;
-  w.u8(narrow ? 2 : 4);
-  for (const auto& t : f.trees()) {
-    w.u32(static_cast<std::uint32_t>(t.nodes.size()));
-    for (const auto& n : t.nodes) {
-      if (n.feature < 0) {
-        w.u8(0xff);
-        w.u32(n.left);
-        w.u32(n.right);
-      } else {
-        // Children are allocated in pairs: right = left + 1.
-        if (n.right != n.left + 1) throw std::logic_error("forest node children are not adjacent");
-        w.u8(static_cast<std::uint8_t>(n.feature));
-        w.f64(n.threshold);
-        w.u32(n.left);
-      }
+  const auto block = f.bytes();
+  w.u64(block.size());
+  w.raw(block.data(), block.size());
+}
+
+// Format 3: the forest's block (quantile_forest.hpp), read in place.
+QuantileForest view_forest(Reader& r, const std::shared_ptr<const void>& owner, const std::string& expected,
+                           TargetForm& form, std::uint32_t expected_features) {
+  if (const auto name = r.text(); name != expected) r.damaged(fmt::format("forest '{}' where '{}' belongs", name, expected));
+  const auto f = r.u8();
+  if (f > 2) r.damaged(fmt::format("unknown target form {}", f));
+  form = static_cast<TargetForm>(f);
+  const auto block = r.bytes(r.count(r.u64(), 1));
+  try {
+    auto forest = QuantileForest::view(owner, block);
+    if (forest.features() != static_cast<int>(expected_features)) {
+      r.damaged(fmt::format("{} features, expected {}", forest.features(), expected_features));
     }
-    w.u64(t.leaf_rows.size());
-    for (auto r : t.leaf_rows) {
-      if (narrow) {
-        w.u8(static_cast<std::uint8_t>(r));
-        w.u8(static_cast<std::uint8_t>(r >> 8));
-      } else {
-        w.u32(r);
-      }
-    }
+    return forest;
+  } catch (const std::invalid_argument& e) {
+    r.damaged(e.what());
   }
 }
 
-QuantileForest read_forest(Reader& r, const std::string& expected, TargetForm& form, std::uint32_t expected_features) {
+// Formats 1 and 2: variable-size nodes, decoded and assembled.
+QuantileForest read_forest_v2(Reader& r, const std::string& expected, TargetForm& form, std::uint32_t expected_features) {
   if (const auto name = r.text(); name != expected) r.damaged(fmt::format("forest '{}' where '{}' belongs", name, expected));
   const auto f = r.u8();
   if (f > 2) r.damaged(fmt::format("unknown target form {}", f));
@@ -461,6 +459,13 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
 }
 
 CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+  auto owned = std::make_shared<const std::vector<std::uint8_t>>(bytes);
+  const std::span<const std::uint8_t> view(owned->data(), owned->size());
+  return parse(std::move(owned), view, name);
+}
+
+CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::span<const std::uint8_t> bytes,
+                                       const std::string& name) {
   if (bytes.size() < sizeof magic || std::memcmp(bytes.data(), magic, sizeof magic) != 0) {
     throw awcc::InputError(fmt::format("{}: not a pdp model file (it does not start with \"pdp-qrf\"); give a file "
                                        "written by pdp train",
@@ -532,8 +537,11 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
   }
   if (r.u32() != 2) r.damaged("the model holds other than two forests");
   const auto p = static_cast<std::uint32_t>(m.ranges.size());
-  m.velocity = read_forest(r, "velocity", m.velocity_form, p);
-  m.turbulence_intensity = read_forest(r, "turbulence_intensity", m.turbulence_form, p);
+  auto forest = [&](const std::string& forest_name, TargetForm& form, std::uint32_t features) {
+    return version >= 3 ? view_forest(r, owner, forest_name, form, features) : read_forest_v2(r, forest_name, form, features);
+  };
+  m.velocity = forest("velocity", m.velocity_form, p);
+  m.turbulence_intensity = forest("turbulence_intensity", m.turbulence_form, p);
   if (version >= 3) {
     const auto extra = r.u32();
     if (extra > 1) r.damaged(fmt::format("{} FSCC forests", extra));
@@ -559,7 +567,7 @@ CorrectionModel CorrectionModel::parse(const std::vector<std::uint8_t>& bytes, c
           if (!std::isfinite(o)) r.damaged("a calibration offset is not finite");
         }
       }
-      f.velocity = read_forest(r, "fscc_velocity", f.form, static_cast<std::uint32_t>(fscc_names.size()));
+      f.velocity = forest("fscc_velocity", f.form, static_cast<std::uint32_t>(fscc_names.size()));
       m.fscc = std::move(f);
     }
   }
@@ -577,15 +585,42 @@ void CorrectionModel::save(const std::filesystem::path& path) const {
   });
 }
 
+namespace {
+
+// A read-only mapping of a whole file, unmapped when the last forest reading
+// it goes. Pages are read ahead in one call (MAP_POPULATE) instead of one
+// fault each.
+struct Mapping {
+  void* data = MAP_FAILED;
+  std::size_t size = 0;
+  Mapping() = default;
+  Mapping(const Mapping&) = delete;
+  Mapping& operator=(const Mapping&) = delete;
+  ~Mapping() {
+    if (data != MAP_FAILED) ::munmap(data, size);
+  }
+};
+
+}  // namespace
+
 CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
-  const auto size = static_cast<std::size_t>(in.tellg());
-  std::vector<std::uint8_t> bytes(size);
-  in.seekg(0);
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
-  if (!in) throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
-  return parse(bytes, path.string());
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw awcc::InputError(fmt::format("{}: not a regular file; give a model file written by pdp train", path.string()));
+  }
+  auto map = std::make_shared<Mapping>();
+  map->size = static_cast<std::size_t>(st.st_size);
+  if (map->size > 0) map->data = ::mmap(nullptr, map->size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+  ::close(fd);
+  if (map->size > 0 && map->data == MAP_FAILED) {
+    throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
+  }
+  const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(map->size > 0 ? map->data : nullptr),
+                                            map->size);
+  return parse(std::move(map), bytes, path.string());
 }
 
 std::span<const awcc::ProfileColumn> correction_csv_columns() {

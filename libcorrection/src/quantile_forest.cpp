@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -212,26 +213,51 @@ QuantileForest QuantileForest::train(const TrainingData& data, const ForestOptio
   }
   const int mtry = options.features_per_split > 0 ? std::min(options.features_per_split, data.features)
                                                   : (data.features + 2) / 3;
-  QuantileForest forest;
-  forest.features_ = data.features;
-  forest.targets_ = data.y;
-  forest.trees_.resize(static_cast<std::size_t>(options.trees));
+  std::vector<RegressionTree> trees(static_cast<std::size_t>(options.trees));
   awcc::parallel_for(static_cast<std::size_t>(options.trees), options.threads, [&](std::size_t t) {
     // The tree's stream depends on (seed, t) only.
     SplitMix mix{options.seed ^ (0xd1b54a32d192ed03ull * (static_cast<std::uint64_t>(t) + 1))};
     TreeBuilder builder(data, options, mtry, mix.next());
-    forest.trees_[t] = builder.build();
+    trees[t] = builder.build();
   });
-  return forest;
+  return assemble(data.features, data.y, std::move(trees));
 }
+
+namespace {
+
+// Little-endian values read and written by their bytes, whatever the machine.
+std::uint32_t load_u32(const std::uint8_t* p) {
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+         static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+std::uint64_t load_u64(const std::uint8_t* p) {
+  return static_cast<std::uint64_t>(load_u32(p)) | static_cast<std::uint64_t>(load_u32(p + 4)) << 32;
+}
+double load_f64(const std::uint8_t* p) { return std::bit_cast<double>(load_u64(p)); }
+void put_u32(std::vector<std::uint8_t>& b, std::uint32_t v) {
+  for (int k = 0; k < 4; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
+}
+void put_u64(std::vector<std::uint8_t>& b, std::uint64_t v) {
+  put_u32(b, static_cast<std::uint32_t>(v));
+  put_u32(b, static_cast<std::uint32_t>(v >> 32));
+}
+void put_f64(std::vector<std::uint8_t>& b, double v) { put_u64(b, std::bit_cast<std::uint64_t>(v)); }
+
+constexpr std::size_t node_bytes = 12;
+constexpr std::uint32_t leaf_tag = 0xffu << 24;
+constexpr std::uint32_t max_nodes = 1u << 24;
+
+}  // namespace
 
 QuantileForest QuantileForest::assemble(int features, std::vector<double> targets, std::vector<RegressionTree> trees) {
   if (features < 1) throw std::invalid_argument("forest: no features");
+  if (features >= 255) throw std::invalid_argument("forest: 255 features or more");
   if (trees.empty()) throw std::invalid_argument("forest: no trees");
   for (std::size_t t = 0; t < trees.size(); ++t) {
     const auto& tree = trees[t];
     const auto count = tree.nodes.size();
     if (count == 0) throw std::invalid_argument(fmt::format("forest: tree {} has no nodes", t));
+    if (count >= max_nodes) throw std::invalid_argument(fmt::format("forest: tree {} has 2^24 nodes or more", t));
     for (std::size_t i = 0; i < count; ++i) {
       const auto& node = tree.nodes[i];
       if (node.feature < 0) {
@@ -239,9 +265,9 @@ QuantileForest QuantileForest::assemble(int features, std::vector<double> target
           throw std::invalid_argument(fmt::format("forest: tree {} leaf {} refers to rows outside the tree", t, i));
         }
       } else {
-        // Children come after their parent: the walk from the root ends.
-        if (node.feature >= features || node.left <= i || node.right <= i || node.left >= count ||
-            node.right >= count || !std::isfinite(node.threshold)) {
+        // Children come after their parent (the walk from the root ends), side by side.
+        if (node.feature >= features || node.left <= i || node.right != node.left + 1 || node.right >= count ||
+            !std::isfinite(node.threshold)) {
           throw std::invalid_argument(fmt::format("forest: tree {} node {} is malformed", t, i));
         }
       }
@@ -253,20 +279,177 @@ QuantileForest QuantileForest::assemble(int features, std::vector<double> target
   for (std::size_t i = 0; i < targets.size(); ++i) {
     if (!std::isfinite(targets[i])) throw std::invalid_argument(fmt::format("forest: target {} is not finite", i));
   }
-  QuantileForest forest;
-  forest.features_ = features;
-  forest.targets_ = std::move(targets);
-  forest.trees_ = std::move(trees);
-  return forest;
+  auto block = std::make_shared<std::vector<std::uint8_t>>();
+  auto& b = *block;
+  put_u32(b, static_cast<std::uint32_t>(features));
+  put_u64(b, targets.size());
+  for (double y : targets) put_f64(b, y);
+  put_u32(b, static_cast<std::uint32_t>(trees.size()));
+  const bool narrow = targets.size() <= 65536;
+  b.push_back(narrow ? 2 : 4);
+  for (const auto& tree : trees) {
+    put_u32(b, static_cast<std::uint32_t>(tree.nodes.size()));
+    for (const auto& n : tree.nodes) {
+      if (n.feature < 0) {
+        put_u32(b, n.left);
+        put_u32(b, n.right);
+        put_u32(b, leaf_tag);
+      } else {
+        put_f64(b, n.threshold);
+        put_u32(b, static_cast<std::uint32_t>(n.feature) << 24 | n.left);
+      }
+    }
+    put_u64(b, tree.leaf_rows.size());
+    for (auto r : tree.leaf_rows) {
+      b.push_back(static_cast<std::uint8_t>(r));
+      b.push_back(static_cast<std::uint8_t>(r >> 8));
+      if (!narrow) {
+        b.push_back(static_cast<std::uint8_t>(r >> 16));
+        b.push_back(static_cast<std::uint8_t>(r >> 24));
+      }
+    }
+  }
+  const std::span<const std::uint8_t> bytes(b.data(), b.size());
+  return view(std::move(block), bytes);
+}
+
+QuantileForest QuantileForest::view(std::shared_ptr<const void> owner, std::span<const std::uint8_t> block) {
+  const std::uint8_t* p = block.data();
+  const std::uint8_t* const end = block.data() + block.size();
+  auto need = [&](std::uint64_t bytes, const char* what) {
+    if (bytes > static_cast<std::uint64_t>(end - p)) throw std::invalid_argument(fmt::format("forest: {} beyond its bytes", what));
+  };
+  QuantileForest f;
+  need(12, "the header");
+  f.features_ = static_cast<int>(load_u32(p));
+  const auto n = load_u64(p + 4);
+  p += 12;
+  if (f.features_ < 1 || f.features_ >= 255) throw std::invalid_argument(fmt::format("forest: {} features", f.features_));
+  // Counts are checked against the bytes left before anything is sized by them.
+  if (n >= std::numeric_limits<std::uint32_t>::max()) throw std::invalid_argument("forest: too many targets");
+  need(n * 8 + 5, "the targets");
+  f.targets_ = p;
+  f.target_count_ = static_cast<std::size_t>(n);
+  for (std::size_t i = 0; i < f.target_count_; ++i) {
+    if (!std::isfinite(load_f64(p + 8 * i))) throw std::invalid_argument(fmt::format("forest: target {} is not finite", i));
+  }
+  p += n * 8;
+  const auto tree_count = load_u32(p);
+  f.row_bytes_ = p[4];
+  p += 5;
+  if (tree_count == 0) throw std::invalid_argument("forest: no trees");
+  need(static_cast<std::uint64_t>(tree_count) * (4 + node_bytes + 8), "the trees");  // each at least one node
+  if (f.row_bytes_ != 2 && f.row_bytes_ != 4) throw std::invalid_argument(fmt::format("forest: held rows of {} bytes", f.row_bytes_));
+  f.trees_.reserve(tree_count);
+  for (std::uint32_t t = 0; t < tree_count; ++t) {
+    TreeView v;
+    need(4, "a tree");
+    v.node_count = load_u32(p);
+    p += 4;
+    if (v.node_count == 0 || v.node_count >= max_nodes) throw std::invalid_argument(fmt::format("forest: tree {} has {} nodes", t, v.node_count));
+    need(static_cast<std::uint64_t>(v.node_count) * node_bytes + 8, "a tree's nodes");
+    v.nodes = p;
+    p += static_cast<std::size_t>(v.node_count) * node_bytes;
+    v.row_count = load_u64(p);
+    p += 8;
+    if (v.row_count > static_cast<std::uint64_t>(end - p)) throw std::invalid_argument("forest: a tree's held rows beyond its bytes");
+    need(v.row_count * static_cast<std::uint64_t>(f.row_bytes_), "a tree's held rows");
+    v.rows = p;
+    p += v.row_count * static_cast<std::uint64_t>(f.row_bytes_);
+    for (std::uint32_t i = 0; i < v.node_count; ++i) {
+      const std::uint8_t* q = v.nodes + static_cast<std::size_t>(i) * node_bytes;
+      const auto info = load_u32(q + 8);
+      if (info == leaf_tag) {
+        const auto first = load_u32(q), count = load_u32(q + 4);
+        if (count == 0 || static_cast<std::uint64_t>(first) + count > v.row_count) {
+          throw std::invalid_argument(fmt::format("forest: tree {} leaf {} refers to rows outside the tree", t, i));
+        }
+      } else {
+        const auto feature = info >> 24, left = info & (max_nodes - 1);
+        if (static_cast<int>(feature) >= f.features_ || left <= i || left + 1 >= v.node_count || !std::isfinite(load_f64(q))) {
+          throw std::invalid_argument(fmt::format("forest: tree {} node {} is malformed", t, i));
+        }
+      }
+    }
+    for (std::uint64_t k = 0; k < v.row_count; ++k) {
+      const std::uint32_t r = f.row_bytes_ == 2 ? (static_cast<std::uint32_t>(v.rows[2 * k]) | static_cast<std::uint32_t>(v.rows[2 * k + 1]) << 8)
+                                                : load_u32(v.rows + 4 * k);
+      if (r >= n) throw std::invalid_argument(fmt::format("forest: tree {} holds row {} of {}", t, r, n));
+    }
+    f.trees_.push_back(v);
+  }
+  if (p != end) throw std::invalid_argument("forest: bytes after the last tree");
+  f.owner_ = std::move(owner);
+  f.block_ = block;
+  return f;
+}
+
+double QuantileForest::target(std::size_t i) const { return load_f64(targets_ + 8 * i); }
+
+std::vector<double> QuantileForest::targets() const {
+  std::vector<double> out(target_count_);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = target(i);
+  return out;
+}
+
+std::vector<RegressionTree> QuantileForest::trees() const {
+  std::vector<RegressionTree> out;
+  for (const auto& v : trees_) {
+    RegressionTree t;
+    for (std::uint32_t i = 0; i < v.node_count; ++i) {
+      const std::uint8_t* q = v.nodes + static_cast<std::size_t>(i) * node_bytes;
+      RegressionTree::Node n;
+      const auto info = load_u32(q + 8);
+      if (info == leaf_tag) {
+        n.feature = -1;
+        n.left = load_u32(q);
+        n.right = load_u32(q + 4);
+      } else {
+        n.feature = static_cast<std::int32_t>(info >> 24);
+        n.threshold = load_f64(q);
+        n.left = info & (max_nodes - 1);
+        n.right = n.left + 1;
+      }
+      t.nodes.push_back(n);
+    }
+    for (std::uint64_t k = 0; k < v.row_count; ++k) {
+      t.leaf_rows.push_back(row_bytes_ == 2 ? (static_cast<std::uint32_t>(v.rows[2 * k]) | static_cast<std::uint32_t>(v.rows[2 * k + 1]) << 8)
+                                            : load_u32(v.rows + 4 * k));
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+std::uint32_t QuantileForest::leaf(const TreeView& t, std::span<const double> x) const {
+  std::uint32_t i = 0;
+  for (;;) {
+    const std::uint8_t* q = t.nodes + static_cast<std::size_t>(i) * node_bytes;
+    const auto info = load_u32(q + 8);
+    if (info == leaf_tag) return i;
+    const auto left = info & (max_nodes - 1);
+    i = x[info >> 24] <= load_f64(q) ? left : left + 1;
+  }
+}
+
+template <class Fn>
+void QuantileForest::for_each_held(const TreeView& t, std::uint32_t leaf, Fn&& fn) const {
+  const std::uint8_t* q = t.nodes + static_cast<std::size_t>(leaf) * node_bytes;
+  if (load_u32(q + 8) != leaf_tag) return;
+  const auto first = load_u32(q), count = load_u32(q + 4);
+  for (std::uint32_t k = first; k < first + count; ++k) {
+    fn(row_bytes_ == 2 ? (static_cast<std::uint32_t>(t.rows[2 * k]) | static_cast<std::uint32_t>(t.rows[2 * k + 1]) << 8)
+                       : load_u32(t.rows + 4 * static_cast<std::size_t>(k)));
+  }
 }
 
 std::vector<double> QuantileForest::weights(std::span<const double> x) const {
-  std::vector<double> w(targets_.size(), 0.0);
+  std::vector<double> w(target_count_, 0.0);
   const double per_tree = 1.0 / static_cast<double>(trees_.size());
   for (const auto& tree : trees_) {
-    const auto rows = tree.rows(tree.leaf(x));
-    const double each = per_tree / static_cast<double>(rows.size());
-    for (auto r : rows) w[r] += each;
+    const auto l = leaf(tree, x);
+    const double each = per_tree / static_cast<double>(load_u32(tree.nodes + static_cast<std::size_t>(l) * node_bytes + 4));
+    for_each_held(tree, l, [&](std::uint32_t r) { w[r] += each; });
   }
   return w;
 }
@@ -277,9 +460,9 @@ WeightedDistribution QuantileForest::distribution(std::span<const double> x) con
   std::vector<std::pair<double, double>> held;
   const double per_tree = 1.0 / static_cast<double>(trees_.size());
   for (const auto& tree : trees_) {
-    const auto rows = tree.rows(tree.leaf(x));
-    const double each = per_tree / static_cast<double>(rows.size());
-    for (auto r : rows) held.emplace_back(targets_[r], each);
+    const auto l = leaf(tree, x);
+    const double each = per_tree / static_cast<double>(load_u32(tree.nodes + static_cast<std::size_t>(l) * node_bytes + 4));
+    for_each_held(tree, l, [&](std::uint32_t r) { held.emplace_back(target(r), each); });
   }
   std::sort(held.begin(), held.end());
   WeightedDistribution d;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <random>
+#include <tuple>
 
 #include "awcc/csv.hpp"
 #include "test_paths.hpp"
@@ -126,7 +127,8 @@ TEST(Correction, LargeTrainingSetsRoundTrip) {
   EXPECT_EQ(back.velocity.trees()[1].leaf_rows, m.velocity.trees()[1].leaf_rows);
   EXPECT_EQ(back.serialise(), bytes);
   std::uint32_t largest = 0;
-  for (auto r : back.velocity.trees()[0].leaf_rows) largest = std::max(largest, r);
+  const auto back_trees = back.velocity.trees();
+  for (auto r : back_trees[0].leaf_rows) largest = std::max(largest, r);
   EXPECT_GT(largest, 65535u);
 }
 
@@ -182,19 +184,21 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   // ...and a file carrying it is refused as damaged. Build the file bytes by
   // patching the serialised root (same size) and recomputing the checksum.
   const auto good = m.serialise();
-  // A split node on file: u8 feature, f64 threshold, u32 left child.
-  std::vector<std::uint8_t> node(13);
-  const auto& root = m.velocity.trees()[0].nodes[0];
-  node[0] = static_cast<std::uint8_t>(root.feature);
+  // A split node on file (format 3): f64 threshold, u32 feature << 24 | left child.
+  std::vector<std::uint8_t> node(12);
+  const auto velocity_trees = m.velocity.trees();
+  const auto& root = velocity_trees[0].nodes[0];
   std::uint64_t bits;
   std::memcpy(&bits, &root.threshold, 8);
-  for (int i = 0; i < 8; ++i) node[1 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(bits >> (8 * i));
-  for (int i = 0; i < 4; ++i) node[9 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(root.left >> (8 * i));
+  for (int i = 0; i < 8; ++i) node[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(bits >> (8 * i));
+  const std::uint32_t info = static_cast<std::uint32_t>(root.feature) << 24 | root.left;
+  for (int i = 0; i < 4; ++i) node[8 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(info >> (8 * i));
   const auto at = std::search(good.begin(), good.end(), node.begin(), node.end());
   ASSERT_NE(at, good.end());
   forged = good;
   const auto offset = static_cast<std::size_t>(at - good.begin());
-  for (int i = 0; i < 4; ++i) forged[offset + 9 + static_cast<std::size_t>(i)] = 0;
+  // Left child 0: a cycle back to the root.
+  for (int i = 0; i < 3; ++i) forged[offset + 8 + static_cast<std::size_t>(i)] = 0;
   const auto crc = correction::crc32(forged.data(), forged.size() - 4);
   for (int i = 0; i < 4; ++i) forged[forged.size() - 4 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
   EXPECT_NE(message(forged).find("malformed"), std::string::npos) << message(forged);
@@ -432,12 +436,78 @@ TEST(Correction, DropletFlowIsNamedAsOutsideWhatTheModelLearnt) {
   EXPECT_EQ(m.correct(f).message.find("droplets"), std::string::npos);
 }
 
-TEST(Correction, TheShippedModelOfFormat2StillCorrects) {
-  const auto path = pdp_test::source_dir() / "samples" / "model" / "awcc.qrf";
-  const auto m = CorrectionModel::load(path);
-  EXPECT_EQ(m.ranges.size(), 7u);
+// Format 2 as model.hpp documents it, written here independently of the
+// library's writer (which writes format 3 only).
+std::vector<std::uint8_t> format2_bytes(const CorrectionModel& m) {
+  std::vector<std::uint8_t> p;
+  auto u8 = [&](std::uint8_t v) { p.push_back(v); };
+  auto u32 = [&](std::uint32_t v) { for (int k = 0; k < 4; ++k) p.push_back(static_cast<std::uint8_t>(v >> (8 * k))); };
+  auto u64 = [&](std::uint64_t v) { u32(static_cast<std::uint32_t>(v)), u32(static_cast<std::uint32_t>(v >> 32)); };
+  auto f64 = [&](double v) { std::uint64_t b; std::memcpy(&b, &v, 8); u64(b); };
+  auto text = [&](const std::string& t) { u32(static_cast<std::uint32_t>(t.size())); p.insert(p.end(), t.begin(), t.end()); };
+  text(m.provenance);
+  u32(static_cast<std::uint32_t>(m.ranges.size()));
+  for (const auto& r : m.ranges) text(r.name), f64(r.min), f64(r.max);
+  f64(m.range_margin);
+  u64(static_cast<std::uint64_t>(m.min_windows));
+  f64(m.processing.filter_a);
+  u8(m.processing.roc ? 1 : 0), u8(0), u8(0), u8(0);
+  u32(2);
+  for (const auto& [name, form, forest] : {std::tuple{"velocity", m.velocity_form, &m.velocity},
+                                           std::tuple{"turbulence_intensity", m.turbulence_form, &m.turbulence_intensity}}) {
+    text(name);
+    u8(static_cast<std::uint8_t>(form));
+    u32(static_cast<std::uint32_t>(forest->features()));
+    const auto targets = forest->targets();
+    u64(targets.size());
+    for (double y : targets) f64(y);
+    const auto trees = forest->trees();
+    u32(static_cast<std::uint32_t>(trees.size()));
+    u8(2);
+    for (const auto& t : trees) {
+      u32(static_cast<std::uint32_t>(t.nodes.size()));
+      for (const auto& n : t.nodes) {
+        if (n.feature < 0) {
+          u8(0xff), u32(n.left), u32(n.right);
+        } else {
+          u8(static_cast<std::uint8_t>(n.feature)), f64(n.threshold), u32(n.left);
+        }
+      }
+      u64(t.leaf_rows.size());
+      for (auto r : t.leaf_rows) u8(static_cast<std::uint8_t>(r)), u8(static_cast<std::uint8_t>(r >> 8));
+    }
+  }
+  std::vector<std::uint8_t> file{'p', 'd', 'p', '-', 'q', 'r', 'f', '\n'};
+  for (int k = 0; k < 4; ++k) file.push_back(static_cast<std::uint8_t>(2u >> (8 * k)));
+  for (int k = 0; k < 8; ++k) file.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(p.size()) >> (8 * k)));
+  file.insert(file.end(), p.begin(), p.end());
+  const auto crc = correction::crc32(file.data(), file.size());
+  for (int k = 0; k < 4; ++k) file.push_back(static_cast<std::uint8_t>(crc >> (8 * k)));
+  return file;
+}
+
+TEST(Correction, Format2FilesStillCorrectAsTheyDid) {
+  const auto m = small_model();
+  const auto old = CorrectionModel::parse(format2_bytes(m), "old.qrf");
+  EXPECT_EQ(old.ranges.size(), 7u);
+  EXPECT_TRUE(old.calibration.empty());
+  EXPECT_FALSE(old.fscc);
   auto f = inside();  // no fs or duration: the seven features suffice
-  const auto c = m.correct(f);
+  for (double u : {5.0, 10.0, 30.0}) {
+    f.velocity = u;
+    const auto a = m.correct(f), b = old.correct(f);
+    ASSERT_TRUE(b.corrected()) << b.message;
+    EXPECT_EQ(a.velocity->quantiles, b.velocity->quantiles);
+    EXPECT_EQ(a.turbulence_intensity->quantiles, b.turbulence_intensity->quantiles);
+  }
+  // Saved again, it is format 3 with the same forests.
+  EXPECT_EQ(old.serialise(), m.serialise());
+}
+
+TEST(Correction, TheShippedModelCorrects) {
+  const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
+  EXPECT_EQ(m.ranges.size(), 7u);
+  const auto c = m.correct(inside());
   EXPECT_TRUE(c.corrected()) << c.message;
 }
 

@@ -48,7 +48,8 @@ TEST(QuantileForest, SingleTreeWeightsReproduceTheLeafsEmpiricalQuantiles) {
   o.seed = 11;
   const auto forest = QuantileForest::train(data, o);
   ASSERT_EQ(forest.trees().size(), 1u);
-  const auto& tree = forest.trees()[0];
+  const auto trees = forest.trees();
+  const auto& tree = trees[0];
   int leaves_checked = 0;
   for (std::size_t i = 0; i < data.rows(); i += 3) {
     const auto x = data.row(i);
@@ -116,7 +117,8 @@ TEST(QuantileForest, RootSplitIsTheBruteForceLeastSquaresSplit) {
     o.features_per_split = 3;
     o.seed = seed;
     const auto forest = QuantileForest::train(data, o);
-    const auto& tree = forest.trees()[0];
+    const auto trees = forest.trees();
+    const auto& tree = trees[0];
     ASSERT_EQ(tree.nodes.size(), 3u);
     const auto& root = tree.nodes[0];
     std::vector<std::uint32_t> sample(tree.leaf_rows.begin(), tree.leaf_rows.end());
@@ -224,20 +226,8 @@ TEST(QuantileForest, SameSeedSameForestWhateverTheThreads) {
   const auto b = QuantileForest::train(data, o);
   o.seed = 78;
   const auto c = QuantileForest::train(data, o);
-  auto same = [](const QuantileForest& x, const QuantileForest& y) {
-    if (x.trees().size() != y.trees().size()) return false;
-    for (std::size_t t = 0; t < x.trees().size(); ++t) {
-      const auto& p = x.trees()[t];
-      const auto& q = y.trees()[t];
-      if (p.leaf_rows != q.leaf_rows || p.nodes.size() != q.nodes.size()) return false;
-      for (std::size_t i = 0; i < p.nodes.size(); ++i) {
-        if (p.nodes[i].feature != q.nodes[i].feature || p.nodes[i].threshold != q.nodes[i].threshold ||
-            p.nodes[i].left != q.nodes[i].left || p.nodes[i].right != q.nodes[i].right)
-          return false;
-      }
-    }
-    return true;
-  };
+  // The whole forest, byte for byte (every node, threshold, held row and target).
+  auto same = [](const QuantileForest& x, const QuantileForest& y) { return std::ranges::equal(x.bytes(), y.bytes()); };
   EXPECT_TRUE(same(a, b));
   EXPECT_FALSE(same(a, c));
 }

@@ -33,7 +33,9 @@
 // right child being left + 1; a leaf: u8 0xff, u32 first held row, u32
 // count), held-row count (u64), held rows. Version 1 files (no processing)
 // were all trained with the default processing, which they are read with.
-// Version 3 admits the extended feature set (the seven measured features,
+// Version 3 stores each forest as its block (correction/quantile_forest.hpp:
+// fixed 12-byte nodes, read in place from the mapped file, nothing built):
+// name, u8 target form, u64 block bytes, the block. It admits the extended feature set (the seven measured features,
 // then fs, duration and windows_accepted: see correction/features.hpp;
 // versions 1 and 2 have the seven only) and, after the processing, the
 // calibration: u32 band count B (0: none), B - 1 window edges (i64), then
@@ -47,6 +49,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
@@ -162,6 +165,10 @@ struct CorrectionModel {
   [[nodiscard]] std::vector<std::uint8_t> serialise() const;
   /// `name` is used in messages only. Throws awcc::InputError.
   static CorrectionModel parse(const std::vector<std::uint8_t>& bytes, const std::string& name);
+  /// The same from bytes that `owner` keeps alive: format 3 forests are read
+  /// in place, nothing is built.
+  static CorrectionModel parse(std::shared_ptr<const void> owner, std::span<const std::uint8_t> bytes,
+                               const std::string& name);
   /// Written to a temporary name and renamed when complete.
   void save(const std::filesystem::path& path) const;
   /// Throws awcc::InputError naming the file, the problem and the fix.

@@ -25,6 +25,7 @@
 // count.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <utility>
@@ -78,19 +79,39 @@ struct WeightedDistribution {
   [[nodiscard]] double quantile(double alpha) const;
 };
 
+/// A forest held as one block of bytes, read in place (so that a model file
+/// mapped into memory is used as it lies, with nothing built). Little-endian
+/// whatever the machine, every value read by copying its bytes (no alignment):
+///   u32 features, u64 target count n, f64 targets[n], u32 tree count,
+///   u8 held-row width (2 bytes when n <= 65,536, else 4); per tree: u32 node
+///   count, nodes of 12 bytes, u64 held-row count, held rows.
+/// A split node: f64 threshold, u32 feature << 24 | left child (the right
+/// child is left + 1); a leaf: u32 first held row, u32 count, u32 0xff << 24.
+/// Trees of 2^24 nodes or more, or 255 features or more, are refused.
 class QuantileForest {
  public:
   QuantileForest() = default;
   /// Grows the forest; throws std::invalid_argument on bad options or data
   /// (non-finite values, no rows, more rows than 2^32 - 1).
   static QuantileForest train(const TrainingData& data, const ForestOptions& options);
-  /// A forest from its parts (model files); throws std::invalid_argument when
-  /// a tree refers to a node, feature or row that does not exist.
+  /// A forest from its parts (format 1 and 2 model files, tests); throws
+  /// std::invalid_argument when a tree refers to a node, feature or row that
+  /// does not exist.
   static QuantileForest assemble(int features, std::vector<double> targets, std::vector<RegressionTree> trees);
+  /// A forest read in place from `block` (the layout above), which `owner`
+  /// keeps alive; checks every node, row and target (throws
+  /// std::invalid_argument naming the fault) and builds nothing but an index
+  /// of the trees.
+  static QuantileForest view(std::shared_ptr<const void> owner, std::span<const std::uint8_t> block);
 
   [[nodiscard]] int features() const { return features_; }
-  [[nodiscard]] const std::vector<double>& targets() const { return targets_; }
-  [[nodiscard]] const std::vector<RegressionTree>& trees() const { return trees_; }
+  /// The block (what a model file stores).
+  [[nodiscard]] std::span<const std::uint8_t> bytes() const { return block_; }
+  [[nodiscard]] std::size_t target_count() const { return target_count_; }
+  [[nodiscard]] double target(std::size_t i) const;
+  /// The training targets and trees, decoded (tests and inspection; prediction does not need them).
+  [[nodiscard]] std::vector<double> targets() const;
+  [[nodiscard]] std::vector<RegressionTree> trees() const;
 
   /// w_i(x) for every training row i (the definition above, dense).
   [[nodiscard]] std::vector<double> weights(std::span<const double> x) const;
@@ -100,9 +121,24 @@ class QuantileForest {
   [[nodiscard]] std::vector<double> quantiles(std::span<const double> x, std::span<const double> levels) const;
 
  private:
+  struct TreeView {
+    const std::uint8_t* nodes = nullptr;
+    std::uint32_t node_count = 0;
+    const std::uint8_t* rows = nullptr;
+    std::uint64_t row_count = 0;
+  };
+  // The leaf x reaches, and its held rows passed to fn one by one.
+  [[nodiscard]] std::uint32_t leaf(const TreeView& t, std::span<const double> x) const;
+  template <class Fn>
+  void for_each_held(const TreeView& t, std::uint32_t leaf, Fn&& fn) const;
+
   int features_ = 0;
-  std::vector<double> targets_;
-  std::vector<RegressionTree> trees_;
+  std::shared_ptr<const void> owner_;
+  std::span<const std::uint8_t> block_;
+  const std::uint8_t* targets_ = nullptr;
+  std::size_t target_count_ = 0;
+  int row_bytes_ = 4;
+  std::vector<TreeView> trees_;
 };
 
 /// Mean pinball (quantile) loss of predicted quantiles q at levels alpha for
