@@ -804,18 +804,22 @@ std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>&
   };
   std::vector<Band> bands{{"all", [](const TrainingRow&) { return true; }}};
   // True Tu (the bands), accepted windows, sampling rate.
-  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 0.35}}) {
+  // Plain copies of the ends: lambdas capture them (clang 14 cannot capture bindings).
+  for (const auto& band : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 0.35}}) {
+    const double lo = band.first, hi = band.second;
     bands.push_back({fmt::format("true Tu {:g}-{:g}", lo, hi), [lo, hi](const TrainingRow& r) {
                        return r.true_turbulence_intensity >= lo && r.true_turbulence_intensity < hi;
                      }});
   }
-  for (const auto& [lo, hi] : std::vector<std::pair<std::int64_t, std::int64_t>>{{10, 30}, {30, 100}, {100, 1LL << 62}}) {
+  for (const auto& band : std::vector<std::pair<std::int64_t, std::int64_t>>{{10, 30}, {30, 100}, {100, 1LL << 62}}) {
+    const std::int64_t lo = band.first, hi = band.second;
     bands.push_back({hi > (1LL << 61) ? fmt::format("windows {}+", lo) : fmt::format("windows {}-{}", lo, hi - 1),
                      [lo, hi](const TrainingRow& r) {
                        return r.features.windows_accepted >= lo && r.features.windows_accepted < hi;
                      }});
   }
-  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0, 50e3}, {50e3, 200e3}, {200e3, 1e300}}) {
+  for (const auto& band : std::vector<std::pair<double, double>>{{0, 50e3}, {50e3, 200e3}, {200e3, 1e300}}) {
+    const double lo = band.first, hi = band.second;
     bands.push_back({hi > 1e299 ? fmt::format("fs {:g} kHz+", lo / 1e3) : fmt::format("fs {:g}-{:g} kHz", lo / 1e3, hi / 1e3),
                      [lo, hi](const TrainingRow& r) { return r.features.fs > lo && r.features.fs <= hi; }});
   }
