@@ -29,6 +29,7 @@ FeatureResult make_features(const Measurement& m) {
   f.dy = m.dy;
   f.np = m.np;
   f.windows_accepted = m.windows_accepted;
+  f.windows_total = m.windows_total;
   f.fs = m.fs;
   f.duration = m.duration;
   auto d32_of = [&](double u) {
@@ -75,6 +76,9 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == "fs" && fs > 0.0) return fs;
   if (name == "duration" && duration > 0.0) return duration;
   if (name == "windows_accepted" && windows_accepted >= 0) return static_cast<double>(windows_accepted);
+  if (name == "data_yield" && windows_accepted >= 0 && windows_total > 0) {
+    return static_cast<double>(windows_accepted) / static_cast<double>(windows_total);
+  }
   if (name == "fscc_velocity" && fscc_velocity > 0.0) return fscc_velocity;
   if (name == "r12_max" && fscc_velocity > 0.0) return r12_max;
   if (name == "fscc_d32" && fscc_d32 > 0.0) return fscc_d32;
@@ -83,18 +87,20 @@ std::optional<double> Features::value(std::string_view name) const {
 
 std::vector<std::string> feature_set_names(std::string_view set) {
   if (set == "fscc") return {Features::fscc_names.begin(), Features::fscc_names.end()};
-  if (set != "measured" && set != "extended") {
-    throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7) or extended (with "
-                                            "fs, duration and accepted windows)",
+  if (set != "measured" && set != "extended" && set != "extended-yield") {
+    throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7), extended (with "
+                                            "fs, duration and accepted windows) or extended-yield (fs, duration and "
+                                            "the data yield)",
                                             set));
   }
   std::vector<std::string> out(Features::names.begin(), Features::names.end());
-  if (set == "extended") out.insert(out.end(), Features::record_names.begin(), Features::record_names.end());
+  if (set != "measured") out.insert(out.end(), Features::record_names.begin(), Features::record_names.end());
+  if (set == "extended-yield") out.back() = "data_yield";
   return out;
 }
 
 std::string feature_set_of(const std::vector<std::string>& names) {
-  for (const char* set : {"measured", "extended"})
+  for (const char* set : {"measured", "extended", "extended-yield"})
     if (names == feature_set_names(set)) return set;
   return {};
 }
@@ -118,6 +124,7 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   if (r.awcc) {
     m.np = r.awcc->np;
     m.windows_accepted = r.awcc->windows_accepted;
+    m.windows_total = r.awcc->windows_total;
   }
   if (!r.awcc) {
     out.status = CorrectionStatus::awcc_not_run;

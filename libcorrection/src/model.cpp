@@ -1,6 +1,7 @@
 #include "correction/model.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <bit>
@@ -489,16 +490,18 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
   CorrectionModel m;
   m.provenance = r.text();
   m.ranges.resize(r.count(r.u32(), 20));
-  // Format 1 and 2 models take the measured features; format 3 also the extended set.
-  const auto names = feature_set_names(m.ranges.size() == Features::count || version < 3 ? "measured" : "extended");
-  if (m.ranges.size() != names.size()) r.damaged(fmt::format("{} feature ranges", m.ranges.size()));
-  for (std::size_t j = 0; j < m.ranges.size(); ++j) {
-    auto& fr = m.ranges[j];
+  // Format 1 and 2 models take the measured features; format 3 also an extended set.
+  std::vector<std::string> names;
+  for (auto& fr : m.ranges) {
     fr.name = r.text();
     fr.min = r.f64();
     fr.max = r.f64();
-    if (fr.name != names[j]) r.damaged(fmt::format("feature {} is '{}', expected '{}'", j, fr.name, names[j]));
+    names.push_back(fr.name);
     if (!(std::isfinite(fr.min) && std::isfinite(fr.max) && fr.min <= fr.max)) r.damaged("a feature range is not finite");
+  }
+  const auto set = feature_set_of(names);
+  if (set.empty() || (version < 3 && set != "measured")) {
+    r.damaged(fmt::format("features ({}) are not a feature set this pdp knows", fmt::join(names, ", ")));
   }
   m.range_margin = r.f64();
   if (!(m.range_margin >= 0.0 && m.range_margin <= 1.0)) r.damaged("range margin outside [0, 1]");

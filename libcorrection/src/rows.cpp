@@ -115,6 +115,7 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     m.velocity = required(a, "velocity", "awcc");
     m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
     m.windows_accepted = static_cast<std::int64_t>(required(a, "windows_accepted", "awcc"));
+    m.windows_total = static_cast<std::int64_t>(number(a, "windows_total").value_or(-1.0));
   } else if (const auto w = number(a, "windows_accepted")) {
     m.windows_accepted = static_cast<std::int64_t>(*w);
   }
@@ -314,6 +315,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
                ? static_cast<int>(need(value("np"), default_np(d), where, "np", "particles per window"))
                : static_cast<int>(value("np").value_or(0.0));
     m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
+    m.windows_total = static_cast<std::int64_t>(value("awcc_windows_total").value_or(-1.0));
     m.fs = value("fs").value_or(0.0);
     m.duration = value("duration").value_or(0.0);
     m.fscc_velocity = value("fscc_velocity");

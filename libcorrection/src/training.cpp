@@ -141,7 +141,8 @@ const awcc::OptionField<T> kTraining[] = {
        return list_text(v);
      }},
     {"feature-set", "-",
-     "features of the model: measured (u, Tu, c, d32, dx, dy, Np) or extended (also fs, duration and accepted windows)",
+     "features of the model: measured (u, Tu, c, d32, dx, dy, Np), extended (also fs, duration and accepted "
+     "windows) or extended-yield (fs, duration and the data yield)",
      [](T& o, std::string_view t) {
        feature_set_names(t);  // refuses an unknown set
        o.feature_set = std::string(t);
@@ -289,6 +290,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       m.dy = number_of(dy_column);
       m.np = static_cast<int>(number_of("np"));
       m.windows_accepted = static_cast<std::int64_t>(optional_number("awcc_windows_accepted").value_or(-1.0));
+      m.windows_total = static_cast<std::int64_t>(optional_number("awcc_windows_total").value_or(-1.0));
       m.fs = optional_number("fs").value_or(0.0);
       m.duration = optional_number("duration").value_or(0.0);
       m.fscc_velocity = optional_number("fscc_velocity");
@@ -683,7 +685,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     result.model.calibration = calibrate(result.model, calibration_rows, o.calibration_bands, o.threads);
   }
   result.calibration_rows = static_cast<std::int64_t>(calibration_rows.size());
-  if (o.feature_set == "extended") train_fscc(set, o, vopt, key, result);
+  if (o.feature_set != "measured") train_fscc(set, o, vopt, key, result);
   result.seconds_train = seconds_since(train_start);
   result.held_out = score(result.model, held_out, &result.predictions, o.threads);
   if (progress) progress(cv_share + 0.1);

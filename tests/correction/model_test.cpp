@@ -418,6 +418,13 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   std::memcpy(&version, bytes.data() + 8, 4);
   EXPECT_EQ(version, 3u);
   EXPECT_EQ(CorrectionModel::parse(bytes, "x.qrf").serialise(), bytes);
+  // The data yield: accepted over formed windows, when both are known.
+  Features y = inside();
+  y.windows_accepted = 30;
+  EXPECT_FALSE(y.value("data_yield"));
+  y.windows_total = 120;
+  EXPECT_DOUBLE_EQ(*y.value("data_yield"), 0.25);
+  EXPECT_EQ(correction::feature_set_names("extended-yield").back(), "data_yield");
   // The unknown-record values are not features.
   Features none;
   EXPECT_FALSE(none.value("fs"));

@@ -12,7 +12,9 @@
 //
 // Extended feature set (METHOD 7, extended domain; model files from format
 // 3): the seven above, then the record's sampling rate fs (Hz), its duration
-// (s) and AWCC's accepted windows. A model records its feature names; a
+// (s) and AWCC's accepted windows ("extended"), or the data yield (accepted
+// over formed windows) in place of the windows ("extended-yield": the two are
+// compared by cross-validation). A model records its feature names; a
 // measurement that lacks one its model needs (a file without fs, say) is
 // not corrected, and says which.
 //
@@ -65,6 +67,7 @@ struct Measurement {
   double dx = 0.0, dy = 0.0;                   ///< tip separations processed, m
   int np = 0;                                  ///< particles per window
   std::int64_t windows_accepted = -1;          ///< -1: not known (another tool's file)
+  std::int64_t windows_total = -1;             ///< AWCC windows formed; -1: not known
   double fs = 0.0;                             ///< sampling rate, Hz (0: not known)
   double duration = 0.0;                       ///< record duration, s (0: not known)
   std::optional<double> fscc_velocity;         ///< FSCC's velocity, m/s (empty: none)
@@ -85,6 +88,7 @@ struct Features {
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
   /// Rows below a model's minimum are not corrected; -1 unknown.
   std::int64_t windows_accepted = -1;
+  std::int64_t windows_total = -1;  ///< -1 unknown; with windows_accepted, the data yield
   double fs = 0.0, duration = 0.0;  ///< Hz, s; 0 = not known
   /// FSCC's velocity (0: none), R12max, and d32 from FSCC's velocity (0: not known).
   double fscc_velocity = 0.0, r12_max = 0.0, fscc_d32 = 0.0;
@@ -97,7 +101,8 @@ struct Features {
 };
 
 /// The feature names of a feature set: "measured" (the seven), "extended"
-/// (the seven and the record's three) or "fscc" (the FSCC forest's). Throws
+/// (the seven and the record's three), "extended-yield" (the same with the
+/// data yield for the accepted windows) or "fscc" (the FSCC forest's). Throws
 /// std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// "measured" or "extended" for a model's names in order; empty when they are neither.

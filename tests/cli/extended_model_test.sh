@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# The extended model end to end (METHOD 7, extended domain): a Monte Carlo
+# sweep over sampling rates and record lengths, pdp train --feature-set
+# extended (calibrated, with its FSCC forest), then pdp process --correct on
+# a recording AWCC cannot serve (too few windows for the model): its velocity
+# is corrected by the FSCC forest and says so, its Tu is not corrected; a
+# profile CSV without fs is refused row by row with the missing feature named.
+# Usage: extended_model_test.sh PDP SCRATCH_DIR
+set -u
+pdp=$1
+dir=$2/extended_model
+rm -rf "$dir" && mkdir -p "$dir"
+source "$(dirname "$0")/lib.sh"
+
+cat >"$dir/mc.toml" <<'TOML'
+[sweep]
+mode = "monte-carlo"
+runs = 720
+seed = 11
+[base]
+dy = "0mm"
+[ranges]
+velocity = ["3m/s", "5m/s"]
+bubble-diameter = ["1.5mm", "2.5mm"]
+fs = ["20kHz", "200kHz", "log"]
+duration = ["1s", "2s"]
+tu = [0.05, 0.2]
+void-fraction = [0.1, 0.3]
+dx = ["3mm", "6mm"]
+np = [7.5, 12.5]
+time-scale = ["10ms", "100ms"]
+TOML
+"$pdp" --log-level error sweep "$dir/mc.toml" -o "$dir/mc.csv" || fail "sweep"
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/x.qrf" --feature-set extended --min-windows 10 --trees 20 \
+  --folds 0 --min-leaf 5 --features-per-split 3 >"$dir/report.txt" || fail "train"
+grep -q "fs, duration, windows_accepted" "$dir/report.txt" || fail "report: no extended features"
+grep -q "FSCC forest (velocity of rows without a usable AWCC result): trained on" "$dir/report.txt" ||
+  fail "report: no FSCC forest"
+grep -q "set aside to calibrate the intervals" "$dir/report.txt" || fail "report: no calibration"
+grep -q "^  windows 10-29 " "$dir/report.txt" || fail "report: no coverage by band of windows"
+
+# A recording inside the ranges; Np 60 leaves AWCC a handful of windows, below the model's 10.
+"$pdp" --log-level warn synth -q --duration 1.5s --fs 60kHz --velocity 4m/s --tu 0.15 --void-fraction 0.2 \
+  --bubble-diameter 2mm --dx 4.5mm --dy 0mm --seed 3 -o "$dir/rec.flac" || fail "synth"
+"$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0mm --np 60 --correct "$dir/x.qrf" \
+  --json "$dir/r.json" --csv "$dir/r.csv" || fail "process --correct"
+/usr/bin/python3 - "$dir/r.json" <<'PY' || fail "the FSCC forest did not correct the row as documented"
+import json, sys
+r = json.load(open(sys.argv[1]))
+r = r["profile"][0] if "profile" in r else r
+c = r["correction"]
+assert c["status"] == "corrected", c
+assert c["forest"] == "fscc", c
+assert c["turbulence_intensity"] is None, c
+q = c["velocity"]["quantiles"]
+assert q["0.025"] <= q["0.1"] <= q["0.5"] <= q["0.9"] <= q["0.975"], q
+assert abs(c["velocity"]["measured"] - r["fscc"]["velocity"]) < 1e-9, (c, r["fscc"])
+assert 2.0 < c["velocity"]["median"] < 8.0, c
+PY
+[[ $(column "$dir/r.csv" correction_forest) == fscc ]] || fail "CSV: correction_forest is not fscc"
+
+# Without fs the extended model cannot correct: each row says which feature is missing.
+/usr/bin/python3 - "$dir/r.csv" "$dir/nofs.csv" <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+i = rows[0].index("fs")
+keep = [[c for j, c in enumerate(r) if j != i] for r in rows]
+keep = [[c for c, h in zip(r, rows[0][:i] + rows[0][i + 1:]) if not h.startswith("correction") and not h.startswith("corrected")]
+        for r in keep]
+csv.writer(open(sys.argv[2], "w", newline="")).writerows(keep)
+PY
+"$pdp" --log-level error correct "$dir/nofs.csv" -m "$dir/x.qrf" -o "$dir/nofs-corrected.csv" || fail "correct without fs"
+[[ $(column "$dir/nofs-corrected.csv" correction_status) != corrected ]] ||
+  fail "no fs: corrected all the same"
+grep -q "fs" <<<"$(column "$dir/nofs-corrected.csv" correction_reason)" || fail "no fs: the reason does not name fs"
+
+if ((failures)); then
+  echo "$failures failures"
+  exit 1
+fi
+echo "extended model CLI: all checks passed"
