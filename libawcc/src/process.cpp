@@ -1,5 +1,6 @@
 #include "awcc/process.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
@@ -69,7 +70,12 @@ detail::ReadAhead<Sample> blocks(Recording& recording, const ProcessOptions& opt
   } else {
     read = [&recording](std::span<std::int16_t> out, std::int64_t n) { return recording.read_int16(out, n); };
   }
-  return detail::ReadAhead<Sample>(std::move(read), options.block_frames, ch.stride, options.read_ahead && two_cores);
+  // A byte budget per block as well as a frame count: a file of thousands of
+  // channels must not allocate gigabytes before any data is read.
+  constexpr std::size_t block_budget = std::size_t{4} << 20;
+  const auto frames = std::clamp<std::int64_t>(
+      static_cast<std::int64_t>(block_budget / (ch.stride * sizeof(Sample))), 1, options.block_frames);
+  return detail::ReadAhead<Sample>(std::move(read), frames, ch.stride, options.read_ahead && two_cores);
 }
 
 // Two passes over floating (or non-16-bit) samples: histograms, then thresholds.

@@ -133,13 +133,19 @@ bool TwoLevelScan::feed(const std::int16_t* data, std::size_t frames) {
       if (!change(tip, position_, v)) return false;
     }
   }
-  offsets_.resize(n);
-  const std::uint32_t* end = find_changes(data, s, n, s, offsets_.data());
-  for (const std::uint32_t* o = offsets_.data(); o != end; ++o) {
-    const std::size_t k = *o;
-    const std::size_t channel = s == 2 ? (k & 1u) : k % s;
-    const int t = tip_of_channel_[channel];
-    if (t >= 0 && !change(tips_[t], position_ + static_cast<std::int64_t>(k / s), data[k])) return false;
+  // In chunks of 64 Ki counts: the offsets' scratch stays small (a noisy
+  // channel changes at every count) and a third value is seen early.
+  constexpr std::size_t chunk = std::size_t{1} << 16;
+  offsets_.resize(std::min(n, chunk));
+  for (std::size_t begin = s; begin < n; begin += chunk) {
+    const std::size_t stop = std::min(n, begin + chunk);
+    const std::uint32_t* end = find_changes(data, begin, stop, s, offsets_.data());
+    for (const std::uint32_t* o = offsets_.data(); o != end; ++o) {
+      const std::size_t k = *o;
+      const std::size_t channel = s == 2 ? (k & 1u) : k % s;
+      const int t = tip_of_channel_[channel];
+      if (t >= 0 && !change(tips_[t], position_ + static_cast<std::int64_t>(k / s), data[k])) return false;
+    }
   }
   std::copy(data + n - s, data + n, last_frame_.begin());
   position_ += static_cast<std::int64_t>(frames);

@@ -11,11 +11,6 @@
 #include <deque>
 #include <fstream>
 #include <iterator>
-
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <stdexcept>
 
 #include "awcc/atomic_output.hpp"
@@ -353,6 +348,10 @@ bool fscc_may_follow(CorrectionStatus s) {
 
 }  // namespace
 
+bool CorrectionModel::falls_back_to_fscc(CorrectionStatus awcc_status) const {
+  return fscc.has_value() && fscc_may_follow(awcc_status);
+}
+
 Correction CorrectionModel::correct_fscc(const Features& f) const {
   if (!fscc) return not_corrected(CorrectionStatus::no_awcc_velocity, "the model has no FSCC forest");
   if (const auto why = fscc_unusable(f); !why.empty()) return not_corrected(CorrectionStatus::no_awcc_velocity, why);
@@ -588,42 +587,19 @@ void CorrectionModel::save(const std::filesystem::path& path) const {
   });
 }
 
-namespace {
-
-// A read-only mapping of a whole file, unmapped when the last forest reading
-// it goes. Pages are read ahead in one call (MAP_POPULATE) instead of one
-// fault each.
-struct Mapping {
-  void* data = MAP_FAILED;
-  std::size_t size = 0;
-  Mapping() = default;
-  Mapping(const Mapping&) = delete;
-  Mapping& operator=(const Mapping&) = delete;
-  ~Mapping() {
-    if (data != MAP_FAILED) ::munmap(data, size);
-  }
-};
-
-}  // namespace
-
 CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw awcc::InputError(fmt::format("{}: not a regular file; give a model file written by pdp train", path.string()));
-  }
-  auto map = std::make_shared<Mapping>();
-  map->size = static_cast<std::size_t>(st.st_size);
-  if (map->size > 0) map->data = ::mmap(nullptr, map->size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-  ::close(fd);
-  if (map->size > 0 && map->data == MAP_FAILED) {
-    throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
-  }
-  const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(map->size > 0 ? map->data : nullptr),
-                                            map->size);
-  return parse(std::move(map), bytes, path.string());
+  // Read into memory once (not mapped: a file replaced in place while a run
+  // uses the model must not change or truncate the forests under it), into
+  // storage that is not zero-filled first; the forests are then read in place.
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
+  const auto size = static_cast<std::size_t>(in.tellg());
+  std::shared_ptr<std::uint8_t[]> bytes(new std::uint8_t[std::max<std::size_t>(size, 1)]);
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(bytes.get()), static_cast<std::streamsize>(size));
+  if (!in) throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
+  const std::span<const std::uint8_t> view(bytes.get(), size);
+  return parse(std::move(bytes), view, path.string());
 }
 
 std::span<const awcc::ProfileColumn> correction_csv_columns() {

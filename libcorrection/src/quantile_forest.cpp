@@ -352,7 +352,9 @@ QuantileForest QuantileForest::view(std::shared_ptr<const void> owner, std::span
     p += static_cast<std::size_t>(v.node_count) * node_bytes;
     v.row_count = load_u64(p);
     p += 8;
-    if (v.row_count > static_cast<std::uint64_t>(end - p)) throw std::invalid_argument("forest: a tree's held rows beyond its bytes");
+    if (v.row_count > static_cast<std::uint64_t>(end - p) || v.row_count >= (std::uint64_t{1} << 32)) {
+      throw std::invalid_argument("forest: a tree's held rows beyond its bytes");
+    }
     need(v.row_count * static_cast<std::uint64_t>(f.row_bytes_), "a tree's held rows");
     v.rows = p;
     p += v.row_count * static_cast<std::uint64_t>(f.row_bytes_);
@@ -436,14 +438,15 @@ template <class Fn>
 void QuantileForest::for_each_held(const TreeView& t, std::uint32_t leaf, Fn&& fn) const {
   const std::uint8_t* q = t.nodes + static_cast<std::size_t>(leaf) * node_bytes;
   if (load_u32(q + 8) != leaf_tag) return;
-  const auto first = load_u32(q), count = load_u32(q + 4);
-  for (std::uint32_t k = first; k < first + count; ++k) {
+  const std::size_t first = load_u32(q), count = load_u32(q + 4);
+  for (std::size_t k = first; k < first + count; ++k) {
     fn(row_bytes_ == 2 ? (static_cast<std::uint32_t>(t.rows[2 * k]) | static_cast<std::uint32_t>(t.rows[2 * k + 1]) << 8)
-                       : load_u32(t.rows + 4 * static_cast<std::size_t>(k)));
+                       : load_u32(t.rows + 4 * k));
   }
 }
 
 std::vector<double> QuantileForest::weights(std::span<const double> x) const {
+  if (x.size() < static_cast<std::size_t>(features_)) throw std::invalid_argument("forest: fewer features than the forest takes");
   std::vector<double> w(target_count_, 0.0);
   const double per_tree = 1.0 / static_cast<double>(trees_.size());
   for (const auto& tree : trees_) {
@@ -455,6 +458,7 @@ std::vector<double> QuantileForest::weights(std::span<const double> x) const {
 }
 
 WeightedDistribution QuantileForest::distribution(std::span<const double> x) const {
+  if (x.size() < static_cast<std::size_t>(features_)) throw std::invalid_argument("forest: fewer features than the forest takes");
   // The held rows of the T leaves, sorted by target: the same F as the dense
   // weights, at a cost of the leaves' sizes instead of n.
   std::vector<std::pair<double, double>> held;

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include <map>
 #include <sstream>
 
@@ -22,6 +24,14 @@ double need(const std::optional<double>& from_file, const std::optional<double>&
   if (from_file) return *from_file;
   if (from_default) return *from_default;
   throw awcc::OptionError(fmt::format("{}: no {} in the file; state the {}", where, quantity, what), quantity);
+}
+
+// A count from a file: a whole number from 0 to 2^53, or the file is refused.
+std::int64_t whole(double v, const std::string& where, const char* name) {
+  if (!(v >= 0.0 && v <= 9007199254740992.0 && v == std::floor(v))) {
+    throw awcc::InputError(fmt::format("{}: {} = {} is not a count (a whole number from 0)", where, name, v));
+  }
+  return static_cast<std::int64_t>(v);
 }
 
 std::optional<double> default_np(const RowDefaults& d) {
@@ -59,10 +69,6 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
     return j[key].get<double>();
   };
-  if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
-    throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
-  }
-  const auto& lead = r["tips"][0];
   auto required = [&](const json& j, const char* key, const char* where) {
     const auto v = number(j, key);
     if (!v) {
@@ -71,17 +77,10 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     }
     return *v;
   };
-  // What every forest shares and FSCC's own, whatever AWCC gave.
+  // AWCC's status first: a row AWCC cannot serve needs nothing else unless
+  // the model's FSCC forest may correct it.
   MeasurementResult result;
   Measurement& m = result.measurement;
-  m.void_fraction = required(lead, "void_fraction", "tips[0]");
-  m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
-  m.fs = number(r, "fs").value_or(0.0);
-  m.duration = number(r, "duration").value_or(0.0);
-  if (r.contains("fscc") && r["fscc"].is_object() && r["fscc"].value("defined", false)) {
-    m.fscc_velocity = number(r["fscc"], "velocity");
-    m.r12_max = number(r["fscc"], "r12_max");
-  }
   const bool has_awcc = r.contains("awcc") && r["awcc"].is_object();
   const json none = json::object();
   const auto& a = has_awcc ? r["awcc"] : none;
@@ -104,27 +103,47 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     result.message = "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
                      "uncorrected AWCC; process without the probe correction to correct it";
   }
+  const bool awcc_usable = result.status == CorrectionStatus::corrected;
+  if (!awcc_usable && !model.falls_back_to_fscc(result.status)) return not_corrected(result.status, result.message);
+  // What every forest shares and FSCC's own.
+  auto gather = [&] {
+    if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
+      throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
+    }
+    const auto& lead = r["tips"][0];
+    m.void_fraction = required(lead, "void_fraction", "tips[0]");
+    m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
+    m.fs = number(r, "fs").value_or(0.0);
+    m.duration = number(r, "duration").value_or(0.0);
+    if (r.contains("fscc") && r["fscc"].is_object() && r["fscc"].value("defined", false)) {
+      m.fscc_velocity = number(r["fscc"], "velocity");
+      m.r12_max = number(r["fscc"], "r12_max");
+    }
+    if (const auto w = number(a, "windows_accepted")) m.windows_accepted = whole(*w, file, "awcc.windows_accepted");
+    if (const auto w = number(a, "windows_total")) m.windows_total = whole(*w, file, "awcc.windows_total");
+    m.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
+    m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
+  };
+  if (!awcc_usable) {
+    try {
+      gather();
+    } catch (const std::exception& e) {  // the FSCC forest cannot have the row: AWCC's status stands
+      return not_corrected(result.status, fmt::format("{}; FSCC forest: {}", result.message, e.what()));
+    }
+    return model.correct(result);
+  }
+  gather();
   std::optional<Processing> processing;
   if (a.contains("options") && a["options"].is_object()) {
     const auto& o = a["options"];
     processing = parse_processing(required(o, "filter_a", "awcc.options"), o.value("roc", true) ? "on" : "off",
                                   o.value("weighting", ""), o.value("signal", ""), o.value("subsample", ""));
   }
-  if (result.status == CorrectionStatus::corrected) {
-    check_processing(model, processing, file, warnings);
-    m.velocity = required(a, "velocity", "awcc");
-    m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
-    m.windows_accepted = static_cast<std::int64_t>(required(a, "windows_accepted", "awcc"));
-    m.windows_total = static_cast<std::int64_t>(number(a, "windows_total").value_or(-1.0));
-  } else if (const auto w = number(a, "windows_accepted")) {
-    m.windows_accepted = static_cast<std::int64_t>(*w);
-  }
-  m.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
-  m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
-  // Np is a feature of the AWCC forest only.
-  m.np = result.status == CorrectionStatus::corrected
-             ? static_cast<int>(need(number(a, "np"), default_np(d), file, "np", "particles per window"))
-             : static_cast<int>(number(a, "np").value_or(0.0));
+  check_processing(model, processing, file, warnings);
+  m.velocity = required(a, "velocity", "awcc");
+  m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
+  m.windows_accepted = whole(required(a, "windows_accepted", "awcc"), file, "awcc.windows_accepted");
+  m.np = static_cast<int>(whole(need(number(a, "np"), default_np(d), file, "np", "particles per window"), file, "np"));
   return model.correct(result);
 }
 
@@ -290,12 +309,42 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
     MeasurementResult result;
     Measurement& m = result.measurement;
     const auto u = value("awcc_velocity"), tu = value("awcc_turbulence_intensity");
+    const std::string probe = text_of("awcc_probe_corrected");
     if (!u || !tu) {
       result.status = CorrectionStatus::no_awcc_velocity;
       result.message = "AWCC gave no velocity";
     } else if (!text_of("awcc_quality").empty() && text_of("awcc_quality") != "ok") {
       result.status = CorrectionStatus::low_quality;
       result.message = "AWCC's quality is " + text_of("awcc_quality") + ": " + text_of("awcc_quality_reason");
+    } else if (probe == "1" || probe == "true") {
+      result.status = CorrectionStatus::probe_corrected;
+      result.message = "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
+                       "uncorrected AWCC; process without the probe correction to correct it";
+    }
+    const bool awcc_usable = result.status == CorrectionStatus::corrected;
+    // What every forest shares and FSCC's own.
+    auto gather = [&] {
+      m.void_fraction = value("void_fraction").value_or(0.0);
+      m.bubble_count_rate = value("bubble_count_rate").value_or(0.0);
+      m.dx = need(value("dx"), d.dx, where, "dx", "streamwise tip separation");
+      m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
+      if (const auto w = value("awcc_windows_accepted")) m.windows_accepted = whole(*w, where, "awcc_windows_accepted");
+      if (const auto w = value("awcc_windows_total")) m.windows_total = whole(*w, where, "awcc_windows_total");
+      m.fs = value("fs").value_or(0.0);
+      m.duration = value("duration").value_or(0.0);
+      m.fscc_velocity = value("fscc_velocity");
+      m.r12_max = value("fscc_r12_max");
+    };
+    Correction c;
+    if (!awcc_usable && !model.falls_back_to_fscc(result.status)) {
+      c = not_corrected(result.status, result.message);
+    } else if (!awcc_usable) {
+      try {
+        gather();
+        c = model.correct(result);
+      } catch (const std::exception& e) {  // the FSCC forest cannot have the row: AWCC's status stands
+        c = not_corrected(result.status, fmt::format("{}; FSCC forest: {}", result.message, e.what()));
+      }
     } else {
       std::optional<Processing> processing;
       if (has_processing && value("awcc_filter_a")) {
@@ -305,22 +354,10 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       check_processing(model, processing, where, out.warnings);
       m.velocity = u;
       m.turbulence_intensity = tu;
+      gather();
+      m.np = static_cast<int>(whole(need(value("np"), default_np(d), where, "np", "particles per window"), where, "np"));
+      c = model.correct(result);
     }
-    m.void_fraction = value("void_fraction").value_or(0.0);
-    m.bubble_count_rate = value("bubble_count_rate").value_or(0.0);
-    m.dx = need(value("dx"), d.dx, where, "dx", "streamwise tip separation");
-    m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
-    // Np is a feature of the AWCC forest only.
-    m.np = result.status == CorrectionStatus::corrected
-               ? static_cast<int>(need(value("np"), default_np(d), where, "np", "particles per window"))
-               : static_cast<int>(value("np").value_or(0.0));
-    m.windows_accepted = static_cast<std::int64_t>(value("awcc_windows_accepted").value_or(0.0));
-    m.windows_total = static_cast<std::int64_t>(value("awcc_windows_total").value_or(-1.0));
-    m.fs = value("fs").value_or(0.0);
-    m.duration = value("duration").value_or(0.0);
-    m.fscc_velocity = value("fscc_velocity");
-    m.r12_max = value("fscc_r12_max");
-    const Correction c = model.correct(result);
     out.text += row + "," + correction_csv_cells(c) + "\n";
   });
   return out;

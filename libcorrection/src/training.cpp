@@ -43,7 +43,11 @@ std::vector<double> vector_of(const Features& f, const std::vector<std::string>&
   x.reserve(names.size());
   for (const auto& n : names) {
     const auto v = f.value(n);
-    if (!v) throw std::runtime_error(fmt::format("a training row has no {}", n));
+    if (!v) {
+      throw std::runtime_error(fmt::format("a training run has no {} (the sweep CSV lacks the column, or the run has "
+                                           "no value): train another feature set, or give sweeps that record it",
+                                           n));
+    }
     x.push_back(*v);
   }
   return x;
@@ -333,14 +337,13 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
   m.min_windows = min_windows;
   m.velocity_form = velocity_form;
   m.turbulence_form = turbulence_form;
-  for (std::size_t j = 0; j < names.size(); ++j) {
-    FeatureRange r{names[j], 1e300, -1e300};
-    for (const auto& row : rows) {
-      const double v = *row.features.value(names[j]);
-      r.min = std::min(r.min, v);
-      r.max = std::max(r.max, v);
+  for (const auto& n : names) m.ranges.push_back({n, 1e300, -1e300});
+  for (const auto& row : rows) {
+    const auto x = vector_of(row.features, names);  // names a missing feature
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      m.ranges[j].min = std::min(m.ranges[j].min, x[j]);
+      m.ranges[j].max = std::max(m.ranges[j].max, x[j]);
     }
-    m.ranges.push_back(r);
   }
   m.velocity = QuantileForest::train(data_of(rows, true, velocity_form, names), velocity_options);
   m.turbulence_intensity = QuantileForest::train(data_of(rows, false, turbulence_form, names), turbulence_options);
@@ -431,11 +434,16 @@ namespace {
 constexpr std::array<double, 3> calibration_alpha{0.5, 0.2, 0.05};
 
 // Q = E_k, k = ceil((n + 1)(1 - alpha)) of the scores (model.hpp, Calibration).
+// With k > n the guarantee needs Q = infinity: too few runs, refused.
 double conformal_offset(std::vector<double> e, double alpha) {
   std::sort(e.begin(), e.end());
   const auto n = static_cast<double>(e.size());
   const auto rank = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 - alpha)));
-  return e[std::min(rank, e.size()) - 1];
+  if (e.empty() || rank > e.size()) {
+    throw std::invalid_argument(fmt::format("{} calibration runs cannot calibrate a {:g} % interval", e.size(),
+                                            100 * (1 - alpha)));
+  }
+  return e[rank - 1];
 }
 
 // A row's conformity scores for the 50, 80, 95 % intervals of a forest's quantiles.
@@ -517,14 +525,13 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   const auto names = feature_set_names("fscc");
   FsccForest f;
   f.form = TargetForm::ratio;
-  for (const auto& n : names) {
-    FeatureRange r{n, 1e300, -1e300};
-    for (const auto& row : training) {
-      const double v = *row.features.value(n);
-      r.min = std::min(r.min, v);
-      r.max = std::max(r.max, v);
+  for (const auto& n : names) f.ranges.push_back({n, 1e300, -1e300});
+  for (const auto& row : training) {
+    const auto x = vector_of(row.features, names);
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      f.ranges[j].min = std::min(f.ranges[j].min, x[j]);
+      f.ranges[j].max = std::max(f.ranges[j].max, x[j]);
     }
-    f.ranges.push_back(r);
   }
   TrainingData d;
   d.features = static_cast<int>(names.size());
@@ -536,7 +543,9 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   ForestOptions fo = velocity_options;
   fo.features_per_split = std::min(fo.features_per_split, d.features);
   f.velocity = QuantileForest::train(d, fo);
-  if (!calibration_rows.empty()) {
+  if (calibration_rows.size() < 100) {
+    result.fscc_note = fmt::format("FSCC forest uncalibrated: {} calibration runs, fewer than 100", calibration_rows.size());
+  } else {
     std::vector<std::array<double, 3>> scores(calibration_rows.size());
     parallel_for(calibration_rows.size(), o.threads, [&](std::size_t i) {
       const auto& r = calibration_rows[i];
@@ -745,9 +754,8 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
         "{:.2f} % raw FSCC, {:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} % ({} rows).",
         result.fscc_training_rows, 100 * f.rmse_raw, 100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95,
         f.rows);
-  } else if (!result.fscc_note.empty()) {
-    result.model.provenance += " " + result.fscc_note + ".";
   }
+  if (!result.fscc_note.empty()) result.model.provenance += " " + result.fscc_note + ".";
   return result;
 }
 

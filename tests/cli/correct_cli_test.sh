@@ -70,6 +70,12 @@ assert abs(c["velocity"]["median"] / j["awcc"]["velocity"] - 1) < 0.3
 PY
 
 # pdp correct on that JSON gives the same correction object.
+# A count that is not a count (1e300 windows) is refused, naming the field; no output.
+python3 -c "
+import json; d = json.load(open('$dir/rec.json')); d['awcc']['windows_accepted'] = 1e300
+json.dump(d, open('$dir/huge.json', 'w'))"
+expect 1 "awcc.windows_accepted = 1e+300 is not a count" "$pdp" correct "$dir/huge.json" -m "$dir/a.qrf" -o "$dir/huge-out.json"
+[[ -e $dir/huge-out.json ]] && fail "an output for a file with a bad count"
 "$pdp" correct "$dir/rec.json" -m "$dir/a.qrf" -o "$dir/again.json" || fail "correct JSON"
 python3 -c "
 import json,sys

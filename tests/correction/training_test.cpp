@@ -387,6 +387,15 @@ TEST(Calibration, BandsAreCalibratedOnTheirOwnAndUnknownWindowsTakeTheWidest) {
   EXPECT_EQ(again.calibration.turbulence_intensity, c.turbulence_intensity);
 }
 
+TEST(Calibration, TooFewRunsAreRefusedNotGuessed) {
+  // k = ceil((n + 1)(1 - alpha)) > n needs an infinite offset: 10 runs cannot
+  // calibrate a 95 % interval (k = 11), and no runs nothing at all.
+  const auto model = shifted_model(2.0, 1);
+  EXPECT_THROW((void)correction::calibrate(model, {}, {30, 100}), std::invalid_argument);
+  EXPECT_THROW((void)correction::calibrate(model, runs(10, 2, 500), {}), std::invalid_argument);
+  EXPECT_NO_THROW((void)correction::calibrate(model, runs(19, 2, 500), {}));  // k = 19
+}
+
 TEST(Calibration, ApplyKeepsTheQuantilesInOrder) {
   // A narrowing larger than an interval's half width stops at the median.
   std::vector<double> t{-3, -2, -1, 0, 1, 2, 3};

@@ -34,7 +34,7 @@
 // count), held-row count (u64), held rows. Version 1 files (no processing)
 // were all trained with the default processing, which they are read with.
 // Version 3 stores each forest as its block (correction/quantile_forest.hpp:
-// fixed 12-byte nodes, read in place from the mapped file, nothing built):
+// fixed 12-byte nodes, read in place from the file's bytes, nothing built):
 // name, u8 target form, u64 block bytes, the block. It admits the extended feature set (the seven measured features,
 // then fs, duration and windows_accepted: see correction/features.hpp;
 // versions 1 and 2 have the seven only) and, after the processing, the
@@ -157,6 +157,8 @@ struct CorrectionModel {
   [[nodiscard]] Correction correct(const MeasurementResult& m) const;
   /// The FSCC forest alone (not_corrected when the model has none).
   [[nodiscard]] Correction correct_fscc(const Features& f) const;
+  /// True when the model has an FSCC forest and a row with this AWCC status may go to it.
+  [[nodiscard]] bool falls_back_to_fscc(CorrectionStatus awcc_status) const;
 
   /// Empty when results processed this way may be corrected, else the
   /// differences ("filter A: model 0.4, results 0.3").

@@ -14,6 +14,7 @@
 #include <functional>
 #include <mutex>
 #include <span>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -27,9 +28,18 @@ class ReadAhead {
   using ReadFn = std::function<std::int64_t(std::span<Sample>, std::int64_t)>;
 
   ReadAhead(ReadFn read, std::int64_t block_frames, std::size_t stride, bool threaded)
-      : read_(std::move(read)), block_frames_(block_frames), threaded_(threaded) {
-    for (auto& s : slots_) s.data.resize(static_cast<std::size_t>(block_frames) * stride);
-    if (threaded_) producer_ = std::thread([this] { produce(); });
+      : read_(std::move(read)), block_frames_(block_frames), stride_(stride), threaded_(threaded) {
+    // Without the thread one slot is all there is to fill.
+    for (std::size_t k = 0; k < (threaded_ ? slots : 1); ++k) {
+      slots_[k].data.resize(static_cast<std::size_t>(block_frames) * stride);
+    }
+    if (threaded_) {
+      try {
+        producer_ = std::thread([this] { produce(); });
+      } catch (const std::system_error&) {
+        threaded_ = false;  // no thread to be had (a process limit): read in next() instead
+      }
+    }
   }
   ReadAhead(const ReadAhead&) = delete;
   ReadAhead& operator=(const ReadAhead&) = delete;
@@ -48,7 +58,7 @@ class ReadAhead {
     if (!threaded_) {
       Slot& s = slots_[0];
       const std::int64_t n = read_(s.data, block_frames_);
-      return std::span<const Sample>(s.data.data(), used(s, n));
+      return std::span<const Sample>(s.data.data(), used(n));
     }
     std::unique_lock lock(mutex_);
     if (ended_) return {};
@@ -63,7 +73,7 @@ class ReadAhead {
     if (s.error) std::rethrow_exception(s.error);
     holding_ = true;
     ended_ = s.frames == 0;
-    return std::span<const Sample>(s.data.data(), used(s, s.frames));
+    return std::span<const Sample>(s.data.data(), used(s.frames));
   }
 
  private:
@@ -75,9 +85,7 @@ class ReadAhead {
     std::exception_ptr error;
   };
 
-  std::size_t used(const Slot& s, std::int64_t frames) const {
-    return static_cast<std::size_t>(frames) * (s.data.size() / static_cast<std::size_t>(block_frames_));
-  }
+  std::size_t used(std::int64_t frames) const { return static_cast<std::size_t>(frames) * stride_; }
 
   void produce() {
     for (std::size_t i = 0;; i = (i + 1) % slots) {
@@ -107,6 +115,7 @@ class ReadAhead {
 
   ReadFn read_;
   std::int64_t block_frames_;
+  std::size_t stride_;
   bool threaded_;
   Slot slots_[slots];
   std::mutex mutex_;
