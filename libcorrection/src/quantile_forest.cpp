@@ -234,6 +234,11 @@ std::uint64_t load_u64(const std::uint8_t* p) {
   return static_cast<std::uint64_t>(load_u32(p)) | static_cast<std::uint64_t>(load_u32(p + 4)) << 32;
 }
 double load_f64(const std::uint8_t* p) { return std::bit_cast<double>(load_u64(p)); }
+// Held row k of a tree whose rows are `width` (2 or 4) bytes each.
+std::uint32_t held_row(const std::uint8_t* rows, int width, std::uint64_t k) {
+  return width == 2 ? static_cast<std::uint32_t>(rows[2 * k]) | static_cast<std::uint32_t>(rows[2 * k + 1]) << 8
+                    : load_u32(rows + 4 * k);
+}
 void put_u32(std::vector<std::uint8_t>& b, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) b.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
 }
@@ -374,8 +379,7 @@ QuantileForest QuantileForest::view(std::shared_ptr<const void> owner, std::span
       }
     }
     for (std::uint64_t k = 0; k < v.row_count; ++k) {
-      const std::uint32_t r = f.row_bytes_ == 2 ? (static_cast<std::uint32_t>(v.rows[2 * k]) | static_cast<std::uint32_t>(v.rows[2 * k + 1]) << 8)
-                                                : load_u32(v.rows + 4 * k);
+      const std::uint32_t r = held_row(v.rows, f.row_bytes_, k);
       if (r >= n) throw std::invalid_argument(fmt::format("forest: tree {} holds row {} of {}", t, r, n));
     }
     f.trees_.push_back(v);
@@ -415,8 +419,7 @@ std::vector<RegressionTree> QuantileForest::trees() const {
       t.nodes.push_back(n);
     }
     for (std::uint64_t k = 0; k < v.row_count; ++k) {
-      t.leaf_rows.push_back(row_bytes_ == 2 ? (static_cast<std::uint32_t>(v.rows[2 * k]) | static_cast<std::uint32_t>(v.rows[2 * k + 1]) << 8)
-                                            : load_u32(v.rows + 4 * k));
+      t.leaf_rows.push_back(held_row(v.rows, row_bytes_, k));
     }
     out.push_back(std::move(t));
   }
@@ -440,8 +443,7 @@ void QuantileForest::for_each_held(const TreeView& t, std::uint32_t leaf, Fn&& f
   if (load_u32(q + 8) != leaf_tag) return;
   const std::size_t first = load_u32(q), count = load_u32(q + 4);
   for (std::size_t k = first; k < first + count; ++k) {
-    fn(row_bytes_ == 2 ? (static_cast<std::uint32_t>(t.rows[2 * k]) | static_cast<std::uint32_t>(t.rows[2 * k + 1]) << 8)
-                       : load_u32(t.rows + 4 * k));
+    fn(held_row(t.rows, row_bytes_, k));
   }
 }
 

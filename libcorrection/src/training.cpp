@@ -375,13 +375,8 @@ struct QuantityScores {
   void finish(double& rmse_raw, double& rmse_corrected, double& median_raw, double& median_corrected,
               double& bias_raw, double& bias_corrected, double& mean_pinball, double& coverage80,
               double& coverage95, std::vector<double>& row_losses) {
-    auto median = [](std::vector<double>& v) {
-      if (v.empty()) return 0.0;
-      std::sort(v.begin(), v.end());
-      return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-    };
-    median_raw = median(abs_raw);
-    median_corrected = median(abs_corrected);
+    median_raw = awcc::median(abs_raw);
+    median_corrected = awcc::median(abs_corrected);
     row_losses = std::move(losses);
     const auto n = static_cast<double>(abs_raw.size());
     if (n == 0) return;
