@@ -11,6 +11,12 @@
 #include <deque>
 #include <fstream>
 #include <iterator>
+
+#include <cerrno>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <stdexcept>
 
 #include "awcc/atomic_output.hpp"
@@ -589,15 +595,34 @@ void CorrectionModel::save(const std::filesystem::path& path) const {
 
 CorrectionModel CorrectionModel::load(const std::filesystem::path& path) {
   // Read into memory once (not mapped: a file replaced in place while a run
-  // uses the model must not change or truncate the forests under it), into
-  // storage that is not zero-filled first; the forests are then read in place.
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
-  const auto size = static_cast<std::size_t>(in.tellg());
-  std::shared_ptr<std::uint8_t[]> bytes(new std::uint8_t[std::max<std::size_t>(size, 1)]);
-  in.seekg(0);
-  in.read(reinterpret_cast<char*>(bytes.get()), static_cast<std::streamsize>(size));
-  if (!in) throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
+  // uses the model must not change or truncate the forests under it). The
+  // memory is taken with its pages in place (MAP_POPULATE): faulting them in
+  // one by one cost more than reading the file.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw awcc::InputError(fmt::format("{}: cannot open the model file; check the path", path.string()));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw awcc::InputError(fmt::format("{}: not a regular file; give a model file written by pdp train", path.string()));
+  }
+  const auto size = static_cast<std::size_t>(st.st_size);
+  void* memory = ::mmap(nullptr, std::max<std::size_t>(size, 1), PROT_READ | PROT_WRITE,
+                        MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+  if (memory == MAP_FAILED) {
+    ::close(fd);
+    throw awcc::InputError(fmt::format("{}: no memory to read the model file ({} bytes)", path.string(), size));
+  }
+  std::shared_ptr<std::uint8_t> bytes(static_cast<std::uint8_t*>(memory),
+                                      [n = std::max<std::size_t>(size, 1)](std::uint8_t* q) { ::munmap(q, n); });
+  std::size_t done = 0;
+  while (done < size) {
+    const auto got = ::read(fd, bytes.get() + done, size - done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    done += static_cast<std::size_t>(got);
+  }
+  ::close(fd);
+  if (done != size) throw awcc::InputError(fmt::format("{}: cannot read the model file", path.string()));
   const std::span<const std::uint8_t> view(bytes.get(), size);
   return parse(std::move(bytes), view, path.string());
 }
