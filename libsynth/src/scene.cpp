@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fmt/format.h>
 #include <stdexcept>
@@ -304,6 +305,21 @@ const SceneField kFields[] = {
     PDP_QUANTITY_FIELD("duration", duration, Dimension::time, "record length, s"),
     SceneField{"seed", Dimension::dimensionless, "random seed (a whole number >= 0)",
                [](Scene& s, std::string_view t) {
+                 // Seeds span all 64 bits (pdp sweep derives them so and prints
+                 // them whole): digits are read exactly, never through a double,
+                 // so that any run of a sweep CSV can be replayed.
+                 const auto first = t.find_first_not_of(" \t");
+                 const auto last = t.find_last_not_of(" \t");
+                 const std::string_view digits =
+                     first == std::string_view::npos ? t : t.substr(first, last - first + 1);
+                 if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string_view::npos) {
+                   std::uint64_t v = 0;
+                   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+                   if (ec != std::errc{} || end != digits.data() + digits.size())
+                     throw std::invalid_argument(fmt::format("seed '{}' is above 2^64 - 1", t));
+                   s.seed = v;
+                   return;
+                 }
                  const auto v = integer(t, "seed");
                  if (v < 0) throw std::invalid_argument(fmt::format("seed '{}' must be >= 0", t));
                  s.seed = static_cast<std::uint64_t>(v);

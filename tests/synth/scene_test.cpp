@@ -155,6 +155,14 @@ TEST(SceneFields, SetByNameWithUnits) {
   EXPECT_THROW(synth::set_scene_field(s, "arrival", "sometimes"), std::invalid_argument);
   EXPECT_THROW(synth::set_scene_field(s, "tips", "0,0;1,1"), std::invalid_argument);
   EXPECT_THROW(synth::set_scene_field(s, "seed", "1.5"), std::invalid_argument);
+  // Sweep seeds use all 64 bits: a seed above 2^53 (where a double rounds
+  // it) and the largest one replay exactly; one past it is refused.
+  synth::set_scene_field(s, "seed", "6351225197166943491");
+  EXPECT_EQ(s.seed, 6351225197166943491ULL);
+  synth::set_scene_field(s, "seed", "18446744073709551615");
+  EXPECT_EQ(s.seed, 18446744073709551615ULL);
+  EXPECT_THROW(synth::set_scene_field(s, "seed", "18446744073709551616"), std::invalid_argument);
+  EXPECT_THROW(synth::set_scene_field(s, "seed", "-3"), std::invalid_argument);
 }
 
 TEST(SceneToml, LoadsNumbersStringsWithUnitsAndTipArrays) {
