@@ -305,6 +305,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       if (fscc_unusable(features.features).empty() && features.features.fs > 0.0 && features.features.duration > 0.0) {
         TrainingRow f = r;
         f.features = features.features;
+        f.awcc_served = features.ok() && features.features.windows_accepted >= min_windows;
         set.fscc_rows.push_back(f);
       }
       if (!features.ok()) {  // no (positive) AWCC velocity, or no bubbles: not corrected either
@@ -538,12 +539,25 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   ForestOptions fo = velocity_options;
   fo.features_per_split = std::min(fo.features_per_split, d.features);
   f.velocity = QuantileForest::train(d, fo);
-  if (calibration_rows.size() < 100) {
+  // Calibrated where it is applied: on the calibration runs AWCC cannot
+  // serve (few bubbles or windows, short records), whose FSCC errors differ
+  // from those of the well-served runs; on all calibration runs when there
+  // are too few of those.
+  std::vector<TrainingRow> unserved;
+  for (const auto& r : calibration_rows)
+    if (!r.awcc_served) unserved.push_back(r);
+  const auto& calibrating_rows = unserved.size() >= 100 ? unserved : calibration_rows;
+  if (calibrating_rows.size() < 100) {
     result.fscc_note = fmt::format("FSCC forest uncalibrated: {} calibration runs, fewer than 100", calibration_rows.size());
   } else {
-    std::vector<std::array<double, 3>> scores(calibration_rows.size());
-    parallel_for(calibration_rows.size(), o.threads, [&](std::size_t i) {
-      const auto& r = calibration_rows[i];
+    result.fscc_calibration =
+        &calibrating_rows == &unserved
+            ? fmt::format("calibrated on the {} calibration runs AWCC cannot serve", unserved.size())
+            : fmt::format("calibrated on all {} calibration runs (only {} that AWCC cannot serve, fewer than 100)",
+                          calibration_rows.size(), unserved.size());
+    std::vector<std::array<double, 3>> scores(calibrating_rows.size());
+    parallel_for(calibrating_rows.size(), o.threads, [&](std::size_t i) {
+      const auto& r = calibrating_rows[i];
       scores[i] = interval_scores(f.velocity.quantiles(vector_of(r.features, names), correction_levels),
                                   to_target(f.form, r.true_velocity, r.features.fscc_velocity));
     });
@@ -558,35 +572,41 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   CorrectionModel scorer;  // the FSCC forest alone, with the model's margin
   scorer.range_margin = result.model.range_margin;
   scorer.fscc = f;
-  FsccScores& sc = result.fscc_held_out;
-  std::vector<double> abs_raw, abs_corrected;
-  double sq_raw = 0.0, sq_corrected = 0.0;
-  for (const auto& r : held_out) {
-    const auto c = scorer.correct_fscc(r.features);
-    if (!c.corrected()) {
-      ++sc.out_of_range;
-      continue;
+  auto score_rows = [&](bool unserved_only) {
+    FsccScores sc;
+    std::vector<double> abs_raw, abs_corrected;
+    double sq_raw = 0.0, sq_corrected = 0.0;
+    for (const auto& r : held_out) {
+      if (unserved_only && r.awcc_served) continue;
+      const auto c = scorer.correct_fscc(r.features);
+      if (!c.corrected()) {
+        ++sc.out_of_range;
+        continue;
+      }
+      const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
+      const double corrected = c.velocity->median() / r.true_velocity - 1.0;
+      sq_raw += raw * raw;
+      sq_corrected += corrected * corrected;
+      abs_raw.push_back(std::fabs(raw));
+      abs_corrected.push_back(std::fabs(corrected));
+      const auto& q = c.velocity->quantiles;
+      sc.coverage80 += q[1] <= r.true_velocity && r.true_velocity <= q[5];
+      sc.coverage95 += q[0] <= r.true_velocity && r.true_velocity <= q[6];
+      ++sc.rows;
     }
-    const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
-    const double corrected = c.velocity->median() / r.true_velocity - 1.0;
-    sq_raw += raw * raw;
-    sq_corrected += corrected * corrected;
-    abs_raw.push_back(std::fabs(raw));
-    abs_corrected.push_back(std::fabs(corrected));
-    const auto& q = c.velocity->quantiles;
-    sc.coverage80 += q[1] <= r.true_velocity && r.true_velocity <= q[5];
-    sc.coverage95 += q[0] <= r.true_velocity && r.true_velocity <= q[6];
-    ++sc.rows;
-  }
-  if (sc.rows > 0) {
-    const auto n = static_cast<double>(sc.rows);
-    sc.rmse_raw = std::sqrt(sq_raw / n);
-    sc.rmse_corrected = std::sqrt(sq_corrected / n);
-    sc.median_abs_raw = awcc::median(abs_raw);
-    sc.median_abs_corrected = awcc::median(abs_corrected);
-    sc.coverage80 /= n;
-    sc.coverage95 /= n;
-  }
+    if (sc.rows > 0) {
+      const auto n = static_cast<double>(sc.rows);
+      sc.rmse_raw = std::sqrt(sq_raw / n);
+      sc.rmse_corrected = std::sqrt(sq_corrected / n);
+      sc.median_abs_raw = awcc::median(abs_raw);
+      sc.median_abs_corrected = awcc::median(abs_corrected);
+      sc.coverage80 /= n;
+      sc.coverage95 /= n;
+    }
+    return sc;
+  };
+  result.fscc_held_out = score_rows(false);
+  result.fscc_held_out_unserved = score_rows(true);
   result.fscc_training_rows = static_cast<std::int64_t>(training.size());
   result.model.fscc = std::move(f);
 }
@@ -744,11 +764,14 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
       100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected, 100 * h.tu_coverage80, 100 * h.tu_coverage95);
   if (result.model.fscc) {
     const auto& f = result.fscc_held_out;
+    const auto& u = result.fscc_held_out_unserved;
     result.model.provenance += fmt::format(
-        " FSCC forest (velocity of rows without a usable AWCC result): trained on {} runs; held out: velocity RMSE "
-        "{:.2f} % raw FSCC, {:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} % ({} rows).",
-        result.fscc_training_rows, 100 * f.rmse_raw, 100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95,
-        f.rows);
+        " FSCC forest (velocity of rows without a usable AWCC result): trained on {} runs{}; held out, the runs AWCC "
+        "cannot serve ({} rows): velocity RMSE {:.2f} % raw FSCC, {:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; "
+        "all runs with an FSCC velocity ({} rows): RMSE {:.2f} % raw, {:.2f} % corrected, coverage {:.1f}/{:.1f} %.",
+        result.fscc_training_rows, result.fscc_calibration.empty() ? "" : ", " + result.fscc_calibration, u.rows,
+        100 * u.rmse_raw, 100 * u.rmse_corrected, 100 * u.coverage80, 100 * u.coverage95, f.rows, 100 * f.rmse_raw,
+        100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95);
   }
   if (!result.fscc_note.empty()) result.model.provenance += " " + result.fscc_note + ".";
   return result;
@@ -779,12 +802,17 @@ std::string TrainResult::report() const {
   line(fmt::format("  Tu mean error          {:7.4f}     {:7.4f}", h.tu_bias_raw, h.tu_bias_corrected));
   line(fmt::format("  coverage 80 % / 95 %   velocity {:.1f} / {:.1f} %, Tu {:.1f} / {:.1f} %", 100 * h.velocity_coverage80,
                    100 * h.velocity_coverage95, 100 * h.tu_coverage80, 100 * h.tu_coverage95));
-  const auto table = coverage_by_band(predictions);
+  const auto table = scores_by_band(predictions);
   if (!table.empty()) {
-    line("Coverage of the held-out runs by band (nominal 80 % and 95 %):");
-    line("  band                          runs   velocity 80 %  95 %    Tu 80 %  95 %");
+    line("Held-out runs by band: errors raw -> corrected (velocity relative, Tu absolute) and coverage (nominal 80 / 95 %):");
+    line("  band                          runs  corrected   u RMSE raw -> corr    u median|err|      Tu RMSE        "
+         "Tu median|err|    u 80 %  95 %   Tu 80 %  95 %");
     for (const auto& b : table) {
-      line(fmt::format("  {:<28} {:>6}   {:9.1f} {:5.1f}   {:7.1f} {:5.1f}", b.band, b.rows, 100 * b.velocity80,
+      line(fmt::format("  {:<28} {:>6} {:>9}   {:7.2f} -> {:6.2f} %   {:5.2f} -> {:5.2f} %   {:.4f} -> {:.4f}   "
+                       "{:.4f} -> {:.4f}   {:5.1f} {:5.1f}   {:6.1f} {:5.1f}",
+                       b.band, b.runs, b.rows, 100 * b.velocity_rmse_raw, 100 * b.velocity_rmse_corrected,
+                       100 * b.velocity_median_abs_raw, 100 * b.velocity_median_abs_corrected, b.tu_rmse_raw,
+                       b.tu_rmse_corrected, b.tu_median_abs_raw, b.tu_median_abs_corrected, 100 * b.velocity80,
                        100 * b.velocity95, 100 * b.tu80, 100 * b.tu95));
     }
   }
@@ -802,14 +830,18 @@ std::string TrainResult::report() const {
   return out;
 }
 
-std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>& predictions) {
-  struct Band {
-    std::string name;
-    std::function<bool(const TrainingRow&)> holds;
-  };
+namespace {
+
+struct Band {
+  std::string name;
+  std::function<bool(const TrainingRow&)> holds;
+};
+
+// The bands of the held-out tables: true Tu (the bands), accepted
+// windows, sampling rate. Plain copies of the ends: lambdas capture them
+// (clang 14 cannot capture bindings).
+std::vector<Band> held_out_bands() {
   std::vector<Band> bands{{"all", [](const TrainingRow&) { return true; }}};
-  // True Tu (the bands), accepted windows, sampling rate.
-  // Plain copies of the ends: lambdas capture them (clang 14 cannot capture bindings).
   for (const auto& band : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 0.35}}) {
     const double lo = band.first, hi = band.second;
     bands.push_back({fmt::format("true Tu {:g}-{:g}", lo, hi), [lo, hi](const TrainingRow& r) {
@@ -828,17 +860,30 @@ std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>&
     bands.push_back({hi > 1e299 ? fmt::format("fs {:g} kHz+", lo / 1e3) : fmt::format("fs {:g}-{:g} kHz", lo / 1e3, hi / 1e3),
                      [lo, hi](const TrainingRow& r) { return r.features.fs > lo && r.features.fs <= hi; }});
   }
-  std::vector<BandCoverage> out;
-  for (const auto& b : bands) {
-    BandCoverage c;
+  return bands;
+}
+
+}  // namespace
+
+std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& predictions) {
+  std::vector<BandScores> out;
+  for (const auto& b : held_out_bands()) {
+    BandScores c;
     c.band = b.name;
+    std::vector<double> u_raw, u_corrected, t_raw, t_corrected;
+    double u_sq_raw = 0.0, u_sq_corrected = 0.0, t_sq_raw = 0.0, t_sq_corrected = 0.0;
     for (const auto& p : predictions) {
-      if (!p.correction.corrected() || !p.correction.velocity || !p.correction.turbulence_intensity ||
-          !b.holds(p.row))
-        continue;
+      if (!b.holds(p.row)) continue;
+      ++c.runs;
+      if (!p.correction.corrected() || !p.correction.velocity || !p.correction.turbulence_intensity) continue;
       const auto& u = p.correction.velocity->quantiles;
       const auto& t = p.correction.turbulence_intensity->quantiles;
       const double uu = p.row.true_velocity, tt = p.row.true_turbulence_intensity;
+      const double ur = p.row.features.velocity / uu - 1.0, uc = p.correction.velocity->median() / uu - 1.0;
+      const double tr = p.row.features.turbulence_intensity - tt, tc = p.correction.turbulence_intensity->median() - tt;
+      u_sq_raw += ur * ur, u_sq_corrected += uc * uc, t_sq_raw += tr * tr, t_sq_corrected += tc * tc;
+      u_raw.push_back(std::fabs(ur)), u_corrected.push_back(std::fabs(uc));
+      t_raw.push_back(std::fabs(tr)), t_corrected.push_back(std::fabs(tc));
       c.velocity80 += u[1] <= uu && uu <= u[5];
       c.velocity95 += u[0] <= uu && uu <= u[6];
       c.tu80 += t[1] <= tt && tt <= t[5];
@@ -848,7 +893,62 @@ std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>&
     if (c.rows == 0) continue;  // a band the runs do not reach (fs bands of a 500 kHz campaign)
     const auto n = static_cast<double>(c.rows);
     c.velocity80 /= n, c.velocity95 /= n, c.tu80 /= n, c.tu95 /= n;
+    c.velocity_rmse_raw = std::sqrt(u_sq_raw / n);
+    c.velocity_rmse_corrected = std::sqrt(u_sq_corrected / n);
+    c.tu_rmse_raw = std::sqrt(t_sq_raw / n);
+    c.tu_rmse_corrected = std::sqrt(t_sq_corrected / n);
+    c.velocity_median_abs_raw = awcc::median(u_raw);
+    c.velocity_median_abs_corrected = awcc::median(u_corrected);
+    c.tu_median_abs_raw = awcc::median(t_raw);
+    c.tu_median_abs_corrected = awcc::median(t_corrected);
     out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPrediction>& predictions,
+                                                 const std::vector<HeldOutPrediction>& other) {
+  if (predictions.size() != other.size()) {
+    throw std::invalid_argument("corrected_by_both: the two prediction sets are not of the same runs");
+  }
+  std::vector<HeldOutPrediction> out;
+  for (std::size_t i = 0; i < predictions.size(); ++i) {
+    if (predictions[i].row.run != other[i].row.run || predictions[i].row.study != other[i].row.study) {
+      throw std::invalid_argument("corrected_by_both: the two prediction sets are not of the same runs");
+    }
+    if (predictions[i].correction.corrected() && other[i].correction.corrected()) out.push_back(predictions[i]);
+  }
+  return out;
+}
+
+std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const std::vector<HeldOutPrediction>& other,
+                              const std::string& other_name) {
+  const auto all = scores_by_band(mine);
+  const auto theirs = scores_by_band(other);
+  const auto both_mine = scores_by_band(corrected_by_both(mine, other));
+  const auto both_theirs = scores_by_band(corrected_by_both(other, mine));
+  auto find = [](const std::vector<BandScores>& t, const std::string& band) -> const BandScores* {
+    for (const auto& b : t)
+      if (b.band == band) return &b;
+    return nullptr;
+  };
+  std::string out = fmt::format(
+      "Against {} on the same held-out runs (errors on the runs both models correct; raw = AWCC's):\n"
+      "  band                          runs  corrected: this  other   u RMSE raw / other / this   "
+      "Tu RMSE raw / other / this   Tu 80 % other / this\n",
+      other_name);
+  for (const auto& a : all) {
+    const auto* t = find(theirs, a.band);
+    const auto* bm = find(both_mine, a.band);
+    const auto* bt = find(both_theirs, a.band);
+    out += fmt::format("  {:<28} {:>6} {:>16} {:>6}", a.band, a.runs, a.rows, t ? t->rows : 0);
+    if (bm && bt) {
+      out += fmt::format("   {:6.2f} / {:6.2f} / {:6.2f} %   {:.4f} / {:.4f} / {:.4f}   {:5.1f} / {:5.1f}",
+                         100 * bt->velocity_rmse_raw, 100 * bt->velocity_rmse_corrected,
+                         100 * bm->velocity_rmse_corrected, bt->tu_rmse_raw, bt->tu_rmse_corrected,
+                         bm->tu_rmse_corrected, 100 * bt->tu80, 100 * bm->tu80);
+    }
+    out += "\n";
   }
   return out;
 }

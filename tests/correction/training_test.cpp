@@ -244,6 +244,14 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
       EXPECT_NEAR(r.fscc_held_out.rmse_raw, 0.10, 1e-9);
       EXPECT_LT(r.fscc_held_out.rmse_corrected, 0.01);
       EXPECT_NE(r.model.provenance.find("FSCC forest"), std::string::npos);
+      // It is scored apart on the runs AWCC cannot serve (one in four); the
+      // 160 calibration runs hold about 40 of those, too few to calibrate
+      // on, so all calibration runs are used and the model says so.
+      EXPECT_GT(r.fscc_held_out_unserved.rows, 25);
+      EXPECT_LT(r.fscc_held_out_unserved.rows, 80);
+      EXPECT_LT(r.fscc_held_out_unserved.rmse_corrected, 0.01);
+      EXPECT_NE(r.fscc_calibration.find("calibrated on all 160 calibration runs"), std::string::npos)
+          << r.fscc_calibration;
       // A row without AWCC: the FSCC forest corrects its velocity, not its Tu.
       correction::Measurement m;
       m.void_fraction = 0.2;
@@ -261,6 +269,14 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
       const auto none = r.model.correct(m);
       EXPECT_EQ(none.status, correction::CorrectionStatus::no_awcc_velocity);
       EXPECT_NE(none.message.find("FSCC forest: FSCC gave no velocity"), std::string::npos) << none.message;
+    }
+    if (std::string(features) == "extended") {
+      // With 60 % of the training runs calibrating (480, about 120 without
+      // AWCC), the FSCC forest is calibrated on the runs it will correct.
+      auto wide = o;
+      wide.calibration = 0.6;
+      const auto w = correction::train_model(set, wide);
+      EXPECT_NE(w.fscc_calibration.find("calibration runs AWCC cannot serve"), std::string::npos) << w.fscc_calibration;
     }
     // The file keeps the feature set.
     const auto again = correction::CorrectionModel::parse(r.model.serialise(), "m.qrf");
@@ -408,7 +424,7 @@ TEST(Calibration, ApplyKeepsTheQuantilesInOrder) {
   EXPECT_EQ(u, (std::vector<double>{-3, -2, 0, 0, 0, 2, 3}));
 }
 
-TEST(Training, CoverageByBandCountsEachBandsRowsInsideTheirIntervals) {
+TEST(Training, ScoresByBandCountEachBandsRowsInsideTheirIntervalsAndTheirErrors) {
   // Four runs: Tu 0.15 with 20 windows at 20 kHz (two inside both intervals,
   // one inside the 95 % only, one outside both) and one Tu 0.32 with 500 windows at 500 kHz.
   auto prediction = [](double true_u, double tu, std::int64_t windows, double fs) {
@@ -417,6 +433,8 @@ TEST(Training, CoverageByBandCountsEachBandsRowsInsideTheirIntervals) {
     p.row.true_turbulence_intensity = tu;
     p.row.features.windows_accepted = windows;
     p.row.features.fs = fs;
+    p.row.features.velocity = 10.5;              // raw AWCC
+    p.row.features.turbulence_intensity = 0.12;  // raw AWCC
     p.correction.status = correction::CorrectionStatus::corrected;
     correction::CorrectedQuantity u, t;
     u.quantiles = {7, 8, 9, 10, 11, 12, 13};
@@ -428,12 +446,12 @@ TEST(Training, CoverageByBandCountsEachBandsRowsInsideTheirIntervals) {
   const std::vector<correction::HeldOutPrediction> p{prediction(10, 0.15, 20, 2e4), prediction(11.5, 0.15, 20, 2e4),
                                                      prediction(12.5, 0.15, 20, 2e4), prediction(14, 0.15, 20, 2e4),
                                                      prediction(10, 0.32, 500, 5e5)};
-  const auto table = correction::coverage_by_band(p);
+  const auto table = correction::scores_by_band(p);
   auto band = [&](const std::string& name) {
     for (const auto& b : table)
       if (b.band == name) return b;
     ADD_FAILURE() << "no band " << name;
-    return correction::BandCoverage{};
+    return correction::BandScores{};
   };
   EXPECT_EQ(band("all").rows, 5);
   EXPECT_DOUBLE_EQ(band("all").velocity80, 3.0 / 5);
@@ -448,6 +466,35 @@ TEST(Training, CoverageByBandCountsEachBandsRowsInsideTheirIntervals) {
   EXPECT_EQ(band("fs 0-50 kHz").rows, 4);
   EXPECT_EQ(band("fs 200 kHz+").rows, 1);
   for (const auto& b : table) EXPECT_NE(b.band, "windows 30-99");  // empty bands are left out
+  // Errors over the band's four runs, from the definitions: velocity
+  // relative (corrected median 10 against 10, 11.5, 12.5, 14), Tu absolute.
+  const auto& tu = band("true Tu 0.1-0.2");
+  const double e[] = {0.0, 10 / 11.5 - 1, 10 / 12.5 - 1, 10.0 / 14 - 1};
+  const double r[] = {0.05, 10.5 / 11.5 - 1, 10.5 / 12.5 - 1, 10.5 / 14 - 1};
+  EXPECT_NEAR(tu.velocity_rmse_corrected, std::sqrt((e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]) / 4), 1e-12);
+  EXPECT_NEAR(tu.velocity_rmse_raw, std::sqrt((r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]) / 4), 1e-12);
+  EXPECT_NEAR(tu.velocity_median_abs_corrected, (-e[1] - e[2]) / 2, 1e-12);  // the mean of the middle two
+  EXPECT_NEAR(tu.velocity_median_abs_raw, (-r[1] - r[2]) / 2, 1e-12);         // of 0.05, 0.087, 0.16, 0.25
+  EXPECT_NEAR(tu.tu_rmse_raw, 0.03, 1e-12);
+  EXPECT_NEAR(tu.tu_median_abs_raw, 0.03, 1e-12);
+  EXPECT_NEAR(tu.tu_rmse_corrected, 0.0, 1e-12);
+
+  // A run left uncorrected counts in its band's runs, not in the scores.
+  auto q = p;
+  q[0].correction = correction::Correction{};
+  q[0].correction.status = correction::CorrectionStatus::too_few_windows;
+  const auto fewer = correction::scores_by_band(q);
+  EXPECT_EQ(fewer.front().runs, 5);
+  EXPECT_EQ(fewer.front().rows, 4);
+  EXPECT_DOUBLE_EQ(fewer.front().velocity80, 2.0 / 4);  // runs 2 and 5 remain inside
+  // The runs both models correct, and a set of other runs refused.
+  const auto both = correction::corrected_by_both(p, q);
+  ASSERT_EQ(both.size(), 4u);
+  EXPECT_EQ(both.front().row.true_velocity, 11.5);
+  auto shuffled = q;
+  shuffled[1].row.run = 7;
+  EXPECT_THROW(correction::corrected_by_both(p, shuffled), std::invalid_argument);
+  EXPECT_NE(correction::comparison_report(p, q, "old.qrf").find("old.qrf"), std::string::npos);
 }
 
 }  // namespace

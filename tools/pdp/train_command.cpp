@@ -25,6 +25,9 @@ void setup_train(CLI::App& app, Command& command, TrainCommandOptions& o) {
   cmd->add_option("--predictions", o.predictions, "write the held-out predictions as CSV");
   cmd->add_option("--learning-curve", o.learning_curve, "write the held-out scores against training runs as CSV");
   cmd->add_option("--report", o.report, "write the report to this file too");
+  cmd->add_option("--compare-model", o.compare_model,
+                  "another model (e.g. the one shipped before) scored on the same held-out runs, band by band")
+      ->check(CLI::ExistingFile);
 }
 
 
@@ -45,7 +48,16 @@ int run_train(const TrainCommandOptions& o) {
     Progress progress("training");
     const auto result = correction::train_model(set, t, [&](double f) { progress(f); });
     // Every output's folder is checked before any is written.
-    const auto report = result.report();
+    auto report = result.report();
+    if (!o.compare_model.empty()) {
+      const auto other = correction::CorrectionModel::load(o.compare_model);
+      std::vector<correction::TrainingRow> rows;
+      for (const auto& p : result.predictions) rows.push_back(p.row);
+      std::vector<correction::HeldOutPrediction> theirs;
+      correction::score(other, rows, &theirs, t.threads);
+      report += correction::comparison_report(result.predictions, theirs,
+                                              std::filesystem::path(o.compare_model).filename().string());
+    }
     std::vector<std::pair<std::string, std::string>> texts;
     if (!o.predictions.empty()) texts.emplace_back(o.predictions, correction::predictions_csv(result.predictions));
     if (!o.learning_curve.empty()) texts.emplace_back(o.learning_curve, correction::learning_curve_csv(result.learning_curve));

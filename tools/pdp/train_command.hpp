@@ -19,6 +19,7 @@ struct TrainCommandOptions {
   std::string predictions;          ///< held-out predictions CSV
   std::string learning_curve;       ///< learning curve CSV
   std::string report;               ///< the report as a text file (also on stdout)
+  std::string compare_model;        ///< another model scored on the same held-out runs
 };
 
 void setup_train(CLI::App& app, Command& command, TrainCommandOptions& options);

@@ -46,6 +46,10 @@ struct TrainingRow {
   std::int64_t run = 0;
   Features features;
   double true_velocity = 0.0, true_turbulence_intensity = 0.0;
+  /// AWCC gave a usable velocity from at least min_windows accepted windows:
+  /// the AWCC forests take the row. The FSCC forest is applied where this is
+  /// false, so that is where it is calibrated and scored.
+  bool awcc_served = true;
 };
 
 struct TrainingSet {
@@ -149,7 +153,9 @@ struct TrainResult {
   std::int64_t training_rows = 0;
   std::int64_t calibration_rows = 0;    ///< set aside to calibrate the intervals
   std::int64_t fscc_training_rows = 0;  ///< the FSCC forest's (extended feature set)
-  FsccScores fscc_held_out;
+  FsccScores fscc_held_out;             ///< all held-out runs with an FSCC velocity
+  FsccScores fscc_held_out_unserved;    ///< those AWCC cannot serve: where the forest is applied
+  std::string fscc_calibration;         ///< which runs calibrated the FSCC forest's intervals
   std::string fscc_note;                ///< why there is no FSCC forest, when there is none
   std::vector<CvEntry> cv;              ///< every grid point scored
   int velocity_min_leaf = 0, velocity_features_per_split = 0;
@@ -179,16 +185,35 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads = 0);
 
-/// Coverage of the corrected rows' 80 % and 95 % intervals in one band of runs.
-struct BandCoverage {
+/// Scores of held-out predictions in one band of runs: errors of the raw and
+/// the corrected values (velocity relative, Tu absolute) and the coverage of
+/// the 80 % and 95 % intervals, over the rows the model corrected.
+struct BandScores {
   std::string band;  ///< "all", "true Tu 0.1-0.2", "windows 30-99", "fs 50-200 kHz", ...
-  std::int64_t rows = 0;
+  std::int64_t runs = 0;  ///< held-out runs in the band
+  std::int64_t rows = 0;  ///< of which corrected (the scores are over these)
+  double velocity_rmse_raw = 0.0, velocity_rmse_corrected = 0.0;
+  double velocity_median_abs_raw = 0.0, velocity_median_abs_corrected = 0.0;
+  double tu_rmse_raw = 0.0, tu_rmse_corrected = 0.0;
+  double tu_median_abs_raw = 0.0, tu_median_abs_corrected = 0.0;
   double velocity80 = 0.0, velocity95 = 0.0, tu80 = 0.0, tu95 = 0.0;
 };
-/// The coverage table of held-out predictions: all runs, by band of the true
-/// Tu (0-0.1, 0.1-0.2, 0.2-0.3, 0.3-0.35), of accepted windows (10-29, 30-99,
-/// 100+) and of fs (up to 50 kHz, 50-200 kHz, above); empty bands left out.
-std::vector<BandCoverage> coverage_by_band(const std::vector<HeldOutPrediction>& predictions);
+/// The scores of held-out predictions: all runs, by band of the true Tu
+/// (0-0.1, 0.1-0.2, 0.2-0.3, 0.3-0.35), of accepted windows (10-29, 30-99,
+/// 100+) and of fs (up to 50 kHz, 50-200 kHz, above); bands without a
+/// corrected row are left out.
+std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& predictions);
+
+/// The rows of `predictions` that `other` also corrected (the same runs in
+/// the same order): to score two models on the runs both correct.
+std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPrediction>& predictions,
+                                                 const std::vector<HeldOutPrediction>& other);
+
+/// A second model (e.g. the one shipped before) on the same held-out runs,
+/// band by band: how many runs each corrects, and the errors of both on the
+/// runs both correct.
+std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const std::vector<HeldOutPrediction>& other,
+                              const std::string& other_name);
 
 /// Held-out predictions as CSV: run, features, truth, raw, quantiles.
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
