@@ -252,6 +252,19 @@ Correction not_corrected(CorrectionStatus status, std::string message) {
 
 namespace {
 
+// Where a row's missing record feature comes from: the columns pdp process
+// writes (read from any CSV), or pdp correct's options for a whole file.
+std::string how_to_give(const std::string& feature) {
+  if (feature == "fs" || feature == "duration") {
+    return fmt::format("a column '{}', or pdp correct --{} for a whole file", feature, feature);
+  }
+  if (feature == "windows_accepted") return "a column 'awcc_windows_accepted': AWCC's accepted windows of the row";
+  if (feature == "data_yield") {
+    return "columns 'awcc_windows_accepted' and 'awcc_windows_total': AWCC's accepted and formed windows of the row";
+  }
+  return fmt::format("a column '{}'", feature);
+}
+
 // Why a feature value is outside its training range, in the field's words
 // where the flow itself is outside what the simulator models.
 std::string out_of_range_reason(const FeatureRange& r, double v) {
@@ -294,8 +307,8 @@ Correction CorrectionModel::correct(const Features& f) const {
     if (!v) {
       return not_corrected(CorrectionStatus::missing_feature,
                            fmt::format("the model takes the record's {} as a feature, and it is not known for this row; "
-                                       "give it (e.g. a CSV column '{}')",
-                                       ranges[j].name, ranges[j].name));
+                                       "give it ({})",
+                                       ranges[j].name, how_to_give(ranges[j].name)));
     }
     x[j] = *v;
   }
@@ -367,7 +380,8 @@ Correction CorrectionModel::correct_fscc(const Features& f) const {
     const auto v = f.value(r.name);
     if (!v) {
       return not_corrected(CorrectionStatus::missing_feature,
-                           fmt::format("the FSCC forest takes the record's {}, which is not known for this row", r.name));
+                           fmt::format("the FSCC forest takes the record's {}, which is not known for this row; give it ({})",
+                                       r.name, how_to_give(r.name)));
     }
     const double pad = range_margin * (r.max - r.min);
     if (!(*v >= r.min - pad && *v <= r.max + pad)) {

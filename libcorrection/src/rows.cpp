@@ -113,8 +113,8 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     const auto& lead = r["tips"][0];
     m.void_fraction = required(lead, "void_fraction", "tips[0]");
     m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
-    m.fs = number(r, "fs").value_or(0.0);
-    m.duration = number(r, "duration").value_or(0.0);
+    m.fs = number(r, "fs").value_or(d.fs.value_or(0.0));
+    m.duration = number(r, "duration").value_or(d.duration.value_or(0.0));
     if (r.contains("fscc") && r["fscc"].is_object() && r["fscc"].value("defined", false)) {
       m.fscc_velocity = number(r["fscc"], "velocity");
       m.r12_max = number(r["fscc"], "r12_max");
@@ -217,8 +217,8 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     m.np = static_cast<int>(need(std::nullopt, default_np(d), where, "np", "particles per window"));
     // The record's features, where the tool's CSV has columns of pdp's names.
     auto optional = [&](const char* name) { return col.count(name) ? value(name) : std::nullopt; };
-    m.fs = optional("fs").value_or(0.0);
-    m.duration = optional("duration").value_or(0.0);
+    m.fs = optional("fs").value_or(d.fs.value_or(0.0));
+    m.duration = optional("duration").value_or(d.duration.value_or(0.0));
     if (const auto w = optional("awcc_windows_accepted")) m.windows_accepted = static_cast<std::int64_t>(*w);
     const auto c = c_value ? model.correct(m)
                            : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
@@ -330,8 +330,8 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
       if (const auto w = value("awcc_windows_accepted")) m.windows_accepted = whole(*w, where, "awcc_windows_accepted");
       if (const auto w = value("awcc_windows_total")) m.windows_total = whole(*w, where, "awcc_windows_total");
-      m.fs = value("fs").value_or(0.0);
-      m.duration = value("duration").value_or(0.0);
+      m.fs = value("fs").value_or(d.fs.value_or(0.0));
+      m.duration = value("duration").value_or(d.duration.value_or(0.0));
       m.fscc_velocity = value("fscc_velocity");
       m.r12_max = value("fscc_r12_max");
     };

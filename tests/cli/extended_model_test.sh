@@ -73,6 +73,14 @@ PY
 [[ $(column "$dir/nofs-corrected.csv" correction_status) != corrected ]] ||
   fail "no fs: corrected all the same"
 grep -q "fs" <<<"$(column "$dir/nofs-corrected.csv" correction_reason)" || fail "no fs: the reason does not name fs"
+grep -q -- "--fs" <<<"$(column "$dir/nofs-corrected.csv" correction_reason)" || fail "no fs: the reason does not say how to give it"
+# Stated for the whole file, the record's fs gives back the same correction.
+"$pdp" --log-level error correct "$dir/nofs.csv" -m "$dir/x.qrf" --fs 60kHz -o "$dir/fs-given.csv" || fail "correct --fs"
+[[ $(column "$dir/fs-given.csv" corrected_velocity_q0.9) == $(column "$dir/r.csv" corrected_velocity_q0.9) ]] ||
+  fail "--fs: not the correction of the file that records fs"
+"$pdp" --log-level error correct "$dir/nofs.csv" -m "$dir/x.qrf" --fs 60 -o "$dir/bad.csv" 2>/dev/null &&
+  fail "--fs without a unit accepted"
+[[ -e "$dir/bad.csv" ]] && fail "--fs without a unit: output written"
 
 if ((failures)); then
   echo "$failures failures"

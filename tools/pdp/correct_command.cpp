@@ -28,6 +28,8 @@ void setup_correct(CLI::App& app, Command& command, CorrectOptions& o) {
   cmd->add_option("--dx", o.dx, "streamwise tip separation, m (units allowed), where the input has none");
   cmd->add_option("--dy", o.dy, "lateral tip separation, m (units allowed), where the input has none");
   cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(1, 1000));
+  cmd->add_option("--fs", o.fs, "sampling rate, Hz (units allowed), where the input has none (extended models)");
+  cmd->add_option("--duration", o.duration, "record length, s (units allowed), where the input has none (extended models)");
 }
 
 int run_correct(const CorrectOptions& o) {
@@ -43,6 +45,18 @@ int run_correct(const CorrectOptions& o) {
     if (!o.dx.empty()) defaults.dx = length(o.dx, "--dx");
     if (!o.dy.empty()) defaults.dy = length(o.dy, "--dy");
     if (o.np > 0) defaults.np = o.np;
+    auto positive = [](const std::string& text, awcc::Dimension dimension, const char* flag) {
+      double v = 0.0;
+      try {
+        v = awcc::parse_quantity(text, dimension);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(fmt::format("{}: {}", flag, e.what()));
+      }
+      if (!(v > 0.0)) throw std::invalid_argument(fmt::format("{}: {} must be positive", flag, text));
+      return v;
+    };
+    if (!o.fs.empty()) defaults.fs = positive(o.fs, awcc::Dimension::frequency, "--fs");
+    if (!o.duration.empty()) defaults.duration = positive(o.duration, awcc::Dimension::time, "--duration");
     if (!o.output.empty() && std::filesystem::exists(o.output) &&
         (std::filesystem::equivalent(o.output, o.input) || std::filesystem::equivalent(o.output, o.model))) {
       throw std::invalid_argument(fmt::format("{} is an input; choose another output file", o.output));

@@ -17,6 +17,8 @@ struct CorrectOptions {
   std::string output;   ///< output file; empty = stdout
   std::string dx, dy;   ///< tip separations where the input lacks them (units allowed)
   int np = 0;           ///< AWCC particles per window where the input lacks it; 0 = not given
+  std::string fs;       ///< sampling rate where the input lacks it (units allowed)
+  std::string duration; ///< record length where the input lacks it (units allowed)
 };
 
 void setup_correct(CLI::App& app, Command& command, CorrectOptions& options);

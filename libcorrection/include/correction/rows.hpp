@@ -18,6 +18,9 @@ namespace correction {
 struct RowDefaults {
   std::optional<double> dx, dy;
   std::optional<int> np;
+  /// The record's sampling rate (Hz) and length (s), features of the
+  /// extended models, for files that do not record them (other tools' CSVs).
+  std::optional<double> fs, duration;
 };
 
 /// What a correction of a file says besides its rows.
