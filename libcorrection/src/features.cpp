@@ -10,7 +10,6 @@ std::string_view to_string(CorrectionStatus status) {
     case CorrectionStatus::corrected: return "corrected";
     case CorrectionStatus::awcc_not_run: return "awcc_not_run";
     case CorrectionStatus::no_awcc_velocity: return "no_awcc_velocity";
-    case CorrectionStatus::low_quality: return "low_quality";
     case CorrectionStatus::no_bubbles: return "no_bubbles";
     case CorrectionStatus::missing_feature: return "missing_feature";
     case CorrectionStatus::too_few_windows: return "too_few_windows";
@@ -135,9 +134,6 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   } else if (r.awcc->probe_corrected) {
     out.status = CorrectionStatus::probe_corrected;
     out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC";
-  } else if (r.awcc->quality != awcc::AwccQuality::ok) {
-    out.status = CorrectionStatus::low_quality;
-    out.message = "AWCC's quality is low: " + r.awcc->quality_reason;
   } else {
     m.velocity = r.awcc->velocity;
     m.turbulence_intensity = r.awcc->turbulence_intensity;

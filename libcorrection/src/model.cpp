@@ -358,7 +358,6 @@ bool fscc_may_follow(CorrectionStatus s) {
   switch (s) {
     case CorrectionStatus::awcc_not_run:
     case CorrectionStatus::no_awcc_velocity:
-    case CorrectionStatus::low_quality:
     case CorrectionStatus::too_few_windows:
     case CorrectionStatus::outside_training_range: return true;
     default: return false;

@@ -93,9 +93,6 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
   } else if (!a.value("defined", false)) {
     result.status = CorrectionStatus::no_awcc_velocity;
     result.message = "AWCC gave no velocity: " + text("reason");
-  } else if (!text("quality").empty() && text("quality") != "ok") {
-    result.status = CorrectionStatus::low_quality;
-    result.message = "AWCC's quality is " + text("quality") + (text("quality_reason").empty() ? "" : ": " + text("quality_reason"));
   } else if (a.value("probe_corrected", false)) {
     // The model learnt AWCC's bias on synthetic records without the needle:
     // a bubble-probe-corrected velocity is not what it corrects.
@@ -313,9 +310,6 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
     if (!u || !tu) {
       result.status = CorrectionStatus::no_awcc_velocity;
       result.message = "AWCC gave no velocity";
-    } else if (!text_of("awcc_quality").empty() && text_of("awcc_quality") != "ok") {
-      result.status = CorrectionStatus::low_quality;
-      result.message = "AWCC's quality is " + text_of("awcc_quality") + ": " + text_of("awcc_quality_reason");
     } else if (probe == "1" || probe == "true") {
       result.status = CorrectionStatus::probe_corrected;
       result.message = "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "

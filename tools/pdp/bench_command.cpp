@@ -213,13 +213,9 @@ std::vector<Row> bench_one(const std::string& name, std::uint64_t seed, const Pl
         m.windows_total = res.windows_total;
         m.fs = fs;  // the record's features, for an extended model
         m.duration = duration;
-        // As pdp process and pdp correct: only AWCC results of ok quality are corrected.
-        if (res.ok() && res.quality != awcc::AwccQuality::ok) m.velocity.reset();
         c.seconds = r.seconds + cost([&] { k = model->correct(m); });
         c.windows = res.windows_accepted;
-        if (res.ok() && res.quality != awcc::AwccQuality::ok) {
-          c.status = "low_quality";
-        } else if (k.corrected()) {
+        if (k.corrected()) {
           c.velocity = k.velocity->median();
           c.tu = k.turbulence_intensity->median();
           c.status = "ok";

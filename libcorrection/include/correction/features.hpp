@@ -48,7 +48,6 @@ enum class CorrectionStatus {
   corrected,               ///< the quantiles are there
   awcc_not_run,            ///< the results hold no AWCC
   no_awcc_velocity,        ///< AWCC gave no (positive) velocity
-  low_quality,             ///< AWCC's quality is low (METHOD 4, item 10): only ok rows are corrected
   no_bubbles,              ///< the leading tip saw no complete bubble (F = 0)
   missing_feature,         ///< the model needs a feature the measurement does not give (e.g. fs)
   too_few_windows,         ///< fewer accepted windows than the model's training runs had
@@ -124,7 +123,13 @@ std::string fscc_unusable(const Features& f);
 
 /// The measurement of a processed recording (AWCC's velocity and Tu, the
 /// leading tip's c and F, the processed dx and dy, Np); `status` says when
-/// AWCC did not run, gave no velocity, or one of low quality.
+/// AWCC did not run, gave no velocity, or was bubble-probe corrected.
+/// AWCC results of quality `low` (METHOD 4, item 10: fewer than 100
+/// accepted windows, or a yield below 5 %) are measurements like `ok` ones:
+/// a model corrects them when it was trained on such runs, which its least
+/// accepted windows (CorrectionModel::min_windows) decides. The training
+/// runs are never selected by yield, and an extended model takes the
+/// windows as a feature, so its interval widens where they are few.
 struct MeasurementResult {
   CorrectionStatus status = CorrectionStatus::corrected;
   std::string message;
