@@ -1,0 +1,45 @@
+#pragma once
+// The engine under pdp sweep and pdp design: tasks, named by index, computed
+// on threads (or MPI ranks), each task's text (whole CSV lines) appended to
+// one file in one write and flushed to disk, so that an interrupted study
+// loses no finished task and resumes from what the file holds.
+
+#include <cstdint>
+#include <functional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pdp {
+
+/// MPI, initialised only when started by mpirun (so that a plain run needs
+/// no MPI daemon) and when pdp was built with it; finalised on destruction.
+class MpiSession {
+ public:
+  MpiSession();
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+  [[nodiscard]] bool on() const { return on_; }
+  [[nodiscard]] int rank() const { return rank_; }
+  [[nodiscard]] int size() const { return size_; }
+  /// The writer's (rank 0) exit code so far and finished tasks, to every rank.
+  void share(int& code, std::set<std::int64_t>& done) const;
+
+ private:
+  bool on_ = false;
+  int rank_ = 0, size_ = 1;
+};
+
+/// "i/n" of --shard: (i, n) with 0 <= i < n; throws std::invalid_argument.
+std::pair<std::int64_t, std::int64_t> parse_shard(const std::string& text);
+
+/// Appends compute(task) for every task to `output` (which exists), on
+/// `threads` threads (0 = all cores), or over the ranks when `mpi` has more
+/// than one (rank 0 writes and hands out tasks one at a time). Progress on a
+/// terminal under `label`. Returns an exit code (README, "Exit status").
+int run_tasks(const std::vector<std::int64_t>& tasks, const std::function<std::string(std::int64_t)>& compute,
+              const std::string& output, int threads, const std::string& label, const MpiSession& mpi);
+
+}  // namespace pdp
