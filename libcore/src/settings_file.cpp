@@ -76,12 +76,25 @@ std::vector<Setting> settings_of(const std::filesystem::path& path, const toml::
 
 }  // namespace
 
-std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path) {
+std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path, const std::vector<std::string>& groups) {
   const toml::table t = parse(path);
   std::vector<SettingTable> out{{"", 1, settings_of(path, t, true)}};
   for (const auto& [key, node] : t) {
-    if (const auto* inner = node.as_table()) {
-      out.push_back({std::string(key.str()), static_cast<int>(node.source().begin.line), settings_of(path, *inner, false)});
+    const auto* inner = node.as_table();
+    if (!inner) continue;
+    const std::string name(key.str());
+    if (std::find(groups.begin(), groups.end(), name) == groups.end()) {
+      out.push_back({name, static_cast<int>(node.source().begin.line), settings_of(path, *inner, false)});
+      continue;
+    }
+    for (const auto& [member, member_node] : *inner) {
+      const auto* table = member_node.as_table();
+      if (!table) {
+        throw InputError(fmt::format("{}:{}: {}.{} is not a table; write [{}.NAME] tables of settings", path.string(),
+                                     member_node.source().begin.line, name, member.str(), name));
+      }
+      out.push_back({name + "." + std::string(member.str()), static_cast<int>(member_node.source().begin.line),
+                     settings_of(path, *table, false)});
     }
   }
   return out;

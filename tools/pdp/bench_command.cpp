@@ -18,6 +18,7 @@
 #include "awcc/process.hpp"
 #include "correction/features.hpp"
 #include "correction/model.hpp"
+#include "study.hpp"
 #include "synth/recording.hpp"
 #include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
@@ -45,21 +46,6 @@ void setup_bench(CLI::App& app, Command& command, BenchOptions& o) {
 }
 
 namespace {
-
-// CPU seconds of this thread: a method's cost, unaffected by other threads
-// sharing the machine.
-double thread_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-template <class F>
-double cost(F&& f) {
-  const double t0 = thread_seconds();
-  f();
-  return thread_seconds() - t0;
-}
 
 synth::Scene named_scene(const std::string& name) {
   synth::Scene s;
@@ -201,18 +187,7 @@ std::vector<Row> bench_one(const std::string& name, std::uint64_t seed, const Pl
         // The correction's cost is AWCC's plus the forest's.
         Row c = row("awcc-intervals+qrf", options.np);
         correction::Correction k;
-        correction::Measurement m;
-        if (res.ok()) m.velocity = res.velocity;
-        m.turbulence_intensity = res.turbulence_intensity;
-        m.void_fraction = phase.void_fraction;
-        m.bubble_count_rate = phase.bubble_count_rate;
-        m.dx = s.dx;
-        m.dy = s.dy;
-        m.np = options.np;
-        m.windows_accepted = res.windows_accepted;
-        m.windows_total = res.windows_total;
-        m.fs = fs;  // the record's features, for an extended model
-        m.duration = duration;
+        const auto m = awcc_measurement(res, phase, s.dx, s.dy, options.np, fs, duration);
         c.seconds = r.seconds + cost([&] { k = model->correct(m); });
         c.windows = res.windows_accepted;
         if (k.corrected()) {

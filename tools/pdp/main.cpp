@@ -15,6 +15,7 @@
 #include "report_command.hpp"
 #include "process_command.hpp"
 #include "sweep_command.hpp"
+#include "design_command.hpp"
 #include "synth_command.hpp"
 #include "train_command.hpp"
 #include "validate_command.hpp"
@@ -42,7 +43,7 @@ int main(int argc, char** argv) {
     pdp::Command command;
     std::function<int()> run;
   };
-  std::vector<Entry> commands(9);
+  std::vector<Entry> commands(10);
   pdp::SynthOptions synth_options;
   pdp::setup_synth(app, commands[0].command, synth_options);
   commands[0].run = [&] { return pdp::run_synth(synth_options); };
@@ -70,6 +71,9 @@ int main(int argc, char** argv) {
   pdp::ReportOptions report_options;
   pdp::setup_report(app, commands[8].command, report_options);
   commands[8].run = [&] { return pdp::run_report(report_options); };
+  pdp::DesignOptions design_options;
+  pdp::setup_design(app, commands[9].command, design_options);
+  commands[9].run = [&] { return pdp::run_design(design_options); };
 
   try {
     app.parse(argc, argv);

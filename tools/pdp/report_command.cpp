@@ -58,7 +58,7 @@ std::vector<fs::path> module_candidates() {
 
 }  // namespace
 
-int write_report(std::vector<std::string> arguments) {
+int write_report(std::vector<std::string> arguments, const std::string& script) {
   const auto python = find_python();
   if (!python) {
     spdlog::error("no python3 found (PDP_PYTHON, /usr/bin/python3, PATH): {}", install_help);
@@ -68,7 +68,7 @@ int write_report(std::vector<std::string> arguments) {
   std::string looked;
   for (const auto& dir : module_candidates()) {
     std::error_code ec;
-    if (fs::is_regular_file(dir / "pdp" / "report.py", ec)) {
+    if (fs::is_regular_file(dir / "pdp" / script, ec)) {
       module_dir = dir;
       break;
     }
@@ -82,7 +82,7 @@ int write_report(std::vector<std::string> arguments) {
   }
   // Run as a script, not -m: its own first lines check the packages and say
   // what to install before anything imports them.
-  std::vector<std::string> args = {*python, (*module_dir / "pdp" / "report.py").string(), "--command-line",
+  std::vector<std::string> args = {*python, (*module_dir / "pdp" / script).string(), "--command-line",
                                    command_line()};
   args.insert(args.end(), arguments.begin(), arguments.end());
   std::vector<std::string> env;
@@ -115,11 +115,11 @@ int write_report(std::vector<std::string> arguments) {
   if (WIFEXITED(status)) {
     const int code = WEXITSTATUS(status);
     if (code >= exit_ok && code <= exit_missing_helper) return code;  // pdp.report speaks the same table
-    spdlog::error("internal error: pdp.report ended with exit status {}; please report it with the command line",
+    spdlog::error("internal error: pdp/{} ended with exit status {}; please report it with the command line", script,
                   code);
     return exit_internal;
   }
-  spdlog::error("internal error: pdp.report was killed by signal {}; please report it with the command line",
+  spdlog::error("internal error: pdp/{} was killed by signal {}; please report it with the command line", script,
                 WIFSIGNALED(status) ? WTERMSIG(status) : 0);
   return exit_internal;
 }

@@ -21,9 +21,10 @@ struct ReportOptions {
 void setup_report(CLI::App& app, Command& command, ReportOptions& options);
 int run_report(const ReportOptions& options);
 
-/// Runs pdp.report with `arguments` (PROFILE.json -o REPORT.html ...).
+/// Runs the Python module's page script (pdp/report.py: `arguments` are
+/// PROFILE.json -o REPORT.html ...; pdp/design_report.py for pdp design).
 /// Returns an exit code of the README's table (logs the reason). Shared by
-/// pdp report and pdp process --report.
-int write_report(std::vector<std::string> arguments);
+/// pdp report, pdp process --report and pdp design --report.
+int write_report(std::vector<std::string> arguments, const std::string& script = "report.py");
 
 }  // namespace pdp

@@ -51,6 +51,25 @@ Summary95 summarise95(const std::vector<double>& values) {
   return s;
 }
 
+correction::Measurement awcc_measurement(const awcc::AwccResult& result, const awcc::PhaseStatistics& lead,
+                                         double dx, double dy, int np, double fs, double duration) {
+  correction::Measurement m;
+  if (result.ok()) {
+    m.velocity = result.velocity;
+    m.turbulence_intensity = result.turbulence_intensity;
+  }
+  m.void_fraction = lead.void_fraction;
+  m.bubble_count_rate = lead.bubble_count_rate;
+  m.dx = dx;
+  m.dy = dy;
+  m.np = np;
+  m.windows_accepted = result.windows_accepted;
+  m.windows_total = result.windows_total;
+  m.fs = fs;
+  m.duration = duration;
+  return m;
+}
+
 RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
   // Processing correlates the first two tips: a study needs them (a one-tip
   // scene is fine for pdp synth, not here).

@@ -14,6 +14,7 @@
 #include "awcc/awcc.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
+#include "correction/features.hpp"
 #include "synth/scene.hpp"
 
 namespace pdp {
@@ -58,6 +59,12 @@ struct RunResult {
 };
 
 RunResult run_scene(const synth::Scene& scene, const StudyOptions& options);
+
+/// What the correction takes from one AWCC result of a synthetic record: its
+/// velocity and Tu (when it gave them), the leading tip's c and F, the pair
+/// processed, Np, the windows and the record's fs and duration.
+correction::Measurement awcc_measurement(const awcc::AwccResult& result, const awcc::PhaseStatistics& lead,
+                                         double dx, double dy, int np, double fs, double duration);
 
 /// Mean and 95 % interval (Student t) of a sample of errors.
 struct Summary95 {

@@ -1,5 +1,7 @@
 #include "terminal.hpp"
 
+#include <ctime>
+
 #include <cstdio>
 #include <fmt/format.h>
 #include <sys/resource.h>
@@ -31,6 +33,12 @@ double peak_memory_mb() {
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 }  // namespace pdp

@@ -29,4 +29,16 @@ double peak_memory_mb();
 /// Seconds since `start`.
 double seconds_since(std::chrono::steady_clock::time_point start);
 
+/// CPU seconds of the calling thread: a method's cost, unaffected by other
+/// threads sharing the machine.
+double thread_seconds();
+
+/// The CPU seconds f() takes on this thread.
+template <class F>
+double cost(F&& f) {
+  const double t0 = thread_seconds();
+  f();
+  return thread_seconds() - t0;
+}
+
 }  // namespace pdp

@@ -30,7 +30,10 @@ struct SettingTable {
 /// Every table of a file, the top-level keys first (name ""). Throws
 /// InputError naming the file and line: unreadable file, invalid TOML, a
 /// table inside a table, a value that is neither a scalar nor a list.
-std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path);
+/// A table named in `groups` holds named tables instead of keys (e.g.
+/// [conditions.wall], [conditions.upper]): they come as "conditions.wall" ...
+std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path,
+                                              const std::vector<std::string>& groups = {});
 
 /// The settings of a file: its top-level keys, or when it has a table named
 /// `table`, the keys of that table (other tables are refused unless listed in

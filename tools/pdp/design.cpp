@@ -1,0 +1,596 @@
+#include "design.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+#include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
+#include "awcc/random.hpp"
+#include "awcc/settings_file.hpp"
+#include "awcc/units.hpp"
+#include "awcc/fscc.hpp"
+#include "awcc/phase_statistics.hpp"
+#include "study.hpp"
+#include "synth/random.hpp"
+#include "synth/synthesiser.hpp"
+#include "terminal.hpp"
+
+namespace pdp {
+namespace {
+
+// The flow quantities of a condition that may be ranges.
+const std::set<std::string> kRangeable{"velocity", "tu", "anisotropy", "time-scale", "void-fraction",
+                                       "bubble-diameter"};
+
+bool is_scene_field(const std::string& name) {
+  for (const auto& f : synth::scene_fields())
+    if (f.name == name) return true;
+  return false;
+}
+
+awcc::Dimension dimension_of(const std::string& name) {
+  for (const auto& f : synth::scene_fields())
+    if (f.name == name) return f.dimension;
+  return awcc::Dimension::dimensionless;
+}
+
+std::uint64_t fnv(std::string_view text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string num(double v) { return fmt::format("{:.10g}", v); }
+std::string num(const std::optional<double>& v) { return v ? num(*v) : std::string(); }
+
+}  // namespace
+
+std::string describe(const DesignCandidate& c) {
+  return fmt::format("dx {:g} mm, dy {:g} mm, Np {}, {:g} kHz, {:g} s", c.dx * 1e3, c.dy * 1e3, c.np, c.fs / 1e3,
+                     c.duration);
+}
+
+DesignDefinition load_design(const std::filesystem::path& path) {
+  DesignDefinition d;
+  const std::string file = path.string();
+  auto fail = [&](const std::string& where, const std::string& what) -> void {
+    throw std::runtime_error(fmt::format("{}: {}: {}", file, where, what));
+  };
+  std::vector<awcc::SettingTable> tables;
+  try {
+    tables = awcc::read_setting_tables(path, {"conditions"});
+  } catch (const awcc::InputError& e) {
+    throw std::runtime_error(e.what());
+  }
+  auto quantity = [&](const std::string& where, const std::string& text, awcc::Dimension dim) {
+    try {
+      return awcc::parse_quantity(text, dim);
+    } catch (const std::exception& e) {
+      fail(where, e.what());
+    }
+    return 0.0;
+  };
+  auto whole = [&](const std::string& where, const std::string& text, std::int64_t lo, std::int64_t hi) -> long long {
+    try {
+      return awcc::parse_whole(text, lo, hi);
+    } catch (const std::exception&) {
+      fail(where, fmt::format("must be a whole number from {} to {}", lo, hi));
+    }
+    return 0LL;
+  };
+  std::vector<double> dxs{1e-3, 2e-3, 3e-3, 5e-3, 7.5e-3, 10e-3}, dys{0.0, 0.5e-3, 1e-3, 2e-3};
+  bool probes_given = false, grid_given = false;
+  std::string canonical;
+  for (const auto& t : tables) {
+    if (t.name.empty()) {
+      if (!t.settings.empty()) fail(t.settings.front().key, "must be in a table: [design], [conditions.NAME], [candidates] or [current]");
+      continue;
+    }
+    for (const auto& s : t.settings) canonical += t.name + "." + s.key + "=" + s.text + ";";
+    if (t.name == "design") {
+      for (const auto& s : t.settings) {
+        const std::string where = "[design] " + s.key;
+        if (s.key == "seeds") d.seeds = static_cast<int>(whole(where, s.text, 2, 1000));
+        else if (s.key == "seed") d.seed = static_cast<std::uint64_t>(whole(where, s.text, 0, std::int64_t{1} << 53));
+        else if (s.key == "objective") {
+          if (s.text != "worst-case" && s.text != "mean") fail(where, "write \"worst-case\" or \"mean\"");
+          d.objective = s.text;
+        } else if (s.key == "values") {
+          if (s.text != "corrected" && s.text != "raw") fail(where, "write \"corrected\" or \"raw\"");
+          d.values = s.text;
+        } else if (s.key == "model") {
+          d.model = s.text;
+        } else {
+          fail(where, "unknown key; use seeds, seed, objective, values, model");
+        }
+      }
+    } else if (t.name.rfind("conditions.", 0) == 0) {
+      DesignCondition c;
+      c.name = t.name.substr(11);
+      if (c.name.empty() || c.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") !=
+                                std::string::npos) {
+        fail("[" + t.name + "]", "a condition's name is letters, digits, - and _");
+      }
+      for (const auto& s : t.settings) {
+        const std::string where = "[" + t.name + "] " + s.key;
+        if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use the names of pdp synth --help or anisotropy");
+        if (s.key == "seed" || s.key == "dx" || s.key == "dy" || s.key == "dz" || s.key == "tips" || s.key == "fs" ||
+            s.key == "duration") {
+          fail(where, "the probe and the record are candidates: give them in [candidates]");
+        }
+        if (s.items.size() >= 2) {
+          if (!kRangeable.count(s.key)) fail(where, "only velocity, tu, anisotropy, time-scale, void-fraction and bubble-diameter take ranges");
+          const bool log = s.items.size() == 3 && s.items[2] == "log";
+          if (s.items.size() != 2 && !log) fail(where, "write a value, [min, max] or [min, max, \"log\"]");
+          const double lo = quantity(where, s.items[0], dimension_of(s.key));
+          const double hi = quantity(where, s.items[1], dimension_of(s.key));
+          if (!(lo <= hi)) fail(where, "min must not exceed max");
+          if (log && !(lo > 0.0)) fail(where, "a log-uniform range needs min > 0");
+          c.ranges[s.key] = {lo, hi};
+          if (log) c.log_ranges.insert(s.key);
+        } else {
+          if (s.key == "anisotropy") quantity(where, s.text, awcc::Dimension::dimensionless);
+          else {
+            synth::Scene probe;
+            try {
+              synth::set_scene_field(probe, s.key, s.text);
+            } catch (const std::exception& e) {
+              fail(where, e.what());
+            }
+          }
+          c.values[s.key] = s.text;
+        }
+      }
+      // Tu errors are relative: a condition needs Tu well above zero.
+      const double tu_min = c.ranges.count("tu") ? c.ranges["tu"].first
+                            : c.values.count("tu") ? quantity("[" + t.name + "] tu", c.values["tu"], awcc::Dimension::dimensionless)
+                                                   : synth::Scene{}.tu;
+      if (!(tu_min >= 0.02)) fail("[" + t.name + "] tu", "Tu below 0.02: its error is relative (Tu / Tu_true - 1); give Tu >= 0.02");
+      d.conditions.push_back(std::move(c));
+    } else if (t.name == "candidates") {
+      for (const auto& s : t.settings) {
+        const std::string where = "[candidates] " + s.key;
+        if (s.items.empty()) fail(where, "must be a non-empty list");
+        if (s.key == "dx" || s.key == "dy") {
+          auto& list = s.key == "dx" ? dxs : dys;
+          list.clear();
+          for (const auto& x : s.items) list.push_back(quantity(where, x, awcc::Dimension::length));
+          grid_given = true;
+        } else if (s.key == "probes") {
+          for (const auto& x : s.items) {
+            const auto cells = awcc::split_cells(x);
+            if (cells.size() != 2) fail(where, fmt::format("'{}': write each probe as \"dx,dy\", e.g. \"5mm,1mm\"", x));
+            d.geometries.push_back({quantity(where, cells[0], awcc::Dimension::length),
+                                    quantity(where, cells[1], awcc::Dimension::length)});
+          }
+          probes_given = true;
+        } else if (s.key == "np") {
+          d.nps.clear();
+          for (const auto& x : s.items) d.nps.push_back(static_cast<int>(whole(where, x, 1, 1000)));
+        } else if (s.key == "fs") {
+          d.fss.clear();
+          for (const auto& x : s.items) d.fss.push_back(quantity(where, x, awcc::Dimension::frequency));
+        } else if (s.key == "duration") {
+          d.durations.clear();
+          for (const auto& x : s.items) d.durations.push_back(quantity(where, x, awcc::Dimension::time));
+        } else {
+          fail(where, "unknown key; use dx, dy, probes, np, fs, duration");
+        }
+      }
+    } else if (t.name == "current") {
+      DesignCandidate c;
+      std::set<std::string> given;
+      for (const auto& s : t.settings) {
+        const std::string where = "[current] " + s.key;
+        given.insert(s.key);
+        if (s.key == "dx") c.dx = quantity(where, s.text, awcc::Dimension::length);
+        else if (s.key == "dy") c.dy = quantity(where, s.text, awcc::Dimension::length);
+        else if (s.key == "np") c.np = static_cast<int>(whole(where, s.text, 1, 1000));
+        else if (s.key == "fs") c.fs = quantity(where, s.text, awcc::Dimension::frequency);
+        else if (s.key == "duration") c.duration = quantity(where, s.text, awcc::Dimension::time);
+        else fail(where, "unknown key; use dx, dy, np, fs, duration");
+      }
+      for (const char* k : {"dx", "dy", "np", "fs", "duration"}) {
+        if (!given.count(k)) fail("[current]", fmt::format("give {} (the current probe needs dx, dy, np, fs and duration)", k));
+      }
+      d.current = c;
+    } else {
+      fail("[" + t.name + "]", "unknown table; use [design], [conditions.NAME], [candidates] and [current]");
+    }
+  }
+  if (d.conditions.empty()) fail("[conditions.NAME]", "give at least one condition, e.g. [conditions.wall] with velocity, tu, void-fraction ...");
+  if (probes_given && grid_given) fail("[candidates]", "give either probes or dx and dy, not both");
+  if (!probes_given) {
+    for (double dx : dxs)
+      for (double dy : dys) d.geometries.push_back({dx, dy});
+  }
+  for (const auto& [dx, dy] : d.geometries) {
+    if (!(dx > 0.0 && dx < 0.1)) fail("[candidates] dx", fmt::format("{} m: a streamwise separation is above 0 and below 100 mm", dx));
+    if (!(dy >= 0.0 && dy < 0.1)) fail("[candidates] dy", fmt::format("{} m: a lateral separation is 0 to 100 mm", dy));
+  }
+  for (double fs : d.fss)
+    if (!(fs >= 1e3 && fs <= 1e8)) fail("[candidates] fs", fmt::format("{} Hz: give 1 kHz to 100 MHz", fs));
+  for (double t : d.durations)
+    if (!(t > 0.0 && t <= 3600.0)) fail("[candidates] duration", fmt::format("{} s: give up to an hour", t));
+  if (d.current) {
+    const auto& c = *d.current;
+    if (std::find(d.geometries.begin(), d.geometries.end(), std::pair{c.dx, c.dy}) == d.geometries.end()) {
+      d.geometries.push_back({c.dx, c.dy});
+    }
+    if (std::find(d.nps.begin(), d.nps.end(), c.np) == d.nps.end()) d.nps.push_back(c.np);
+    if (std::find(d.fss.begin(), d.fss.end(), c.fs) == d.fss.end()) d.fss.push_back(c.fs);
+    if (std::find(d.durations.begin(), d.durations.end(), c.duration) == d.durations.end()) d.durations.push_back(c.duration);
+  }
+  if (d.geometries.size() > 63) fail("[candidates]", fmt::format("{} geometries: a simulated probe has at most 63 trailing tips", d.geometries.size()));
+  // The canonical text of what the rows depend on (not the objective, the
+  // values ranked on or the model's name: changing those re-ranks the same rows).
+  std::string c = fmt::format("seeds={};seed={};", d.seeds, d.seed);
+  for (const auto& cond : d.conditions) {
+    c += "condition=" + cond.name + ";";
+    for (const auto& [k, v] : cond.values) c += k + "=" + v + ";";
+    for (const auto& [k, r] : cond.ranges) c += fmt::format("{}={:.17g},{:.17g}{};", k, r.first, r.second, cond.log_ranges.count(k) ? ",log" : "");
+  }
+  for (const auto& [dx, dy] : d.geometries) c += fmt::format("g={:.17g},{:.17g};", dx, dy);
+  for (int np : d.nps) c += fmt::format("np={};", np);
+  for (double fs : d.fss) c += fmt::format("fs={:.17g};", fs);
+  for (double t : d.durations) c += fmt::format("duration={:.17g};", t);
+  d.canonical = c;
+  return d;
+}
+
+std::uint64_t design_id(const DesignDefinition& d) { return fnv(d.canonical) >> 1; }
+
+std::int64_t DesignDefinition::tasks() const {
+  return static_cast<std::int64_t>(conditions.size() * fss.size() * durations.size()) * seeds;
+}
+
+std::int64_t DesignDefinition::rows_per_task() const {
+  return static_cast<std::int64_t>(geometries.size() * nps.size());
+}
+
+std::vector<DesignCandidate> DesignDefinition::candidates() const {
+  std::vector<DesignCandidate> out;
+  for (const auto& [dx, dy] : geometries)
+    for (int np : nps)
+      for (double fs : fss)
+        for (double t : durations) out.push_back({dx, dy, np, fs, t});
+  return out;
+}
+
+DesignTask DesignDefinition::task(std::int64_t index) const {
+  DesignTask t;
+  t.index = index;
+  std::int64_t i = index;
+  t.record = static_cast<int>(i % seeds);
+  i /= seeds;
+  t.duration = durations[static_cast<std::size_t>(i % static_cast<std::int64_t>(durations.size()))];
+  i /= static_cast<std::int64_t>(durations.size());
+  t.fs = fss[static_cast<std::size_t>(i % static_cast<std::int64_t>(fss.size()))];
+  i /= static_cast<std::int64_t>(fss.size());
+  t.condition = static_cast<std::size_t>(i);
+  const auto& c = conditions.at(t.condition);
+  // The record's flow and bubbles depend on the condition and the record
+  // number only: every setting and geometry sees the same flow.
+  const std::uint64_t key = seed ^ fnv(c.name);
+  synth::Scene s;
+  for (const auto& [k, v] : c.values) {
+    if (k == "anisotropy") t.anisotropy = awcc::parse_quantity(v, awcc::Dimension::dimensionless);
+    else synth::set_scene_field(s, k, v);
+  }
+  synth::Rng rng(awcc::derive_seed(key, static_cast<std::uint64_t>(t.record)), synth::Stream::bubbles);
+  for (const auto& [k, r] : c.ranges) {
+    const double u = rng.uniform();
+    const double v = c.log_ranges.count(k) ? std::exp(std::log(r.first) + (std::log(r.second) - std::log(r.first)) * u)
+                                           : r.first + (r.second - r.first) * u;
+    if (k == "anisotropy") t.anisotropy = v;
+    else synth::set_scene_field(s, k, fmt::format("{:.17g}{}", v, awcc::si_unit(dimension_of(k))));
+  }
+  if (!c.values.count("tu-y") && !c.ranges.count("tu-y")) s.tu_y = t.anisotropy * s.tu;
+  if (!c.values.count("tu-z") && !c.ranges.count("tu-z")) s.tu_z = t.anisotropy * s.tu;
+  s.seed = awcc::derive_seed(key ^ 0x5eedull, static_cast<std::uint64_t>(t.record));
+  s.fs = t.fs;
+  s.duration = t.duration;
+  s.tips.clear();
+  s.tips.push_back({0.0, 0.0, 0.0});
+  double closest = std::numeric_limits<double>::infinity();
+  for (const auto& [dx, dy] : geometries) {
+    s.tips.push_back({dx, dy, 0.0});
+    closest = std::min(closest, std::hypot(dx, dy));
+  }
+  if (!(s.realisation_step > 0.0)) {
+    const double t_min = std::min({s.time_scale_of(0), s.time_scale_of(1), s.time_scale_of(2)});
+    s.realisation_step = std::min(t_min / 50.0, closest / s.velocity / 10.0);
+  }
+  t.scene = s;
+  return t;
+}
+
+std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTask& task,
+                                       const correction::CorrectionModel* model, const awcc::AwccOptions& processing) {
+  synth::Synthesis syn;
+  const double seconds_synth = cost([&] { syn = synth::synthesise(task.scene); });
+  const auto& lead = syn.signals.at(0);
+  const auto phase = awcc::phase_statistics(lead);
+  std::vector<DesignRow> rows;
+  for (std::size_t g = 0; g < d.geometries.size(); ++g) {
+    const auto [dx, dy] = d.geometries[g];
+    const auto& trail = syn.signals.at(g + 1);
+    std::optional<awcc::FsccResult> fscc;  // once per pair, and only when the FSCC forest needs it
+    for (int np : d.nps) {
+      DesignRow r;
+      r.task = task.index;
+      r.condition = d.conditions[task.condition].name;
+      r.record = task.record;
+      r.seed = task.scene.seed;
+      r.candidate = {dx, dy, np, task.fs, task.duration};
+      r.truth_velocity = syn.truth.realised.mean_velocity[0];
+      r.truth_turbulence_intensity = syn.truth.realised.turbulence_intensity[0];
+      r.seconds_synth = seconds_synth;
+      awcc::AwccOptions options = processing;
+      options.np = np;
+      awcc::AwccResult res;
+      r.seconds_awcc = cost([&] { res = awcc::awcc(lead, trail, dx, options); });
+      if (res.ok()) {
+        r.awcc_velocity = res.velocity;
+        r.awcc_turbulence_intensity = res.turbulence_intensity;
+      }
+      r.windows_accepted = res.windows_accepted;
+      r.windows_total = res.windows_total;
+      if (model) {
+        auto m = awcc_measurement(res, phase, dx, dy, np, task.fs, task.duration);
+        correction::Correction c;
+        r.seconds_awcc += cost([&] { c = model->correct(m); });
+        if (!c.corrected() && model->falls_back_to_fscc(c.status)) {
+          if (!fscc) r.seconds_awcc += cost([&] { fscc = awcc::fscc(lead, trail, dx, {}); });
+          if (fscc->ok()) {
+            m.fscc_velocity = fscc->velocity;
+            m.r12_max = fscc->r12_max;
+            r.seconds_awcc += cost([&] { c = model->correct(m); });
+          }
+        }
+        r.correction_status = std::string(correction::to_string(c.status));
+        if (c.corrected()) {
+          r.correction_forest = c.forest;
+          if (c.velocity) r.corrected_velocity = c.velocity->median();
+          if (c.turbulence_intensity) r.corrected_turbulence_intensity = c.turbulence_intensity->median();
+        }
+      }
+      rows.push_back(std::move(r));
+    }
+  }
+  return rows;
+}
+
+std::string design_rows_header() {
+  return "design,task,condition,record,seed,dx,dy,np,fs,duration,truth_velocity,truth_turbulence_intensity,"
+         "awcc_velocity,awcc_turbulence_intensity,windows_accepted,windows_total,corrected_velocity,"
+         "corrected_turbulence_intensity,correction_status,correction_forest,seconds_awcc,seconds_synth";
+}
+
+std::string design_row_text(const DesignRow& r, std::uint64_t design) {
+  return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f},{:.4f}", design, r.task,
+                     r.condition, r.record, r.seed, num(r.candidate.dx), num(r.candidate.dy), r.candidate.np,
+                     num(r.candidate.fs), num(r.candidate.duration), num(r.truth_velocity),
+                     num(r.truth_turbulence_intensity), num(r.awcc_velocity), num(r.awcc_turbulence_intensity),
+                     r.windows_accepted, r.windows_total, num(r.corrected_velocity),
+                     num(r.corrected_turbulence_intensity), r.correction_status, r.correction_forest, r.seconds_awcc,
+                     r.seconds_synth);
+}
+
+std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::uint64_t design) {
+  std::vector<DesignRow> out;
+  std::ifstream in(csv, std::ios::binary);
+  if (!in) return out;
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (text.empty()) return out;
+  // A crash while writing leaves a partial last line: it is not a row.
+  if (text.back() != '\n') text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
+  std::size_t pos = 0;
+  std::int64_t line_number = 0;
+  const std::string file = csv.string();
+  while (pos < text.size()) {
+    const auto end = text.find('\n', pos);
+    const std::string line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_number;
+    if (line_number == 1) {
+      if (line != design_rows_header()) {
+        throw awcc::InputError(fmt::format("{}: not the runs file of pdp design (its header differs); give another -o or "
+                                           "remove the file",
+                                           file));
+      }
+      continue;
+    }
+    const auto cells = awcc::split_cells(line);
+    const auto where = fmt::format("{}:{}", file, line_number);
+    if (cells.size() != 22) throw awcc::InputError(fmt::format("{}: {} cells where the header has 22", where, cells.size()));
+    auto number = [&](std::size_t i) {
+      const auto v = awcc::cell_number(cells[i]);
+      if (!v) throw awcc::InputError(fmt::format("{}: column {} = '{}' is not a number", where, i + 1, cells[i]));
+      return *v;
+    };
+    auto optional = [&](std::size_t i) -> std::optional<double> {
+      if (cells[i].empty()) return std::nullopt;
+      return number(i);
+    };
+    if (cells[0] != std::to_string(design)) {
+      throw awcc::InputError(fmt::format("{}: a row of another design ({}); the definition changed since these rows "
+                                         "were written: give another -o or remove the file",
+                                         where, cells[0]));
+    }
+    DesignRow r;
+    r.task = static_cast<std::int64_t>(number(1));
+    r.condition = cells[2];
+    r.record = static_cast<int>(number(3));
+    r.seed = std::stoull(cells[4]);
+    r.candidate = {number(5), number(6), static_cast<int>(number(7)), number(8), number(9)};
+    r.truth_velocity = number(10);
+    r.truth_turbulence_intensity = number(11);
+    r.awcc_velocity = optional(12);
+    r.awcc_turbulence_intensity = optional(13);
+    r.windows_accepted = static_cast<std::int64_t>(number(14));
+    r.windows_total = static_cast<std::int64_t>(number(15));
+    r.corrected_velocity = optional(16);
+    r.corrected_turbulence_intensity = optional(17);
+    r.correction_status = cells[18];
+    r.correction_forest = cells[19];
+    r.seconds_awcc = number(20);
+    r.seconds_synth = number(21);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+ErrorStats error_stats(const std::vector<double>& errors) {
+  ErrorStats s;
+  s.count = static_cast<std::int64_t>(errors.size());
+  if (errors.empty()) return s;
+  double sum = 0.0, squares = 0.0;
+  for (double e : errors) sum += e, squares += e * e;
+  const auto n = static_cast<double>(errors.size());
+  s.bias = sum / n;
+  s.rms = std::sqrt(squares / n);
+  if (errors.size() > 1) {
+    double ss = 0.0;
+    for (double e : errors) ss += (e - s.bias) * (e - s.bias);
+    s.spread = std::sqrt(ss / (n - 1.0));
+  }
+  return s;
+}
+
+std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const std::vector<DesignRow>& rows) {
+  std::map<std::pair<DesignCandidate, std::string>, std::vector<const DesignRow*>> groups;
+  for (const auto& r : rows) groups[{r.candidate, r.condition}].push_back(&r);
+  const bool corrected = d.values == "corrected";
+  std::vector<RankedCandidate> out;
+  for (const auto& candidate : d.candidates()) {
+    RankedCandidate rc;
+    rc.candidate = candidate;
+    rc.current = d.current && *d.current == candidate;
+    double worst = 0.0, sum = 0.0;
+    for (const auto& condition : d.conditions) {
+      ConditionScore cs;
+      cs.condition = condition.name;
+      std::vector<double> ru, rt, cu, ct;
+      double yield = 0.0, seconds = 0.0, corrected_count = 0.0;
+      const auto it = groups.find({candidate, condition.name});
+      if (it != groups.end()) {
+        for (const DesignRow* r : it->second) {
+          ++cs.records;
+          seconds += r->seconds_awcc;
+          if (r->windows_total > 0) yield += static_cast<double>(r->windows_accepted) / static_cast<double>(r->windows_total);
+          if (r->awcc_velocity) ru.push_back(*r->awcc_velocity / r->truth_velocity - 1.0);
+          if (r->awcc_turbulence_intensity) rt.push_back(*r->awcc_turbulence_intensity / r->truth_turbulence_intensity - 1.0);
+          // Reported values: the model's median where it corrected, AWCC's elsewhere.
+          const auto u = r->corrected_velocity ? r->corrected_velocity : r->awcc_velocity;
+          const auto tu = r->corrected_turbulence_intensity ? r->corrected_turbulence_intensity : r->awcc_turbulence_intensity;
+          if (r->corrected_velocity) ++corrected_count;
+          if (u) cu.push_back(*u / r->truth_velocity - 1.0);
+          if (tu) ct.push_back(*tu / r->truth_turbulence_intensity - 1.0);
+          const bool has = corrected ? (u && tu) : (r->awcc_velocity && r->awcc_turbulence_intensity);
+          if (!has) ++cs.failures;
+        }
+      }
+      if (cs.records > 0) {
+        const auto n = static_cast<double>(cs.records);
+        cs.data_yield = yield / n;
+        cs.seconds = seconds / n;
+        cs.corrected_fraction = corrected_count / n;
+      }
+      cs.raw_u = error_stats(ru);
+      cs.raw_tu = error_stats(rt);
+      cs.corrected_u = error_stats(cu);
+      cs.corrected_tu = error_stats(ct);
+      cs.score = corrected ? cs.corrected_u.rms + cs.corrected_tu.rms : cs.raw_u.rms + cs.raw_tu.rms;
+      // A condition without a single scored record cannot be ranked on.
+      if (cs.records == 0 || (corrected ? cs.corrected_u.count == 0 || cs.corrected_tu.count == 0
+                                        : cs.raw_u.count == 0 || cs.raw_tu.count == 0)) {
+        cs.score = std::numeric_limits<double>::infinity();
+        cs.failures = std::max<std::int64_t>(cs.failures, 1);
+      }
+      rc.failures += cs.failures;
+      worst = std::max(worst, cs.score);
+      sum += cs.score;
+      rc.seconds += cs.seconds / static_cast<double>(d.conditions.size());
+      rc.conditions.push_back(std::move(cs));
+    }
+    rc.objective = d.objective == "mean" ? sum / static_cast<double>(d.conditions.size()) : worst;
+    out.push_back(std::move(rc));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const RankedCandidate& a, const RankedCandidate& b) {
+    if (a.failures != b.failures) return a.failures < b.failures;
+    if (a.objective != b.objective) return a.objective < b.objective;
+    if (a.seconds != b.seconds) return a.seconds < b.seconds;
+    return a.candidate < b.candidate;
+  });
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].rank = static_cast<int>(i + 1);
+  return out;
+}
+
+std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d) {
+  std::string out =
+      "rank,objective,failures,current,dx,dy,np,fs,duration,seconds_awcc,condition,records,condition_failures,score,"
+      "u_bias,u_spread,u_rms,tu_bias,tu_spread,tu_rms,raw_u_bias,raw_u_spread,raw_u_rms,raw_tu_bias,raw_tu_spread,"
+      "raw_tu_rms,corrected_fraction,data_yield\n";
+  const bool corrected = d.values == "corrected";
+  for (const auto& r : ranked) {
+    for (const auto& c : r.conditions) {
+      const auto& u = corrected ? c.corrected_u : c.raw_u;
+      const auto& t = corrected ? c.corrected_tu : c.raw_tu;
+      out += fmt::format("{},{},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n",
+                         r.rank, num(r.objective), r.failures, r.current ? 1 : 0, num(r.candidate.dx),
+                         num(r.candidate.dy), r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), r.seconds,
+                         c.condition, c.records, c.failures, num(c.score), num(u.bias), num(u.spread), num(u.rms),
+                         num(t.bias), num(t.spread), num(t.rms), num(c.raw_u.bias), num(c.raw_u.spread),
+                         num(c.raw_u.rms), num(c.raw_tu.bias), num(c.raw_tu.spread), num(c.raw_tu.rms),
+                         c.corrected_fraction, c.data_yield);
+    }
+  }
+  return out;
+}
+
+std::string design_summary(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d,
+                           const std::string& model_note) {
+  std::string out;
+  if (ranked.empty()) return out;
+  const bool corrected = d.values == "corrected";
+  const auto& best = ranked.front();
+  out += fmt::format("{} candidates x {} conditions, {} records each; ranked on the {} of |u error| + |Tu error| "
+                     "(RMS over the records, relative) {} ({})\n",
+                     ranked.size(), d.conditions.size(), d.seeds, d.objective == "mean" ? "mean over the conditions" : "worst condition",
+                     corrected ? "of the reported values: the corrected median where the model corrects, AWCC's elsewhere"
+                               : "of raw AWCC",
+                     model_note);
+  out += fmt::format("Recommended: {}: {} {:.3f}{}\n", describe(best.candidate),
+                     d.objective == "mean" ? "mean" : "worst-case", best.objective,
+                     best.failures ? fmt::format(" ({} records without a value)", best.failures) : "");
+  out += "  condition             u bias  u spread   Tu bias  Tu spread   raw u bias  raw Tu bias   yield  corrected\n";
+  for (const auto& c : best.conditions) {
+    const auto& u = corrected ? c.corrected_u : c.raw_u;
+    const auto& t = corrected ? c.corrected_tu : c.raw_tu;
+    out += fmt::format("  {:<20} {:+6.1f} % {:7.1f} % {:+7.1f} % {:8.1f} %   {:+8.1f} % {:+9.1f} %  {:5.0f} %  {:6.0f} %\n",
+                       c.condition, 100 * u.bias, 100 * u.spread, 100 * t.bias, 100 * t.spread, 100 * c.raw_u.bias,
+                       100 * c.raw_tu.bias, 100 * c.data_yield, 100 * c.corrected_fraction);
+  }
+  auto versus = [&](const RankedCandidate& other, const char* what) {
+    std::string ratio = std::isfinite(other.objective) && best.objective > 0.0
+                            ? fmt::format("{:.1f}x the recommended error", other.objective / best.objective)
+                            : "no value in some records";
+    out += fmt::format("{}: {} (rank {} of {}): {:.3f}{}; {}\n", what, describe(other.candidate), other.rank,
+                       ranked.size(), other.objective,
+                       other.failures ? fmt::format(", {} records without a value", other.failures) : "", ratio);
+  };
+  versus(ranked.back(), "Worst");
+  for (const auto& r : ranked)
+    if (r.current) versus(r, "Current probe");
+  return out;
+}
+
+}  // namespace pdp
