@@ -524,10 +524,14 @@ std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const st
     rc.objective = d.objective == "mean" ? sum / static_cast<double>(d.conditions.size()) : worst;
     out.push_back(std::move(rc));
   }
+  // Ties (equal objectives) go to the cheaper record: the shorter one, then
+  // the lower rate. Not to the measured CPU seconds, which differ from run
+  // to run: the same rows must give the same ranking.
   std::stable_sort(out.begin(), out.end(), [](const RankedCandidate& a, const RankedCandidate& b) {
     if (a.failures != b.failures) return a.failures < b.failures;
     if (a.objective != b.objective) return a.objective < b.objective;
-    if (a.seconds != b.seconds) return a.seconds < b.seconds;
+    if (a.candidate.duration != b.candidate.duration) return a.candidate.duration < b.candidate.duration;
+    if (a.candidate.fs != b.candidate.fs) return a.candidate.fs < b.candidate.fs;
     return a.candidate < b.candidate;
   });
   for (std::size_t i = 0; i < out.size(); ++i) out[i].rank = static_cast<int>(i + 1);

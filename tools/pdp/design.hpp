@@ -45,7 +45,8 @@
 // values ranked on; its objective the worst (or the mean) over conditions.
 // Candidates whose records gave no value (AWCC refused, too few windows) rank
 // after those without, fewest failures first; then by objective; then by
-// cost.
+// cost: the shorter record, then the lower sampling rate (the CPU seconds
+// are reported, not ranked on: they differ from run to run).
 
 #include <cstdint>
 #include <filesystem>
