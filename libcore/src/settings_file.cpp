@@ -87,15 +87,20 @@ std::vector<SettingTable> read_setting_tables(const std::filesystem::path& path,
       out.push_back({name, static_cast<int>(node.source().begin.line), settings_of(path, *inner, false)});
       continue;
     }
+    std::vector<SettingTable> members;
     for (const auto& [member, member_node] : *inner) {
       const auto* table = member_node.as_table();
       if (!table) {
         throw InputError(fmt::format("{}:{}: {}.{} is not a table; write [{}.NAME] tables of settings", path.string(),
                                      member_node.source().begin.line, name, member.str(), name));
       }
-      out.push_back({name + "." + std::string(member.str()), static_cast<int>(member_node.source().begin.line),
-                     settings_of(path, *table, false)});
+      members.push_back({name + "." + std::string(member.str()), static_cast<int>(member_node.source().begin.line),
+                         settings_of(path, *table, false)});
     }
+    // In the file's order (the parser keeps them sorted by name).
+    std::stable_sort(members.begin(), members.end(),
+                     [](const SettingTable& a, const SettingTable& b) { return a.line < b.line; });
+    out.insert(out.end(), members.begin(), members.end());
   }
   return out;
 }

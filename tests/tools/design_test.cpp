@@ -40,6 +40,10 @@ TEST(DesignFile, ReadsConditionsCandidatesAndTheCurrentProbe) {
   EXPECT_EQ(d.seeds, 3);
   ASSERT_EQ(d.conditions.size(), 2u);
   EXPECT_EQ(d.conditions[0].name, "upper");
+  EXPECT_EQ(d.conditions[1].name, "wall");
+  // Conditions keep the file's order, not their names'.
+  const auto z = pdp::load_design(write("order.toml", "[conditions.z]\ntu = 0.2\n[conditions.a]\ntu = 0.3\n"));
+  EXPECT_EQ(z.conditions[0].name, "z");
   EXPECT_EQ(d.conditions[1].ranges.at("velocity"), (std::pair{2.0, 4.0}));
   EXPECT_TRUE(d.conditions[1].log_ranges.count("void-fraction"));
   // The current probe's geometry joins the grid's four.

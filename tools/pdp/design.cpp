@@ -538,6 +538,16 @@ std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const st
   return out;
 }
 
+namespace {
+
+// Bias, spread and RMS; empty cells where no record gave a value (not 0).
+std::string stats_cells(const ErrorStats& s) {
+  if (s.count == 0) return ",,";
+  return fmt::format("{},{},{}", num(s.bias), s.count > 1 ? num(s.spread) : std::string(), num(s.rms));
+}
+
+}  // namespace
+
 std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d) {
   std::string out =
       "rank,objective,failures,current,dx,dy,np,fs,duration,seconds_awcc,condition,records,condition_failures,score,"
@@ -548,13 +558,11 @@ std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignD
     for (const auto& c : r.conditions) {
       const auto& u = corrected ? c.corrected_u : c.raw_u;
       const auto& t = corrected ? c.corrected_tu : c.raw_tu;
-      out += fmt::format("{},{},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n",
-                         r.rank, num(r.objective), r.failures, r.current ? 1 : 0, num(r.candidate.dx),
-                         num(r.candidate.dy), r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), r.seconds,
-                         c.condition, c.records, c.failures, num(c.score), num(u.bias), num(u.spread), num(u.rms),
-                         num(t.bias), num(t.spread), num(t.rms), num(c.raw_u.bias), num(c.raw_u.spread),
-                         num(c.raw_u.rms), num(c.raw_tu.bias), num(c.raw_tu.spread), num(c.raw_tu.rms),
-                         c.corrected_fraction, c.data_yield);
+      out += fmt::format("{},{},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
+                         num(r.objective), r.failures, r.current ? 1 : 0, num(r.candidate.dx), num(r.candidate.dy),
+                         r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), r.seconds, c.condition,
+                         c.records, c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
+                         stats_cells(c.raw_tu), c.corrected_fraction, c.data_yield);
     }
   }
   return out;
