@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "awcc/errors.hpp"
+#include "awcc/probe_correction.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
 
@@ -184,10 +185,42 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   d.values = "raw";
   const auto raw = pdp::rank_candidates(d, rows);
   EXPECT_NEAR(raw[0].objective, 0.2, 1e-12);
+  // A needle scales every velocity of its candidate by the predicted ratio:
+  // the same rows, ranked with a 1 mm needle, carry that ratio in u's bias.
+  auto with_needle = d;
+  with_needle.needles = {0.0, 1e-3};
+  for (auto& r : rows) r.void_fraction = 0.1, r.count_rate = 80.0;
+  const auto needled = pdp::rank_candidates(with_needle, rows);
+  ASSERT_EQ(needled.size(), 12u);
+  for (const auto& n : needled) {
+    if (n.candidate.needle == 0.0 || n.candidate.dx != c[1].dx || n.candidate.duration != c[1].duration) continue;
+    const double ratio = pdp::needle_velocity_ratio(4.0, 0.1, 80.0, c[1].dx, 1e-3);
+    EXPECT_NEAR(n.conditions[0].raw_u.bias, ratio * 1.1 - 1.0, 1e-12);
+    EXPECT_NEAR(n.conditions[0].raw_tu.bias, 0.1, 1e-12);  // Tu is left alone
+  }
   // The ranked CSV: one row per candidate and condition, best first.
   const auto csv = pdp::ranked_csv(ranked, d);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6 * 2);
   EXPECT_EQ(csv.substr(csv.find('\n') + 1, 2), "1,");
+}
+
+TEST(DesignScores, TheNeedlesSlowingIsTheInverseOfTheProbeCorrection) {
+  // u_m = ratio u0 is the measured velocity whose correction (METHOD 9)
+  // gives back u0: by construction, to the bisection's tolerance.
+  const double u0 = 3.0, c = 0.08, f = 60.0, dx = 5e-3;
+  const double r = pdp::needle_velocity_ratio(u0, c, f, dx, 0.6e-3);
+  EXPECT_LT(r, 1.0);
+  EXPECT_GT(r, 0.8);
+  awcc::ProbeCorrectionOptions o;
+  o.enabled = true;
+  o.needle_diameter = 0.6e-3;
+  const auto back = awcc::correct_window(r * u0, c, f, dx, o);
+  ASSERT_EQ(back.outcome, awcc::CorrectionOutcome::corrected);
+  EXPECT_NEAR(back.velocity, u0, 1e-6 * u0);
+  // A thicker needle slows more; no needle, or c above 0.3 (not bubbly), not at all.
+  EXPECT_LT(pdp::needle_velocity_ratio(u0, c, f, dx, 1.2e-3), r);
+  EXPECT_EQ(pdp::needle_velocity_ratio(u0, c, f, dx, 0.0), 1.0);
+  EXPECT_EQ(pdp::needle_velocity_ratio(u0, 0.35, f, dx, 0.6e-3), 1.0);
 }
 
 TEST(DesignRows, WrittenRowsReadBackAndForeignOnesAreRefused) {

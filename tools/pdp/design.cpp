@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
@@ -14,6 +15,7 @@
 #include "awcc/units.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
+#include "awcc/probe_correction.hpp"
 #include "study.hpp"
 #include "synth/random.hpp"
 #include "synth/synthesiser.hpp"
@@ -53,8 +55,8 @@ std::string num(const std::optional<double>& v) { return v ? num(*v) : std::stri
 }  // namespace
 
 std::string describe(const DesignCandidate& c) {
-  return fmt::format("dx {:g} mm, dy {:g} mm, Np {}, {:g} kHz, {:g} s", c.dx * 1e3, c.dy * 1e3, c.np, c.fs / 1e3,
-                     c.duration);
+  return fmt::format("dx {:g} mm, dy {:g} mm, Np {}, {:g} kHz, {:g} s{}", c.dx * 1e3, c.dy * 1e3, c.np, c.fs / 1e3,
+                     c.duration, c.needle > 0.0 ? fmt::format(", needle {:g} mm", c.needle * 1e3) : "");
 }
 
 DesignDefinition load_design(const std::filesystem::path& path) {
@@ -87,13 +89,11 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   };
   std::vector<double> dxs{1e-3, 2e-3, 3e-3, 5e-3, 7.5e-3, 10e-3}, dys{0.0, 0.5e-3, 1e-3, 2e-3};
   bool probes_given = false, grid_given = false;
-  std::string canonical;
   for (const auto& t : tables) {
     if (t.name.empty()) {
       if (!t.settings.empty()) fail(t.settings.front().key, "must be in a table: [design], [conditions.NAME], [candidates] or [current]");
       continue;
     }
-    for (const auto& s : t.settings) canonical += t.name + "." + s.key + "=" + s.text + ";";
     if (t.name == "design") {
       for (const auto& s : t.settings) {
         const std::string where = "[design] " + s.key;
@@ -180,8 +180,14 @@ DesignDefinition load_design(const std::filesystem::path& path) {
         } else if (s.key == "duration") {
           d.durations.clear();
           for (const auto& x : s.items) d.durations.push_back(quantity(where, x, awcc::Dimension::time));
+        } else if (s.key == "needle") {
+          d.needles.clear();
+          for (const auto& x : s.items) {
+            d.needles.push_back(quantity(where, x, awcc::Dimension::length));
+            if (!(d.needles.back() >= 0.0 && d.needles.back() < 0.01)) fail(where, "a needle diameter is 0 (none) to 10 mm");
+          }
         } else {
-          fail(where, "unknown key; use dx, dy, probes, np, fs, duration");
+          fail(where, "unknown key; use dx, dy, probes, np, fs, duration, needle");
         }
       }
     } else if (t.name == "current") {
@@ -195,7 +201,8 @@ DesignDefinition load_design(const std::filesystem::path& path) {
         else if (s.key == "np") c.np = static_cast<int>(whole(where, s.text, 1, 1000));
         else if (s.key == "fs") c.fs = quantity(where, s.text, awcc::Dimension::frequency);
         else if (s.key == "duration") c.duration = quantity(where, s.text, awcc::Dimension::time);
-        else fail(where, "unknown key; use dx, dy, np, fs, duration");
+        else if (s.key == "needle") c.needle = quantity(where, s.text, awcc::Dimension::length);
+        else fail(where, "unknown key; use dx, dy, np, fs, duration, needle");
       }
       for (const char* k : {"dx", "dy", "np", "fs", "duration"}) {
         if (!given.count(k)) fail("[current]", fmt::format("give {} (the current probe needs dx, dy, np, fs and duration)", k));
@@ -227,6 +234,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
     if (std::find(d.nps.begin(), d.nps.end(), c.np) == d.nps.end()) d.nps.push_back(c.np);
     if (std::find(d.fss.begin(), d.fss.end(), c.fs) == d.fss.end()) d.fss.push_back(c.fs);
     if (std::find(d.durations.begin(), d.durations.end(), c.duration) == d.durations.end()) d.durations.push_back(c.duration);
+    if (std::find(d.needles.begin(), d.needles.end(), c.needle) == d.needles.end()) d.needles.push_back(c.needle);
   }
   if (d.geometries.size() > 63) fail("[candidates]", fmt::format("{} geometries: a simulated probe has at most 63 trailing tips", d.geometries.size()));
   // The canonical text of what the rows depend on (not the objective, the
@@ -241,6 +249,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   for (int np : d.nps) c += fmt::format("np={};", np);
   for (double fs : d.fss) c += fmt::format("fs={:.17g};", fs);
   for (double t : d.durations) c += fmt::format("duration={:.17g};", t);
+  // Not the needles: they scale the rows at ranking, and the rows stay valid.
   d.canonical = c;
   return d;
 }
@@ -260,7 +269,8 @@ std::vector<DesignCandidate> DesignDefinition::candidates() const {
   for (const auto& [dx, dy] : geometries)
     for (int np : nps)
       for (double fs : fss)
-        for (double t : durations) out.push_back({dx, dy, np, fs, t});
+        for (double t : durations)
+          for (double needle : needles) out.push_back({dx, dy, np, fs, t, needle});
   return out;
 }
 
@@ -332,6 +342,8 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
       r.candidate = {dx, dy, np, task.fs, task.duration};
       r.truth_velocity = syn.truth.realised.mean_velocity[0];
       r.truth_turbulence_intensity = syn.truth.realised.turbulence_intensity[0];
+      r.void_fraction = phase.void_fraction;
+      r.count_rate = phase.bubble_count_rate;
       r.seconds_synth = seconds_synth;
       awcc::AwccOptions options = processing;
       options.np = np;
@@ -370,15 +382,15 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
 
 std::string design_rows_header() {
   return "design,task,condition,record,seed,dx,dy,np,fs,duration,truth_velocity,truth_turbulence_intensity,"
-         "awcc_velocity,awcc_turbulence_intensity,windows_accepted,windows_total,corrected_velocity,"
+         "void_fraction,count_rate,awcc_velocity,awcc_turbulence_intensity,windows_accepted,windows_total,corrected_velocity,"
          "corrected_turbulence_intensity,correction_status,correction_forest,seconds_awcc,seconds_synth";
 }
 
 std::string design_row_text(const DesignRow& r, std::uint64_t design) {
-  return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f},{:.4f}", design, r.task,
+  return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f},{:.4f}", design, r.task,
                      r.condition, r.record, r.seed, num(r.candidate.dx), num(r.candidate.dy), r.candidate.np,
                      num(r.candidate.fs), num(r.candidate.duration), num(r.truth_velocity),
-                     num(r.truth_turbulence_intensity), num(r.awcc_velocity), num(r.awcc_turbulence_intensity),
+                     num(r.truth_turbulence_intensity), num(r.void_fraction), num(r.count_rate), num(r.awcc_velocity), num(r.awcc_turbulence_intensity),
                      r.windows_accepted, r.windows_total, num(r.corrected_velocity),
                      num(r.corrected_turbulence_intensity), r.correction_status, r.correction_forest, r.seconds_awcc,
                      r.seconds_synth);
@@ -410,7 +422,7 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     }
     const auto cells = awcc::split_cells(line);
     const auto where = fmt::format("{}:{}", file, line_number);
-    if (cells.size() != 22) throw awcc::InputError(fmt::format("{}: {} cells where the header has 22", where, cells.size()));
+    if (cells.size() != 24) throw awcc::InputError(fmt::format("{}: {} cells where the header has 24", where, cells.size()));
     auto number = [&](std::size_t i) {
       const auto v = awcc::cell_number(cells[i]);
       if (!v) throw awcc::InputError(fmt::format("{}: column {} = '{}' is not a number", where, i + 1, cells[i]));
@@ -433,16 +445,18 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     r.candidate = {number(5), number(6), static_cast<int>(number(7)), number(8), number(9)};
     r.truth_velocity = number(10);
     r.truth_turbulence_intensity = number(11);
-    r.awcc_velocity = optional(12);
-    r.awcc_turbulence_intensity = optional(13);
-    r.windows_accepted = static_cast<std::int64_t>(number(14));
-    r.windows_total = static_cast<std::int64_t>(number(15));
-    r.corrected_velocity = optional(16);
-    r.corrected_turbulence_intensity = optional(17);
-    r.correction_status = cells[18];
-    r.correction_forest = cells[19];
-    r.seconds_awcc = number(20);
-    r.seconds_synth = number(21);
+    r.void_fraction = number(12);
+    r.count_rate = number(13);
+    r.awcc_velocity = optional(14);
+    r.awcc_turbulence_intensity = optional(15);
+    r.windows_accepted = static_cast<std::int64_t>(number(16));
+    r.windows_total = static_cast<std::int64_t>(number(17));
+    r.corrected_velocity = optional(18);
+    r.corrected_turbulence_intensity = optional(19);
+    r.correction_status = cells[20];
+    r.correction_forest = cells[21];
+    r.seconds_awcc = number(22);
+    r.seconds_synth = number(23);
     out.push_back(std::move(r));
   }
   return out;
@@ -465,9 +479,55 @@ ErrorStats error_stats(const std::vector<double>& errors) {
   return s;
 }
 
+double needle_velocity_ratio(double true_velocity, double void_fraction, double count_rate, double dx, double needle) {
+  if (!(needle > 0.0) || !(true_velocity > 0.0)) return 1.0;
+  awcc::ProbeCorrectionOptions o;
+  o.enabled = true;
+  o.needle_diameter = needle;
+  if (void_fraction > o.max_void_fraction) return 1.0;
+  // u0(u_m) >= u_m rises with u_m: bisect u0(u_m) = u_true on (0, u_true].
+  auto undisturbed = [&](double measured) -> std::optional<double> {
+    const auto c = awcc::correct_window(measured, void_fraction, count_rate, dx, o);
+    if (c.outcome != awcc::CorrectionOutcome::corrected) return std::nullopt;
+    return c.velocity;
+  };
+  double hi = true_velocity, lo = 0.5 * true_velocity;
+  const auto at_hi = undisturbed(hi);
+  if (!at_hi || *at_hi <= true_velocity) return 1.0;  // no slowing predicted
+  for (int k = 0;; ++k) {  // lower lo until u0(lo) < u_true
+    const auto at_lo = undisturbed(lo);
+    if (at_lo && *at_lo < true_velocity) break;
+    if (k == 7) return 1.0;
+    hi = lo;
+    lo *= 0.5;
+  }
+  for (int k = 0; k < 60 && hi - lo > 1e-9 * true_velocity; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    const auto at = undisturbed(mid);
+    if (!at) return 1.0;
+    (*at < true_velocity ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi) / true_velocity;
+}
+
 std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const std::vector<DesignRow>& rows) {
+  // Rows do not depend on the needle: it scales their velocities below.
   std::map<std::pair<DesignCandidate, std::string>, std::vector<const DesignRow*>> groups;
-  for (const auto& r : rows) groups[{r.candidate, r.condition}].push_back(&r);
+  for (const auto& r : rows) {
+    auto key = r.candidate;
+    key.needle = 0.0;
+    groups[{key, r.condition}].push_back(&r);
+  }
+  // The needle's ratio per record, pair and needle (every Np shares it).
+  std::map<std::tuple<std::int64_t, double, double, double>, double> ratios;
+  auto ratio = [&](const DesignRow& r, double needle) {
+    if (!(needle > 0.0)) return 1.0;
+    const auto key = std::tuple{r.task, r.candidate.dx, r.candidate.dy, needle};
+    if (auto it = ratios.find(key); it != ratios.end()) return it->second;
+    const double v = needle_velocity_ratio(r.truth_velocity, r.void_fraction, r.count_rate, r.candidate.dx, needle);
+    ratios[key] = v;
+    return v;
+  };
   const bool corrected = d.values == "corrected";
   std::vector<RankedCandidate> out;
   for (const auto& candidate : d.candidates()) {
@@ -480,19 +540,22 @@ std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const st
       cs.condition = condition.name;
       std::vector<double> ru, rt, cu, ct;
       double yield = 0.0, seconds = 0.0, corrected_count = 0.0;
-      const auto it = groups.find({candidate, condition.name});
+      auto key = candidate;
+      key.needle = 0.0;
+      const auto it = groups.find({key, condition.name});
       if (it != groups.end()) {
         for (const DesignRow* r : it->second) {
           ++cs.records;
           seconds += r->seconds_awcc;
+          const double slowed = ratio(*r, candidate.needle);
           if (r->windows_total > 0) yield += static_cast<double>(r->windows_accepted) / static_cast<double>(r->windows_total);
-          if (r->awcc_velocity) ru.push_back(*r->awcc_velocity / r->truth_velocity - 1.0);
+          if (r->awcc_velocity) ru.push_back(slowed * *r->awcc_velocity / r->truth_velocity - 1.0);
           if (r->awcc_turbulence_intensity) rt.push_back(*r->awcc_turbulence_intensity / r->truth_turbulence_intensity - 1.0);
           // Reported values: the model's median where it corrected, AWCC's elsewhere.
           const auto u = r->corrected_velocity ? r->corrected_velocity : r->awcc_velocity;
           const auto tu = r->corrected_turbulence_intensity ? r->corrected_turbulence_intensity : r->awcc_turbulence_intensity;
           if (r->corrected_velocity) ++corrected_count;
-          if (u) cu.push_back(*u / r->truth_velocity - 1.0);
+          if (u) cu.push_back(slowed * *u / r->truth_velocity - 1.0);
           if (tu) ct.push_back(*tu / r->truth_turbulence_intensity - 1.0);
           const bool has = corrected ? (u && tu) : (r->awcc_velocity && r->awcc_turbulence_intensity);
           if (!has) ++cs.failures;
@@ -550,7 +613,7 @@ std::string stats_cells(const ErrorStats& s) {
 
 std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d) {
   std::string out =
-      "rank,objective,failures,current,dx,dy,np,fs,duration,seconds_awcc,condition,records,condition_failures,score,"
+      "rank,objective,failures,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,condition_failures,score,"
       "u_bias,u_spread,u_rms,tu_bias,tu_spread,tu_rms,raw_u_bias,raw_u_spread,raw_u_rms,raw_tu_bias,raw_tu_spread,"
       "raw_tu_rms,corrected_fraction,data_yield\n";
   const bool corrected = d.values == "corrected";
@@ -558,9 +621,10 @@ std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignD
     for (const auto& c : r.conditions) {
       const auto& u = corrected ? c.corrected_u : c.raw_u;
       const auto& t = corrected ? c.corrected_tu : c.raw_tu;
-      out += fmt::format("{},{},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
+      out += fmt::format("{},{},{},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
                          num(r.objective), r.failures, r.current ? 1 : 0, num(r.candidate.dx), num(r.candidate.dy),
-                         r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), r.seconds, c.condition,
+                         r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), num(r.candidate.needle),
+                         r.seconds, c.condition,
                          c.records, c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
                          stats_cells(c.raw_tu), c.corrected_fraction, c.data_yield);
     }

@@ -20,7 +20,8 @@
 //   [candidates]        dx and dy: lists whose grid is tried (default 1, 2,
 //                       3, 5, 7.5, 10 mm x 0, 0.5, 1, 2 mm), or probes = list of
 //                       "dx,dy" (existing probes) instead; np (5, 10, 20); fs
-//                       (100 kHz); duration (60 s).
+//                       (100 kHz); duration (60 s); needle: outer diameters
+//                       of the leading needle (default none: point tips).
 //   [current]           optional: the lab's probe and settings (dx, dy, np, fs,
 //                       duration), ranked with the candidates and named in the summary.
 //
@@ -43,6 +44,16 @@
 // (sqrt(bias^2 + (n - 1)/n sd^2)); the data yield; AWCC's CPU seconds per
 // record. The score of a candidate in a condition is RMS_u + RMS_Tu of the
 // values ranked on; its objective the worst (or the mean) over conditions.
+// The needle (optional): the synthetic tips are points, so a needle is not
+// simulated; its slowing of the pierced bubbles (METHOD 9) is predicted per
+// record from the model of Hohermuth et al. (awcc/probe_correction.hpp) at
+// the record's true velocity, the leading tip's c and F and the pair's dx:
+// the measured velocity u_m whose correction gives back the true u0 (found
+// by bisection), and every velocity of the candidate, raw and corrected, is
+// scaled by u_m / u0 (the correction model learnt needle-free records). Tu
+// is a ratio of velocities and is left alone. Above c = 0.3 the model does
+// not apply (not bubbly flow) and no slowing is predicted.
+//
 // Candidates whose records gave no value (AWCC refused, too few windows) rank
 // after those without, fewest failures first; then by objective; then by
 // cost: the shorter record, then the lower sampling rate (the CPU seconds
@@ -74,6 +85,7 @@ struct DesignCandidate {
   double dx = 0.0, dy = 0.0;  ///< m
   int np = 10;
   double fs = 0.0, duration = 0.0;  ///< Hz, s
+  double needle = 0.0;        ///< outer diameter of the leading needle, m; 0 = point tips
   friend bool operator==(const DesignCandidate&, const DesignCandidate&) = default;
   friend auto operator<=>(const DesignCandidate&, const DesignCandidate&) = default;
 };
@@ -100,6 +112,7 @@ struct DesignDefinition {
   std::vector<std::pair<double, double>> geometries;  ///< (dx, dy), m; the current probe's included
   std::vector<int> nps{5, 10, 20};
   std::vector<double> fss{100e3}, durations{60.0};
+  std::vector<double> needles{0.0};                ///< m; 0 = none
   std::optional<DesignCandidate> current;
   std::string canonical;                           ///< for the design id
 
@@ -127,6 +140,7 @@ struct DesignRow {
   std::uint64_t seed = 0;
   DesignCandidate candidate;
   double truth_velocity = 0.0, truth_turbulence_intensity = 0.0;
+  double void_fraction = 0.0, count_rate = 0.0;  ///< leading tip, measured (the needle's slowing depends on them)
   std::optional<double> awcc_velocity, awcc_turbulence_intensity;
   std::int64_t windows_accepted = 0, windows_total = 0;
   std::optional<double> corrected_velocity, corrected_turbulence_intensity;
@@ -174,6 +188,10 @@ struct RankedCandidate {
   double seconds = 0.0;                    ///< mean AWCC CPU seconds per record over conditions
   std::vector<ConditionScore> conditions;  ///< in the definition's order
 };
+
+/// The needle's predicted velocity ratio u_m / u0 for a record (see above);
+/// 1 without a needle, above c = 0.3, or when the model finds no u_m.
+double needle_velocity_ratio(double true_velocity, double void_fraction, double count_rate, double dx, double needle);
 
 /// Scores and ranks every candidate from the rows (the definition's
 /// objective and values).
