@@ -5,12 +5,13 @@ geometry and settings measure a flow best, and why.
     (or: pdp design --config DESIGN.toml -o RANKED.csv --report design.html)
 
 It reads the ranked CSV pdp design writes (one row per candidate and
-condition, best first; docs in tools/pdp/design.hpp) and shows:
+condition, best first; docs in tools/pdp/design.hpp; the needle column,
+the leading needle's diameter in m, 0 for point tips, is optional) and shows:
 
 - the recommended candidate (rank 1) with its errors in every condition, and
   how much better it is than the worst candidate and the lab's current probe;
 - per condition, maps over the probe geometry (dx, dy) at the recommended
-  Np, fs and duration: the RMS errors of u and Tu that the ranking uses, and
+  Np, fs, duration and needle: the RMS errors of u and Tu that the ranking uses, and
   raw AWCC's signed biases of u and Tu, which show the mechanisms (METHOD 6:
   E1 selective sampling grows with dx; E2 oblique impacts with dy at small
   dx); a heat map when the geometries form a grid, else a scatter;
@@ -47,8 +48,11 @@ COLUMNS = ["rank", "objective", "failures", "current", "dx", "dy", "np", "fs", "
            "condition", "records", "condition_failures", "score", "u_bias", "u_spread", "u_rms", "tu_bias",
            "tu_spread", "tu_rms", "raw_u_bias", "raw_u_spread", "raw_u_rms", "raw_tu_bias", "raw_tu_spread",
            "raw_tu_rms", "corrected_fraction", "data_yield"]
+# Optional columns and their value when absent (files of pdp design before needles).
+OPTIONAL = {"needle": 0.0}
 # Per candidate (the same on each of its rows) and per condition; the rest may be empty or inf.
-CANDIDATE_FIELDS = ["rank", "objective", "failures", "current", "dx", "dy", "np", "fs", "duration", "seconds_awcc"]
+CANDIDATE_FIELDS = ["rank", "objective", "failures", "current", "dx", "dy", "np", "fs", "duration", "needle",
+                    "seconds_awcc"]
 CONDITION_VALUES = ["score", "u_bias", "u_spread", "u_rms", "tu_bias", "tu_spread", "tu_rms", "raw_u_bias",
                     "raw_u_spread", "raw_u_rms", "raw_tu_bias", "raw_tu_spread", "raw_tu_rms", "corrected_fraction",
                     "data_yield"]
@@ -106,7 +110,7 @@ class Candidate:
         self.current = fields["current"] == 1
         self.dx, self.dy = fields["dx"], fields["dy"]
         self.np = int(fields["np"])
-        self.fs, self.duration = fields["fs"], fields["duration"]
+        self.fs, self.duration, self.needle = fields["fs"], fields["duration"], fields["needle"]
         self.seconds = fields["seconds_awcc"]
         self.conditions = {}  # name -> {column: value}
 
@@ -116,12 +120,14 @@ class Candidate:
 
     @property
     def setting(self):
-        return (self.np, self.fs, self.duration)
+        """Everything but the geometry: Np, fs, duration, needle."""
+        return (self.np, self.fs, self.duration, self.needle)
 
     @property
     def name(self):
+        """As pdp design names it: "dx 3 mm, dy 0.5 mm, Np 10, 100 kHz, 60 s[, needle 0.8 mm]"."""
         return (f"dx {mm(self.dx)} mm, dy {mm(self.dy)} mm, Np {self.np}, {self.fs / 1e3:g} kHz, "
-                f"{self.duration:g} s")
+                f"{self.duration:g} s" + (f", needle {mm(self.needle)} mm" if self.needle else ""))
 
     def score(self, condition):
         return self.conditions.get(condition, {}).get("score")
@@ -138,26 +144,29 @@ def read_ranked(path):
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputProblem(f"{path}: not text (UTF-8): give the ranked CSV pdp design -o wrote") from None
-    reader = csv.DictReader(text.splitlines())
-    header = reader.fieldnames or []
+    lines = list(csv.reader(text.splitlines()))
+    header = [h.strip() for h in lines[0]] if lines else []
     missing = [c for c in COLUMNS if c not in header]
     if missing:
         raise InputProblem(f"{path}: column{'s' if len(missing) > 1 else ''} {', '.join(missing)} missing: not a "
                            "ranked CSV of pdp design; give the file pdp design -o wrote")
     candidates, conditions = {}, []
-    for line, row in enumerate(reader, start=2):
-        if None in row or any(row.get(c) is None for c in COLUMNS):
-            raise InputProblem(f"{path}: line {line} has {len(row) - (None in row)} cells, not "
-                               f"{len(header)}: the file is cut or edited; write it again with pdp design")
-        fields, values = {}, {}
-        for c in COLUMNS:
+    for line, cells in enumerate(lines[1:], start=2):
+        if not cells:
+            continue
+        if len(cells) != len(header):
+            raise InputProblem(f"{path}: line {line} has {len(cells)} cells, not {len(header)}: the file is cut or "
+                               "edited; write it again with pdp design")
+        row = dict(zip(header, cells))
+        fields, values = dict(OPTIONAL), {}
+        for c in COLUMNS + [c for c in OPTIONAL if c in header]:
             if c == "condition":
                 continue
             try:
                 v = value(row[c])
             except ValueError:
                 raise InputProblem(f"{path}: line {line}, column {c}: '{row[c]}' is not a number") from None
-            if c in WHOLE or c in ("dx", "dy", "fs", "duration"):
+            if c in WHOLE or c in ("dx", "dy", "fs", "duration", "needle"):
                 if v is None:
                     raise InputProblem(f"{path}: line {line}, column {c}: empty or not finite; every row names its "
                                        "candidate: write the file again with pdp design")
@@ -165,7 +174,7 @@ def read_ranked(path):
                 if c in WHOLE and (v != int(v) or v < lo or (hi is not None and v > hi)):
                     raise InputProblem(f"{path}: line {line}, column {c}: {row[c]} is not a whole number from {lo}"
                                        f"{f' to {hi}' if hi is not None else ' up'}")
-                if (c in ("fs", "duration") and v <= 0) or (c == "dx" and v < 0):
+                if (c in ("fs", "duration") and v <= 0) or (c in ("dx", "needle") and v < 0):
                     raise InputProblem(f"{path}: line {line}, column {c}: {row[c]} is out of range")
             (fields if c in CANDIDATE_FIELDS else values)[c] = v
         name = row["condition"].strip()
@@ -249,7 +258,7 @@ def pct(v, signed=False, digits=1):
 def ratio(other, best):
     """other's objective / best's, as text."""
     if other.objective is None:
-        return "no value (it failed in every record of some condition)"
+        return "not comparable (no value in every record of some condition)"
     if best.objective is None or best.objective <= 0:
         return "not defined (the recommended candidate's objective is not positive)"
     return f"{other.objective / best.objective:.1f}x the recommended error"
@@ -337,7 +346,9 @@ def _text_colour(cmap, norm, v):
 
 
 def _cell_text(v, signed):
-    return f"{v:+.1f}" if signed else f"{v:.1f}"
+    """A value in %: one decimal under 10, none above (cells are narrow)."""
+    digits = 1 if abs(v) < 9.95 else 0
+    return f"{v:+.{digits}f}" if signed else f"{v:.{digits}f}"
 
 
 MARKS = {  # role -> (edge colour, line style, line width, label)
@@ -346,7 +357,7 @@ MARKS = {  # role -> (edge colour, line style, line width, label)
 }
 
 
-def _grid_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsize=7):
+def _grid_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsize=7, prefix=""):
     """A heat map: dx across, dy up, one cell per grid geometry, annotated in %.
     values: geometry -> value in % or None (a hatched blank cell). Returns (mesh, blank cells)."""
     import numpy as np
@@ -370,7 +381,7 @@ def _grid_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsiz
         extra = (notes or {}).get(g)
         if v is None:
             ax.add_patch(Rectangle((i - 0.5, j - 0.5), 1, 1, facecolor="#f4f4f4", edgecolor=p.GREY, hatch="///",
-                                   lw=0.5, gid=f"blank-{i}-{j}", zorder=2))
+                                   lw=0.5, gid=f"{prefix}blank-{i}-{j}", zorder=2))
             ax.text(i, j, "no value" + (f"\n{extra}" if extra else ""), ha="center", va="center", fontsize=6,
                     color=p.BLACK, zorder=3, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none"})
             blank += 1
@@ -381,8 +392,9 @@ def _grid_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsiz
         if geometry in layout.geometries:
             colour, ls, lw, _ = MARKS[role]
             inset = 0.06 if role == "recommended" else 0.14
-            ax.add_patch(Rectangle((col[geometry[0]] - 0.5 + inset, row[geometry[1]] - 0.5 + inset), 1 - 2 * inset,
-                                   1 - 2 * inset, fill=False, edgecolor=colour, ls=ls, lw=lw, gid=role, zorder=4))
+            corner = (col[geometry[0]] - 0.5 + inset, row[geometry[1]] - 0.5 + inset)
+            ax.add_patch(Rectangle(corner, 1 - 2 * inset, 1 - 2 * inset, fill=False, edgecolor=colour, ls=ls, lw=lw,
+                                   gid=prefix + role, zorder=4))
     ax.set_xticks(range(nx), [mm(x) for x in layout.xs])
     ax.set_yticks(range(ny), [mm(y) for y in layout.ys])
     ax.set_xlim(-0.5, nx - 0.5)
@@ -393,7 +405,7 @@ def _grid_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsiz
     return mesh, blank
 
 
-def _scatter_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsize=7):
+def _scatter_map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsize=7, prefix=""):
     """Geometries that are not a grid: one point each at (dx, dy) in mm, coloured by its value in %."""
     p = _plotting()
     have = [g for g in layout.geometries if values.get(g) is not None]
@@ -404,7 +416,7 @@ def _scatter_map(ax, layout, values, norm, cmap, signed, marks, notes=None, font
         v = values.get(g)
         extra = (notes or {}).get(g)
         if v is None:
-            ax.scatter([1e3 * g[0]], [1e3 * g[1]], marker="X", s=70, color=p.GREY, zorder=3, gid=f"blank-{k}")
+            ax.scatter([1e3 * g[0]], [1e3 * g[1]], marker="X", s=70, color=p.GREY, zorder=3, gid=f"{prefix}blank-{k}")
             blank += 1
         ax.annotate(("no value" if v is None else _cell_text(v, signed)) + (f" ({extra})" if extra else ""),
                     (1e3 * g[0], 1e3 * g[1]), textcoords="offset points", xytext=(0, -13), ha="center", va="top",
@@ -414,19 +426,22 @@ def _scatter_map(ax, layout, values, norm, cmap, signed, marks, notes=None, font
             colour, ls, lw, _ = MARKS[role]
             ax.scatter([1e3 * geometry[0]], [1e3 * geometry[1]], marker="s" if role == "recommended" else "D",
                        s=420 if role == "recommended" else 300, facecolors="none", edgecolors=colour, linewidths=lw,
-                       linestyles=ls, zorder=4, gid=role)
+                       linestyles=ls, zorder=4, gid=prefix + role)
     xs, ys = [1e3 * g[0] for g in layout.geometries], [1e3 * g[1] for g in layout.geometries]
-    for lo, hi, setter in ((min(xs), max(xs), ax.set_xlim), (min(ys), max(ys), ax.set_ylim)):
-        pad = 0.15 * (hi - lo) or 0.5
-        setter(lo - pad, hi + pad)
+    # Room for the labels under the points: more below than above.
+    for lo, hi, setter, below, above in ((min(xs), max(xs), ax.set_xlim, 0.15, 0.15),
+                                         (min(ys), max(ys), ax.set_ylim, 0.3, 0.15)):
+        span = hi - lo or 1.0
+        setter(lo - below * span, hi + above * span)
     ax.set_xlabel("dx (mm)")
     ax.set_ylabel("dy (mm)")
     return mesh, blank
 
 
-def _map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsize=7):
+def _map(ax, layout, values, norm, cmap, signed, marks, notes=None, fontsize=7, prefix=""):
+    """A heat map when the geometries are a grid, else a scatter; element ids start with prefix."""
     draw = _grid_map if layout.grid else _scatter_map
-    return draw(ax, layout, values, norm, cmap, signed, marks, notes, fontsize)
+    return draw(ax, layout, values, norm, cmap, signed, marks, notes, fontsize, prefix)
 
 
 def _marks_legend(fig, marks, y=0.0):
@@ -462,11 +477,12 @@ def map_svg(layout, values, title, diverging, marks, salt, off_grid_note=None):
         ax.set_title(title)
         cax = fig.add_axes([1 - (right - 0.1) / width, bottom / height, 0.1 / width, 1 - (bottom + top) / height])
         cax.grid(False)
-        fig.colorbar(mesh, cax=cax).set_label("%")
+        fig.colorbar(mesh, cax=cax)
+        cax.set_title("%", fontsize=7.5, loc="left")
         _marks_legend(fig, [(r, g) for r, g in marks if g in layout.geometries], y=0.12 / height if off_grid_note
                       else 0.0)
         if off_grid_note:
-            p.footer(fig, off_grid_note)
+            fig.text(0.02, 0.01, off_grid_note, fontsize=7, color=p.BLACK)
         return p.svg(fig, salt=salt), blank
 
 
@@ -490,7 +506,8 @@ def objective_svg(layout, by_np, marks_of, salt):
             ax = axes[k // cols][k % cols]
             marks = marks_of(np_)
             all_marks += [(r, g) for r, g in marks if g in layout.geometries]
-            mesh, _ = _map(ax, layout, values, norm, cmap, False, marks, notes, fontsize=_cell_font(layout, 6.5))
+            mesh, _ = _map(ax, layout, values, norm, cmap, False, marks, notes, fontsize=_cell_font(layout, 6.5),
+                            prefix=f"np{np_}-")
             ax.set_title(f"Np {np_}")
             ax.set_gid(f"np-{np_}")
         for k in range(n, rows * cols):
@@ -506,24 +523,34 @@ def objective_svg(layout, by_np, marks_of, salt):
 
 
 def condition_rows(candidate, conditions):
+    """The errors of a candidate in each condition, as the tables show them."""
+    signed = {"u_bias", "tu_bias", "raw_u_bias", "raw_tu_bias"}
     rows = []
     for name in conditions:
         v = candidate.conditions.get(name)
         if v is None:
             rows.append({"condition": name, "missing": True})
             continue
-        get = v.get
-        rows.append({"condition": name, "missing": False, "records": int(get("records")),
-                     "failures": int(get("condition_failures")), "score": pct(get("score")), "u_bias": pct(get("u_bias"), True),
-                     "u_spread": pct(get("u_spread")), "u_rms": pct(get("u_rms")), "tu_bias": pct(get("tu_bias"), True),
-                     "tu_spread": pct(get("tu_spread")), "tu_rms": pct(get("tu_rms")),
-                     "raw_u_bias": pct(get("raw_u_bias"), True), "raw_tu_bias": pct(get("raw_tu_bias"), True),
-                     "data_yield": pct(get("data_yield"), digits=0),
-                     "corrected_fraction": pct(get("corrected_fraction"), digits=0)})
+        row = {"condition": name, "missing": False, "records": int(v["records"]),
+               "failures": int(v["condition_failures"])}
+        for q in ("score", "u_bias", "u_spread", "u_rms", "tu_bias", "tu_spread", "tu_rms", "raw_u_bias",
+                  "raw_tu_bias"):
+            row[q] = pct(v.get(q), signed=q in signed)
+        for q in ("data_yield", "corrected_fraction"):
+            row[q] = pct(v.get(q), digits=0)
+        rows.append(row)
     return rows
 
 
-def build(csv_path, design_path=None, command_line=None, pdp_version=None):
+def setting_of(c):
+    """A candidate's setting as the page writes it; text: "Np 10, 100 kHz, 60 s[, needle 0.8 mm]"."""
+    s = {"np": c.np, "fs": f"{c.fs / 1e3:g}", "duration": f"{c.duration:g}", "needle": mm(c.needle)}
+    s["text"] = f"Np {s['np']}, {s['fs']} kHz, {s['duration']} s" + (f", needle {s['needle']} mm" if c.needle else "")
+    s["at"] = f"{s['fs']} kHz, {s['duration']} s" + (f", needle {s['needle']} mm" if c.needle else "")
+    return s
+
+
+def build(csv_path, design_path=None, command_line=None, pdp_version=None, argv=None):
     import jinja2
 
     candidates, conditions, digest = read_ranked(csv_path)
@@ -534,7 +561,7 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None):
     kind = ranking_kind(candidates, design)
     corrected = ranked_on_corrected(candidates)
 
-    # Maps: every candidate at the recommended Np, fs and duration, by geometry.
+    # Maps: every candidate at the recommended Np, fs, duration and needle, by geometry.
     at_best = {c.geometry: c for c in candidates if c.setting == best.setting}
     layout = Layout([c.geometry for c in candidates], current.geometry if current else None)
     marks = [("recommended", best.geometry)] + ([("current", current.geometry)] if current else [])
@@ -559,13 +586,13 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None):
                             "cells": len(layout.geometries), "diverging": diverging})
         maps.append({"name": name, "description": (design or {}).get("conditions", {}).get(name), "figures": figures})
 
-    # The objective over (dx, dy) for each Np, at the recommended fs and duration.
+    # The objective over (dx, dy) for each Np, at the recommended fs, duration and needle.
     nps = sorted({c.np for c in candidates})
     objective_figure = None
     if len(nps) > 1:
         by_np = []
         for n in nps:
-            at = {c.geometry: c for c in candidates if c.setting == (n, best.fs, best.duration)}
+            at = {c.geometry: c for c in candidates if c.setting == (n,) + best.setting[1:]}
             values = {g: (None if at.get(g) is None or at[g].objective is None else 100 * at[g].objective)
                       for g in layout.geometries}
             notes = {g: f"{at[g].failures} failed" for g in layout.geometries if at.get(g) and at[g].failures}
@@ -573,18 +600,15 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None):
 
         def marks_of(n):
             return ([("recommended", best.geometry)] if best.np == n else []) + (
-                [("current", current.geometry)] if current and current.np == n and current.fs == best.fs
-                and current.duration == best.duration else [])
+                [("current", current.geometry)] if current and current.setting == (n,) + best.setting[1:] else [])
         objective_figure = objective_svg(layout, by_np, marks_of, "objective")
 
-    # The best candidate of each setting (Np, fs, duration).
+    # The best candidate of each setting (Np, fs, duration, needle).
     settings = []
     for setting in sorted({c.setting for c in candidates}):
         first = next(c for c in candidates if c.setting == setting)  # candidates are in rank order
-        settings.append({"np": setting[0], "fs": f"{setting[1] / 1e3:g}", "duration": f"{setting[2]:g}",
-                         "rank": first.rank, "dx": mm(first.dx), "dy": mm(first.dy),
-                         "objective": pct(first.objective), "failures": first.failures,
-                         "best": first is best})
+        settings.append(dict(setting_of(first), rank=first.rank, dx=mm(first.dx), dy=mm(first.dy),
+                             objective=pct(first.objective), failures=first.failures, best=first is best))
 
     # The ranking table: the first 15, the current probe and the worst.
     shown = [c for c in candidates if c.rank <= candidates[min(TABLE_TOP, len(candidates)) - 1].rank]
@@ -594,12 +618,10 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None):
     for c in shown:
         roles = (["recommended"] if c is best else []) + (["current probe"] if c.current else []) + (
             ["worst"] if c is worst and c is not best else [])
-        table.append({"gap": previous is not None and candidates.index(c) != candidates.index(previous) + 1,
-                      "rank": c.rank, "dx": mm(c.dx), "dy": mm(c.dy), "np": c.np, "fs": f"{c.fs / 1e3:g}",
-                      "duration": f"{c.duration:g}", "objective": pct(c.objective), "failures": c.failures,
-                      "scores": [pct(c.score(n)) for n in conditions],
-                      "seconds": "no value" if c.seconds is None else f"{c.seconds:.3g}", "roles": roles,
-                      "current": c.current, "best": c is best})
+        table.append(dict(setting_of(c), gap=previous is not None and candidates.index(c) != candidates.index(
+            previous) + 1, rank=c.rank, dx=mm(c.dx), dy=mm(c.dy), objective=pct(c.objective), failures=c.failures,
+            scores=[pct(c.score(n)) for n in conditions], roles=roles, current=c.current, best=c is best,
+            seconds="no value" if c.seconds is None else f"{c.seconds:.3g}"))
         previous = c
 
     def summary_of(c):
@@ -609,15 +631,18 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None):
                 "dx": mm(c.dx), "dy": mm(c.dy)}
 
     summary = {"best": summary_of(best), "worst": summary_of(worst), "worst_ratio": ratio(worst, best),
+               "nothing_measured": best.objective is None,
                "current": summary_of(current) if current else None,
                "current_is_best": current is best,
                "current_ratio": ratio(current, best) if current else None,
                "count": len(candidates), "conditions": len(conditions), "kind": kind, "corrected": corrected,
                "geometries": len(set(c.geometry for c in candidates)), "nps": nps,
                "fss": sorted({f"{c.fs / 1e3:g}" for c in candidates}, key=float),
-               "durations": sorted({f"{c.duration:g}" for c in candidates}, key=float)}
+               "durations": sorted({f"{c.duration:g}" for c in candidates}, key=float),
+               "needles": sorted({mm(c.needle) for c in candidates}, key=float)}
+    argv = sys.argv[1:] if argv is None else argv
     made = {"command_line": command_line or " ".join(["python3 pdp/design_report.py"]
-                                                      + [shlex.quote(a) for a in sys.argv[1:]]),
+                                                      + [shlex.quote(a) for a in argv]),
             "utc_time": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "pdp_version": pdp_version, "ranked": csv_path, "ranked_sha256": digest}
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(os.path.dirname(os.path.abspath(__file__))),
@@ -625,11 +650,9 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None):
     title = os.path.basename(design_path) if design_path else os.path.basename(csv_path)
     return env.get_template("design_report.html.j2").render(
         title=title, summary=summary, maps=maps, layout={"grid": layout.grid, "off_grid": layout.off_grid},
-        best_setting={"np": best.np, "fs": f"{best.fs / 1e3:g}", "duration": f"{best.duration:g}"},
-        objective_figure=objective_figure, settings=settings, table=table, conditions=conditions,
-        design=design, made=made, top=TABLE_TOP, current_setting=(
-            {"np": current.np, "fs": f"{current.fs / 1e3:g}", "duration": f"{current.duration:g}",
-             "same": current.setting == best.setting} if current else None))
+        best_setting=setting_of(best), objective_figure=objective_figure, settings=settings, table=table,
+        conditions=conditions, design=design, made=made, top=TABLE_TOP, needles=any(c.needle for c in candidates),
+        current_setting=dict(setting_of(current), same=current.setting == best.setting) if current else None)
 
 
 def write_atomically(text, out):
@@ -700,7 +723,7 @@ def main(argv=None):
         return EXIT_MISSING_PACKAGE
     try:
         page = build(args.input, args.config, command_line=args.command_line,
-                     pdp_version=_pdp_version(args.pdp_version))
+                     pdp_version=_pdp_version(args.pdp_version), argv=argv)
     except InputProblem as e:
         print(f"pdp design: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT

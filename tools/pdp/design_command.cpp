@@ -10,6 +10,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/parallel.hpp"
+#include "awcc/version.hpp"
 #include "correction/features.hpp"
 #include "correction/model.hpp"
 #include "design.hpp"
@@ -198,7 +199,8 @@ int run_design(const DesignOptions& o) {
     fmt::print("{}", design_summary(ranked, d, model_note));
     spdlog::info("{}: {} candidates ranked", o.output, ranked.size());
     if (!o.report.empty()) {
-      return write_report({o.output, "--config", o.config, "-o", o.report}, "design_report.py");
+      return write_report({o.output, "--config", o.config, "-o", o.report, "--pdp-version", awcc::version},
+                          "design_report.py");
     }
   } catch (const std::exception& e) {
     return report_error(e);
