@@ -21,6 +21,11 @@
       with the corrected 80 % intervals.
   plot_study.py learning LEARNING.csv OUT.png
       held-out scores of pdp train --learning-curve against training runs.
+  plot_study.py design RANKED.csv OUT.png [--np N]
+      pdp design's maps over (dx, dy), one row per condition: raw AWCC's u
+      and Tu biases (the mechanisms) and the RMS errors ranked on, at the
+      recommended candidate's Np, fs and duration (or at Np N); the maps of
+      pdp design --report, drawn by its code.
 
 Every figure carries the command line that made it in its footer.
 """
@@ -347,6 +352,44 @@ def learning(path, out):
     fig.savefig(out, dpi=110)
 
 
+def design(path, out, np_=None):
+    import matplotlib
+    import design_report as page  # python/pdp/design_report.py, beside plotting
+    candidates, conditions, _ = page.read_ranked(path)
+    best = candidates[0]
+    setting = ((np_ if np_ is not None else best.np),) + best.setting[1:]
+    at = {c.geometry: c for c in candidates if c.setting == setting}
+    if not at:
+        raise SystemExit(f"{path}: no candidate at Np {setting[0]}")
+    currents = [c for c in candidates if c.current]
+    layout = page.Layout([c.geometry for c in candidates], currents[0].geometry if currents else None)
+    first = next(c for c in candidates if c.setting == setting)  # the best at this setting
+    marks = [("recommended", first.geometry)] + ([("current", currents[0].geometry)] if currents else [])
+    order = [2, 3, 0, 1]  # the biases (mechanisms) first, then what is ranked on
+    with matplotlib.rc_context(page.MAP_FONTS):
+        height = 2.8 * len(conditions) + 0.7
+        fig, axes = plotting.figure(width=3.3 * 4 + 0.6, height=height, rows=len(conditions), cols=4)
+        for i, name in enumerate(conditions):
+            for j, q in enumerate(order):
+                column, title, diverging = page.MAP_QUANTITIES[q]
+                values = {}
+                for g in layout.geometries:
+                    v = at[g].conditions.get(name, {}).get(column) if g in at else None
+                    values[g] = None if v is None else 100 * v
+                cmap = matplotlib.colormaps[page.DIVERGING_MAP if diverging else page.SEQUENTIAL_MAP]
+                norm = page._norm(list(values.values()), diverging)
+                ax = axes[i][j]
+                mesh, _ = page._map(ax, layout, values, norm, cmap, diverging, marks, fontsize=6.5)
+                ax.set_title(f"{name}: {title} (%)")
+                fig.colorbar(mesh, ax=ax, fraction=0.05, pad=0.03)
+        fig.subplots_adjust(wspace=0.55, hspace=0.5, top=1 - 0.6 / height, bottom=0.55 / height, left=0.05,
+                            right=0.97)
+        fig.suptitle(f"Np {setting[0]}, {setting[1] / 1e3:g} kHz, {setting[2]:g} s; box: the best geometry at this "
+                     f"Np{', dashed: the current probe' if currents else ''}", fontsize=9)
+    footer(fig)
+    fig.savefig(out, dpi=110)
+
+
 def main(argv):
     if len(argv) >= 4 and argv[1] == "bench":
         bench(argv[2], argv[3])
@@ -361,6 +404,8 @@ def main(argv):
         correction(argv[2], argv[3])
     elif len(argv) >= 4 and argv[1] == "learning":
         learning(argv[2], argv[3])
+    elif len(argv) >= 4 and argv[1] == "design":
+        design(argv[2], argv[3], int(argv[argv.index("--np") + 1]) if "--np" in argv else None)
     else:
         raise SystemExit(__doc__)
 
