@@ -37,7 +37,6 @@ import math
 import os
 import shlex
 import sys
-import tempfile
 
 EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_OUTPUT_FAILED, EXIT_INTERNAL, EXIT_MISSING_PACKAGE = 1, 2, 3, 4, 5
 MISSING_PACKAGE_HELP = ("pdp design --report draws with matplotlib and NumPy and writes the page with Jinja2: "
@@ -655,20 +654,6 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None, argv=
         current_setting=dict(setting_of(current), same=current.setting == best.setting) if current else None)
 
 
-def write_atomically(text, out):
-    folder = os.path.dirname(os.path.abspath(out))
-    fd, tmp = tempfile.mkstemp(prefix=".pdp-design-report-", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def _pdp_version(given):
     """The version pdp passed, else the Python module's beside this file, else None."""
     if given:
@@ -736,7 +721,7 @@ def main(argv=None):
         print("pdp design: internal error in the report; please report it with the command line", file=sys.stderr)
         return EXIT_INTERNAL
     try:
-        write_atomically(page, args.output)
+        _plotting().write_page(page, args.output, prefix=".pdp-design-report-")
     except OSError as e:
         print(f"pdp design: {args.output}: cannot write: {e.strerror}; choose a writable folder with --report",
               file=sys.stderr)

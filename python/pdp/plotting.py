@@ -15,7 +15,9 @@ m/s; never metres in scientific notation.
 
 import io
 import math
+import os
 import re
+import tempfile
 
 import matplotlib
 
@@ -543,3 +545,20 @@ POSITION_PANELS = [("chord-time-pdf", "chord-time PDF"), ("chord-length-pdf", "c
                    ("window-velocities", "AWCC window velocities"), ("window-histogram", "window velocity histogram"),
                    ("cluster-sizes", "cluster sizes"), ("arrival-pdf", "arrival-time PDF"),
                    ("velocity-spectrum", "velocity spectrum")]
+
+
+def write_page(text, out, prefix=".pdp-page-"):
+    """Writes a page (HTML text) to `out` through a temporary file in the same
+    folder and a rename: a reader never sees a partial page, and an error
+    leaves no file behind. Raises OSError."""
+    folder = os.path.dirname(os.path.abspath(out))
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, out)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

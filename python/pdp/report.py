@@ -28,7 +28,6 @@ import math
 import os
 import shlex
 import sys
-import tempfile
 
 EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_OUTPUT_FAILED, EXIT_INTERNAL, EXIT_MISSING_PACKAGE = 1, 2, 3, 4, 5
 MISSING_PACKAGE_HELP = ("pdp report draws with matplotlib and writes the page with Jinja2: install Debian's "
@@ -342,20 +341,6 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
         provenance=provenance, made=made, panels=plotting.POSITION_PANELS, single="profile" not in data)
 
 
-def write_atomically(text, out):
-    folder = os.path.dirname(os.path.abspath(out))
-    fd, tmp = tempfile.mkstemp(prefix=".pdp-report-", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def _parser():
     """The report's options: their one declaration (pdp report hands its arguments here)."""
     parser = argparse.ArgumentParser(prog="pdp report", description="One self-contained HTML page for a pdp "
@@ -453,7 +438,8 @@ def main(argv=None):
         print("pdp report: internal error; please report it with the command line", file=sys.stderr)
         return EXIT_INTERNAL
     try:
-        write_atomically(page, args.output)
+        from pdp import plotting
+        plotting.write_page(page, args.output, prefix=".pdp-report-")
     except OSError as e:
         print(f"pdp report: {args.output}: cannot write: {e.strerror}; choose a writable folder with -o",
               file=sys.stderr)
