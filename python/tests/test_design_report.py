@@ -7,6 +7,7 @@ candidate has no value; bad input, a bad --config and an unwritable output
 get the documented exit status and no page. The module is loaded from the
 source tree: it needs no compiled core."""
 
+import csv
 import html.parser
 import importlib.util
 import os
@@ -332,8 +333,8 @@ duration = "3s"
     assert done.returncode == 0, done.stderr
     page = Page((tmp_path / "tiny.html").read_text())
     check_self_contained(page)
-    first = (tmp_path / "tiny.csv").read_text().splitlines()[1].split(",")
-    assert f"dx {float(first[4]) * 1e3:g} mm, dy {float(first[5]) * 1e3:g} mm, Np {first[6]}" \
+    first = next(csv.DictReader((tmp_path / "tiny.csv").read_text().splitlines()))
+    assert f"dx {float(first['dx']) * 1e3:g} mm, dy {float(first['dy']) * 1e3:g} mm, Np {first['np']}" \
         in page.texts["recommended"]
     assert [(m["data-condition"], m["data-quantity"]) for m in page.maps] == [("base", q) for q in QUANTITIES]
     assert "design --config tiny.toml -o tiny.csv" in page.texts["design-provenance"]

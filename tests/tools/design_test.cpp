@@ -176,6 +176,10 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   EXPECT_EQ(ranked[4].failures, 2);      // candidates without records: no value anywhere
   EXPECT_TRUE(std::isinf(ranked[5].objective));
   EXPECT_NEAR(ranked[2].conditions[0].raw_u.bias, 0.2, 1e-12);
+  // Every record of a candidate has the same errors: no resample changes
+  // the order, and the first is first in all of them.
+  EXPECT_EQ(ranked[0].best_share, 1.0);
+  EXPECT_EQ(ranked[1].best_share, 0.0);
   EXPECT_NEAR(ranked[2].conditions[0].data_yield, 0.5, 1e-12);
   // The mean over conditions puts candidate 0 (mean 0.1) level with 1 and
   // ahead of 2 (cost); raw values double every score.
@@ -185,6 +189,33 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   d.values = "raw";
   const auto raw = pdp::rank_candidates(d, rows);
   EXPECT_NEAR(raw[0].objective, 0.2, 1e-12);
+  // Records that disagree: c[1] and c[2] swap their corrected errors (5 and
+  // 15 %) between the two records, and c[3]'s record without a value is
+  // record 1 of condition b: a resample that leaves that record out (1 in 4)
+  // puts the error-free c[3] first, the others do not. So two candidates
+  // share the firsts, and each resample has exactly one first.
+  d.values = "corrected";
+  d.objective = "worst-case";
+  auto noisy = rows;
+  for (auto& r : noisy) {
+    r.record = static_cast<int>(&r - noisy.data()) / 8;  // two records of 8 rows
+    const bool swap = (r.candidate == c[1]) == (r.record == 0);
+    if (r.candidate == c[1] || r.candidate == c[2]) {
+      const double e = swap ? 0.05 : 0.15;
+      r.corrected_velocity = 4.0 * (1 + e), r.corrected_turbulence_intensity = 0.2 * (1 + e);
+    }
+  }
+  const auto shares = pdp::rank_candidates(d, noisy);
+  double total = 0.0;
+  for (const auto& r : shares) total += r.best_share;
+  EXPECT_NEAR(total, 1.0, 1e-12);
+  for (const auto& r : shares) {
+    if (r.candidate == c[3]) {
+      EXPECT_GT(r.best_share, 0.1);  // about 1/4 of 200
+      EXPECT_LT(r.best_share, 0.45);
+    }
+  }
+  EXPECT_LT(shares[0].best_share, 0.9);
   // A needle scales every velocity of its candidate by the predicted ratio:
   // the same rows, ranked with a 1 mm needle, carry that ratio in u's bias.
   auto with_needle = d;

@@ -510,16 +510,21 @@ double needle_velocity_ratio(double true_velocity, double void_fraction, double 
   return 0.5 * (lo + hi) / true_velocity;
 }
 
-std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const std::vector<DesignRow>& rows) {
+namespace {
+
+// The needle's ratio per record, pair and needle (every Np shares it), kept
+// across the rankings of the bootstrap.
+using NeedleRatios = std::map<std::tuple<std::int64_t, double, double, double>, double>;
+
+std::vector<RankedCandidate> rank_with(const DesignDefinition& d, const std::vector<const DesignRow*>& rows,
+                                       NeedleRatios& ratios) {
   // Rows do not depend on the needle: it scales their velocities below.
   std::map<std::pair<DesignCandidate, std::string>, std::vector<const DesignRow*>> groups;
-  for (const auto& r : rows) {
-    auto key = r.candidate;
+  for (const DesignRow* r : rows) {
+    auto key = r->candidate;
     key.needle = 0.0;
-    groups[{key, r.condition}].push_back(&r);
+    groups[{key, r->condition}].push_back(r);
   }
-  // The needle's ratio per record, pair and needle (every Np shares it).
-  std::map<std::tuple<std::int64_t, double, double, double>, double> ratios;
   auto ratio = [&](const DesignRow& r, double needle) {
     if (!(needle > 0.0)) return 1.0;
     const auto key = std::tuple{r.task, r.candidate.dx, r.candidate.dy, needle};
@@ -601,6 +606,41 @@ std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const st
   return out;
 }
 
+}  // namespace
+
+std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const std::vector<DesignRow>& rows) {
+  std::vector<const DesignRow*> all;
+  for (const auto& r : rows) all.push_back(&r);
+  NeedleRatios ratios;
+  auto ranked = rank_with(d, all, ratios);
+  // How sure the ranking is: the records of each condition resampled with
+  // replacement (the same draw for every candidate, which shares the records),
+  // the candidates ranked again; a candidate's share is how often it came first.
+  std::map<std::pair<std::string, int>, std::vector<const DesignRow*>> records;
+  for (const auto& r : rows) records[{r.condition, r.record}].push_back(&r);
+  std::map<std::string, std::vector<int>> numbers;  // each condition's record numbers
+  for (const auto& [key, unused] : records) numbers[key.first].push_back(key.second);
+  std::map<DesignCandidate, double> firsts;
+  std::uint64_t state = awcc::derive_seed(d.seed, 0xb007);
+  for (int b = 0; b < kBootstrapResamples; ++b) {
+    std::vector<const DesignRow*> sample;
+    for (const auto& [condition, list] : numbers) {
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        state = awcc::derive_seed(state, static_cast<std::uint64_t>(b));
+        const int record = list[state % list.size()];
+        const auto& rs = records[{condition, record}];
+        sample.insert(sample.end(), rs.begin(), rs.end());
+      }
+    }
+    firsts[rank_with(d, sample, ratios).front().candidate] += 1.0;
+  }
+  for (auto& r : ranked) {
+    const auto it = firsts.find(r.candidate);
+    r.best_share = it == firsts.end() ? 0.0 : it->second / kBootstrapResamples;
+  }
+  return ranked;
+}
+
 namespace {
 
 // Bias, spread and RMS; empty cells where no record gave a value (not 0).
@@ -613,7 +653,7 @@ std::string stats_cells(const ErrorStats& s) {
 
 std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d) {
   std::string out =
-      "rank,objective,failures,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,condition_failures,score,"
+      "rank,objective,failures,best_share,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,condition_failures,score,"
       "u_bias,u_spread,u_rms,tu_bias,tu_spread,tu_rms,raw_u_bias,raw_u_spread,raw_u_rms,raw_tu_bias,raw_tu_spread,"
       "raw_tu_rms,corrected_fraction,data_yield\n";
   const bool corrected = d.values == "corrected";
@@ -621,8 +661,8 @@ std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignD
     for (const auto& c : r.conditions) {
       const auto& u = corrected ? c.corrected_u : c.raw_u;
       const auto& t = corrected ? c.corrected_tu : c.raw_tu;
-      out += fmt::format("{},{},{},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
-                         num(r.objective), r.failures, r.current ? 1 : 0, num(r.candidate.dx), num(r.candidate.dy),
+      out += fmt::format("{},{},{},{:.3g},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
+                         num(r.objective), r.failures, r.best_share, r.current ? 1 : 0, num(r.candidate.dx), num(r.candidate.dy),
                          r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), num(r.candidate.needle),
                          r.seconds, c.condition,
                          c.records, c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
@@ -655,6 +695,18 @@ std::string design_summary(const std::vector<RankedCandidate>& ranked, const Des
                        c.condition, 100 * u.bias, 100 * u.spread, 100 * t.bias, 100 * t.spread, 100 * c.raw_u.bias,
                        100 * c.raw_tu.bias, 100 * c.data_yield, 100 * c.corrected_fraction);
   }
+  // How sure: the recommendation's share of the bootstrap, and any other
+  // candidate that came first in at least 5 % of the resamples.
+  std::string others;
+  for (std::size_t i = 1; i < ranked.size(); ++i) {
+    if (ranked[i].best_share >= 0.05) {
+      others += fmt::format("{}{} ({:.0f} %)", others.empty() ? "" : "; ", describe(ranked[i].candidate),
+                            100 * ranked[i].best_share);
+    }
+  }
+  out += fmt::format("Stability: first in {:.0f} % of {} bootstrap resamples of the records{}\n", 100 * best.best_share,
+                     kBootstrapResamples,
+                     others.empty() ? "" : "; also first: " + others + " (more seeds would separate them)");
   auto versus = [&](const RankedCandidate& other, const char* what) {
     std::string ratio = std::isfinite(other.objective) && best.objective > 0.0
                             ? fmt::format("{:.1f}x the recommended error", other.objective / best.objective)

@@ -186,6 +186,9 @@ struct RankedCandidate {
   std::int64_t failures = 0;
   double objective = 0.0;
   double seconds = 0.0;                    ///< mean AWCC CPU seconds per record over conditions
+  /// Share of the bootstrap resamples of the records in which this candidate
+  /// ranks first: how sure the recommendation is.
+  double best_share = 0.0;
   std::vector<ConditionScore> conditions;  ///< in the definition's order
 };
 
@@ -193,8 +196,14 @@ struct RankedCandidate {
 /// 1 without a needle, above c = 0.3, or when the model finds no u_m.
 double needle_velocity_ratio(double true_velocity, double void_fraction, double count_rate, double dx, double needle);
 
+/// Resamples of the records for the ranking's stability.
+constexpr int kBootstrapResamples = 200;
+
 /// Scores and ranks every candidate from the rows (the definition's
-/// objective and values).
+/// objective and values), and says how often each ranks first when the
+/// records of each condition are resampled with replacement
+/// (kBootstrapResamples times, seeded by the design's seed: the same rows
+/// give the same shares).
 std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const std::vector<DesignRow>& rows);
 
 /// The ranked CSV: one row per candidate and condition, best candidate first.
