@@ -284,6 +284,24 @@ int Calibration::band(std::int64_t windows) const {
   return b;
 }
 
+int Calibration::tu_band(double tu_median) const {
+  int h = 0;
+  while (h < static_cast<int>(tu_edges.size()) && tu_median >= tu_edges[static_cast<std::size_t>(h)]) ++h;
+  return h;
+}
+
+std::array<double, 3> Calibration::offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
+                                           double tu_median) const {
+  const auto h = static_cast<std::size_t>(tu_band(tu_median));
+  const int w = band(windows);
+  if (w >= 0) return groups[static_cast<std::size_t>(w) * tu_bands() + h];
+  std::array<double, 3> o;
+  o.fill(-std::numeric_limits<double>::infinity());
+  for (std::size_t b = 0; b <= window_edges.size(); ++b)
+    for (std::size_t k = 0; k < 3; ++k) o[k] = std::max(o[k], groups[b * tu_bands() + h][k]);
+  return o;
+}
+
 void Calibration::apply(const std::array<double, 3>& offsets, std::vector<double>& t) {
   // Levels 0.025 0.1 0.25 0.5 0.75 0.9 0.975: pairs (2, 4), (1, 5), (0, 6).
   for (std::size_t k = 0; k < 3; ++k) {
@@ -321,23 +339,17 @@ Correction CorrectionModel::correct(const Features& f) const {
   }
   Correction c;
   c.status = CorrectionStatus::corrected;
-  const int band = calibration.band(f.windows_accepted);
-  auto one = [&](const QuantileForest& forest, TargetForm form, double measured, bool nonnegative,
-                 const std::vector<std::array<double, 3>>& offsets) {
+  auto velocity_t = velocity.quantiles(x, correction_levels);
+  auto tu_t = turbulence_intensity.quantiles(x, correction_levels);
+  if (!calibration.empty()) {
+    // The group's Tu band: the Tu forest's own median, before calibration.
+    const double tu_median = from_target(turbulence_form, tu_t[3], f.turbulence_intensity);
+    Calibration::apply(calibration.offsets(calibration.velocity, f.windows_accepted, tu_median), velocity_t);
+    Calibration::apply(calibration.offsets(calibration.turbulence_intensity, f.windows_accepted, tu_median), tu_t);
+  }
+  auto one = [&](const std::vector<double>& t, TargetForm form, double measured, bool nonnegative) {
     CorrectedQuantity q;
     q.measured = measured;
-    auto t = forest.quantiles(x, correction_levels);
-    if (!offsets.empty()) {
-      std::array<double, 3> o{};
-      if (band >= 0) {
-        o = offsets[static_cast<std::size_t>(band)];
-      } else {  // windows not known: each interval's widest band
-        o.fill(-std::numeric_limits<double>::infinity());
-        for (const auto& b : offsets)
-          for (std::size_t k = 0; k < 3; ++k) o[k] = std::max(o[k], b[k]);
-      }
-      Calibration::apply(o, t);
-    }
     for (std::size_t k = 0; k < t.size(); ++k) {
       q.quantiles[k] = from_target(form, t[k], measured);
       if (nonnegative) q.quantiles[k] = std::max(0.0, q.quantiles[k]);
@@ -345,9 +357,8 @@ Correction CorrectionModel::correct(const Features& f) const {
     return q;
   };
   c.forest = "awcc";
-  c.velocity = one(velocity, velocity_form, f.velocity, false, calibration.velocity);
-  c.turbulence_intensity =
-      one(turbulence_intensity, turbulence_form, f.turbulence_intensity, true, calibration.turbulence_intensity);
+  c.velocity = one(velocity_t, velocity_form, f.velocity, false);
+  c.turbulence_intensity = one(tu_t, turbulence_form, f.turbulence_intensity, true);
   return c;
 }
 
@@ -445,9 +456,11 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
   payload.u8(processing.weighting == awcc::Weighting::none ? 1 : 0);
   payload.u8(processing.signal == awcc::CorrelationSignal::raw ? 1 : 0);
   payload.u8(processing.subsample == awcc::Subsample::parabolic ? 1 : 0);
-  payload.u32(static_cast<std::uint32_t>(calibration.velocity.size()));
+  payload.u32(calibration.empty() ? 0 : static_cast<std::uint32_t>(calibration.window_edges.size() + 1));
   if (!calibration.empty()) {
     for (auto e : calibration.window_edges) payload.i64(e);
+    payload.u32(static_cast<std::uint32_t>(calibration.tu_bands()));
+    for (double e : calibration.tu_edges) payload.f64(e);
     for (const auto* bands : {&calibration.velocity, &calibration.turbulence_intensity})
       for (const auto& b : *bands)
         for (double o : b) payload.f64(o);
@@ -546,8 +559,15 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
         e = r.i64();
         if (e < 0 || (&e != c.window_edges.data() && e <= *(&e - 1))) r.damaged("calibration band edges not increasing");
       }
+      const auto tu_bands = version >= 4 ? r.count(r.u32(), 48) : std::size_t{1};
+      if (tu_bands < 1) r.damaged("no Tu band in the calibration");
+      c.tu_edges.resize(tu_bands - 1);
+      for (auto& e : c.tu_edges) {
+        e = r.f64();
+        if (!std::isfinite(e) || (&e != c.tu_edges.data() && e <= *(&e - 1))) r.damaged("calibration Tu edges not increasing");
+      }
       for (auto* b : {&c.velocity, &c.turbulence_intensity}) {
-        b->resize(bands);
+        b->resize(bands * tu_bands);
         for (auto& band : *b)
           for (double& o : band) {
             o = r.f64();

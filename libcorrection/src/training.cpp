@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -144,6 +145,22 @@ const awcc::OptionField<T> kTraining[] = {
        std::vector<int> v(o.calibration_bands.begin(), o.calibration_bands.end());
        return list_text(v);
      }},
+    {"calibration-tu-bands", "-",
+     "values of the model's Tu where the calibration's Tu bands meet (each band of windows and Tu is calibrated on its "
+     "own); none = one Tu band",
+     [](T& o, std::string_view t) {
+       o.calibration_tu_bands.clear();
+       if (t == "none") return;
+       for (const auto& cell : awcc::split_cells(t)) {
+         o.calibration_tu_bands.push_back(awcc::parse_quantity(cell, awcc::Dimension::dimensionless));
+       }
+     },
+     [](const T& o) {
+       if (o.calibration_tu_bands.empty()) return std::string("none");
+       std::string s;
+       for (double v : o.calibration_tu_bands) s += (s.empty() ? "" : ",") + fmt::format("{:g}", v);
+       return s;
+     }},
     {"feature-set", "-",
      "features of the model: measured (u, Tu, c, d32, dx, dy, Np), extended (also fs, duration and accepted "
      "windows) or extended-yield (fs, duration and the data yield)",
@@ -180,6 +197,11 @@ std::string TrainOptions::validate() const {
   if (!(calibration >= 0.0 && calibration < 1.0)) return fmt::format("calibration fraction {}: give a fraction in [0, 1)", calibration);
   for (std::size_t i = 1; i < calibration_bands.size(); ++i)
     if (calibration_bands[i] <= calibration_bands[i - 1]) return "calibration bands: give increasing window counts";
+  for (std::size_t i = 0; i < calibration_tu_bands.size(); ++i) {
+    if (!std::isfinite(calibration_tu_bands[i]) || (i > 0 && calibration_tu_bands[i] <= calibration_tu_bands[i - 1])) {
+      return "calibration Tu bands: give increasing values of Tu";
+    }
+  }
   std::size_t features = 0;
   try {
     features = feature_set_names(feature_set).size();
@@ -452,14 +474,17 @@ std::array<double, 3> interval_scores(const std::vector<double>& t, double targe
 }  // namespace
 
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
-                      const std::vector<std::int64_t>& window_edges, int threads) {
+                      const std::vector<std::int64_t>& window_edges, int threads,
+                      const std::vector<double>& tu_edges) {
   std::vector<std::string> names;
   for (const auto& r : model.ranges) names.push_back(r.name);
   Calibration c;
   c.window_edges = window_edges;
-  // Scores of each row: velocity then Tu, intervals 50, 80, 95 %.
+  c.tu_edges = tu_edges;
+  // Scores of each row: velocity then Tu, intervals 50, 80, 95 %; its
+  // window band and Tu band (the Tu forest's median, as correct() finds it).
   std::vector<std::array<double, 6>> scores(rows.size());
-  std::vector<int> band(rows.size());
+  std::vector<int> band(rows.size()), tu_band(rows.size());
   parallel_for(rows.size(), threads, [&](std::size_t i) {
     const auto& r = rows[i];
     const auto x = vector_of(r.features, names);
@@ -468,29 +493,43 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
       const auto form = f == 0 ? model.velocity_form : model.turbulence_form;
       const double target = f == 0 ? to_target(form, r.true_velocity, r.features.velocity)
                                    : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity);
-      const auto e = interval_scores(forest.quantiles(x, correction_levels), target);
+      const auto t = forest.quantiles(x, correction_levels);
+      const auto e = interval_scores(t, target);
       for (std::size_t k = 0; k < 3; ++k) scores[i][static_cast<std::size_t>(3 * f) + k] = e[k];
+      if (f == 1) tu_band[i] = c.tu_band(from_target(form, t[3], r.features.turbulence_intensity));
     }
     band[i] = c.band(r.features.windows_accepted);
   });
-  auto offsets = [&](int b, std::size_t column0) {
+  // The offsets of the rows that `in` admits.
+  auto offsets = [&](const std::function<bool(std::size_t)>& in, std::size_t column0) {
     std::array<double, 3> q{};
     for (std::size_t k = 0; k < 3; ++k) {
       std::vector<double> e;
       for (std::size_t i = 0; i < rows.size(); ++i)
-        if (b < 0 || band[i] == b) e.push_back(scores[i][column0 + k]);
+        if (in(i)) e.push_back(scores[i][column0 + k]);
       q[k] = conformal_offset(std::move(e), calibration_alpha[k]);
     }
     return q;
   };
-  const std::size_t bands = window_edges.size() + 1;
-  for (std::size_t b = 0; b < bands; ++b) {
-    // A band with too few calibration runs (fewer than 1/alpha for the 95 %
-    // interval, with margin) takes the pooled offsets.
-    const auto n = std::count(band.begin(), band.end(), static_cast<int>(b));
-    const int group = n >= 50 ? static_cast<int>(b) : -1;
-    c.velocity.push_back(offsets(group, 0));
-    c.turbulence_intensity.push_back(offsets(group, 3));
+  // A group with too few calibration runs (fewer than 1/alpha for the 95 %
+  // interval, with margin) takes its window band's offsets; a window band
+  // with too few, the pooled ones.
+  constexpr std::int64_t least = 50;
+  for (std::size_t b = 0; b <= window_edges.size(); ++b) {
+    const int w = static_cast<int>(b);
+    const auto in_band = std::count(band.begin(), band.end(), w);
+    for (std::size_t h = 0; h < c.tu_bands(); ++h) {
+      std::int64_t in_group = 0;
+      for (std::size_t i = 0; i < rows.size(); ++i) in_group += band[i] == w && tu_band[i] == static_cast<int>(h);
+      std::function<bool(std::size_t)> in = [](std::size_t) { return true; };
+      if (in_group >= least) {
+        in = [&band, &tu_band, w, h](std::size_t i) { return band[i] == w && tu_band[i] == static_cast<int>(h); };
+      } else if (in_band >= least) {
+        in = [&band, w](std::size_t i) { return band[i] == w; };
+      }
+      c.velocity.push_back(offsets(in, 0));
+      c.turbulence_intensity.push_back(offsets(in, 3));
+    }
   }
   return c;
 }
@@ -706,7 +745,8 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   const auto train_start = std::chrono::steady_clock::now();
   result.model = fit_model(training, vform, tform, vopt, topt, o.min_windows, names);
   if (!calibration_rows.empty()) {
-    result.model.calibration = calibrate(result.model, calibration_rows, o.calibration_bands, o.threads);
+    result.model.calibration =
+        calibrate(result.model, calibration_rows, o.calibration_bands, o.threads, o.calibration_tu_bands);
   }
   result.calibration_rows = static_cast<std::int64_t>(calibration_rows.size());
   if (o.feature_set != "measured") train_fscc(set, o, vopt, key, result);
@@ -731,7 +771,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
     auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows, names);
     if (num != den && !calibration_rows.empty()) {
-      m.calibration = calibrate(m, calibration_rows, o.calibration_bands, o.threads);
+      m.calibration = calibrate(m, calibration_rows, o.calibration_bands, o.threads, o.calibration_tu_bands);
     }
     // Every point scores the same held-out rows: those inside the full
     // model's ranges (a small subset's own ranges would drop the hard rows).
@@ -834,31 +874,42 @@ namespace {
 
 struct Band {
   std::string name;
-  std::function<bool(const TrainingRow&)> holds;
+  std::function<bool(const HeldOutPrediction&)> holds;
 };
 
-// The bands of the held-out tables: true Tu (the bands), accepted
-// windows, sampling rate. Plain copies of the ends: lambdas capture them
+// The bands of the held-out tables: true Tu (the bands), the
+// model's Tu, accepted windows, sampling rate. Plain copies of the ends: lambdas capture them
 // (clang 14 cannot capture bindings).
 std::vector<Band> held_out_bands() {
-  std::vector<Band> bands{{"all", [](const TrainingRow&) { return true; }}};
+  std::vector<Band> bands{{"all", [](const HeldOutPrediction&) { return true; }}};
   for (const auto& band : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 0.35}}) {
     const double lo = band.first, hi = band.second;
-    bands.push_back({fmt::format("true Tu {:g}-{:g}", lo, hi), [lo, hi](const TrainingRow& r) {
-                       return r.true_turbulence_intensity >= lo && r.true_turbulence_intensity < hi;
+    bands.push_back({fmt::format("true Tu {:g}-{:g}", lo, hi), [lo, hi](const HeldOutPrediction& p) {
+                       return p.row.true_turbulence_intensity >= lo && p.row.true_turbulence_intensity < hi;
+                     }});
+  }
+  // The model's Tu (its corrected median): what a lab sees, and what the
+  // calibration's Tu bands are made of.
+  for (const auto& band : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 1e300}}) {
+    const double lo = band.first, hi = band.second;
+    bands.push_back({hi > 1e299 ? fmt::format("model Tu {:g}+", lo) : fmt::format("model Tu {:g}-{:g}", lo, hi),
+                     [lo, hi](const HeldOutPrediction& p) {
+                       if (!p.correction.turbulence_intensity) return false;
+                       const double t = p.correction.turbulence_intensity->median();
+                       return t >= lo && t < hi;
                      }});
   }
   for (const auto& band : std::vector<std::pair<std::int64_t, std::int64_t>>{{10, 30}, {30, 100}, {100, 1LL << 62}}) {
     const std::int64_t lo = band.first, hi = band.second;
     bands.push_back({hi > (1LL << 61) ? fmt::format("windows {}+", lo) : fmt::format("windows {}-{}", lo, hi - 1),
-                     [lo, hi](const TrainingRow& r) {
-                       return r.features.windows_accepted >= lo && r.features.windows_accepted < hi;
+                     [lo, hi](const HeldOutPrediction& p) {
+                       return p.row.features.windows_accepted >= lo && p.row.features.windows_accepted < hi;
                      }});
   }
   for (const auto& band : std::vector<std::pair<double, double>>{{0, 50e3}, {50e3, 200e3}, {200e3, 1e300}}) {
     const double lo = band.first, hi = band.second;
     bands.push_back({hi > 1e299 ? fmt::format("fs {:g} kHz+", lo / 1e3) : fmt::format("fs {:g}-{:g} kHz", lo / 1e3, hi / 1e3),
-                     [lo, hi](const TrainingRow& r) { return r.features.fs > lo && r.features.fs <= hi; }});
+                     [lo, hi](const HeldOutPrediction& p) { return p.row.features.fs > lo && p.row.features.fs <= hi; }});
   }
   return bands;
 }
@@ -873,7 +924,7 @@ std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& pre
     std::vector<double> u_raw, u_corrected, t_raw, t_corrected;
     double u_sq_raw = 0.0, u_sq_corrected = 0.0, t_sq_raw = 0.0, t_sq_corrected = 0.0;
     for (const auto& p : predictions) {
-      if (!b.holds(p.row)) continue;
+      if (!b.holds(p)) continue;
       ++c.runs;
       if (!p.correction.corrected() || !p.correction.velocity || !p.correction.turbulence_intensity) continue;
       const auto& u = p.correction.velocity->quantiles;

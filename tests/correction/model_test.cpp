@@ -136,8 +136,8 @@ TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "pdp-qrf\n");
-  // Format version 3 as u32 little-endian.
-  EXPECT_EQ(bytes[8], 3);
+  // Format version 4 as u32 little-endian.
+  EXPECT_EQ(bytes[8], 4);
   EXPECT_EQ(bytes[9], 0);
   EXPECT_EQ(bytes[10], 0);
   EXPECT_EQ(bytes[11], 0);
@@ -169,8 +169,8 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   const std::string text = "velocity,turbulence_intensity\n1,2\n";
   EXPECT_NE(message({text.begin(), text.end()}).find("not a pdp model file"), std::string::npos);
   auto newer = bytes;
-  newer[8] = 4;
-  EXPECT_NE(message(newer).find("version 4"), std::string::npos) << message(newer);
+  newer[8] = 5;
+  EXPECT_NE(message(newer).find("version 5"), std::string::npos) << message(newer);
   // A structural fault with a valid checksum: the reader checks the trees too.
   auto forged = bytes;
   // The first tree's root node follows the velocity targets; find it by
@@ -417,7 +417,7 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   const auto bytes = m.serialise();
   std::uint32_t version = 0;
   std::memcpy(&version, bytes.data() + 8, 4);
-  EXPECT_EQ(version, 3u);
+  EXPECT_EQ(version, 4u);
   EXPECT_EQ(CorrectionModel::parse(bytes, "x.qrf").serialise(), bytes);
   // The data yield: accepted over formed windows, when both are known.
   Features y = inside();

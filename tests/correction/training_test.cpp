@@ -370,6 +370,54 @@ TEST(Calibration, ConformalOffsetsBringCoverageToNominal) {
   EXPECT_DOUBLE_EQ(s.velocity_rmse_corrected, raw.velocity_rmse_corrected);
 }
 
+TEST(Calibration, TuBandsAreCalibratedOnTheirOwn) {
+  // The Tu forest learnt nothing of Tu (every training run had 0.2), so its
+  // median is the measured Tu: runs measured at Tu 0.05 fall in the first Tu
+  // band, at 0.25 in the third. The calm runs' velocities spread 1, the
+  // turbulent ones' 0.5: each Tu band's 80 % interval is set by its own runs,
+  // and bands without runs take the window band's pooled offsets.
+  auto model = shifted_model(2.0, 4);
+  model.ranges[1] = {"turbulence_intensity", 0.0, 0.5};  // both kinds inside
+  auto calm = runs(600, 5, 500), turbulent = runs(600, 6, 500);
+  for (auto& r : calm) r.features.turbulence_intensity = 0.05;
+  for (auto& r : turbulent) {
+    r.features.turbulence_intensity = 0.25;
+    r.true_velocity = 10.0 + 0.5 * (r.true_velocity - 10.0);
+  }
+  std::vector<correction::TrainingRow> both(calm);
+  both.insert(both.end(), turbulent.begin(), turbulent.end());
+  auto m = model;
+  m.calibration = correction::calibrate(model, both, {}, 0, {0.1, 0.2, 0.3});
+  const auto& c = m.calibration;
+  ASSERT_EQ(c.velocity.size(), 4u);  // one window band x four Tu bands
+  EXPECT_EQ(c.tu_band(0.05), 0);
+  EXPECT_EQ(c.tu_band(0.25), 2);
+  EXPECT_GT(c.velocity[0][1], c.velocity[2][1] + 0.3);  // the calm band is wider
+  EXPECT_LT(c.velocity[1][1], c.velocity[0][1]);        // empty: pooled, between the two
+  EXPECT_GT(c.velocity[1][1], c.velocity[2][1]);
+  EXPECT_EQ(c.velocity[1], c.velocity[3]);
+  // New runs of each kind: nominal coverage (3000 runs: sd 0.7 %, bound 4 %).
+  auto new_calm = runs(3000, 7, 500), new_turbulent = runs(3000, 8, 500);
+  for (auto& r : new_calm) r.features.turbulence_intensity = 0.05;
+  for (auto& r : new_turbulent) {
+    r.features.turbulence_intensity = 0.25;
+    r.true_velocity = 10.0 + 0.5 * (r.true_velocity - 10.0);
+  }
+  EXPECT_NEAR(correction::score(m, new_calm).velocity_coverage80, 0.80, 0.04);
+  EXPECT_NEAR(correction::score(m, new_turbulent).velocity_coverage80, 0.80, 0.04);
+  // Calibrated by windows alone, the two kinds miss nominal in opposite ways.
+  auto pooled = model;
+  pooled.calibration = correction::calibrate(model, both, {}, 0, {});
+  EXPECT_GT(correction::score(pooled, new_calm).velocity_coverage80, 0.80 - 0.15);
+  EXPECT_LT(correction::score(pooled, new_calm).velocity_coverage80, 0.75);
+  EXPECT_GT(correction::score(pooled, new_turbulent).velocity_coverage80, 0.88);
+  // The Tu bands survive the file.
+  const auto again = correction::CorrectionModel::parse(m.serialise(), "m.qrf");
+  EXPECT_EQ(again.calibration.tu_edges, c.tu_edges);
+  EXPECT_EQ(again.calibration.velocity, c.velocity);
+  EXPECT_EQ(again.calibration.turbulence_intensity, c.turbulence_intensity);
+}
+
 TEST(Calibration, BandsAreCalibratedOnTheirOwnAndUnknownWindowsTakeTheWidest) {
   // Runs with 10-29 windows spread 1, runs with 100+ spread 0.5: each band's
   // 80 % interval is set by its own runs.
@@ -399,6 +447,7 @@ TEST(Calibration, BandsAreCalibratedOnTheirOwnAndUnknownWindowsTakeTheWidest) {
   // The calibration survives the file.
   const auto again = correction::CorrectionModel::parse(m.serialise(), "m.qrf");
   EXPECT_EQ(again.calibration.window_edges, c.window_edges);
+  EXPECT_TRUE(again.calibration.tu_edges.empty());
   EXPECT_EQ(again.calibration.velocity, c.velocity);
   EXPECT_EQ(again.calibration.turbulence_intensity, c.turbulence_intensity);
 }

@@ -38,8 +38,9 @@
 // name, u8 target form, u64 block bytes, the block. It admits the extended feature set (the seven measured features,
 // then fs, duration and windows_accepted: see correction/features.hpp;
 // versions 1 and 2 have the seven only) and, after the processing, the
-// calibration: u32 band count B (0: none), B - 1 window edges (i64), then
-// B x 3 offsets (f64) for the velocity and B x 3 for Tu; after the two
+// calibration: u32 band count B (0: none), B - 1 window edges (i64), [version
+// 4: u32 Tu band count T, T - 1 Tu edges (f64); version 3: T = 1], then
+// B x T x 3 offsets (f64) for the velocity and B x T x 3 for Tu; after the two
 // forests, u32 0 or 1, then the FSCC forest: its feature ranges (count, then
 // name, min, max), its calibration (u32 0 or 1, then 3 offsets) and the
 // forest ("fscc_velocity").
@@ -105,17 +106,33 @@ Correction not_corrected(CorrectionStatus status, std::string message);
 /// (and at most 1 - alpha + 1/(n + 1)); Q < 0 narrows an interval that was
 /// too wide. Intervals: the central 50 %, 80 % and 95 % of the reported
 /// levels; the median is left as the forest gives it. Groups are bands of
-/// accepted windows, the feature that most changes how wide an interval
-/// must be; a row whose windows are unknown takes each interval's widest
-/// group.
+/// accepted windows (the feature that most changes how wide an interval
+/// must be) crossed with bands of the Tu forest's uncalibrated median (how
+/// turbulent the model reads the flow: a function of the features only, so
+/// the guarantee holds within each group, and the intervals of u and Tu are
+/// as wide as each range of Tu needs). A group with fewer than 50
+/// calibration runs takes its window band's offsets, and a window band with
+/// fewer, the pooled ones. A row whose windows are unknown takes each
+/// interval's widest window band at its Tu band.
 struct Calibration {
   /// Band g holds windows in [edges[g - 1], edges[g]) (band 0 from 0, the last to infinity).
   std::vector<std::int64_t> window_edges;
-  /// Per band: Q of the 50 %, 80 % and 95 % intervals, in target units.
+  /// Tu band h holds the Tu forest's median in [edges[h - 1], edges[h]);
+  /// empty: one Tu band (format 3 files).
+  std::vector<double> tu_edges;
+  /// Per group (window band w, Tu band h at w x (tu_edges.size() + 1) + h):
+  /// Q of the 50 %, 80 % and 95 % intervals, in target units.
   std::vector<std::array<double, 3>> velocity, turbulence_intensity;
   [[nodiscard]] bool empty() const { return velocity.empty(); }
-  /// The band of a row (-1 when its windows are not known).
+  /// The window band of a row (-1 when its windows are not known).
   [[nodiscard]] int band(std::int64_t windows) const;
+  /// The Tu band of a median.
+  [[nodiscard]] int tu_band(double tu_median) const;
+  [[nodiscard]] std::size_t tu_bands() const { return tu_edges.size() + 1; }
+  /// The offsets of a row: its group's, or with unknown windows each
+  /// interval's widest over the window bands at its Tu band.
+  [[nodiscard]] std::array<double, 3> offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
+                                              double tu_median) const;
   /// Applies the offsets of `band` to the quantiles t at correction_levels
   /// (target units), keeping them in order.
   static void apply(const std::array<double, 3>& offsets, std::vector<double>& t);
@@ -132,7 +149,7 @@ struct FsccForest {
 };
 
 struct CorrectionModel {
-  static constexpr std::uint32_t format_version = 3;
+  static constexpr std::uint32_t format_version = 4;
 
   std::string provenance;             ///< how the model was made (sweep, rows, options, held-out scores)
   std::vector<FeatureRange> ranges;   ///< training data [min, max] per feature, feature order
