@@ -92,8 +92,11 @@ void finish_parsing(Command& c) {
   }
   for (CLI::Option* option : c.required) {
     if (option->count() == 0) {
-      throw std::invalid_argument(fmt::format("{} is required (on the command line or in --config); see pdp {} --help",
-                                              option->get_name(), c.app->get_name()));
+      // A command whose --config is its input (pdp design) has no settings file.
+      const bool settings_file = option->get_name() != "--config";
+      throw std::invalid_argument(fmt::format("{} is required{}; see pdp {} --help", option->get_name(),
+                                              settings_file ? " (on the command line or in --config)" : "",
+                                              c.app->get_name()));
     }
   }
 }
