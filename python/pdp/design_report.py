@@ -38,7 +38,7 @@ import os
 import shlex
 import sys
 
-EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_OUTPUT_FAILED, EXIT_INTERNAL, EXIT_MISSING_PACKAGE = 1, 2, 3, 4, 5
+EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_MISSING_PACKAGE = 1, 2, 5  # the others: plotting.finish_page
 MISSING_PACKAGE_HELP = ("pdp design --report draws with matplotlib and NumPy and writes the page with Jinja2: "
                         "install Debian's python3-matplotlib, python3-numpy and python3-jinja2 (sudo apt install "
                         "python3-matplotlib python3-numpy python3-jinja2)")
@@ -706,28 +706,11 @@ def main(argv=None):
     except ImportError as e:
         print(f"pdp design: {e.name} is missing: {MISSING_PACKAGE_HELP}", file=sys.stderr)
         return EXIT_MISSING_PACKAGE
-    try:
-        page = build(args.input, args.config, command_line=args.command_line,
-                     pdp_version=_pdp_version(args.pdp_version), argv=argv)
-    except InputProblem as e:
-        print(f"pdp design: {e}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except UsageProblem as e:
-        print(f"pdp design: {e}", file=sys.stderr)
-        return EXIT_BAD_USAGE
-    except Exception:  # a defect: Python's own exit status 1 would read as bad input
-        import traceback
-        traceback.print_exc()
-        print("pdp design: internal error in the report; please report it with the command line", file=sys.stderr)
-        return EXIT_INTERNAL
-    try:
-        _plotting().write_page(page, args.output, prefix=".pdp-design-report-")
-    except OSError as e:
-        print(f"pdp design: {args.output}: cannot write: {e.strerror}; choose a writable folder with --report",
-              file=sys.stderr)
-        return EXIT_OUTPUT_FAILED
-    print(f"pdp design: wrote {args.output}", file=sys.stderr)
-    return 0
+    return _plotting().finish_page(
+        "pdp design", lambda: build(args.input, args.config, command_line=args.command_line,
+                                    pdp_version=_pdp_version(args.pdp_version), argv=argv),
+        args.output, "--report", {InputProblem: EXIT_BAD_INPUT, UsageProblem: EXIT_BAD_USAGE},
+        prefix=".pdp-design-report-")
 
 
 if __name__ == "__main__":

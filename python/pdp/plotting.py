@@ -562,3 +562,34 @@ def write_page(text, out, prefix=".pdp-page-"):
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+# pdp's exit status (README, "Exit status") for what finish_page decides.
+EXIT_OUTPUT_FAILED, EXIT_INTERNAL = 3, 4
+
+
+def finish_page(program, build, output, output_flag, problems, prefix=".pdp-page-"):
+    """The end of a page script (pdp report, pdp design --report): builds the
+    page, writes it (write_page) and returns pdp's exit status (README, "Exit
+    status"). `problems` maps the script's exception classes to their exit
+    status (bad input 1, bad usage 2); any other exception is a defect (4),
+    an unwritable page 3."""
+    import sys
+    try:
+        page = build()
+    except tuple(problems) as e:
+        print(f"{program}: {e}", file=sys.stderr)
+        return next(code for kind, code in problems.items() if isinstance(e, kind))
+    except Exception:  # a defect: Python's own exit status 1 would read as bad input
+        import traceback
+        traceback.print_exc()
+        print(f"{program}: internal error; please report it with the command line", file=sys.stderr)
+        return EXIT_INTERNAL
+    try:
+        write_page(page, output, prefix=prefix)
+    except OSError as e:
+        print(f"{program}: {output}: cannot write: {e.strerror}; choose a writable folder with {output_flag}",
+              file=sys.stderr)
+        return EXIT_OUTPUT_FAILED
+    print(f"{program}: wrote {output}", file=sys.stderr)
+    return 0

@@ -29,7 +29,7 @@ import os
 import shlex
 import sys
 
-EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_OUTPUT_FAILED, EXIT_INTERNAL, EXIT_MISSING_PACKAGE = 1, 2, 3, 4, 5
+EXIT_BAD_INPUT, EXIT_BAD_USAGE, EXIT_MISSING_PACKAGE = 1, 2, 5  # the others: plotting.finish_page
 MISSING_PACKAGE_HELP = ("pdp report draws with matplotlib and writes the page with Jinja2: install Debian's "
                         "python3-matplotlib and python3-jinja2 (sudo apt install python3-matplotlib python3-jinja2)")
 
@@ -426,26 +426,11 @@ def main(argv=None):
         print(f"pdp report: the pdp module cannot be loaded ({e}): build pdp with its Python module or install it "
               "(cmake --install), and run Debian's /usr/bin/python3", file=sys.stderr)
         return EXIT_MISSING_PACKAGE
-    try:
-        page = build(args.input, detail=not args.no_detail, jobs=args.jobs, command_line=args.command_line,
-                     input_name=args.input_name)
-    except InputProblem as e:
-        print(f"pdp report: {e}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except Exception:  # a defect: Python's own exit status 1 would read as bad input
-        import traceback
-        traceback.print_exc()
-        print("pdp report: internal error; please report it with the command line", file=sys.stderr)
-        return EXIT_INTERNAL
-    try:
-        from pdp import plotting
-        plotting.write_page(page, args.output, prefix=".pdp-report-")
-    except OSError as e:
-        print(f"pdp report: {args.output}: cannot write: {e.strerror}; choose a writable folder with -o",
-              file=sys.stderr)
-        return EXIT_OUTPUT_FAILED
-    print(f"pdp report: wrote {args.output}", file=sys.stderr)
-    return 0
+    from pdp import plotting
+    return plotting.finish_page(
+        "pdp report", lambda: build(args.input, detail=not args.no_detail, jobs=args.jobs,
+                                    command_line=args.command_line, input_name=args.input_name),
+        args.output, "-o", {InputProblem: EXIT_BAD_INPUT}, prefix=".pdp-report-")
 
 
 if __name__ == "__main__":
