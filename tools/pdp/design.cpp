@@ -330,7 +330,8 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
   const auto phase = awcc::phase_statistics(lead);
   std::vector<DesignRow> rows;
   for (std::size_t g = 0; g < d.geometries.size(); ++g) {
-    const auto [dx, dy] = d.geometries[g];
+    // Plain copies: lambdas below capture them (clang 14 cannot capture bindings).
+    const double dx = d.geometries[g].first, dy = d.geometries[g].second;
     const auto& trail = syn.signals.at(g + 1);
     std::optional<awcc::FsccResult> fscc;  // once per pair, and only when the FSCC forest needs it
     for (int np : d.nps) {
