@@ -378,9 +378,23 @@ QuantileForest QuantileForest::view(std::shared_ptr<const void> owner, std::span
         }
       }
     }
-    for (std::uint64_t k = 0; k < v.row_count; ++k) {
-      const std::uint32_t r = held_row(v.rows, f.row_bytes_, k);
-      if (r >= n) throw std::invalid_argument(fmt::format("forest: tree {} holds row {} of {}", t, r, n));
+    // The largest held row first (a loop the compiler vectorises: reading a
+    // model checks every row of every tree); the offending row only when
+    // there is one.
+    std::uint32_t largest = 0;
+    if (f.row_bytes_ == 2) {
+      for (std::uint64_t k = 0; k < v.row_count; ++k) {
+        largest = std::max(largest, static_cast<std::uint32_t>(v.rows[2 * k]) |
+                                        static_cast<std::uint32_t>(v.rows[2 * k + 1]) << 8);
+      }
+    } else {
+      for (std::uint64_t k = 0; k < v.row_count; ++k) largest = std::max(largest, load_u32(v.rows + 4 * k));
+    }
+    if (largest >= n) {
+      for (std::uint64_t k = 0; k < v.row_count; ++k) {
+        const std::uint32_t r = held_row(v.rows, f.row_bytes_, k);
+        if (r >= n) throw std::invalid_argument(fmt::format("forest: tree {} holds row {} of {}", t, r, n));
+      }
     }
     f.trees_.push_back(v);
   }
