@@ -216,7 +216,8 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     auto optional = [&](const char* name) { return col.count(name) ? value(name) : std::nullopt; };
     m.fs = optional("fs").value_or(d.fs.value_or(0.0));
     m.duration = optional("duration").value_or(d.duration.value_or(0.0));
-    if (const auto w = optional("awcc_windows_accepted")) m.windows_accepted = static_cast<std::int64_t>(*w);
+    if (const auto w = optional("awcc_windows_accepted")) m.windows_accepted = whole(*w, where, "awcc_windows_accepted");
+    if (const auto w = optional("awcc_windows_total")) m.windows_total = whole(*w, where, "awcc_windows_total");
     const auto c = c_value ? model.correct(m)
                            : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
     out.text += row;

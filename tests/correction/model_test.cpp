@@ -5,10 +5,13 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
+#include <map>
 #include <random>
 #include <tuple>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
+#include "correction/rows.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -437,6 +440,72 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   EXPECT_FALSE(none.value("fs"));
   EXPECT_FALSE(none.value("windows_accepted"));
   EXPECT_FALSE(none.value("colour"));
+}
+
+TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
+  // An extended-yield model (data yield = accepted / formed windows) and the
+  // CSV other AWCC tools write: with the columns fs, duration,
+  // awcc_windows_accepted and awcc_windows_total a row is corrected; without
+  // the formed windows it says the data yield is missing and how to give it;
+  // fs and duration may come from pdp correct's options instead.
+  std::mt19937_64 g(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto names = correction::feature_set_names("extended-yield");
+  correction::TrainingData v, t;
+  v.features = t.features = static_cast<int>(names.size());
+  CorrectionModel m;
+  for (const auto& n : names) m.ranges.push_back({n, 1e300, -1e300});
+  for (int i = 0; i < 300; ++i) {
+    Features f = inside();
+    f.velocity = 1 + 9 * u(g);
+    f.turbulence_intensity = 0.05 + 0.3 * u(g);
+    f.void_fraction = 0.01 + 0.3 * u(g);
+    f.d32 = 1e-3 + 5e-3 * u(g);
+    f.fs = 1e4 + 1e5 * u(g);
+    f.duration = 20 + 100 * u(g);
+    f.windows_accepted = 10 + static_cast<std::int64_t>(100 * u(g));
+    f.windows_total = f.windows_accepted + static_cast<std::int64_t>(100 * u(g));
+    std::vector<double> x;
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      x.push_back(*f.value(names[j]));
+      m.ranges[j].min = std::min(m.ranges[j].min, x.back());
+      m.ranges[j].max = std::max(m.ranges[j].max, x.back());
+    }
+    v.x.insert(v.x.end(), x.begin(), x.end());
+    t.x.insert(t.x.end(), x.begin(), x.end());
+    v.y.push_back(1.0);
+    t.y.push_back(0.0);
+  }
+  correction::ForestOptions o;
+  o.trees = 5;
+  m.velocity = correction::QuantileForest::train(v, o);
+  m.turbulence_intensity = correction::QuantileForest::train(t, o);
+  m.min_windows = 10;
+  correction::RowDefaults d;
+  d.dx = 5e-3, d.dy = 1e-3, d.np = 10;
+  const std::string head = "u [m/s],u_rms [m/s],c [-],d_32a [m]";
+  const std::string row = "5,1,0.1,0.003";
+  auto corrected = [&](const std::string& extra_head, const std::string& extra_row, const correction::RowDefaults& defaults) {
+    const auto out = correction::correct_profile_csv(m, head + extra_head + "\n" + row + extra_row + "\n", defaults, "tool.csv");
+    const auto lines = awcc::split_cells(out.text.substr(0, out.text.find('\n')));
+    const auto cells = awcc::split_cells(out.text.substr(out.text.find('\n') + 1, out.text.rfind('\n') - out.text.find('\n') - 1));
+    std::map<std::string, std::string> by_name;
+    for (std::size_t i = 0; i < lines.size() && i < cells.size(); ++i) by_name[lines[i]] = cells[i];
+    return by_name;
+  };
+  auto all = corrected(",fs,duration,awcc_windows_accepted,awcc_windows_total", ",50000,60,40,80", d);
+  EXPECT_EQ(all["correction_status [-]"], "corrected") << all["correction_reason [-]"];
+  auto no_total = corrected(",fs,duration,awcc_windows_accepted", ",50000,60,40", d);
+  EXPECT_EQ(no_total["correction_status [-]"], "missing_feature");
+  EXPECT_NE(no_total["correction_reason [-]"].find("awcc_windows_total"), std::string::npos) << no_total["correction_reason [-]"];
+  auto given = d;
+  given.fs = 50000, given.duration = 60;
+  auto by_option = corrected(",awcc_windows_accepted,awcc_windows_total", ",40,80", given);
+  EXPECT_EQ(by_option["correction_status [-]"], "corrected") << by_option["correction_reason [-]"];
+  EXPECT_EQ(by_option["u_corrected [m/s]"], all["u_corrected [m/s]"]);
+  // A count that is not a whole number is refused, naming the row.
+  EXPECT_THROW(corrected(",fs,duration,awcc_windows_accepted,awcc_windows_total", ",50000,60,40.5,80", d),
+               awcc::InputError);
 }
 
 TEST(Correction, DropletFlowIsNamedAsOutsideWhatTheModelLearnt) {
