@@ -107,6 +107,8 @@ expect 1 "a row of another design" "$pdp" design --config "$dir/other.toml" -o "
 # Bad designs: exit 2, the table and key named, nothing written.
 printf '[conditions.a]\ntu = 0.2\ndx = "5mm"\n' >"$dir/bad.toml"
 expect 2 "[conditions.a] dx" "$pdp" design --config "$dir/bad.toml" -o "$dir/bad.csv"
+printf '[conditions.a]\ntu = 0.2\nvelocity = "0m/s"\n' >"$dir/bad3.toml"
+expect 2 "condition a record 0" "$pdp" design --config "$dir/bad3.toml" -o "$dir/bad.csv"
 printf '[candidates]\nnp = [5]\n' >"$dir/bad2.toml"
 expect 2 "give at least one condition" "$pdp" design --config "$dir/bad2.toml" -o "$dir/bad.csv"
 [[ -e "$dir/bad.csv" || -e "$dir/bad.runs.csv" ]] && fail "a bad design wrote a file"

@@ -89,6 +89,16 @@ int run_design(const DesignOptions& o) {
     const int code = report_error(e);
     return code == exit_bad_input ? exit_bad_usage : code;
   }
+  // Every record's scene before any is simulated: a flow the simulator
+  // cannot make is the design's fault, named before minutes are spent.
+  for (std::int64_t t = 0; t < d.tasks(); ++t) {
+    const auto task = d.task(t);
+    if (const auto errors = task.scene.validate(); !errors.empty()) {
+      spdlog::error("{}: condition {} record {}: {}", o.config, d.conditions[task.condition].name, task.record,
+                    errors.front());
+      return exit_bad_usage;
+    }
+  }
   const std::uint64_t id = design_id(d);
   const std::vector<std::string> runs = o.runs.empty() ? std::vector<std::string>{runs_default(o.output)} : o.runs;
   const std::int64_t per_task = d.rows_per_task();
