@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <random>
 #include <tuple>
@@ -68,6 +69,42 @@ Features inside() {
   f.np = 10;
   f.windows_accepted = 500;
   return f;
+}
+
+// A model of 300 runs drawn by `draw` on the feature set `set`: its ranges
+// those of the draws, its velocity forest learning `velocity_target(f)`
+// (ratio form), its Tu forest 0.01 (difference form); 5 trees, min windows 10.
+double uniform(std::mt19937_64& g) { return std::uniform_real_distribution<double>(0.0, 1.0)(g); }
+
+CorrectionModel model_of(const std::string& set, std::uint64_t seed,
+                         const std::function<void(Features&, std::mt19937_64&)>& draw,
+                         const std::function<double(const Features&)>& velocity_target) {
+  std::mt19937_64 g(seed);
+  const auto names = correction::feature_set_names(set);
+  correction::TrainingData v, t;
+  v.features = t.features = static_cast<int>(names.size());
+  CorrectionModel m;
+  for (const auto& n : names) m.ranges.push_back({n, 1e300, -1e300});
+  for (int i = 0; i < 300; ++i) {
+    Features f = inside();
+    draw(f, g);
+    std::vector<double> x;
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      x.push_back(*f.value(names[j]));
+      m.ranges[j].min = std::min(m.ranges[j].min, x.back());
+      m.ranges[j].max = std::max(m.ranges[j].max, x.back());
+    }
+    v.x.insert(v.x.end(), x.begin(), x.end());
+    t.x.insert(t.x.end(), x.begin(), x.end());
+    v.y.push_back(velocity_target(f));
+    t.y.push_back(0.01);
+  }
+  correction::ForestOptions o;
+  o.trees = 5;
+  m.velocity = correction::QuantileForest::train(v, o);
+  m.turbulence_intensity = correction::QuantileForest::train(t, o);
+  m.min_windows = 10;
+  return m;
 }
 
 TEST(Correction, Crc32MatchesTheStandardCheckValue) {
@@ -381,36 +418,14 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   // A model whose ranges are the extended set: a row without fs is not
   // corrected and says which feature is missing; with it, it is corrected
   // exactly as the forests say; the file reads back bit for bit, as version 3.
-  std::mt19937_64 g(9);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto names = correction::feature_set_names("extended");
   ASSERT_EQ(names.size(), 10u);
-  correction::TrainingData v, t;
-  v.features = t.features = 10;
-  CorrectionModel m;
-  for (const auto& n : names) m.ranges.push_back({n, 1e300, -1e300});
-  for (int i = 0; i < 300; ++i) {
-    Features f = inside();
-    f.velocity = 1 + 49 * u(g);
-    f.fs = 1e4 + 1e6 * u(g);
-    f.duration = 20 + 280 * u(g);
-    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * u(g));
-    std::vector<double> x;
-    for (std::size_t j = 0; j < names.size(); ++j) {
-      x.push_back(*f.value(names[j]));
-      m.ranges[j].min = std::min(m.ranges[j].min, x.back());
-      m.ranges[j].max = std::max(m.ranges[j].max, x.back());
-    }
-    v.x.insert(v.x.end(), x.begin(), x.end());
-    t.x.insert(t.x.end(), x.begin(), x.end());
-    v.y.push_back(1.0 + 1e-7 * f.fs);
-    t.y.push_back(0.01);
-  }
-  correction::ForestOptions o;
-  o.trees = 5;
-  m.velocity = correction::QuantileForest::train(v, o);
-  m.turbulence_intensity = correction::QuantileForest::train(t, o);
-  m.min_windows = 10;
+  auto m = model_of("extended", 9, [](Features& f, std::mt19937_64& g) {
+    f.velocity = 1 + 49 * uniform(g);
+    f.fs = 1e4 + 1e6 * uniform(g);
+    f.duration = 20 + 280 * uniform(g);
+    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * uniform(g));
+  }, [](const Features& f) { return 1.0 + 1e-7 * f.fs; });
   Features f = inside();
   const auto missing = m.correct(f);
   EXPECT_EQ(missing.status, correction::CorrectionStatus::missing_feature);
@@ -448,39 +463,16 @@ TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
   // awcc_windows_accepted and awcc_windows_total a row is corrected; without
   // the formed windows it says the data yield is missing and how to give it;
   // fs and duration may come from pdp correct's options instead.
-  std::mt19937_64 g(3);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const auto names = correction::feature_set_names("extended-yield");
-  correction::TrainingData v, t;
-  v.features = t.features = static_cast<int>(names.size());
-  CorrectionModel m;
-  for (const auto& n : names) m.ranges.push_back({n, 1e300, -1e300});
-  for (int i = 0; i < 300; ++i) {
-    Features f = inside();
-    f.velocity = 1 + 9 * u(g);
-    f.turbulence_intensity = 0.05 + 0.3 * u(g);
-    f.void_fraction = 0.01 + 0.3 * u(g);
-    f.d32 = 1e-3 + 5e-3 * u(g);
-    f.fs = 1e4 + 1e5 * u(g);
-    f.duration = 20 + 100 * u(g);
-    f.windows_accepted = 10 + static_cast<std::int64_t>(100 * u(g));
-    f.windows_total = f.windows_accepted + static_cast<std::int64_t>(100 * u(g));
-    std::vector<double> x;
-    for (std::size_t j = 0; j < names.size(); ++j) {
-      x.push_back(*f.value(names[j]));
-      m.ranges[j].min = std::min(m.ranges[j].min, x.back());
-      m.ranges[j].max = std::max(m.ranges[j].max, x.back());
-    }
-    v.x.insert(v.x.end(), x.begin(), x.end());
-    t.x.insert(t.x.end(), x.begin(), x.end());
-    v.y.push_back(1.0);
-    t.y.push_back(0.0);
-  }
-  correction::ForestOptions o;
-  o.trees = 5;
-  m.velocity = correction::QuantileForest::train(v, o);
-  m.turbulence_intensity = correction::QuantileForest::train(t, o);
-  m.min_windows = 10;
+  const auto m = model_of("extended-yield", 3, [](Features& f, std::mt19937_64& g) {
+    f.velocity = 1 + 9 * uniform(g);
+    f.turbulence_intensity = 0.05 + 0.3 * uniform(g);
+    f.void_fraction = 0.01 + 0.3 * uniform(g);
+    f.d32 = 1e-3 + 5e-3 * uniform(g);
+    f.fs = 1e4 + 1e5 * uniform(g);
+    f.duration = 20 + 100 * uniform(g);
+    f.windows_accepted = 10 + static_cast<std::int64_t>(100 * uniform(g));
+    f.windows_total = f.windows_accepted + static_cast<std::int64_t>(100 * uniform(g));
+  }, [](const Features&) { return 1.0; });
   correction::RowDefaults d;
   d.dx = 5e-3, d.dy = 1e-3, d.np = 10;
   const std::string head = "u [m/s],u_rms [m/s],c [-],d_32a [m]";
