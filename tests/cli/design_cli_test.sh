@@ -104,6 +104,13 @@ fi
 sed 's/seed = 5/seed = 6/' "$dir/flow.toml" >"$dir/other.toml"
 expect 1 "a row of another design" "$pdp" design --config "$dir/other.toml" -o "$dir/one.csv" --runs "$dir/one.runs.csv"
 
+# A file that is not a model, or not a runs file of pdp design: exit 1, the file named, nothing written.
+printf 'not a model\n' >"$dir/junk.qrf"
+expect 1 "junk.qrf: not a pdp model file" "$pdp" design --config "$dir/flow.toml" -o "$dir/junk.csv" --model "$dir/junk.qrf"
+printf 'a,b\n1,2\n' >"$dir/foreign.csv"
+expect 1 "not the runs file of pdp design" "$pdp" design --config "$dir/flow.toml" -o "$dir/junk.csv" --runs "$dir/foreign.csv"
+[[ -e "$dir/junk.csv" ]] && fail "a refused design wrote its ranking"
+
 # Bad designs: exit 2, the table and key named, nothing written.
 printf '[conditions.a]\ntu = 0.2\ndx = "5mm"\n' >"$dir/bad.toml"
 expect 2 "[conditions.a] dx" "$pdp" design --config "$dir/bad.toml" -o "$dir/bad.csv"

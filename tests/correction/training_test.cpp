@@ -292,6 +292,12 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   o.feature_set = "measured";
   o.features_per_split_grid = {8};
   EXPECT_NE(o.validate().find("give 1 to 7"), std::string::npos);
+  o.features_per_split_grid = {3};
+  o.features_per_split = 3;
+  EXPECT_EQ(o.validate(), "");
+  // Calibration Tu bands out of order are refused, not sorted silently.
+  o.calibration_tu_bands = {0.2, 0.1};
+  EXPECT_NE(o.validate().find("calibration Tu bands"), std::string::npos);
 }
 
 // A model of one varying feature (velocity 1-2 m/s) whose forest learnt
