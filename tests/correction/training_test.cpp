@@ -521,6 +521,16 @@ TEST(Training, ScoresByBandCountEachBandsRowsInsideTheirIntervalsAndTheirErrors)
   EXPECT_EQ(band("fs 0-50 kHz").rows, 4);
   EXPECT_EQ(band("fs 200 kHz+").rows, 1);
   for (const auto& b : table) EXPECT_NE(b.band, "windows 30-99");  // empty bands are left out
+  {
+    // A band holds its lower end: Tu 0.35 is the campaign's top band, not 0.3-0.35.
+    const auto edge = correction::scores_by_band({prediction(10, 0.35, 500, 5e5)});
+    bool top = false;
+    for (const auto& b : edge) {
+      EXPECT_NE(b.band, "true Tu 0.3-0.35");
+      if (b.band == "true Tu 0.35-0.45") top = b.rows == 1;
+    }
+    EXPECT_TRUE(top);
+  }
   // Errors over the band's four runs, from the definitions: velocity
   // relative (corrected median 10 against 10, 11.5, 12.5, 14), Tu absolute.
   const auto& tu = band("true Tu 0.1-0.2");
