@@ -986,24 +986,37 @@ std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const 
     return nullptr;
   };
   std::string out = fmt::format(
-      "Against {} on the same held-out runs (errors on the runs both models correct; raw = AWCC's):\n"
+      "Against {} on the same held-out runs: errors on the runs both models correct (raw = AWCC's; velocity "
+      "relative, Tu absolute):\n"
       "  band                          runs  corrected: this  other   u RMSE raw / other / this   "
-      "Tu RMSE raw / other / this   Tu 80 % other / this\n",
+      "u median|err| raw / other / this   Tu RMSE raw / other / this   Tu median|err| raw / other / this\n",
       other_name);
+  std::string coverage =
+      "Coverage on the same runs (nominal 80 / 95 %), other / this:\n"
+      "  band                          both     u 80 %         u 95 %         Tu 80 %        Tu 95 %\n";
   for (const auto& a : all) {
+    // Each model reads its own Tu, so a band of it would hold other runs for
+    // each: bands of the model's Tu are left out of the comparison.
+    if (a.band.starts_with("model Tu")) continue;
     const auto* t = find(theirs, a.band);
     const auto* bm = find(both_mine, a.band);
     const auto* bt = find(both_theirs, a.band);
     out += fmt::format("  {:<28} {:>6} {:>16} {:>6}", a.band, a.runs, a.rows, t ? t->rows : 0);
     if (bm && bt) {
-      out += fmt::format("   {:6.2f} / {:6.2f} / {:6.2f} %   {:.4f} / {:.4f} / {:.4f}   {:5.1f} / {:5.1f}",
+      out += fmt::format("   {:6.2f} / {:6.2f} / {:6.2f} %   {:6.2f} / {:6.2f} / {:6.2f} %       "
+                         "{:.4f} / {:.4f} / {:.4f}   {:.4f} / {:.4f} / {:.4f}",
                          100 * bt->velocity_rmse_raw, 100 * bt->velocity_rmse_corrected,
-                         100 * bm->velocity_rmse_corrected, bt->tu_rmse_raw, bt->tu_rmse_corrected,
-                         bm->tu_rmse_corrected, 100 * bt->tu80, 100 * bm->tu80);
+                         100 * bm->velocity_rmse_corrected, 100 * bt->velocity_median_abs_raw,
+                         100 * bt->velocity_median_abs_corrected, 100 * bm->velocity_median_abs_corrected,
+                         bt->tu_rmse_raw, bt->tu_rmse_corrected, bm->tu_rmse_corrected, bt->tu_median_abs_raw,
+                         bt->tu_median_abs_corrected, bm->tu_median_abs_corrected);
+      coverage += fmt::format("  {:<28} {:>6}   {:5.1f} / {:5.1f}  {:5.1f} / {:5.1f}  {:5.1f} / {:5.1f}  {:5.1f} / {:5.1f}\n",
+                              a.band, bm->rows, 100 * bt->velocity80, 100 * bm->velocity80, 100 * bt->velocity95,
+                              100 * bm->velocity95, 100 * bt->tu80, 100 * bm->tu80, 100 * bt->tu95, 100 * bm->tu95);
     }
     out += "\n";
   }
-  return out;
+  return out + coverage;
 }
 
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {

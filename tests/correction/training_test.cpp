@@ -559,7 +559,16 @@ TEST(Training, ScoresByBandCountEachBandsRowsInsideTheirIntervalsAndTheirErrors)
   auto shuffled = q;
   shuffled[1].row.run = 7;
   EXPECT_THROW(correction::corrected_by_both(p, shuffled), std::invalid_argument);
-  EXPECT_NE(correction::comparison_report(p, q, "old.qrf").find("old.qrf"), std::string::npos);
+  // The report's coverage on the 4 runs both correct (the same quantiles in
+  // both): true u 11.5, 12.5, 14, 10 against [8, 12] and [7, 13] -> 2/4 and
+  // 3/4; true Tu 0.15 (three) and 0.32 against [0.1, 0.2] and [0, 0.4] -> 3/4, 4/4.
+  const auto report = correction::comparison_report(p, q, "old.qrf");
+  EXPECT_NE(report.find("old.qrf"), std::string::npos);
+  EXPECT_EQ(report.find("model Tu"), std::string::npos);
+  const auto all_line = report.substr(report.find("\n  all ", report.find("Coverage")) + 1);
+  EXPECT_EQ(all_line.substr(0, all_line.find('\n')),
+            fmt::format("  {:<28} {:>6}   {:5.1f} / {:5.1f}  {:5.1f} / {:5.1f}  {:5.1f} / {:5.1f}  {:5.1f} / {:5.1f}", "all",
+                        4, 50.0, 50.0, 75.0, 75.0, 75.0, 75.0, 100.0, 100.0));
 }
 
 }  // namespace

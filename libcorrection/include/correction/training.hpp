@@ -217,8 +217,9 @@ std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPredic
                                                  const std::vector<HeldOutPrediction>& other);
 
 /// A second model (e.g. the one shipped before) on the same held-out runs,
-/// band by band: how many runs each corrects, and the errors of both on the
-/// runs both correct.
+/// band by band (not by the model's Tu: each model has its own): how many
+/// runs each corrects, and the errors and coverage of both on the runs both
+/// correct.
 std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const std::vector<HeldOutPrediction>& other,
                               const std::string& other_name);
 
