@@ -52,8 +52,10 @@ def test_a_profile_with_positions_and_the_correction_equals_the_cli(cli, real_fi
     assert len(r.profile) == len(expected["profile"]) == len(real_files)
     for got, want in zip(r.profile, expected["profile"]):
         assert got == want, got["file"]
-    # Files 08-10 are corrected, the others say why not (docs/validation.md).
-    assert [row.correction.status for row in r.profile[-3:]] == ["corrected"] * 3
+    # Every row is corrected by the shipped model (docs/validation.md): file 01
+    # (2 accepted windows) by its FSCC forest, the others by the AWCC forest.
+    assert [row.correction.status for row in r.profile] == ["corrected"] * 10
+    assert [row.correction.forest for row in r.profile] == ["fscc"] + ["awcc"] * 9
 
 
 def test_a_synthetic_recording_equals_the_cli_and_its_arrays(cli, scratch):

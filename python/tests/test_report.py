@@ -233,15 +233,19 @@ def test_the_real_report_draws_each_position_from_its_recording(real):
 
 def test_an_insufficient_row_is_a_gap_with_its_reason(real):
     """Real file 01 (2 mm) has 2 accepted AWCC windows: its velocity cell is a
-    gap whose note gives AWCC's reason, and its correction's."""
+    gap whose note gives AWCC's reason; the FSCC forest corrects its velocity,
+    and its corrected Tu is a gap saying that forest corrects the velocity only."""
     page = page_of(real)
     row0 = load(real / "profile.json")["profile"][0]
     assert row0["awcc"]["quality"] == "insufficient"
     value, gap = page.columns["awcc_velocity"][0]
     assert value is None and gap
     assert "windows accepted" in page.ids[f"gap-{gap}"]
-    _, gap = page.columns["corrected_velocity"][0]
-    assert "not corrected" in page.ids[f"gap-{gap}"]
+    value, gap = page.columns["corrected_velocity"][0]
+    assert value == pytest.approx(row0["correction"]["velocity"]["median"]) and gap is None
+    assert row0["correction"]["forest"] == "fscc"
+    _, gap = page.columns["corrected_turbulence_intensity"][0]
+    assert "Tu not corrected" in page.ids[f"gap-{gap}"] and "velocity only" in page.ids[f"gap-{gap}"]
     _, gap = page.columns["awcc_velocity_measured"][9]
     assert "no bubble-probe correction" in page.ids[f"gap-{gap}"]
 

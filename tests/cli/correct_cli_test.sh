@@ -149,16 +149,22 @@ grep -q "not a pdp model file" <<<"$err" || fail "foreign model message: $err"
 err=$("$pdp" correct "$dir/mc.csv" -m "$dir/a.qrf" 2>&1) && fail "a sweep CSV corrected as a profile"
 grep -q "mc.csv: no column 'bubble_count_rate'" <<<"$err" || fail "wrong input message: $err"
 
-# The shipped model loads and corrects (it was trained on 60 s records; this
-# row is inside its ranges).
+# The shipped model loads and corrects a lab-like record (30 s at 20 kHz: inside its ranges); the 4 s
+# record above is shorter than any of its training records (20-300 s) and is refused with the reason.
 shipped=$src/samples/model/awcc.qrf
 if [[ -f "$shipped" ]]; then
-  "$pdp" correct "$dir/rec.json" -m "$shipped" -o "$dir/shipped.json" || fail "shipped model"
+  "$pdp" --log-level warn synth -q --duration 30s --fs 20kHz --velocity 3m/s --tu 0.2 --void-fraction 0.1 \
+    --bubble-diameter 3mm --dx 5mm --seed 9 -o "$dir/lab.flac" || fail "synth lab record"
+  "$pdp" --log-level error process "$dir/lab.flac" --dx 5mm --np 10 --correct "$shipped" --json "$dir/shipped.json" ||
+    fail "shipped model"
   python3 -c "
 import json,sys
 c=json.load(open('$dir/shipped.json'))['correction']
-sys.exit(0 if c['in_range'] and c['velocity']['quantiles']['0.025'] <= c['velocity']['quantiles']['0.975'] else 1)" ||
+q=c['velocity']['quantiles']; t=c['turbulence_intensity']['quantiles']
+sys.exit(0 if c['in_range'] and c['forest'] == 'awcc' and q['0.025'] <= q['0.5'] <= q['0.975'] and t['0.1'] <= t['0.9'] else 1)" ||
     fail "shipped model did not correct"
+  "$pdp" correct "$dir/rec.json" -m "$shipped" -o "$dir/short.json" || fail "shipped model on a short record"
+  grep -q '"reason": "duration = 4 is outside the training range' "$dir/short.json" || fail "a 4 s record is not named outside the ranges: $(grep -o '"reason": "[^"]*' "$dir/short.json")"
 else
   fail "samples/model/awcc.qrf is missing"
 fi

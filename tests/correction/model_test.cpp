@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
@@ -409,7 +410,7 @@ TEST(Correction, ModelFileKeepsTheProcessing) {
   const auto back = CorrectionModel::parse(m.serialise(), "m.qrf");
   EXPECT_TRUE(back.processing == m.processing);
   EXPECT_NE(back.mismatch(correction::Processing{}), "");
-  const auto shipped = std::filesystem::path(PDP_SOURCE_DIR) / "samples" / "model" / "awcc.qrf";
+  const auto shipped = std::filesystem::path(PDP_SOURCE_DIR) / "samples" / "model" / "awcc-60s-500kHz.qrf";
   const auto v1 = CorrectionModel::load(shipped);
   EXPECT_TRUE(v1.processing == correction::Processing{});
 }
@@ -579,9 +580,44 @@ TEST(Correction, Format2FilesStillCorrectAsTheyDid) {
   EXPECT_EQ(old.serialise(), m.serialise());
 }
 
-TEST(Correction, TheShippedModelCorrects) {
+TEST(Correction, TheShippedModelCorrectsTheRecordsLabsMake) {
+  // Issue 18: the data yield as the record feature (chosen by
+  // cross-validation, docs/validation.md), rows from 10 accepted windows, an
+  // FSCC forest, calibrated intervals. A 45 s, 20 kHz row with 30 of 300
+  // windows is corrected by the AWCC forest, with quantiles in order.
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
+  EXPECT_EQ(correction::feature_set_of([&] {
+              std::vector<std::string> n;
+              for (const auto& r : m.ranges) n.push_back(r.name);
+              return n;
+            }()),
+            "extended-yield");
+  EXPECT_EQ(m.min_windows, 10);
+  ASSERT_TRUE(m.fscc.has_value());
+  EXPECT_FALSE(m.calibration.empty());
+  Features f = inside();
+  f.velocity = 3.0;
+  f.fs = 20e3;
+  f.duration = 45;
+  f.windows_accepted = 30;
+  f.windows_total = 300;
+  const auto c = m.correct(f);
+  ASSERT_TRUE(c.corrected()) << c.message;
+  EXPECT_EQ(c.forest, "awcc");
+  for (const auto* q : {&*c.velocity, &*c.turbulence_intensity})
+    EXPECT_TRUE(std::is_sorted(q->quantiles.begin(), q->quantiles.end()));
+  // Droplet flow (c above the campaign's 0.6) stays flagged.
+  f.void_fraction = 0.7;
+  EXPECT_EQ(m.correct(f).status, correction::CorrectionStatus::outside_training_range);
+}
+
+TEST(Correction, TheModelForSixtySecondRecordsAt500kHzStillCorrects) {
+  // The model shipped before issue 18 (seven measured features, at least 100
+  // windows, no FSCC forest): old files keep working.
+  const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc-60s-500kHz.qrf");
   EXPECT_EQ(m.ranges.size(), 7u);
+  EXPECT_EQ(m.min_windows, 100);
+  EXPECT_FALSE(m.fscc.has_value());
   const auto c = m.correct(inside());
   EXPECT_TRUE(c.corrected()) << c.message;
 }
