@@ -879,9 +879,9 @@ struct Band {
 
 // The bands of the held-out tables: true Tu (the bands, and the
 // campaign's top, 0.35-0.45, apart: a band at the edge of the drawn range is
-// where quantile forests cover worst), the
-// model's Tu, accepted windows, sampling rate. Plain copies of the ends: lambdas capture them
-// (clang 14 cannot capture bindings).
+// where quantile forests cover worst), the model's Tu, accepted windows,
+// sampling rate. Plain copies of the ends: lambdas capture them (clang 14
+// cannot capture bindings).
 std::vector<Band> held_out_bands() {
   std::vector<Band> bands{{"all", [](const HeldOutPrediction&) { return true; }}};
   for (const auto& band : std::vector<std::pair<double, double>>{{0, 0.1}, {0.1, 0.2}, {0.2, 0.3}, {0.3, 0.35}, {0.35, 0.45}}) {

@@ -205,8 +205,8 @@ struct BandScores {
   double velocity80 = 0.0, velocity95 = 0.0, tu80 = 0.0, tu95 = 0.0;
 };
 /// The scores of held-out predictions: all runs, by band of the true Tu
-/// (0-0.1, 0.1-0.2, 0.2-0.3, 0.3-0.35, 0.35-0.45), of the model's corrected Tu (0-0.1,
-/// 0.1-0.2, 0.2-0.3, 0.3+), of accepted windows (10-29, 30-99,
+/// (0-0.1, 0.1-0.2, 0.2-0.3, 0.3-0.35, 0.35-0.45), of the model's corrected
+/// Tu (0-0.1, 0.1-0.2, 0.2-0.3, 0.3+), of accepted windows (10-29, 30-99,
 /// 100+) and of fs (up to 50 kHz, 50-200 kHz, above); bands without a
 /// corrected row are left out.
 std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& predictions);
