@@ -50,6 +50,19 @@ TEST(ParseQuantity, DimensionalQuantitiesNeedTheirUnit) {
   EXPECT_DOUBLE_EQ(parse_quantity("0.0", Dimension::velocity), 0.0);
 }
 
+// A ratio given a unit (--calibration-tu-bands 0.1m/s, a Tu written as a
+// velocity) is refused, not read as 0.1.
+TEST(ParseQuantity, DimensionlessQuantitiesRefuseAUnit) {
+  for (const char* text : {"0.1m/s", "0.1mm", "0.1Hz"}) {
+    try {
+      (void)parse_quantity(text, Dimension::dimensionless);
+      FAIL() << text << " accepted as a plain number";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("is not a plain number"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(ParseQuantity, RefusesWrongUnitsWithAMessageNamingThem) {
   try {
     parse_quantity("5kg", Dimension::length);
