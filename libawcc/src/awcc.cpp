@@ -1,5 +1,6 @@
 #include "awcc/awcc.hpp"
 
+#include "awcc/detail/awcc_driver.hpp"
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/order_statistics.hpp"
 #include "overlap_impulses.hpp"
@@ -719,7 +720,6 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
 
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options,
                 AwccWorkspace& workspace) {
-  using namespace detail;
   if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   if (options.signal != CorrelationSignal::binary) {
     throw std::invalid_argument("AWCC of air intervals correlates binary signals; raw voltages need the recording");
@@ -727,44 +727,68 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   if (leading.sample_count != trailing.sample_count || leading.fs != trailing.fs) {
     throw std::invalid_argument("AWCC needs two signals of the same length and sampling rate");
   }
+  if (options.path == CorrelationPath::fft) {
+    detail::RenderedFftCorrelations rendered(leading, trailing);
+    return detail::run_awcc(leading, dx, options, rendered, workspace);
+  }
+  detail::IntervalCorrelations intervals(leading, trailing);
+  return detail::run_awcc(leading, dx, options, intervals, workspace);
+}
+
+namespace detail {
+
+WindowPeak fft_window_peak(std::span<const double> x, std::span<const double> y, std::int64_t k_min,
+                           std::int64_t k_max, const AwccOptions& options, AwccWorkspace& workspace) {
+  const auto r = window_correlation_fft(x, y, k_min, k_max, workspace);
+  if (r.empty()) return {.peak = {}, .constant = true};
+  return {.peak = analyse_correlation(r, options.subsample, options.prominence_fraction, workspace), .constant = false};
+}
+
+WindowPeak IntervalCorrelations::correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max,
+                                           const AwccOptions& options, AwccWorkspace& workspace) {
+  auto& r = workspace.scratch().piecewise;
+  window_correlation_piecewise(leading_, trailing_, w.start, w.length, k_min, k_max, workspace, r);
+  if (r.empty()) return {.peak = {}, .constant = true};
+  return {.peak = analyse_correlation(r, options.subsample, options.prominence_fraction, workspace), .constant = false};
+}
+
+WindowPeak RenderedFftCorrelations::correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max,
+                                              const AwccOptions& options, AwccWorkspace& workspace) {
+  auto& s = workspace.scratch();
+  const auto n = static_cast<std::size_t>(w.length);
+  s.rendered_x.resize(n);
+  s.rendered_y.resize(n);
+  leading_.render(w.start, s.rendered_x);
+  trailing_.render(w.start, s.rendered_y);
+  s.samples_x.assign(s.rendered_x.begin(), s.rendered_x.end());
+  s.samples_y.assign(s.rendered_y.begin(), s.rendered_y.end());
+  return fft_window_peak(s.samples_x, s.samples_y, k_min, k_max, options, workspace);
+}
+
+AwccResult run_awcc(const AirIntervals& leading, double dx, const AwccOptions& options, WindowCorrelations& source,
+                    AwccWorkspace& workspace) {
   AwccResult result;
   result.np = options.np;
   result.options = options;
   result.windows = awcc_windows(leading, options.np);
   const double fs = leading.fs;
-  const bool use_fft = options.path == CorrelationPath::fft;
-  std::vector<std::uint8_t> dense_x, dense_y;
-  std::vector<double> xs, ys;
-  PiecewiseCorrelation piecewise;  // reused: its buffers outlive the windows
   for (auto& w : result.windows) {
     const auto [k_min, k_max] = awcc_lag_range(w.length, dx, fs, options);
     if (k_max < k_min) {
+      source.skip(w, workspace);
       w.fate = WindowFate::too_short;
       continue;
     }
-    if (use_fft) {
-      const auto n = static_cast<std::size_t>(w.length);
-      dense_x.resize(n);
-      dense_y.resize(n);
-      leading.render(w.start, dense_x);
-      trailing.render(w.start, dense_y);
-      xs.assign(dense_x.begin(), dense_x.end());
-      ys.assign(dense_y.begin(), dense_y.end());
-      analyse_window(w, window_correlation_fft(xs, ys, k_min, k_max, workspace), k_min, dx, fs, options, workspace);
-    } else {
-      auto& r = piecewise;
-      window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max, workspace, r);
-      const CorrelationPeak p = r.empty() ? CorrelationPeak{}
-                                          : analyse_correlation(r, options.subsample, options.prominence_fraction,
-                                                                workspace);
-      analyse_window(w, p, r.empty(), k_min, dx, fs, options);
-    }
+    const WindowPeak p = source.correlate(w, k_min, k_max, options, workspace);
+    analyse_window(w, p.peak, p.constant, k_min, dx, fs, options);
   }
   correct_windows(result, dx, options);
   awcc_summarise(result, options);
   if (!(dx > 0.0) && result.ok()) no_tip_separation(result);
   return result;
 }
+
+}  // namespace detail
 
 void detail::no_tip_separation(AwccResult& result) {
   result.status = AwccStatus::no_tip_separation;
