@@ -16,16 +16,8 @@
 namespace awcc {
 
 std::string_view to_string(WindowFate fate) {
-  switch (fate) {
-    case WindowFate::accepted: return "accepted";
-    case WindowFate::correlation: return "correlation";
-    case WindowFate::lag: return "lag";
-    case WindowFate::roc: return "roc";
-    case WindowFate::constant: return "constant";
-    case WindowFate::too_short: return "too_short";
-    case WindowFate::correction: return "correction";
-  }
-  return "?";
+  const auto i = static_cast<std::size_t>(fate);
+  return i < window_fate_names.size() ? window_fate_names[i] : "?";
 }
 
 std::string_view to_string(Weighting weighting) { return weighting == Weighting::duration ? "duration" : "none"; }
@@ -598,22 +590,14 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     for (std::size_t i = 0; i < windows.size(); ++i)
       if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
   }
-  result.windows_accepted = result.rejected_correlation = result.rejected_lag = result.rejected_roc =
-      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = result.negative_lag_windows =
-          result.rejected_correction = 0;
+  result.windows_by_fate.fill(0);
+  result.lag_zero_windows = result.negative_lag_windows = 0;
   for (const auto& w : windows) {
-    switch (w.fate) {
-      case WindowFate::accepted: ++result.windows_accepted; break;
-      case WindowFate::correlation: ++result.rejected_correlation; break;
-      case WindowFate::lag: ++result.rejected_lag; break;
-      case WindowFate::roc: ++result.rejected_roc; break;
-      case WindowFate::constant: ++result.rejected_constant; break;
-      case WindowFate::too_short: ++result.rejected_too_short; break;
-      case WindowFate::correction: ++result.rejected_correction; break;
-    }
+    ++result.windows_by_fate[static_cast<std::size_t>(w.fate)];
     if (w.fate == WindowFate::lag && w.lag_samples == 0) ++result.lag_zero_windows;
     if (w.fate == WindowFate::lag && w.lag_samples < 0) ++result.negative_lag_windows;
   }
+  result.windows_accepted = result.count(WindowFate::accepted);
   result.status = AwccStatus::too_few_windows;
   result.quality = AwccQuality::insufficient;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
@@ -646,10 +630,11 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       result.message = fmt::format(
           "{} of {} windows accepted ({} rejected by the correlation filter, {} by a non-positive lag, {} by the "
           "outlier cutoff, {} constant{}): too few for statistics (fewer than {})",
-          result.windows_accepted, result.windows_total, result.rejected_correlation, result.rejected_lag,
-          result.rejected_roc, result.rejected_constant,
-          result.rejected_too_short ? fmt::format(", {} too short for the velocity range", result.rejected_too_short)
-                                    : std::string(),
+          result.windows_accepted, result.windows_total, result.count(WindowFate::correlation),
+          result.count(WindowFate::lag), result.count(WindowFate::roc), result.count(WindowFate::constant),
+          result.count(WindowFate::too_short)
+              ? fmt::format(", {} too short for the velocity range", result.count(WindowFate::too_short))
+              : std::string(),
           options.windows_reported);
     }
     insufficient();

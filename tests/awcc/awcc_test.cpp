@@ -296,14 +296,14 @@ TEST(Awcc, UndefinedCasesCarryReasonsAndNoNaN) {
   r = awcc::awcc(x, x, 1.0, {});
   EXPECT_FALSE(r.ok());
   EXPECT_NE(r.message.find("shorter than one sample"), std::string::npos) << r.message;
-  EXPECT_EQ(r.rejected_lag, r.windows_total);
+  EXPECT_EQ(r.count(awcc::WindowFate::lag), r.windows_total);
   // Constant trailing tip.
   AirIntervals water;
   water.fs = x.fs;
   water.sample_count = x.sample_count;
   r = awcc::awcc(x, water, 1.0, {});
   EXPECT_FALSE(r.ok());
-  EXPECT_EQ(r.rejected_constant, r.windows_total);
+  EXPECT_EQ(r.count(awcc::WindowFate::constant), r.windows_total);
   for (double v : {r.velocity, r.velocity_rms, r.turbulence_intensity}) EXPECT_TRUE(std::isfinite(v));
 }
 
