@@ -36,32 +36,32 @@ class WindowCorrelations {
   virtual void skip(const AwccWindow& /*w*/, AwccWorkspace& /*workspace*/) {}
 };
 
-/// Binary signals by their air intervals: exact, the piecewise-linear
-/// correlation analysed at its breakpoints.
-class IntervalCorrelations final : public WindowCorrelations {
+/// The two tips' binary signals, which the sources below correlate.
+class BinarySignals : public WindowCorrelations {
  public:
-  IntervalCorrelations(const AirIntervals& leading, const AirIntervals& trailing)
-      : leading_(leading), trailing_(trailing) {}
-  WindowPeak correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max, const AwccOptions& options,
-                       AwccWorkspace& workspace) override;
+  BinarySignals(const AirIntervals& leading, const AirIntervals& trailing) : leading_(leading), trailing_(trailing) {}
 
- private:
+ protected:
   const AirIntervals& leading_;
   const AirIntervals& trailing_;
 };
 
-/// Binary signals rendered sample by sample over each window and correlated
-/// by FFTs (agrees with the interval path to rounding).
-class RenderedFftCorrelations final : public WindowCorrelations {
+/// Binary signals by their air intervals: exact, the piecewise-linear
+/// correlation analysed at its breakpoints.
+class IntervalCorrelations final : public BinarySignals {
  public:
-  RenderedFftCorrelations(const AirIntervals& leading, const AirIntervals& trailing)
-      : leading_(leading), trailing_(trailing) {}
+  using BinarySignals::BinarySignals;
   WindowPeak correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max, const AwccOptions& options,
                        AwccWorkspace& workspace) override;
+};
 
- private:
-  const AirIntervals& leading_;
-  const AirIntervals& trailing_;
+/// Binary signals rendered sample by sample over each window and correlated
+/// by FFTs (agrees with the interval path to rounding).
+class RenderedFftCorrelations final : public BinarySignals {
+ public:
+  using BinarySignals::BinarySignals;
+  WindowPeak correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max, const AwccOptions& options,
+                       AwccWorkspace& workspace) override;
 };
 
 /// The FFT path's peak of a window given as its samples (binary 0/1 or
