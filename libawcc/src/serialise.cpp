@@ -356,6 +356,8 @@ json to_json(const ProcessResult& r) {
                                               static_cast<double>(a.windows_total))
                                         : json(nullptr)},
     };
+    // From the counts by fate (nlohmann::json sorts an object's keys: the
+    // file reads as when they were listed by hand).
     for (std::size_t i = 0; i < window_fate_count; ++i) {
       const auto fate = static_cast<WindowFate>(i);
       out["awcc"][window_count_key(fate)] = a.count(fate);
