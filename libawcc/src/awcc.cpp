@@ -1,5 +1,6 @@
 #include "awcc/awcc.hpp"
 
+#include "awcc/detail/awcc_driver.hpp"
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/order_statistics.hpp"
 #include "overlap_impulses.hpp"
@@ -15,16 +16,8 @@
 namespace awcc {
 
 std::string_view to_string(WindowFate fate) {
-  switch (fate) {
-    case WindowFate::accepted: return "accepted";
-    case WindowFate::correlation: return "correlation";
-    case WindowFate::lag: return "lag";
-    case WindowFate::roc: return "roc";
-    case WindowFate::constant: return "constant";
-    case WindowFate::too_short: return "too_short";
-    case WindowFate::correction: return "correction";
-  }
-  return "?";
+  const auto i = static_cast<std::size_t>(fate);
+  return i < window_fate_names.size() ? window_fate_names[i] : "?";
 }
 
 std::string_view to_string(Weighting weighting) { return weighting == Weighting::duration ? "duration" : "none"; }
@@ -304,19 +297,22 @@ std::vector<double> window_correlation_fft(std::span<const double> x, std::span<
   if (!(qx > 1e-20 * static_cast<double>(n) * (1.0 + mx * mx)) || !(qy > 1e-20 * static_cast<double>(n) * (1.0 + my * my)))
     return {};
   const std::size_t m = fast_fft_size(2 * n - 1);
-  FftPlan& plan = workspace.scratch().plans.get(m);
-  auto& xs = workspace.scratch().spectrum;
-  auto r = plan.real();
+  auto& scratch = workspace.scratch();
+  const FftPlan& plan = scratch.plans.get(m);
+  auto& buffers = scratch.fft;
+  buffers.resize(m);
+  auto& xs = scratch.spectrum;
+  auto r = buffers.real();
   std::fill(r.begin(), r.end(), 0.0);
   for (std::size_t i = 0; i < n; ++i) r[i] = x[i] - mx;
-  plan.forward();
-  xs.assign(plan.spectrum().begin(), plan.spectrum().end());
+  plan.forward(buffers);
+  xs.assign(buffers.spectrum().begin(), buffers.spectrum().end());
   std::fill(r.begin(), r.end(), 0.0);
   for (std::size_t i = 0; i < n; ++i) r[i] = y[i] - my;
-  plan.forward();
-  auto spec = plan.spectrum();
+  plan.forward(buffers);
+  auto spec = buffers.spectrum();
   for (std::size_t i = 0; i < spec.size(); ++i) spec[i] *= std::conj(xs[i]);
-  plan.inverse();
+  plan.inverse(buffers);
   const double norm = 1.0 / (static_cast<double>(m) * std::sqrt(qx * qy));
   std::vector<double> out(static_cast<std::size_t>(k_max - k_min + 1));
   const auto sm = static_cast<std::int64_t>(m);
@@ -594,22 +590,14 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     for (std::size_t i = 0; i < windows.size(); ++i)
       if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
   }
-  result.windows_accepted = result.rejected_correlation = result.rejected_lag = result.rejected_roc =
-      result.rejected_constant = result.rejected_too_short = result.lag_zero_windows = result.negative_lag_windows =
-          result.rejected_correction = 0;
+  result.windows_by_fate.fill(0);
+  result.lag_zero_windows = result.negative_lag_windows = 0;
   for (const auto& w : windows) {
-    switch (w.fate) {
-      case WindowFate::accepted: ++result.windows_accepted; break;
-      case WindowFate::correlation: ++result.rejected_correlation; break;
-      case WindowFate::lag: ++result.rejected_lag; break;
-      case WindowFate::roc: ++result.rejected_roc; break;
-      case WindowFate::constant: ++result.rejected_constant; break;
-      case WindowFate::too_short: ++result.rejected_too_short; break;
-      case WindowFate::correction: ++result.rejected_correction; break;
-    }
+    ++result.windows_by_fate[static_cast<std::size_t>(w.fate)];
     if (w.fate == WindowFate::lag && w.lag_samples == 0) ++result.lag_zero_windows;
     if (w.fate == WindowFate::lag && w.lag_samples < 0) ++result.negative_lag_windows;
   }
+  result.windows_accepted = result.count(WindowFate::accepted);
   result.status = AwccStatus::too_few_windows;
   result.quality = AwccQuality::insufficient;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
@@ -642,10 +630,11 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       result.message = fmt::format(
           "{} of {} windows accepted ({} rejected by the correlation filter, {} by a non-positive lag, {} by the "
           "outlier cutoff, {} constant{}): too few for statistics (fewer than {})",
-          result.windows_accepted, result.windows_total, result.rejected_correlation, result.rejected_lag,
-          result.rejected_roc, result.rejected_constant,
-          result.rejected_too_short ? fmt::format(", {} too short for the velocity range", result.rejected_too_short)
-                                    : std::string(),
+          result.windows_accepted, result.windows_total, result.count(WindowFate::correlation),
+          result.count(WindowFate::lag), result.count(WindowFate::roc), result.count(WindowFate::constant),
+          result.count(WindowFate::too_short)
+              ? fmt::format(", {} too short for the velocity range", result.count(WindowFate::too_short))
+              : std::string(),
           options.windows_reported);
     }
     insufficient();
@@ -716,7 +705,6 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
 
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options,
                 AwccWorkspace& workspace) {
-  using namespace detail;
   if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   if (options.signal != CorrelationSignal::binary) {
     throw std::invalid_argument("AWCC of air intervals correlates binary signals; raw voltages need the recording");
@@ -724,44 +712,68 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   if (leading.sample_count != trailing.sample_count || leading.fs != trailing.fs) {
     throw std::invalid_argument("AWCC needs two signals of the same length and sampling rate");
   }
+  if (options.path == CorrelationPath::fft) {
+    detail::RenderedFftCorrelations rendered(leading, trailing);
+    return detail::run_awcc(leading, dx, options, rendered, workspace);
+  }
+  detail::IntervalCorrelations intervals(leading, trailing);
+  return detail::run_awcc(leading, dx, options, intervals, workspace);
+}
+
+namespace detail {
+
+WindowPeak fft_window_peak(std::span<const double> x, std::span<const double> y, std::int64_t k_min,
+                           std::int64_t k_max, const AwccOptions& options, AwccWorkspace& workspace) {
+  const auto r = window_correlation_fft(x, y, k_min, k_max, workspace);
+  if (r.empty()) return {.peak = {}, .constant = true};
+  return {.peak = analyse_correlation(r, options.subsample, options.prominence_fraction, workspace), .constant = false};
+}
+
+WindowPeak IntervalCorrelations::correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max,
+                                           const AwccOptions& options, AwccWorkspace& workspace) {
+  auto& r = workspace.scratch().piecewise;
+  window_correlation_piecewise(leading_, trailing_, w.start, w.length, k_min, k_max, workspace, r);
+  if (r.empty()) return {.peak = {}, .constant = true};
+  return {.peak = analyse_correlation(r, options.subsample, options.prominence_fraction, workspace), .constant = false};
+}
+
+WindowPeak RenderedFftCorrelations::correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max,
+                                              const AwccOptions& options, AwccWorkspace& workspace) {
+  auto& s = workspace.scratch();
+  const auto n = static_cast<std::size_t>(w.length);
+  s.rendered_x.resize(n);
+  s.rendered_y.resize(n);
+  leading_.render(w.start, s.rendered_x);
+  trailing_.render(w.start, s.rendered_y);
+  s.samples_x.assign(s.rendered_x.begin(), s.rendered_x.end());
+  s.samples_y.assign(s.rendered_y.begin(), s.rendered_y.end());
+  return fft_window_peak(s.samples_x, s.samples_y, k_min, k_max, options, workspace);
+}
+
+AwccResult run_awcc(const AirIntervals& leading, double dx, const AwccOptions& options, WindowCorrelations& source,
+                    AwccWorkspace& workspace) {
   AwccResult result;
   result.np = options.np;
   result.options = options;
   result.windows = awcc_windows(leading, options.np);
   const double fs = leading.fs;
-  const bool use_fft = options.path == CorrelationPath::fft;
-  std::vector<std::uint8_t> dense_x, dense_y;
-  std::vector<double> xs, ys;
-  PiecewiseCorrelation piecewise;  // reused: its buffers outlive the windows
   for (auto& w : result.windows) {
     const auto [k_min, k_max] = awcc_lag_range(w.length, dx, fs, options);
     if (k_max < k_min) {
+      source.skip(w, workspace);
       w.fate = WindowFate::too_short;
       continue;
     }
-    if (use_fft) {
-      const auto n = static_cast<std::size_t>(w.length);
-      dense_x.resize(n);
-      dense_y.resize(n);
-      leading.render(w.start, dense_x);
-      trailing.render(w.start, dense_y);
-      xs.assign(dense_x.begin(), dense_x.end());
-      ys.assign(dense_y.begin(), dense_y.end());
-      analyse_window(w, window_correlation_fft(xs, ys, k_min, k_max, workspace), k_min, dx, fs, options, workspace);
-    } else {
-      auto& r = piecewise;
-      window_correlation_piecewise(leading, trailing, w.start, w.length, k_min, k_max, workspace, r);
-      const CorrelationPeak p = r.empty() ? CorrelationPeak{}
-                                          : analyse_correlation(r, options.subsample, options.prominence_fraction,
-                                                                workspace);
-      analyse_window(w, p, r.empty(), k_min, dx, fs, options);
-    }
+    const WindowPeak p = source.correlate(w, k_min, k_max, options, workspace);
+    analyse_window(w, p.peak, p.constant, k_min, dx, fs, options);
   }
   correct_windows(result, dx, options);
   awcc_summarise(result, options);
   if (!(dx > 0.0) && result.ok()) no_tip_separation(result);
   return result;
 }
+
+}  // namespace detail
 
 void detail::no_tip_separation(AwccResult& result) {
   result.status = AwccStatus::no_tip_separation;

@@ -86,13 +86,14 @@ std::vector<double> lagged_products_by_fft(const AirIntervals& x, const AirInter
   // circular correlation of size M >= B + K - 1 holds lags 0..K-1 unwrapped.
   const std::size_t block = std::max<std::size_t>(4 * lags, 1 << 15);
   const std::size_t m = fast_fft_size(block + lags - 1);
-  FftPlan& plan = plans.get(m);
+  const FftPlan& plan = plans.get(m);
+  FftBuffers buffers(m);
   std::vector<std::complex<double>> xs(m / 2 + 1);
   std::vector<std::uint8_t> dense(block + lags - 1);
   for (std::int64_t b = t0; b < t1; b += static_cast<std::int64_t>(block)) {
     const auto len = static_cast<std::size_t>(std::min<std::int64_t>(static_cast<std::int64_t>(block), t1 - b));
     x.render(b, std::span<std::uint8_t>(dense.data(), len));
-    auto r = plan.real();
+    auto r = buffers.real();
     std::fill(r.begin(), r.end(), 0.0);
     bool any = false;
     for (std::size_t i = 0; i < len; ++i) {
@@ -100,8 +101,8 @@ std::vector<double> lagged_products_by_fft(const AirIntervals& x, const AirInter
       any = any || dense[i];
     }
     if (!any) continue;
-    plan.forward();
-    std::copy(plan.spectrum().begin(), plan.spectrum().end(), xs.begin());
+    plan.forward(buffers);
+    std::copy(buffers.spectrum().begin(), buffers.spectrum().end(), xs.begin());
     const std::int64_t y0 = b + k_min;
     const std::size_t ylen = len + lags - 1;
     std::fill(r.begin(), r.end(), 0.0);
@@ -111,10 +112,10 @@ std::vector<double> lagged_products_by_fft(const AirIntervals& x, const AirInter
       y.render(lo, std::span<std::uint8_t>(dense.data(), static_cast<std::size_t>(hi - lo)));
       for (std::int64_t i = lo; i < hi; ++i) r[static_cast<std::size_t>(i - y0)] = dense[static_cast<std::size_t>(i - lo)];
     }
-    plan.forward();
-    auto spec = plan.spectrum();
+    plan.forward(buffers);
+    auto spec = buffers.spectrum();
     for (std::size_t i = 0; i < spec.size(); ++i) spec[i] *= std::conj(xs[i]);
-    plan.inverse();
+    plan.inverse(buffers);
     const double scale = 1.0 / static_cast<double>(m);
     for (std::size_t j = 0; j < lags; ++j) out[j] += r[j] * scale;
   }

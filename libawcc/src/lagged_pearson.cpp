@@ -21,7 +21,8 @@ LaggedPearson::LaggedPearson(std::int64_t x_start, std::int64_t window, std::int
   const std::size_t m = fast_fft_size(std::min(w, std::max<std::size_t>(8 * lags_, std::size_t{1} << 13)) + lags_ - 1);
   chunk_ = m - lags_ + 1;
   plan_ = &plans.get(m);
-  x_plan_ = &plans.get(m, 1);
+  x_fft_.resize(m);
+  y_fft_.resize(m);
   x_buffer_.reserve(m);
   y_buffer_.reserve(m);
   restart(x_start);
@@ -128,7 +129,7 @@ void LaggedPearson::feed(std::int64_t first, std::span<const double> x, std::spa
 }
 
 void LaggedPearson::run_chunks(bool final) {
-  FftPlan& plan = *plan_;
+  const FftPlan& plan = *plan_;
   const std::size_t m = plan.size();
   // Chunks start at `used` in the buffers; what they consumed is dropped
   // once at the end (not after each chunk: that would move the rest each time).
@@ -137,18 +138,18 @@ void LaggedPearson::run_chunks(bool final) {
     const auto len = static_cast<std::size_t>(std::min<std::int64_t>(static_cast<std::int64_t>(chunk_), x_end_ - x_next_));
     const std::size_t needed = len + lags_ - 1;  // y over [x_next + k_first, x_next + len + k_last)
     if (!final && ((!same_signal_ && x_buffer_.size() - used < chunk_) || y_buffer_.size() - used < needed)) break;
-    auto xr = x_plan_->real();
+    auto xr = x_fft_.real();
     // x at x_next is y's sample -k_first of this chunk's span.
     const double* xs = same_signal_ ? y_buffer_.data() + used - k_first_ : x_buffer_.data() + used;
     std::copy_n(xs, len, xr.begin());
     std::fill(xr.begin() + static_cast<std::ptrdiff_t>(len), xr.end(), 0.0);
-    x_plan_->forward();
-    const auto x_spectrum = x_plan_->spectrum();
-    auto r = plan.real();
+    plan.forward(x_fft_);
+    const auto x_spectrum = x_fft_.spectrum();
+    auto r = y_fft_.real();
     std::copy_n(y_buffer_.begin() + static_cast<std::ptrdiff_t>(used), needed, r.begin());
     std::fill(r.begin() + static_cast<std::ptrdiff_t>(needed), r.end(), 0.0);
-    plan.forward();
-    auto spectrum = plan.spectrum();
+    plan.forward(y_fft_);
+    auto spectrum = y_fft_.spectrum();
     // Y conj(X), written out: std::complex's product guards against
     // infinities at a call per element; these values are finite.
     auto* y = reinterpret_cast<double*>(spectrum.data());
@@ -159,7 +160,7 @@ void LaggedPearson::run_chunks(bool final) {
       y[i] = re;
       y[i + 1] = im;
     }
-    plan.inverse();
+    plan.inverse(y_fft_);
     const double scale = 1.0 / static_cast<double>(m);
     for (std::size_t j = 0; j < lags_; ++j) products_[j] += r[j] * scale;
     used += len;

@@ -8,6 +8,7 @@
 #include <thread>
 #include <type_traits>
 
+#include "awcc/detail/awcc_driver.hpp"
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/detail/read_ahead.hpp"
 #include "awcc/detail/two_level_scan.hpp"
@@ -464,82 +465,100 @@ std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOpt
            phase_statistics(r.trailing, po)}};
 }
 
+namespace {
+
+// The raw voltages of the two tips over each window, read block by block as
+// the driver asks for the windows (in order; they tile the record from its start).
+class RawVoltageCorrelations final : public detail::WindowCorrelations {
+ public:
+  RawVoltageCorrelations(Recording& recording, const ProcessOptions& options)
+      : recording_(recording), block_frames_(options.block_frames),
+        stride_(static_cast<std::size_t>(recording.info().channels)),
+        lead_(static_cast<std::size_t>(options.leading_channel)),
+        trail_(static_cast<std::size_t>(options.trailing_channel)),
+        block_(static_cast<std::size_t>(options.block_frames) * stride_) {
+    recording_.rewind();
+  }
+
+  detail::WindowPeak correlate(const AwccWindow& w, std::int64_t k_min, std::int64_t k_max, const AwccOptions& options,
+                               AwccWorkspace& workspace) override {
+    read(w, workspace);
+    auto& s = workspace.scratch();
+    return detail::fft_window_peak(s.samples_x, s.samples_y, k_min, k_max, options, workspace);
+  }
+  void skip(const AwccWindow& w, AwccWorkspace& workspace) override { read(w, workspace); }
+
+ private:
+  // The window's samples into the workspace's samples_x, samples_y.
+  void read(const AwccWindow& w, AwccWorkspace& workspace) {
+    auto& xs = workspace.scratch().samples_x;
+    auto& ys = workspace.scratch().samples_y;
+    xs.clear();
+    ys.clear();
+    const std::int64_t end = w.start + w.length;
+    while (position_ < end) {
+      if (position_ >= block_start_ + in_block_) {
+        block_start_ += in_block_;
+        in_block_ = recording_.read(block_, block_frames_);
+        if (in_block_ == 0) {
+          throw InputError(fmt::format("{}: the recording ended at frame {} while reading it again for AWCC",
+                                       recording_.info().path.string(), position_));
+        }
+        continue;
+      }
+      const std::int64_t from = std::max(position_, w.start);
+      const std::int64_t to = std::min(end, block_start_ + in_block_);
+      for (std::int64_t t = from; t < to; ++t) {
+        const auto f = static_cast<std::size_t>(t - block_start_);
+        xs.push_back(block_[f * stride_ + lead_]);
+        ys.push_back(block_[f * stride_ + trail_]);
+      }
+      position_ = to;
+    }
+  }
+
+  Recording& recording_;
+  std::int64_t block_frames_;
+  std::size_t stride_, lead_, trail_;
+  std::vector<float> block_;
+  std::int64_t position_ = 0, in_block_ = 0, block_start_ = 0;  // next frame; frames in the block; its first frame
+};
+
+}  // namespace
+
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
-  auto recording = open_recording(path, options.reader);
-  return awcc_raw(*recording, b, options);
+  return awcc_raw(*open_recording(path, options.reader), b, options);
 }
 
 AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options) {
-  const std::filesystem::path& path = recording.info().path;
-  recording.rewind();
+  AwccWorkspace workspace;
+  return awcc_raw(recording, b, options, workspace);
+}
+
+AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options,
+                    AwccWorkspace& workspace) {
   const AwccOptions& ao = options.awcc_options;
   if (auto why = ao.validate(); !why.empty()) throw std::invalid_argument(why);
-  AwccResult result;
-  result.np = ao.np;
-  result.options = ao;
-  result.windows = awcc_windows(b.leading, ao.np);
-  const auto stride = static_cast<std::size_t>(recording.info().channels);
-  const auto lead = static_cast<std::size_t>(options.leading_channel);
-  const auto trail = static_cast<std::size_t>(options.trailing_channel);
-  std::vector<float> block(static_cast<std::size_t>(options.block_frames) * stride);
-  std::vector<double> xs, ys;
-  AwccWorkspace workspace;
-  const double fs = b.info.fs;
-  std::int64_t position = 0, in_block = 0, block_start = 0;
-  std::size_t w = 0;
-  // Windows are contiguous: fill each from the blocks as they come.
-  while (w < result.windows.size()) {
-    AwccWindow& window = result.windows[w];
-    if (position >= block_start + in_block) {
-      block_start += in_block;
-      in_block = recording.read(block, options.block_frames);
-      if (in_block == 0) {
-        throw InputError(fmt::format("{}: the recording ended at frame {} while reading it again for AWCC",
-                                             path.string(), position));
-      }
-      continue;
-    }
-    const std::int64_t end = window.start + window.length;
-    const std::int64_t take = std::min(end, block_start + in_block) - position;
-    for (std::int64_t i = 0; i < take; ++i) {
-      const auto f = static_cast<std::size_t>(position - block_start + i);
-      xs.push_back(block[f * stride + lead]);
-      ys.push_back(block[f * stride + trail]);
-    }
-    position += take;
-    if (position == end) {
-      const auto [k_min, k_max] = detail::awcc_lag_range(window.length, options.dx, fs, ao);
-      if (k_max < k_min) {
-        window.fate = WindowFate::too_short;
-      } else {
-        const auto r = detail::window_correlation_fft(xs, ys, k_min, k_max, workspace);
-        detail::analyse_window(window, r, k_min, options.dx, fs, ao, workspace);
-      }
-      xs.clear();
-      ys.clear();
-      ++w;
-    }
-  }
-  detail::correct_windows(result, options.dx, ao);
-  detail::awcc_summarise(result, ao);
-  if (!(options.dx > 0.0) && result.ok()) detail::no_tip_separation(result);
-  return result;
+  RawVoltageCorrelations voltages(recording, options);
+  return detail::run_awcc(b.leading, options.dx, ao, voltages, workspace);
 }
 
 FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording& b, const ProcessOptions& options) {
-  auto recording = open_recording(path, options.reader);
-  return fscc_raw(*recording, b, options);
+  return fscc_raw(*open_recording(path, options.reader), b, options);
 }
 
 FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options) {
+  FftPlanCache plans;
+  return fscc_raw(recording, b, options, plans);
+}
+
+FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options,
+                    FftPlanCache& plans) {
   const std::filesystem::path& path = recording.info().path;
   recording.rewind();
   const auto stride = static_cast<std::size_t>(recording.info().channels);
   const auto lead = static_cast<std::size_t>(options.leading_channel);
   const auto trail = static_cast<std::size_t>(options.trailing_channel);
-  // Plans are built once per thread and serve every record processed on it
-  // (planning costs as much as a record's transforms).
-  thread_local FftPlanCache plans;
   RawCorrelation correlation(b.info.frames, b.info.fs, options.fscc_options, plans);
   // 16-bit counts are read as they are stored (volts = count x quantum, exact in double).
   const bool counts = recording.has_int16() && recording.info().quantum > 0.0;
@@ -578,12 +597,23 @@ FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const Pro
 }
 
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
+  ProcessWorkspace workspace;
+  return process_recording(path, options, workspace);
+}
+
+ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options,
+                                ProcessWorkspace& workspace) {
   if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
   auto recording = open_recording(path, options.reader);
-  return process_recording(*recording, options);
+  return process_recording(*recording, options, workspace);
 }
 
 ProcessResult process_recording(Recording& recording, const ProcessOptions& options) {
+  ProcessWorkspace workspace;
+  return process_recording(recording, options, workspace);
+}
+
+ProcessResult process_recording(Recording& recording, const ProcessOptions& options, ProcessWorkspace& workspace) {
   const auto start = std::chrono::steady_clock::now();
   recording.rewind();
   const auto binarised = binarise_recording(recording, options);
@@ -595,8 +625,8 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& opti
     out.info = binarised.info;
     out.dx = options.dx;
     out.dy = options.dy;
-    if (options.fscc) out.fscc = fscc_raw(recording, binarised, options);
-    if (options.awcc) out.awcc = awcc_raw(recording, binarised, options);
+    if (options.fscc) out.fscc = fscc_raw(recording, binarised, options, workspace.plans);
+    if (options.awcc) out.awcc = awcc_raw(recording, binarised, options, workspace.awcc);
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
     add_structure(out, binarised, options);

@@ -35,6 +35,11 @@ constexpr WindowColumnFormat kWindowColumns[] = {
     {{"measured_velocity", "m/s", [](const AwccWindow& w) { return w.measured_velocity; }, nullptr}, "{:.9g}"},
 };
 
+// The JSON's count of the windows of a fate: windows_accepted, windows_rejected_<fate>.
+std::string window_count_key(WindowFate fate) {
+  return fate == WindowFate::accepted ? "windows_accepted" : fmt::format("windows_rejected_{}", to_string(fate));
+}
+
 }  // namespace
 
 std::span<const WindowColumn> awcc_window_columns() {
@@ -337,12 +342,6 @@ json to_json(const ProcessResult& r) {
         {"turbulence_intensity", value(a.turbulence_intensity)},
         {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
         {"windows_total", a.windows_total},
-        {"windows_accepted", a.windows_accepted},
-        {"windows_rejected_correlation", a.rejected_correlation},
-        {"windows_rejected_lag", a.rejected_lag},
-        {"windows_rejected_roc", a.rejected_roc},
-        {"windows_rejected_constant", a.rejected_constant},
-        {"windows_rejected_too_short", a.rejected_too_short},
         {"windows_lag_zero", a.lag_zero_windows},
         {"roc_iterations", a.roc_iterations},
         {"windows_negative_lag", a.negative_lag_windows},
@@ -352,12 +351,17 @@ json to_json(const ProcessResult& r) {
         {"velocity_measured", a.probe_corrected ? value(a.velocity_measured) : json(nullptr)},
         {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
         {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
-        {"windows_rejected_correction", a.rejected_correction},
         {"windows_not_bubbly", a.windows_not_bubbly},
         {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
                                               static_cast<double>(a.windows_total))
                                         : json(nullptr)},
     };
+    // From the counts by fate (nlohmann::json sorts an object's keys: the
+    // file reads as when they were listed by hand).
+    for (std::size_t i = 0; i < window_fate_count; ++i) {
+      const auto fate = static_cast<WindowFate>(i);
+      out["awcc"][window_count_key(fate)] = a.count(fate);
+    }
   }
   return out;
 }
@@ -679,15 +683,16 @@ std::string ProcessResult::report() const {
       line(fmt::format("        bubble-probe corrected (measured: velocity {:.4f} m/s, u_rms {:.4f} m/s, Tu {:.4f}); {} "
                        "windows failed the correction, {} not bubbly (as measured)",
                        a.velocity_measured, a.velocity_rms_measured, a.turbulence_intensity_measured,
-                       a.rejected_correction, a.windows_not_bubbly));
+                       a.count(WindowFate::correction), a.windows_not_bubbly));
     }
     line(fmt::format("        quality {}{}", to_string(a.quality),
                      a.quality == AwccQuality::low ? ": " + a.quality_reason : std::string()));
     line(fmt::format("        windows {} accepted of {} (rejected: {} correlation, {} lag, {} outlier cutoff, {} "
                      "constant{})",
-                     a.windows_accepted, a.windows_total, a.rejected_correlation, a.rejected_lag, a.rejected_roc,
-                     a.rejected_constant,
-                     a.rejected_too_short ? fmt::format(", {} too short", a.rejected_too_short) : std::string()));
+                     a.windows_accepted, a.windows_total, a.count(WindowFate::correlation),
+                     a.count(WindowFate::lag), a.count(WindowFate::roc), a.count(WindowFate::constant),
+                     a.count(WindowFate::too_short) ? fmt::format(", {} too short", a.count(WindowFate::too_short))
+                                                    : std::string()));
   }
   if (structure) {
     const auto& st = *structure;

@@ -54,17 +54,18 @@ PowerSpectrum welch_psd(std::span<const double> x, double rate, int segment_leng
     window[n] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(n) / static_cast<double>(l));
     power += window[n] * window[n];
   }
-  FftPlan plan(l);
+  const FftPlan plan(l);
+  FftBuffers buffers(l);
   const std::size_t bins = l / 2 + 1;
   p.density.assign(bins, 0.0);
   for (std::size_t first = 0; first + l <= x.size(); first += step) {
     double mean = 0.0;
     for (std::size_t n = 0; n < l; ++n) mean += x[first + n];
     mean /= static_cast<double>(l);
-    auto r = plan.real();
+    auto r = buffers.real();
     for (std::size_t n = 0; n < l; ++n) r[n] = (x[first + n] - mean) * window[n];
-    plan.forward();
-    const auto s = plan.spectrum();
+    plan.forward(buffers);
+    const auto s = buffers.spectrum();
     for (std::size_t k = 0; k < bins; ++k) p.density[k] += std::norm(s[k]);
     ++p.segments;
   }
@@ -86,16 +87,17 @@ std::vector<double> autocorrelation(std::span<const double> x, std::size_t max_l
   mean /= static_cast<double>(n);
   // Through the FFT: |X|^2 of the zero-padded series is the circular
   // autocorrelation, linear for lags below the padding.
-  FftPlan plan(fast_fft_size(n + max_lag + 1));
-  auto r = plan.real();
+  const FftPlan plan(fast_fft_size(n + max_lag + 1));
+  FftBuffers buffers(plan.size());
+  auto r = buffers.real();
   std::fill(r.begin(), r.end(), 0.0);
   for (std::size_t i = 0; i < n; ++i) r[i] = x[i] - mean;
-  plan.forward();
-  for (auto& c : plan.spectrum()) c = std::norm(c);
-  plan.inverse();
+  plan.forward(buffers);
+  for (auto& c : buffers.spectrum()) c = std::norm(c);
+  plan.inverse(buffers);
   std::vector<double> out(max_lag + 1);
-  const double zero = plan.real()[0];
-  for (std::size_t k = 0; k <= max_lag; ++k) out[k] = zero > 0.0 ? plan.real()[k] / zero : 0.0;
+  const double zero = r[0];
+  for (std::size_t k = 0; k <= max_lag; ++k) out[k] = zero > 0.0 ? r[k] / zero : 0.0;
   return out;
 }
 

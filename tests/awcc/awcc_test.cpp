@@ -1,8 +1,11 @@
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/awcc.hpp"
+#include "awcc/detail/awcc_driver.hpp"
+#include "awcc/process.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -155,6 +158,160 @@ TEST(Awcc, RecoversPlantedDelaysPerWindowExactly) {
   }
 }
 
+// --- The one driver and its correlation sources -------------------------------
+
+// Windows of the interval and FFT sources: the same lag in every window (and
+// the planted one), the same fate, R12max and SPR to rounding (METHOD 4, item
+// 2: both paths give the same R12 to rounding; 1e-10 as in
+// WindowCorrelation.IntervalPathEqualsNaiveAndFftPaths), the same velocity to
+// rounding of the refined lag.
+void expect_same_windows(const awcc::AwccResult& a, const awcc::AwccResult& b) {
+  ASSERT_EQ(a.windows.size(), b.windows.size());
+  for (std::size_t i = 0; i < a.windows.size(); ++i) {
+    const auto &u = a.windows[i], &v = b.windows[i];
+    ASSERT_EQ(u.start, v.start);
+    EXPECT_EQ(u.fate, v.fate) << "window " << i;
+    EXPECT_EQ(u.lag_samples, v.lag_samples) << "window " << i;
+    EXPECT_NEAR(u.r12_max, v.r12_max, 1e-10) << "window " << i;
+    EXPECT_NEAR(u.spr, v.spr, 1e-9) << "window " << i;
+    EXPECT_NEAR(u.velocity, v.velocity, 1e-9 * std::fabs(u.velocity)) << "window " << i;
+  }
+}
+
+TEST(AwccDriver, FftAndIntervalSourcesGiveThePlantedVelocities) {
+  const auto p = planted(21, 10);
+  awcc::AwccOptions o;
+  o.subsample = awcc::Subsample::parabolic;  // velocities from refined lags: rounding shows, within tolerance
+  const double dx = 0.01;
+  awcc::AwccWorkspace workspace;
+  awcc::detail::IntervalCorrelations intervals(p.leading, p.trailing);
+  awcc::detail::RenderedFftCorrelations rendered(p.leading, p.trailing);
+  const auto by_intervals = awcc::detail::run_awcc(p.leading, dx, o, intervals, workspace);
+  const auto by_fft = awcc::detail::run_awcc(p.leading, dx, o, rendered, workspace);
+  ASSERT_EQ(by_intervals.windows.size(), p.delays.size());
+  for (std::size_t i = 0; i < p.delays.size(); ++i) {
+    EXPECT_EQ(by_intervals.windows[i].lag_samples, p.delays[i]) << "window " << i;
+    // A planted shift of d samples peaks at d; the parabola through a binary
+    // correlation's rounded triangle stays within half a sample of it.
+    EXPECT_NEAR(by_intervals.windows[i].lag * 1000.0, static_cast<double>(p.delays[i]), 0.5) << "window " << i;
+  }
+  expect_same_windows(by_intervals, by_fft);
+  ASSERT_TRUE(by_intervals.ok()) << by_intervals.message;
+  EXPECT_EQ(by_intervals.windows_by_fate, by_fft.windows_by_fate);
+  EXPECT_NEAR(by_intervals.velocity, by_fft.velocity, 1e-9 * by_intervals.velocity);
+  // awcc() is the same driver with the source its options name.
+  o.path = awcc::CorrelationPath::fft;
+  const auto through_awcc = awcc::awcc(p.leading, p.trailing, dx, o);
+  for (std::size_t i = 0; i < by_fft.windows.size(); ++i) {
+    EXPECT_EQ(through_awcc.windows[i].lag, by_fft.windows[i].lag) << "window " << i;
+  }
+}
+
+// Counts of every fate over the windows, by brute force.
+void expect_fates_counted(const awcc::AwccResult& r) {
+  std::int64_t sum = 0;
+  for (std::size_t i = 0; i < awcc::window_fate_count; ++i) {
+    const auto fate = static_cast<awcc::WindowFate>(i);
+    const auto brute = std::count_if(r.windows.begin(), r.windows.end(),
+                                     [fate](const awcc::AwccWindow& w) { return w.fate == fate; });
+    EXPECT_EQ(r.count(fate), brute) << awcc::to_string(fate);
+    sum += r.count(fate);
+  }
+  EXPECT_EQ(sum, r.windows_total);
+  EXPECT_EQ(r.windows_total, static_cast<std::int64_t>(r.windows.size()));
+  EXPECT_EQ(r.windows_accepted, r.count(awcc::WindowFate::accepted));
+}
+
+TEST(AwccDriver, FatesAreCountedOncePerWindowAndSumToTheTotal) {
+  // Every fate, on windows summarised as they are (no cutoff: fates stay).
+  awcc::AwccResult mixed;
+  std::mt19937 rng(3);
+  for (int i = 0; i < 700; ++i) {
+    awcc::AwccWindow w;
+    w.fate = static_cast<awcc::WindowFate>(rng() % awcc::window_fate_count);
+    w.velocity = 1.0 + 0.01 * (i % 17);
+    w.duration = 0.1;
+    w.lag_samples = w.fate == awcc::WindowFate::lag ? -1 : 5;
+    mixed.windows.push_back(w);
+  }
+  awcc::AwccOptions o;
+  o.roc = false;
+  awcc::detail::awcc_summarise(mixed, o);
+  for (std::size_t i = 0; i < awcc::window_fate_count; ++i) EXPECT_GT(mixed.windows_by_fate[i], 50) << i;
+  expect_fates_counted(mixed);
+  // The driver's own fates: a planted delay in the first half of the windows,
+  // an unrelated trailing signal in the second (filter and lag rejections),
+  // the outlier cutoff, and windows too short for a stated velocity range.
+  const auto p = planted(5, 8);
+  const auto noise = telegraph(p.leading.sample_count, 99, 1000.0, 30, 60);
+  const auto windows = awcc::awcc_windows(p.leading, 8);
+  const std::int64_t half = windows[windows.size() / 2].start;
+  awcc::AirIntervals trailing = p.trailing;
+  trailing.intervals.clear();
+  for (const auto& iv : p.trailing.intervals)
+    if (iv.stop <= half) trailing.intervals.push_back(iv);
+  for (const auto& iv : noise.intervals)
+    if (iv.start >= half) trailing.intervals.push_back(iv);
+  awcc::AwccOptions d;
+  const auto r = awcc::awcc(p.leading, trailing, 1.0, d);
+  EXPECT_GT(r.count(awcc::WindowFate::accepted), 0);
+  EXPECT_GT(r.count(awcc::WindowFate::correlation) + r.count(awcc::WindowFate::lag), 0);
+  expect_fates_counted(r);
+  std::vector<std::int64_t> lengths;
+  for (const auto& w : windows) lengths.push_back(w.length);
+  std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
+  const double least_lag = static_cast<double>(lengths[lengths.size() / 2]);  // half the windows are shorter
+  d.velocity_max = 1.0 * 1000.0 / least_lag;
+  d.velocity_min = d.velocity_max.value() / 4.0;
+  const auto ranged = awcc::awcc(p.leading, trailing, 1.0, d);
+  EXPECT_GT(ranged.count(awcc::WindowFate::too_short), 0);
+  expect_fates_counted(ranged);
+}
+
+TEST(AwccDriver, RawVoltagesThatAreTheBinarySignalGiveTheBinaryResult) {
+  // Voltages of exactly 0 and 1 V: the raw-voltage source reads the binary
+  // signals back from the recording and must give the rendered FFT source's
+  // windows bit for bit (the same samples into the same transforms), and the
+  // interval source's to rounding. Blocks of 997 frames split the windows.
+  const auto p = planted(13, 10, 120'000);
+  const auto lead = awcc::to_dense(p.leading), trail = awcc::to_dense(p.trailing);
+  std::vector<float> frames;
+  for (std::size_t i = 0; i < lead.size(); ++i) {
+    frames.push_back(lead[i]);
+    frames.push_back(trail[i]);
+  }
+  auto recording = awcc::memory_recording(frames, 2, p.leading.fs);
+  awcc::ProcessOptions o;
+  o.dx = 5e-3;
+  o.block_frames = 997;
+  o.allow_unusual = true;  // 1 kHz test signals
+  o.awcc_options.signal = awcc::CorrelationSignal::raw;
+  o.awcc_options.subsample = awcc::Subsample::parabolic;
+  const auto binarised = awcc::binarise_recording(*recording, o);
+  ASSERT_EQ(binarised.leading.intervals, p.leading.intervals);
+  ASSERT_EQ(binarised.trailing.intervals, p.trailing.intervals);
+  const auto raw = awcc::awcc_raw(*recording, binarised, o);
+  awcc::AwccOptions binary = o.awcc_options;
+  binary.signal = awcc::CorrelationSignal::binary;
+  binary.path = awcc::CorrelationPath::fft;
+  const auto rendered = awcc::awcc(p.leading, p.trailing, o.dx, binary);
+  ASSERT_EQ(raw.windows.size(), rendered.windows.size());
+  ASSERT_GT(raw.windows.size(), 100u);
+  for (std::size_t i = 0; i < raw.windows.size(); ++i) {
+    const auto &u = raw.windows[i], &v = rendered.windows[i];
+    EXPECT_EQ(u.fate, v.fate) << "window " << i;
+    EXPECT_EQ(u.lag, v.lag) << "window " << i;
+    EXPECT_EQ(u.r12_max, v.r12_max) << "window " << i;
+    EXPECT_EQ(u.spr, v.spr) << "window " << i;
+    EXPECT_EQ(u.velocity, v.velocity) << "window " << i;
+  }
+  EXPECT_EQ(raw.windows_by_fate, rendered.windows_by_fate);
+  EXPECT_EQ(raw.velocity, rendered.velocity);
+  EXPECT_EQ(raw.turbulence_intensity, rendered.turbulence_intensity);
+  binary.path = awcc::CorrelationPath::intervals;
+  expect_same_windows(awcc::awcc(p.leading, p.trailing, o.dx, binary), raw);
+}
+
 TEST(Awcc, ParabolicRefinementRecoversFractionalDelays) {
   // Delays of k + 0.5 samples: build at 10x the rate, decimate.
   const std::int64_t n = 1'000'000;
@@ -296,14 +453,14 @@ TEST(Awcc, UndefinedCasesCarryReasonsAndNoNaN) {
   r = awcc::awcc(x, x, 1.0, {});
   EXPECT_FALSE(r.ok());
   EXPECT_NE(r.message.find("shorter than one sample"), std::string::npos) << r.message;
-  EXPECT_EQ(r.rejected_lag, r.windows_total);
+  EXPECT_EQ(r.count(awcc::WindowFate::lag), r.windows_total);
   // Constant trailing tip.
   AirIntervals water;
   water.fs = x.fs;
   water.sample_count = x.sample_count;
   r = awcc::awcc(x, water, 1.0, {});
   EXPECT_FALSE(r.ok());
-  EXPECT_EQ(r.rejected_constant, r.windows_total);
+  EXPECT_EQ(r.count(awcc::WindowFate::constant), r.windows_total);
   for (double v : {r.velocity, r.velocity_rms, r.turbulence_intensity}) EXPECT_TRUE(std::isfinite(v));
 }
 

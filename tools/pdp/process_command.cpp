@@ -249,6 +249,7 @@ int run_process(ProcessCommandOptions& o) {
   std::vector<std::string> inputs, skipped;
   try {
     Progress progress("processing");
+    awcc::ProcessWorkspace workspace;  // FFT plans shared by the records
     for (std::size_t i = 0; i < o.files.size(); ++i) {
       // A synthetic recording's sidecar states its volts per count.
       awcc::ProcessOptions file_options = options;
@@ -256,7 +257,7 @@ int run_process(ProcessCommandOptions& o) {
         if (const auto vpc = synth::sidecar_volts_per_count(o.files[i])) file_options.reader.volts_per_count = *vpc;
       }
       try {
-        results.push_back(awcc::process_recording(o.files[i], file_options));
+        results.push_back(awcc::process_recording(o.files[i], file_options, workspace));
       } catch (const awcc::InputError& e) {
         // Among several inputs (a glob), a file that is not a recording is
         // skipped and said; a damaged recording still stops the profile.

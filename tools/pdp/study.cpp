@@ -252,8 +252,9 @@ std::string run_report(const RunResult& r) {
   if (r.awcc) {
     if (!r.awcc->ok()) out += "AWCC undefined: " + r.awcc->message + "\n";
     out += fmt::format("AWCC windows: {} accepted of {} ({} correlation, {} lag, {} outlier cutoff, {} constant)\n",
-                       r.awcc->windows_accepted, r.awcc->windows_total, r.awcc->rejected_correlation,
-                       r.awcc->rejected_lag, r.awcc->rejected_roc, r.awcc->rejected_constant);
+                       r.awcc->windows_accepted, r.awcc->windows_total, r.awcc->count(awcc::WindowFate::correlation),
+                       r.awcc->count(awcc::WindowFate::lag), r.awcc->count(awcc::WindowFate::roc),
+                       r.awcc->count(awcc::WindowFate::constant));
     if (r.window_bias) {
       out += fmt::format("window level: AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms {:.4f} m/s\n",
                          *r.window_bias, *r.window_rms);

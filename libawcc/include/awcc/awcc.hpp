@@ -41,6 +41,7 @@
 //    reported and flagged; ok otherwise. Windows that mostly peak at negative
 //    lags mean swapped tips (or a dx of the wrong sign): no velocity.
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -61,6 +62,13 @@ namespace awcc {
 enum class Weighting { duration, none };
 enum class CorrelationPath { automatic, fft, intervals };
 enum class WindowFate { accepted, correlation, lag, roc, constant, too_short, correction };
+/// The fates' names in the enum's order: the windows table's fate column and
+/// the result's window counts (awcc/serialise.hpp) are written from this one table.
+inline constexpr std::array<std::string_view, 7> window_fate_names{"accepted", "correlation", "lag",       "roc",
+                                                                   "constant", "too_short",   "correction"};
+inline constexpr std::size_t window_fate_count = window_fate_names.size();
+static_assert(static_cast<std::size_t>(WindowFate::correction) + 1 == window_fate_count,
+              "a fate added to WindowFate needs its name in window_fate_names");
 
 std::string_view to_string(WindowFate fate);
 std::string_view to_string(Weighting weighting);
@@ -150,9 +158,13 @@ struct AwccResult {
   double velocity_rms = 0.0;    ///< m/s
   double turbulence_intensity = 0.0;
   Interval95 velocity_ci95, velocity_rms_ci95, turbulence_intensity_ci95;
-  std::int64_t windows_total = 0, windows_accepted = 0;
-  std::int64_t rejected_correlation = 0, rejected_lag = 0, rejected_roc = 0, rejected_constant = 0;
-  std::int64_t rejected_too_short = 0;  ///< windows shorter than the velocity range's least lag
+  std::int64_t windows_total = 0;
+  std::int64_t windows_accepted = 0;  ///< count(WindowFate::accepted), the N of the moments
+  /// Windows of each fate, indexed by WindowFate (count() reads one); they sum
+  /// to windows_total. too_short: shorter than the velocity range's least lag;
+  /// correction: the bubble-probe correction failed.
+  std::array<std::int64_t, window_fate_count> windows_by_fate{};
+  [[nodiscard]] std::int64_t count(WindowFate fate) const { return windows_by_fate[static_cast<std::size_t>(fate)]; }
   std::int64_t lag_zero_windows = 0;  ///< windows peaking at lag 0 (delay below one sample)
   std::int64_t negative_lag_windows = 0;  ///< windows peaking at a negative lag
   int roc_iterations = 0;
@@ -160,7 +172,6 @@ struct AwccResult {
   /// velocities; these of the measured ones over the same windows.
   bool probe_corrected = false;
   double velocity_measured = 0.0, velocity_rms_measured = 0.0, turbulence_intensity_measured = 0.0;
-  std::int64_t rejected_correction = 0;   ///< windows whose correction failed
   std::int64_t windows_not_bubbly = 0;    ///< accepted windows above the bubbly void fraction: as measured
   std::vector<AwccWindow> windows;
 };

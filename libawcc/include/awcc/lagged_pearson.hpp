@@ -56,8 +56,8 @@ class LaggedPearson {
 
   std::int64_t window_, x_begin_ = 0, x_end_ = 0, k_first_, k_last_, y_begin_ = 0, y_end_ = 0;
   std::size_t lags_, chunk_;
-  FftPlan* plan_;    // y's transform and the inverse
-  FftPlan* x_plan_;  // x's transform (its spectrum stays while y's is made)
+  const FftPlan* plan_;
+  FftBuffers x_fft_, y_fft_;  // x's spectrum stays while y's is made
   // x from x_next_ (next chunk start) on; y from x_next_ + k_first on.
   std::vector<double> x_buffer_, y_buffer_;
   std::int64_t x_next_ = 0, x_fed_ = 0, y_fed_ = 0;  // next chunk start; samples fed so far up to these indices

@@ -11,6 +11,7 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
+#include "awcc/fft.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/recording.hpp"
@@ -109,12 +110,25 @@ BinarisedRecording binarise_recording(Recording& recording, const ProcessOptions
 /// Phase statistics (and FSCC, and AWCC on the binary signals) from binarised signals.
 ProcessResult process_binarised(const BinarisedRecording& recording, const ProcessOptions& options);
 
+/// What the raw-voltage correlations keep from record to record: FFT plans
+/// (built once per size, used const) and scratch. Owned by the caller and
+/// reused for the records it processes in turn, one per thread (not shared):
+/// planning costs about as much as a record's transforms. A fresh one gives
+/// the same numbers.
+struct ProcessWorkspace {
+  FftPlanCache plans;  ///< FSCC's
+  AwccWorkspace awcc;  ///< AWCC's window correlations
+};
+
 /// AWCC correlating the raw voltages of the recording, windows from its
 /// binarised leading tip (reads the file once more, block by block).
 AwccResult awcc_raw(const std::filesystem::path& path, const BinarisedRecording& recording,
                     const ProcessOptions& options);
 /// The same from the open recording the signals came from (read again from its start).
 AwccResult awcc_raw(Recording& recording, const BinarisedRecording& binarised, const ProcessOptions& options);
+/// The same with the caller's workspace.
+AwccResult awcc_raw(Recording& recording, const BinarisedRecording& binarised, const ProcessOptions& options,
+                    AwccWorkspace& workspace);
 
 /// FSCC correlating the raw voltages of the recording (reads the file once
 /// more, block by block; fscc_options.segments segments, S = 1 the whole record).
@@ -122,11 +136,18 @@ FsccResult fscc_raw(const std::filesystem::path& path, const BinarisedRecording&
                     const ProcessOptions& options);
 /// The same from the open recording the signals came from (read again from its start).
 FsccResult fscc_raw(Recording& recording, const BinarisedRecording& binarised, const ProcessOptions& options);
+/// The same with the caller's FFT plans.
+FsccResult fscc_raw(Recording& recording, const BinarisedRecording& binarised, const ProcessOptions& options,
+                    FftPlanCache& plans);
 
 /// All of the above, as the options ask (awcc_options.signal chooses what
 /// both FSCC and AWCC correlate).
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options);
 /// The same for an open recording (a file or arrays in memory), read from its start.
 ProcessResult process_recording(Recording& recording, const ProcessOptions& options);
+/// Both with the caller's workspace (records processed in turn share its plans).
+ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options,
+                                ProcessWorkspace& workspace);
+ProcessResult process_recording(Recording& recording, const ProcessOptions& options, ProcessWorkspace& workspace);
 
 }  // namespace awcc

@@ -99,7 +99,11 @@ void tips_swapped(AwccResult& result, const std::string& why);
 
 /// Scratch of the window correlations (AwccWorkspace owns one).
 struct AwccScratch {
-  FftPlanCache plans;
+  FftPlanCache plans;                           // one per FFT size, built on first use
+  FftBuffers fft;                               // the transform of the window being correlated
+  std::vector<std::uint8_t> rendered_x, rendered_y;  // a window of binary signals, sample by sample
+  std::vector<double> samples_x, samples_y;     // a window's samples as the FFT path takes them
+  PiecewiseCorrelation piecewise;               // the interval path's correlation of the window
   std::vector<AirInterval> clipped_x, clipped_y;
   std::vector<double> air_x, air_y;             // cumulative air of the clipped intervals
   std::vector<std::int32_t> impulse;
