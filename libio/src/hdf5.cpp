@@ -261,7 +261,6 @@ class Hdf5Recording final : public Recording {
  public:
   Hdf5Recording(const fs::path& path, const ReaderOptions& options) {
     info_.path = path;
-    info_.format = InputFormat::hdf5;
     std::error_code ec;
     file_size_ = fs::file_size(path, ec);
     if (ec) reader_fail(path, fmt::format("cannot read its size ({})", ec.message()));

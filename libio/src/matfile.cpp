@@ -203,19 +203,6 @@ std::string class_name(int c, bool logical, bool complex) {
   return complex ? "complex " + name : name;
 }
 
-template <class T>
-T load(const unsigned char* p, bool swap) {
-  T v;
-  if (!swap) {
-    std::memcpy(&v, p, sizeof(T));
-  } else {
-    unsigned char b[sizeof(T)];
-    std::reverse_copy(p, p + sizeof(T), b);
-    std::memcpy(&v, b, sizeof(T));
-  }
-  return v;
-}
-
 template <class Out>
 void convert(const unsigned char* p, Kind kind, std::size_t n, bool swap, Out* out) {
   switch (kind) {
@@ -727,7 +714,6 @@ class MatRecording final : public Recording {
  public:
   MatRecording(const fs::path& path, const ReaderOptions& options) {
     info_.path = path;
-    info_.format = InputFormat::matlab;
     std::error_code ec;
     const std::uint64_t size = fs::file_size(path, ec);
     if (ec) reader_fail(path, fmt::format("cannot read: {}", ec.message()));

@@ -138,7 +138,6 @@ class TdmsRecording final : public Recording {
  public:
   TdmsRecording(const fs::path& path, const ReaderOptions& options) : in_(path, std::ios::binary) {
     info_.path = path;
-    info_.format = InputFormat::tdms;
     if (!in_) reader_fail(path, "cannot open for reading");
     const auto size = fs::file_size(path);
     parse(path, options, size);

@@ -180,7 +180,7 @@ TEST(Hdf5Reader, PdpSimLayoutWithIntegerSensorIdsBinarisesToItsIntervals) {
   const auto p = pdpsim_file(scratch("binary_signal.h5"), n, 50e3, false);
   auto r = awcc::open_recording(p, {});
   const auto& info = r->info();
-  EXPECT_EQ(info.format, awcc::InputFormat::hdf5);
+  EXPECT_EQ(info.format, "hdf5");
   EXPECT_EQ(info.channels, 2);
   EXPECT_EQ(info.frames, static_cast<std::int64_t>(n));
   EXPECT_NEAR(info.fs, 50e3, 50e3 * 1e-12);
@@ -212,7 +212,7 @@ TEST(Hdf5Reader, StringSensorIdsAndTheSignatureAfterAUserBlock) {
   // No extension: found by its signature, at byte 512 behind a user block.
   const auto p = pdpsim_file(scratch("signal_without_extension"), 1000, 20e3, true, 512);
   auto r = awcc::open_recording(p, {});
-  EXPECT_EQ(r->info().format, awcc::InputFormat::hdf5);
+  EXPECT_EQ(r->info().format, "hdf5");
   EXPECT_EQ(r->info().channel_names, (std::vector<std::string>{"lead", "trail"}));
   EXPECT_NEAR(r->info().fs, 20e3, 1e-6);
   // Fixed-length strings (numpy 'S') too.

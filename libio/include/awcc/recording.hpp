@@ -38,11 +38,17 @@
 
 namespace awcc {
 
-enum class InputFormat { automatic, sndfile, uq_dat, raw, csv, tdms, hdf5, matlab };
+/// The formats read, by name: "sndfile", "dat", "raw", "csv", "tdms", "hdf5",
+/// "mat", as listed to users; kAutomaticFormat is not among them. A name, not
+/// an enumeration: the registry (libio/src/formats.cpp) owns the list, so that
+/// a new format is its reader plus one row there.
+std::span<const std::string_view> input_formats();
+/// ReaderOptions::format for "detect it by extension and content".
+inline constexpr std::string_view kAutomaticFormat = "auto";
+
 enum class SampleType { int16, int32, float32, float64 };
 enum class ByteOrder { little, big };
 
-std::string_view to_string(InputFormat format);
 std::string_view to_string(SampleType type);
 
 /// Layout of a headerless raw file (all fields stated by the user).
@@ -61,7 +67,7 @@ struct CsvLayout {
 };
 
 struct ReaderOptions {
-  InputFormat format = InputFormat::automatic;
+  std::string format{kAutomaticFormat};  ///< an input_formats() name, or kAutomaticFormat
   RawLayout raw;
   CsvLayout csv;
   /// Hz; required for .dat, raw files and CSV without a time column. A file
@@ -88,7 +94,7 @@ struct ReaderOptions {
 
 struct RecordingInfo {
   std::filesystem::path path;
-  InputFormat format = InputFormat::automatic;
+  std::string format;              ///< the input_formats() name of the reader ("array" for memory)
   std::string description;         ///< e.g. "FLAC, int16", "UQ .dat", "CSV (3 columns, time in column 0)"
   int channels = 0;                ///< data channels (a CSV time column is not one)
   double fs = 0.0;                 ///< Hz
@@ -117,6 +123,10 @@ class Recording {
 
  protected:
   RecordingInfo info_;
+
+ private:
+  // The registry names the format it opened (RecordingInfo::format).
+  friend std::unique_ptr<Recording> open_recording(const std::filesystem::path& path, const ReaderOptions& options);
 };
 
 /// Opens a recording (detecting the format by content and extension unless
