@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "awcc/order_statistics.hpp"
+#include "awcc/detail/time_base.hpp"
 #include "awcc/units.hpp"
 #include "reader_support.hpp"
 
@@ -252,14 +252,27 @@ class CsvRecording final : public Recording {
     in_.clear();
     in_.seekg(data_start_);
     line_ = first_line_;
+    // Forced, the stated rate sets the time column aside (time_base.hpp).
+    const bool forced = options.override_fs && options.fs > 0.0;
+    std::optional<TimeBaseRate> timed;
+    std::string timed_where;
+    if (time_column_ >= 0 && !forced) {
+      const std::string& name = names[static_cast<std::size_t>(time_column_)];
+      timed_where = fmt::format("its time column '{}'", name);
+      timed = time_column_rate(name, time_unit(header ? name : std::string()));
+    }
     if (lvm_delta) {
+      if (timed && !agrees(*timed, 1.0 / *lvm_delta)) {
+        reader_fail(path,
+                    fmt::format("its Delta_X gives a sampling rate of {} but {} steps at {}: one of them is wrong; "
+                                "correct the file, or force the rate",
+                                format_quantity(1.0 / *lvm_delta, Dimension::frequency), timed_where,
+                                format_quantity(timed->fs, Dimension::frequency)),
+                    "override_fs");
+      }
       info_.fs = stated_rate(path, options, 1.0 / *lvm_delta, "its Delta_X");
-    } else if (time_column_ >= 0) {
-      const double unit = time_unit(header ? names[static_cast<std::size_t>(time_column_)] : std::string());
-      // Time stamps are printed rounded: the rate from them agrees with a
-      // stated one to 0.1 %, not to the last digit.
-      info_.fs = stated_rate(path, options, fs_from_time_column() / unit,
-                             fmt::format("its time column '{}'", names[static_cast<std::size_t>(time_column_)]), 1e-3);
+    } else if (timed) {
+      info_.fs = stated_rate(path, options, timed->fs, timed_where, timed->tolerance);
     } else if (options.fs > 0.0) {
       info_.fs = options.fs;
     } else {
@@ -325,19 +338,6 @@ class CsvRecording final : public Recording {
     return parse_number(c, value);
   }
 
-  // The rounding step of printed stamps: the least gap between distinct step
-  // values (steps of 3 and 4 us at 300 kHz printed to 1 us give 1 us); 0
-  // when every step is the same.
-  static double resolution(std::vector<double> steps) {
-    std::sort(steps.begin(), steps.end());
-    double r = 0.0;
-    for (std::size_t i = 1; i < steps.size(); ++i) {
-      const double d = steps[i] - steps[i - 1];
-      if (d > 1e-9 * std::fabs(steps[i]) && (r == 0.0 || d < r)) r = d;
-    }
-    return r;
-  }
-
   // Seconds per unit of a time column named with a unit in brackets
   // ("Time [ms]", "t (us)"); 1 without one.
   double time_unit(const std::string& name) const {
@@ -385,36 +385,59 @@ class CsvRecording final : public Recording {
     return true;
   }
 
-  double fs_from_time_column() {
-    // The sampling interval from the first rows' time stamps (median step).
-    std::vector<double> times;
+  // The rate of the time column by the time-base rule (awcc/detail/time_base.hpp),
+  // over its rows up to the first that is not a row of the table (read() refuses it).
+  TimeBaseRate time_column_rate(const std::string& name, double unit) const {
+    TimeBase base;
+    base.path = info_.path;
+    base.name = fmt::format("the time column '{}'", name);
+    base.where = [this](std::uint64_t index) { return fmt::format("line {}", line_of_row(index)); };
+    base.fix = "name the right time column, or state the sampling rate and force it";
+    base.quantity = "time_column";
+    base.scan = [&](const TimeBase::Sink& sink) {
+      std::ifstream in(info_.path, std::ios::binary);
+      in.seekg(data_start_);
+      std::vector<double> block;
+      std::uint64_t first = 0;
+      double resolution = 0.0;
+      std::string line, cell;
+      std::int64_t number = first_line_;
+      while (bounded_getline(in, line, info_.path, ++number)) {
+        if (trim(line).empty()) continue;
+        const auto cells = split(line, delimiter_);
+        double t;
+        if (static_cast<int>(cells.size()) != columns_ || !number_of(cells[static_cast<std::size_t>(time_column_)], t)) {
+          break;
+        }
+        cell = trim(cells[static_cast<std::size_t>(time_column_)]);
+        std::replace(cell.begin(), cell.end(), ',', '.');
+        // The finest printed digit: a column printed to fixed decimals has one throughout.
+        const double q = resolution_of_text(cell);
+        if (q > 0.0 && (resolution == 0.0 || q < resolution)) resolution = q;
+        block.push_back(t * unit);
+        if (block.size() == 4096) {
+          sink(first, block);
+          first += block.size();
+          block.clear();
+        }
+      }
+      sink(first, block);
+      return TimeBaseScan{first + block.size(), resolution * unit};
+    };
+    return time_base_rate(base);
+  }
+
+  // The line number of data row `row` (from 0; blank lines are no rows).
+  [[nodiscard]] std::int64_t line_of_row(std::uint64_t row) const {
+    std::ifstream in(info_.path, std::ios::binary);
+    in.seekg(data_start_);
     std::string line;
-    std::int64_t number = line_;
-    while (times.size() < 2001 && bounded_getline(in_, line, info_.path, ++number)) {
-      if (trim(line).empty()) continue;
-      const auto cells = split(line, delimiter_);
-      double t;
-      if (static_cast<int>(cells.size()) != columns_ || !number_of(cells[static_cast<std::size_t>(time_column_)], t)) break;
-      times.push_back(t);
+    std::int64_t number = first_line_;
+    std::uint64_t seen = 0;
+    while (bounded_getline(in, line, info_.path, ++number)) {
+      if (!trim(line).empty() && seen++ == row) break;
     }
-    if (times.size() < 2) reader_fail(info_.path, "too few rows to take the sampling rate from the time column; state the sampling rate", "fs");
-    std::vector<double> steps;
-    for (std::size_t i = 1; i < times.size(); ++i) steps.push_back(times[i] - times[i - 1]);
-    // The mean step (last minus first over the steps) is as exact as the
-    // stamps' rounding allows; the median guards against a column that is
-    // not a clock (steps that vary by more than 1 %).
-    const double dt = (times.back() - times.front()) / static_cast<double>(times.size() - 1);
-    const double typical = median(steps);
-    if (!(dt > 0.0) || !(typical > 0.0)) {
-      reader_fail(info_.path, "the time column does not increase; state the sampling rate or fix the column", "time_column");
-    }
-    if (std::fabs(typical / dt - 1.0) > 0.01 && std::fabs(typical - dt) > 1.001 * resolution(steps)) {
-      reader_fail(info_.path, fmt::format("the time column's steps are uneven ({:.6g} typical, {:.6g} on average): not a "
-                                   "clock of evenly spaced samples; name the time column or state the sampling rate",
-                                   typical, dt),
-           "time_column");
-    }
-    return 1.0 / dt;
+    return number;
   }
 
   std::ifstream in_;

@@ -425,13 +425,15 @@ TEST(Hdf5Reader, ChannelsBySamplesIsReadTransposedAndSaysSo) {
     ASSERT_EQ(v[2 * i], static_cast<float>(i));
     ASSERT_EQ(v[2 * i + 1], -static_cast<float>(i));
   }
-  // 17 rows: more than a probe's channels, so samples x channels as stored.
+  // 17 rows, 100 columns: too many rows to be a probe's channels, too few to
+  // be the samples of 100 channels: refused, as the MATLAB reader refuses it
+  // (one rule, awcc/detail/columns.hpp).
   o.datasets = {"wide"};
   o.fs = 1e3;
-  auto wide = awcc::open_recording(p, o);
-  EXPECT_EQ(wide->info().frames, 17);
-  EXPECT_EQ(wide->info().channels, 100);
-  EXPECT_FALSE(has(wide->info().description, "transposed"));
+  std::string quantity;
+  const auto message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
+  EXPECT_TRUE(has(message, "'/wide' is 17 x 100: more columns than rows, but too many rows (more than 16)")) << message;
+  EXPECT_EQ(quantity, "datasets");
 }
 
 TEST(Hdf5Reader, AbsentOrAmbiguousDatasetsAreRefusedWithTheList) {
@@ -490,7 +492,9 @@ TEST(Hdf5Reader, ATimeBaseThatIsNotUniformOrIncreasingIsRefused) {
   for (std::size_t i = 0; i < n; ++i) gap[i] = static_cast<double>(i + (i >= 500 ? 100 : 0)) * 1e-5;  // samples lost
   std::string quantity;
   auto message = refusal([&] { (void)awcc::open_recording(file("gap.h5", gap), {}); }, &quantity);
-  EXPECT_TRUE(has(message, "'/time'") && has(message, "not uniform")) << message;
+  EXPECT_TRUE(has(message, "'/time'") && has(message, "not evenly spaced") &&
+              has(message, "the longest step, 0.00101 s, is to value 500"))
+      << message;
   EXPECT_EQ(quantity, "override_fs");
 
   std::vector<double> back(n);
