@@ -246,6 +246,7 @@ class CsvRecording final : public Recording {
       info_.channel_names.push_back(names[static_cast<std::size_t>(c)]);
     }
     info_.channels = static_cast<int>(data_columns_.size());
+    read_cells_ = std::max(time_column_, data_columns_.empty() ? -1 : data_columns_.back()) + 1;
     if (info_.channels <= 0) reader_fail(path, "the file has no data column besides its time column", "not_a_recording");
     data_start_ = row_starts[first_data];
     first_line_ = row_lines[first_data] - 1;
@@ -297,7 +298,7 @@ class CsvRecording final : public Recording {
       ++line_;
       if (trim(line).empty()) continue;
       const auto cells = split(line, delimiter_);
-      if (static_cast<int>(cells.size()) != columns_) {
+      if (!fits(cells)) {
         reader_fail(info_.path, fmt::format("line {} has {} cells where the first row has {}; fix or remove the line", line_,
                                      cells.size(), columns_));
       }
@@ -330,6 +331,18 @@ class CsvRecording final : public Recording {
   }
 
  private:
+  // A row of the table: every column read is there. The columns after them
+  // hold no samples (LabVIEW's Comment, a trailing separator): LabVIEW writes
+  // rows with and without the empty Comment cell, so they may be left out, or
+  // come as empty cells beyond the first row's.
+  [[nodiscard]] bool fits(const std::vector<std::string_view>& cells) const {
+    if (static_cast<int>(cells.size()) < read_cells_) return false;
+    for (auto k = static_cast<std::size_t>(columns_); k < cells.size(); ++k) {
+      if (!trim(cells[k]).empty()) return false;
+    }
+    return true;
+  }
+
   // A number in the file's decimal convention.
   [[nodiscard]] bool number_of(std::string_view cell, double& value) const {
     if (decimal_ == '.') return parse_number(cell, value);
@@ -406,7 +419,7 @@ class CsvRecording final : public Recording {
         if (trim(line).empty()) continue;
         const auto cells = split(line, delimiter_);
         double t;
-        if (static_cast<int>(cells.size()) != columns_ || !number_of(cells[static_cast<std::size_t>(time_column_)], t)) {
+        if (!fits(cells) || !number_of(cells[static_cast<std::size_t>(time_column_)], t)) {
           break;
         }
         cell = trim(cells[static_cast<std::size_t>(time_column_)]);
@@ -444,6 +457,7 @@ class CsvRecording final : public Recording {
   char delimiter_ = ',';
   char decimal_ = '.';
   int columns_ = 0;
+  int read_cells_ = 0;  // a row holds at least the columns up to the last one read
   int time_column_ = -1;
   std::vector<int> data_columns_;
   std::streampos data_start_ = 0;

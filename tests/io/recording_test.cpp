@@ -415,3 +415,40 @@ TEST(Lvm, MultipleXColumnsAndDeltaX) {
   EXPECT_EQ(info.channel_names, (std::vector<std::string>{"Voltage", "Voltage_0"}));
   EXPECT_EQ(samples.size(), 200u);
 }
+
+// LabVIEW writes rows with and without the empty trailing Comment cell (and
+// files that mix them): every form reads as the same samples, rate and names.
+TEST(Lvm, RowsWithoutTheEmptyCommentCellReadLikeRowsWithIt) {
+  const std::string head = "LabVIEW Measurement\t\nWriter_Version\t2\nSeparator\tTab\nDecimal_Separator\t.\n"
+                           "***End_of_Header***\t\n\nChannels\t2\t\nDelta_X\t0.0001\t0.0001\t\n"
+                           "***End_of_Header***\t\nX_Value\tVoltage\tVoltage_0\tComment\n";
+  auto file = [&](const std::string& name, auto with_comment) {
+    std::string text = head;
+    for (int i = 0; i < 300; ++i) {
+      text += fmt::format("{:.6f}\t{}\t{}{}\n", i * 1e-4, i % 3 ? 4.125 : 0.25, i % 4 ? 3.5 : 0.5,
+                          with_comment(i) ? "\t" : "");
+    }
+    return read_columns(name, text);
+  };
+  const auto [kept_info, kept] = file("comment_kept.lvm", [](int) { return true; });
+  const auto [left_info, left] = file("comment_left_out.lvm", [](int) { return false; });
+  const auto [mixed_info, mixed] = file("comment_mixed.lvm", [](int i) { return i % 2 == 0; });
+  ASSERT_EQ(kept.size(), 600u);
+  EXPECT_EQ(kept[0], 0.25f);
+  EXPECT_EQ(kept[1], 0.5f);
+  EXPECT_EQ(kept[2 * 299], 4.125f);
+  EXPECT_EQ(kept[2 * 299 + 1], 3.5f);
+  for (const auto& [info, samples] : {std::pair{left_info, left}, std::pair{mixed_info, mixed}}) {
+    EXPECT_EQ(samples, kept);
+    EXPECT_EQ(info.fs, kept_info.fs);
+    EXPECT_EQ(info.channel_names, kept_info.channel_names);
+  }
+  EXPECT_DOUBLE_EQ(kept_info.fs, 10e3);
+  EXPECT_EQ(kept_info.channel_names, (std::vector<std::string>{"Voltage", "Voltage_0"}));
+  // A missing sample cell is no Comment left out: still refused.
+  const std::string broken = head + "0.000000\t4.1\t3.5\t\n0.000100\t4.1\t3.5\n0.000200\t4.1\n";
+  const auto p = scratch("comment_broken.lvm");
+  std::ofstream(p, std::ios::binary) << broken;
+  EXPECT_NE(error_of(p).find("line 13 has 2 cells where the first row has 4"), std::string::npos) << error_of(p);
+}
+
