@@ -28,7 +28,7 @@
 // chunks, so memory does not grow with the recording's length.
 //
 // Debian's libhdf5 is not thread-safe: every call into it holds
-// hdf5_library_mutex() (handles close under it too), and HDF5's own printing
+// hdf5_library_mutex() (handles are released under it too), and HDF5's own printing
 // of its error stack is off: a damaged file gives our message, with HDF5's
 // innermost complaint quoted.
 #include <hdf5.h>
@@ -64,30 +64,25 @@ constexpr std::size_t kMaxListed = 4096;
 // Values of the time dataset read at a time while checking it.
 constexpr hsize_t kTimeBlock = 1 << 16;
 
-// The library lock, reentrant within a thread: handles close themselves
-// (RAII) whether or not their owner already holds it.
-thread_local int lock_depth = 0;
-
+// The library lock. Not reentrant, and no handle takes it: every Handle is
+// released where it is held (a local Handle inside a LibraryLock's scope; the
+// recording's own in Held, whose deleter takes it). So no thread needs to know
+// whether it holds the lock already, and nothing per thread is kept.
 class LibraryLock {
  public:
-  LibraryLock() {
-    if (lock_depth == 0) {
-      hdf5_library_mutex().lock();
-      // Set at every first entry: another user of the library (matio) may
-      // have turned the printing back on.
-      H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    }
-    ++lock_depth;
+  LibraryLock() : lock_(hdf5_library_mutex()) {
+    // Set at every entry: another user of the library (matio) may have turned
+    // the printing back on.
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   }
-  ~LibraryLock() {
-    if (--lock_depth == 0) hdf5_library_mutex().unlock();
-  }
-  LibraryLock(const LibraryLock&) = delete;
-  LibraryLock& operator=(const LibraryLock&) = delete;
+
+ private:
+  std::lock_guard<std::mutex> lock_;
 };
 
 // Any identifier libhdf5 hands out (file, group, dataset, dataspace,
-// datatype, attribute, property list), released when the handle goes.
+// datatype, attribute, property list), released when the handle goes, which
+// must be under the LibraryLock.
 class Handle {
  public:
   Handle() = default;
@@ -104,10 +99,7 @@ class Handle {
   Handle& operator=(const Handle&) = delete;
   ~Handle() { reset(); }
   void reset() noexcept {
-    if (id_ >= 0) {
-      LibraryLock lock;
-      H5Idec_ref(id_);
-    }
+    if (id_ >= 0) H5Idec_ref(id_);
     id_ = H5I_INVALID_HID;
   }
   [[nodiscard]] hid_t get() const { return id_; }
@@ -1155,8 +1147,21 @@ class Hdf5Recording final : public Recording {
                });
   }
 
-  Handle file_;
-  std::vector<Source> sources_;
+  // What the recording holds of libhdf5, released under the lock whether the
+  // recording ends or its constructor throws (after its own lock is gone).
+  struct Held {
+    Handle file;
+    std::vector<Source> sources;
+  };
+  struct ReleaseUnderLock {
+    void operator()(Held* held) const {
+      LibraryLock lock;
+      delete held;
+    }
+  };
+  std::unique_ptr<Held, ReleaseUnderLock> held_{new Held};
+  Handle& file_ = held_->file;
+  std::vector<Source>& sources_ = held_->sources;
   std::vector<std::vector<unsigned char>> buffers_;
   Kind kind_ = Kind::f64;
   bool pdpsim_ = false;
