@@ -467,16 +467,11 @@ class CsvRecording final : public Recording {
 }  // namespace
 
 bool looks_like_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char buffer[512];
-  in.read(buffer, sizeof(buffer));
-  const auto n = in.gcount();
-  if (n <= 0) return false;
-  for (std::streamsize i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(buffer[i]);
-    if (c == 0 || (c < 32 && c != '\n' && c != '\r' && c != '\t')) return false;
-  }
-  return true;
+  const std::string head = leading_bytes(path, 512);
+  return !head.empty() && std::none_of(head.begin(), head.end(), [](char ch) {
+    const auto c = static_cast<unsigned char>(ch);
+    return c == 0 || (c < 32 && c != '\n' && c != '\r' && c != '\t');
+  });
 }
 
 std::unique_ptr<Recording> open_csv(const fs::path& path, const ReaderOptions& options) {

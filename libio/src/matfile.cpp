@@ -1220,10 +1220,7 @@ class MatRecording final : public Recording {
 }  // namespace
 
 bool matlab_magic(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char m[19] = {};
-  in.read(m, sizeof(m));
-  const std::string_view text(m, static_cast<std::size_t>(in.gcount()));
+  const std::string text = leading_bytes(path, 19);
   return text == "MATLAB 5.0 MAT-file" || text == "MATLAB 7.3 MAT-file";
 }
 

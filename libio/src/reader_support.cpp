@@ -1,6 +1,7 @@
 // The readers' shared support (reader_support.hpp).
 #include <cmath>
 #include <fmt/format.h>
+#include <fstream>
 #include <stdexcept>
 
 #include "awcc/errors.hpp"
@@ -43,6 +44,14 @@ void check_finite(const std::filesystem::path& path, std::span<const float> valu
                              std::isnan(values[i]) ? "NaN" : "infinite"));
     }
   }
+}
+
+std::string leading_bytes(const std::filesystem::path& path, std::size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(n, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(n));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
 }
 
 // The writer in libsynth takes the same lock (libcore owns it).

@@ -37,6 +37,9 @@ T load(const void* p, bool swap) {
   return v;
 }
 
+/// The first n bytes of a file (fewer when it is shorter): what magic tests look at.
+std::string leading_bytes(const std::filesystem::path& path, std::size_t n);
+
 /// Refuses a block of interleaved samples holding a NaN or an infinity,
 /// naming the sample, channel and frame (first_frame: the block's first).
 void check_finite(const std::filesystem::path& path, std::span<const float> values, std::int64_t first_frame,

@@ -26,9 +26,15 @@ struct DataChunk {
 };
 std::optional<DataChunk> declared_data(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
+  // n bytes from byte `at`, or false at the file's end.
+  const auto read_at = [&in](std::uint64_t at, char* out, std::streamsize n) {
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    in.read(out, n);
+    return in.gcount() == n;
+  };
   char head[40] = {};
-  in.read(head, 40);
-  if (in.gcount() < 40) return std::nullopt;
+  if (!read_at(0, head, 40)) return std::nullopt;
   auto u32 = [](const char* p) { return load<std::uint32_t>(p, std::endian::native == std::endian::big); };
   auto u64 = [](const char* p) { return load<std::uint64_t>(p, std::endian::native == std::endian::big); };
   const std::string_view magic(head, 4);
@@ -37,16 +43,12 @@ std::optional<DataChunk> declared_data(const fs::path& path) {
     std::uint64_t pos = 12;
     for (int chunks = 0; chunks < 64; ++chunks) {
       char c[8];
-      in.clear();
-      in.seekg(static_cast<std::streamoff>(pos));
-      in.read(c, 8);
-      if (in.gcount() < 8) return std::nullopt;
+      if (!read_at(pos, c, 8)) return std::nullopt;
       const std::string_view id(c, 4);
       const std::uint64_t size = u32(c + 4);
       if (id == "ds64") {
         char d[16];
-        in.read(d, 16);
-        if (in.gcount() < 16) return std::nullopt;
+        if (!read_at(pos + 8, d, 16)) return std::nullopt;
         ds64_data = u64(d + 8);
       }
       if (id == "data") {
@@ -66,10 +68,7 @@ std::optional<DataChunk> declared_data(const fs::path& path) {
     std::uint64_t pos = 40;  // riff GUID, size, wave GUID
     for (int chunks = 0; chunks < 64; ++chunks) {
       char c[24];
-      in.clear();
-      in.seekg(static_cast<std::streamoff>(pos));
-      in.read(c, 24);
-      if (in.gcount() < 24) return std::nullopt;
+      if (!read_at(pos, c, 24)) return std::nullopt;
       const std::uint64_t size = u64(c + 16);  // includes the 24-byte chunk header
       if (size < 24) return std::nullopt;
       if (std::memcmp(c, data_guid, 16) == 0) return DataChunk{pos + 24, size - 24};
@@ -202,10 +201,7 @@ class SndfileRecording final : public Recording {
 }  // namespace
 
 bool audio_magic(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char m[4] = {0, 0, 0, 0};
-  in.read(m, 4);
-  const std::string_view s(m, 4);
+  const std::string s = leading_bytes(path, 4);
   return s == "RIFF" || s == "RIFX" || s == "RF64" || s == "fLaC" || s == "FORM" || s == "riff" || s == "OggS" ||
          s == "caff" || s == ".snd";
 }
