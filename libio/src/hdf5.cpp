@@ -13,8 +13,9 @@
 // The rate: an attribute of the dataset, its group or the root (fs, Fs,
 // sampling_rate, sample_rate, sampling_frequency in Hz; dt, wf_increment,
 // sampling_interval in s), else a `time` (or `t`) dataset beside it (by the
-// time-base rule of awcc/detail/time_base.hpp), else the stated fs. An attribute and a time dataset
-// that disagree are refused: one of them is wrong.
+// time-base rule of awcc/detail/time_base.hpp), else the stated fs. An
+// attribute and a time dataset that disagree (beyond the rule's tolerance)
+// are refused: one of them is wrong.
 //
 // Integer samples are counts: volts = count x quantum, the quantum stated
 // (volts_per_count) or an attribute `volts_per_count` of the dataset; without

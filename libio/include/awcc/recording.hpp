@@ -8,8 +8,8 @@
 //  - headerless raw files with a stated layout (sample type, byte order,
 //    channels, header bytes, volts per count);
 //  - column files (CSV, TSV, semicolon-separated with decimal commas, LabVIEW
-//    .lvm text; header row optional, a time column found by name or by its
-//    values);
+//    .lvm text, its rows with or without the empty trailing Comment cell;
+//    header row optional, a time column found by name or by its values);
 //  - NI TDMS (LabVIEW's binary logger), written from NI's published format:
 //    segments of lead-in, metadata and raw data, interleaved or not, int16,
 //    int32, float32 and float64 channels with linear scaling properties,
@@ -22,6 +22,10 @@
 //  - MATLAB .mat, v5 and v7.3: the variables named (`variables`: one matrix
 //    samples x channels or one vector per channel), or the single numeric
 //    matrix with two or more columns.
+// A time base (a time column, dataset or variable) gives the rate by one rule
+// (awcc/detail/time_base.hpp): the mean step, every step within 0.1 % of it,
+// a stated rate agreeing within 0.1 %. The formats, their names, extensions
+// and detection are one registry (libio/src/formats.cpp).
 // Every reader hands out interleaved float volts (frames x channels) in
 // blocks, so memory does not depend on the file's length; rewind() starts
 // again for a second pass. Damaged input is refused with a message naming the
