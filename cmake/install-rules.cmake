@@ -1,4 +1,4 @@
-# Installs the libraries (awcc::core, awcc::awcc, synth::synth,
+# Installs the libraries (awcc::core, awcc::io, awcc::awcc, synth::synth,
 # correction::correction), their headers, the pdp tool and one CMake package
 # "pdp": consumers write find_package(pdp CONFIG REQUIRED) and link what they
 # use. Headers under awcc/detail/ are the libraries' own and not installed.
@@ -6,20 +6,21 @@ include(CMakePackageConfigHelpers)
 
 set(PDP_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/pdp")
 
-foreach(target awcc_core awcc synth correction)
+foreach(target awcc_core awcc_io awcc synth correction)
   install(TARGETS ${target} EXPORT ${target}Targets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
     RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
     INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endforeach()
-install(DIRECTORY libcore/include/awcc libawcc/include/awcc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+install(DIRECTORY libcore/include/awcc libio/include/awcc libawcc/include/awcc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   PATTERN detail EXCLUDE)
 install(FILES ${PROJECT_BINARY_DIR}/generated/awcc/version.hpp
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/awcc)
 install(DIRECTORY libsynth/include/synth libcorrection/include/correction DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
 install(EXPORT awcc_coreTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
+install(EXPORT awcc_ioTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT awccTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT synthTargets NAMESPACE synth:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT correctionTargets NAMESPACE correction:: DESTINATION ${PDP_INSTALL_CMAKEDIR})

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -57,10 +58,27 @@ std::string cells_or(const std::vector<std::string>& names, const char* empty) {
   return out.empty() ? std::string(empty) : out;
 }
 
-constexpr std::array<std::pair<const char*, InputFormat>, 8> kFormats{
-    {{"auto", InputFormat::automatic}, {"sndfile", InputFormat::sndfile}, {"dat", InputFormat::uq_dat},
-     {"raw", InputFormat::raw}, {"csv", InputFormat::csv}, {"tdms", InputFormat::tdms}, {"hdf5", InputFormat::hdf5},
-     {"mat", InputFormat::matlab}}};
+// The recording formats as the registry (awcc/recording.hpp) names them: "auto | sndfile | dat | ...".
+const std::string& format_choices() {
+  static const std::string choices = [] {
+    std::string out(kAutomaticFormat);
+    for (auto name : input_formats()) out += " | " + std::string(name);
+    return out;
+  }();
+  return choices;
+}
+std::string input_format(std::string_view text) {
+  const auto names = input_formats();
+  if (text != kAutomaticFormat && std::find(names.begin(), names.end(), text) == names.end()) {
+    throw std::invalid_argument(fmt::format("'{}' is not one of {}", text, format_choices()));
+  }
+  return std::string(text);
+}
+const std::string& format_help() {
+  static const std::string help =
+      fmt::format("recording format: {} (auto: from content and extension)", format_choices());
+  return help;
+}
 constexpr std::array<std::pair<const char*, SampleType>, 4> kTypes{{{"int16", SampleType::int16},
                                                                     {"int32", SampleType::int32},
                                                                     {"float32", SampleType::float32},
@@ -86,9 +104,9 @@ constexpr std::array<std::pair<const char*, CorrelationPath>, 3> kPaths{{{"auto"
 
 using R = ReaderOptions;
 const OptionField<R> kReader[] = {
-    {"format", "", "recording format: auto | sndfile | dat | raw | csv | tdms | hdf5 | mat (auto: from content and extension)",
-     [](R& o, std::string_view t) { o.format = choice(t, kFormats); },
-     [](const R& o) { return name_of(o.format, kFormats); }},
+    {"format", "", format_help(),
+     [](R& o, std::string_view t) { o.format = input_format(t); },
+     [](const R& o) { return o.format; }},
     {"fs", "Hz", "sampling rate (needed for .dat, raw and CSV without a time column; must agree with a file's own)",
      [](R& o, std::string_view t) { o.fs = quantity(t, Dimension::frequency); },
      [](const R& o) { return o.fs > 0.0 ? format_quantity(o.fs, Dimension::frequency) : std::string("from the file"); }},

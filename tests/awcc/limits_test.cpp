@@ -220,7 +220,7 @@ TEST(Limits, ValuesAtTheInt16LimitsAndDenormalFloats) {
   }
   awcc::ProcessOptions p;
   p.reader.fs = 20e3;
-  p.reader.format = awcc::InputFormat::raw;
+  p.reader.format = "raw";
   p.reader.raw.sample_type = awcc::SampleType::float32;
   p.dx = 5e-3;
   const auto q = awcc::process_recording(raw, p);

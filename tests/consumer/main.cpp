@@ -1,9 +1,11 @@
 // A downstream program built against the installed package: it synthesises a
-// short scene (synth::synth), processes it (awcc::awcc), trains a small
+// short scene (synth::synth), reads samples through a recording (awcc::io),
+// processes it (awcc::awcc), trains a small
 // correction model on synthetic runs, saves it, loads it back and corrects a
 // measurement (correction::correction), and checks a property of each step so
 // that linking alone is not mistaken for success.
 #include <awcc/awcc.hpp>
+#include <awcc/recording.hpp>
 #include <awcc/units.hpp>
 #include <awcc/version.hpp>
 #include <correction/model.hpp>
@@ -22,6 +24,12 @@ int main(int argc, char** argv) {
   const double c = result.signals.at(0).void_fraction();
   const auto a = awcc::awcc(result.signals[0], result.signals[1], scene.streamwise_separation());
   const bool awcc_ok = a.ok() && a.velocity > 5.0 && a.velocity < 15.0;
+
+  // awcc::io: two channels of frames handed back interleaved as given.
+  const auto recording = awcc::memory_recording(std::vector<float>{0.25f, 4.0f, 0.5f, 3.5f}, 2, 1000.0);
+  std::vector<float> frames(4, 0.0f);
+  const bool io_ok = recording->read(frames, 2) == 2 && frames[1] == 4.0f && frames[2] == 0.5f &&
+                     recording->info().format == "array";
 
   // Training rows: truth = 0.9 x measured, Tu truth = measured + 0.05.
   std::vector<correction::TrainingRow> rows;
@@ -61,8 +69,9 @@ int main(int argc, char** argv) {
   const auto corrected = loaded.correct(m);
   const bool correction_ok = corrected.corrected() && std::abs(corrected.velocity->median() - 3.6) < 1e-9 &&
                              std::abs(corrected.turbulence_intensity->median() - 0.2) < 1e-9;
-  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s)\n", awcc::version, c,
-              a.velocity, awcc_ok ? "ok" : "wrong", corrected.velocity ? corrected.velocity->median() : 0.0,
-              correction_ok ? "ok" : "wrong");
-  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok) ? 0 : 1;
+  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s), recording read (%s)\n",
+              awcc::version, c, a.velocity, awcc_ok ? "ok" : "wrong",
+              corrected.velocity ? corrected.velocity->median() : 0.0, correction_ok ? "ok" : "wrong",
+              io_ok ? "ok" : "wrong");
+  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok && io_ok) ? 0 : 1;
 }

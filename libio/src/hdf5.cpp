@@ -7,17 +7,15 @@
 //    among them is the time base, not a channel), else its only 2-D one;
 //  - else pdp-sim's layout (awcc/pdpsim_layout.hpp): the root dataset `signal`;
 //  - else the file's only numeric 2-D dataset.
-// A 2-D dataset with more columns than rows and at most 16 rows is taken as
-// channels x samples (MATLAB and NumPy users store it so as often as not; no
-// probe recording has fewer samples than channels) and read transposed, which
-// the description says.
+// A 2-D dataset is samples x channels, or channels x samples read transposed
+// (which the description says), by the rule of awcc/detail/columns.hpp.
 //
 // The rate: an attribute of the dataset, its group or the root (fs, Fs,
 // sampling_rate, sample_rate, sampling_frequency in Hz; dt, wf_increment,
-// sampling_interval in s), else a `time` (or `t`) dataset beside it (the mean
-// step over its whole span; the first step must agree within 0.1 % and the
-// values must increase), else the stated fs. An attribute and a time dataset
-// that disagree are refused: one of them is wrong.
+// sampling_interval in s), else a `time` (or `t`) dataset beside it (by the
+// time-base rule of awcc/detail/time_base.hpp), else the stated fs. An
+// attribute and a time dataset that disagree (beyond the rule's tolerance)
+// are refused: one of them is wrong.
 //
 // Integer samples are counts: volts = count x quantum, the quantum stated
 // (volts_per_count) or an attribute `volts_per_count` of the dataset; without
@@ -31,7 +29,7 @@
 // chunks, so memory does not grow with the recording's length.
 //
 // Debian's libhdf5 is not thread-safe: every call into it holds
-// hdf5_library_mutex() (handles close under it too), and HDF5's own printing
+// hdf5_library_mutex() (handles are released under it too), and HDF5's own printing
 // of its error stack is off: a damaged file gives our message, with HDF5's
 // innermost complaint quoted.
 #include <hdf5.h>
@@ -47,6 +45,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "awcc/detail/columns.hpp"
+#include "awcc/detail/time_base.hpp"
 #include "awcc/pdpsim_layout.hpp"
 #include "awcc/units.hpp"
 #include "reader_support.hpp"
@@ -65,30 +65,25 @@ constexpr std::size_t kMaxListed = 4096;
 // Values of the time dataset read at a time while checking it.
 constexpr hsize_t kTimeBlock = 1 << 16;
 
-// The library lock, reentrant within a thread: handles close themselves
-// (RAII) whether or not their owner already holds it.
-thread_local int lock_depth = 0;
-
+// The library lock. Not reentrant, and no handle takes it: every Handle is
+// released where it is held (a local Handle inside a LibraryLock's scope; the
+// recording's own in Held, whose deleter takes it). So no thread needs to know
+// whether it holds the lock already, and nothing per thread is kept.
 class LibraryLock {
  public:
-  LibraryLock() {
-    if (lock_depth == 0) {
-      hdf5_library_mutex().lock();
-      // Set at every first entry: another user of the library (matio) may
-      // have turned the printing back on.
-      H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    }
-    ++lock_depth;
+  LibraryLock() : lock_(hdf5_library_mutex()) {
+    // Set at every entry: another user of the library (matio) may have turned
+    // the printing back on.
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   }
-  ~LibraryLock() {
-    if (--lock_depth == 0) hdf5_library_mutex().unlock();
-  }
-  LibraryLock(const LibraryLock&) = delete;
-  LibraryLock& operator=(const LibraryLock&) = delete;
+
+ private:
+  std::lock_guard<std::mutex> lock_;
 };
 
 // Any identifier libhdf5 hands out (file, group, dataset, dataspace,
-// datatype, attribute, property list), released when the handle goes.
+// datatype, attribute, property list), released when the handle goes, which
+// must be under the LibraryLock.
 class Handle {
  public:
   Handle() = default;
@@ -105,10 +100,7 @@ class Handle {
   Handle& operator=(const Handle&) = delete;
   ~Handle() { reset(); }
   void reset() noexcept {
-    if (id_ >= 0) {
-      LibraryLock lock;
-      H5Idec_ref(id_);
-    }
+    if (id_ >= 0) H5Idec_ref(id_);
     id_ = H5I_INVALID_HID;
   }
   [[nodiscard]] hid_t get() const { return id_; }
@@ -238,6 +230,16 @@ std::string shape_text(const std::vector<hsize_t>& dims) {
   return s.empty() ? std::string("scalar") : s;
 }
 
+// The k-th value of a block read as stored (values of type T).
+template <class T>
+auto stored(const std::vector<unsigned char>& block) {
+  return [bytes = block.data()](std::size_t k) {
+    T v;
+    std::memcpy(&v, bytes + k * sizeof(T), sizeof(T));
+    return v;
+  };
+}
+
 // One dataset contributing channels.
 struct Source {
   std::string name;       // absolute path in the file
@@ -261,7 +263,6 @@ class Hdf5Recording final : public Recording {
  public:
   Hdf5Recording(const fs::path& path, const ReaderOptions& options) {
     info_.path = path;
-    info_.format = InputFormat::hdf5;
     std::error_code ec;
     file_size_ = fs::file_size(path, ec);
     if (ec) reader_fail(path, fmt::format("cannot read its size ({})", ec.message()));
@@ -312,15 +313,9 @@ class Hdf5Recording final : public Recording {
     const auto frames = static_cast<std::size_t>(n);
     std::size_t first = 0;
     for (std::size_t s = 0; s < sources_.size(); ++s) {
-      const auto& src = sources_[s];
-      const auto width = static_cast<std::size_t>(src.channels);
-      const auto* bytes = buffers_[s].data();
-      for (std::size_t i = 0; i < frames; ++i) {
-        for (std::size_t c = 0; c < width; ++c) {
-          const std::size_t at = src.transposed ? c * frames + i : i * width + c;
-          std::memcpy(&out[i * channels + first + c], bytes + at * sizeof(std::int16_t), sizeof(std::int16_t));
-        }
-      }
+      const auto width = static_cast<std::size_t>(sources_[s].channels);
+      interleave(frames, width, sources_[s].transposed, stored<std::int16_t>(buffers_[s]), out, channels, first,
+                 [](std::int16_t v, std::size_t, std::size_t) { return v; });
       first += width;
     }
     position_ += n;
@@ -445,10 +440,15 @@ class Hdf5Recording final : public Recording {
     if (s.dims.size() == 1) {
       shape(s, s.dims[0], 1);
     } else if (s.dims.size() == 2) {
-      // Channels x samples (at most 16 rows, more columns): transposed.
-      s.transposed = s.dims[1] > s.dims[0] && s.dims[0] <= 16;
-      if (s.transposed) shape(s, s.dims[1], s.dims[0]);
-      else shape(s, s.dims[0], s.dims[1]);
+      const auto layout = column_layout(s.dims[0], s.dims[1]);
+      if (!layout) {
+        fail(fmt::format("dataset '{}' is {}: more columns than rows, but too many rows (more than {}) to be "
+                         "channels; store it samples x channels, or name the dataset(s) holding the channels",
+                         s.name, shape_text(s.dims), kMaxStackedChannels),
+             "datasets");
+      }
+      s.transposed = layout->transposed;
+      shape(s, layout->frames, layout->channels);
     } else {
       fail(fmt::format("dataset '{}' has {} dimensions ({}): samples x channels (2-D) or one channel (1-D) is "
                        "expected; name a 1-D or 2-D dataset",
@@ -912,6 +912,7 @@ class Hdf5Recording final : public Recording {
   struct Rate {
     double fs;
     std::string where;
+    double tolerance = 1e-6;  // relative, of a stated rate: a time base's is wider (time_base.hpp)
   };
 
   double rate(const ReaderOptions& options) {
@@ -919,7 +920,7 @@ class Hdf5Recording final : public Recording {
     if (options.override_fs && options.fs > 0.0) return options.fs;
     const auto attribute = rate_attribute();
     const auto timed = rate_from_time();
-    if (attribute && timed && std::fabs(attribute->fs - timed->fs) > 1e-6 * timed->fs) {
+    if (attribute && timed && std::fabs(attribute->fs - timed->fs) > timed->tolerance * timed->fs) {
       fail(fmt::format("{} states a sampling rate of {} but {} steps at {}: one of them is wrong; correct the file, "
                        "or force the rate",
                        attribute->where, format_quantity(attribute->fs, Dimension::frequency), timed->where,
@@ -927,7 +928,7 @@ class Hdf5Recording final : public Recording {
            "override_fs");
     }
     if (attribute) return stated_rate(info_.path, options, attribute->fs, attribute->where);
-    if (timed) return stated_rate(info_.path, options, timed->fs, timed->where);
+    if (timed) return stated_rate(info_.path, options, timed->fs, timed->where, timed->tolerance);
     if (options.fs > 0.0) return options.fs;
     fail(fmt::format("dataset '{}' records no sampling rate (no attribute fs, Fs, sampling_rate, sample_rate, "
                      "sampling_frequency, dt, wf_increment or sampling_interval on it, its group or the root, and no "
@@ -1034,58 +1035,46 @@ class Hdf5Recording final : public Recording {
     if (n < 2) return std::nullopt;
     // A time base cut short is refused, not read as zeros.
     check_storage(name, dataset, dims, H5Tget_size(type.get()), 1);
-    Handle file_space(H5Dget_space(dataset));
-    std::vector<double> values;
-    double t0 = 0.0, t1 = 0.0, previous = 0.0, last = 0.0;
-    for (hsize_t at = 0; at < n; at += kTimeBlock) {
-      const hsize_t count = std::min(kTimeBlock, n - at);
-      values.resize(static_cast<std::size_t>(count));
-      Handle memory(H5Screate_simple(1, &count, nullptr));
-      // A 2-D time base (MATLAB's 1 x n or n x 1) is selected as its flat run of elements.
-      hsize_t start2[2] = {0, 0}, count2[2] = {0, 0};
-      if (dims.size() == 2) {
-        start2[0] = dims[0] == 1 ? 0 : at;
-        start2[1] = dims[0] == 1 ? at : 0;
-        count2[0] = dims[0] == 1 ? 1 : count;
-        count2[1] = dims[0] == 1 ? count : 1;
-      }
-      const herr_t selected =
-          dims.size() == 1 ? H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &at, nullptr, &count, nullptr)
-                           : H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start2, nullptr, count2, nullptr);
-      if (selected < 0 ||
-          H5Dread(dataset, H5T_NATIVE_DOUBLE, memory.get(), file_space.get(), H5P_DEFAULT, values.data()) < 0) {
-        fail(fmt::format("dataset '{}' cannot be read at values {} to {}{}: the file is damaged", name, at,
-                         at + count, hdf5_says()));
-      }
-      for (hsize_t i = 0; i < count; ++i) {
-        const double t = values[static_cast<std::size_t>(i)];
-        const hsize_t index = at + i;
-        if (!std::isfinite(t)) {
-          fail(fmt::format("value {} of dataset '{}' is not finite: correct the time base, or force the rate", index,
-                           name),
-               "override_fs");
+    std::optional<Kind> kind;
+    (void)classify(type.get(), kind);
+    const bool floating = kind == Kind::f32 || kind == Kind::f64;
+    TimeBase base;
+    base.path = info_.path;
+    base.name = fmt::format("dataset '{}'", name);
+    base.where = [](std::uint64_t index) { return fmt::format("value {}", index); };
+    base.float_bits = kind == Kind::f32 ? 24 : (floating ? 53 : 0);
+    base.fix = "correct it, or force the rate";
+    base.quantity = "override_fs";
+    base.scan = [&](const TimeBase::Sink& sink) {
+      Handle file_space(H5Dget_space(dataset));
+      std::vector<double> values;
+      for (hsize_t at = 0; at < n; at += kTimeBlock) {
+        const hsize_t count = std::min(kTimeBlock, n - at);
+        values.resize(static_cast<std::size_t>(count));
+        Handle memory(H5Screate_simple(1, &count, nullptr));
+        // A 2-D time base (MATLAB's 1 x n or n x 1) is selected as its flat run of elements.
+        hsize_t start2[2] = {0, 0}, count2[2] = {0, 0};
+        if (dims.size() == 2) {
+          start2[0] = dims[0] == 1 ? 0 : at;
+          start2[1] = dims[0] == 1 ? at : 0;
+          count2[0] = dims[0] == 1 ? 1 : count;
+          count2[1] = dims[0] == 1 ? count : 1;
         }
-        if (index == 0) t0 = t;
-        if (index == 1) t1 = t;
-        if (index > 0 && !(t > previous)) {
-          fail(fmt::format("dataset '{}' does not increase at value {} ({} s after {} s): it is not a time base of "
-                           "one recording; correct it, or force the rate",
-                           name, index, t, previous),
-               "override_fs");
+        const herr_t selected =
+            dims.size() == 1 ? H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &at, nullptr, &count, nullptr)
+                             : H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start2, nullptr, count2, nullptr);
+        if (selected < 0 ||
+            H5Dread(dataset, H5T_NATIVE_DOUBLE, memory.get(), file_space.get(), H5P_DEFAULT, values.data()) < 0) {
+          fail(fmt::format("dataset '{}' cannot be read at values {} to {}{}: the file is damaged", name, at,
+                           at + count, hdf5_says()));
         }
-        previous = t;
+        sink(at, values);
       }
-      last = previous;
-    }
-    const double mean = (last - t0) / static_cast<double>(n - 1);
-    const double first = t1 - t0;
-    if (std::fabs(first - mean) > 1e-3 * mean) {
-      fail(fmt::format("dataset '{}' is not uniform: its first step is {} s but its mean step {} s (more than 0.1 % "
-                       "apart: samples missing, or runs joined); correct it, or force the rate",
-                       name, first, mean),
-           "override_fs");
-    }
-    return Rate{1.0 / mean, fmt::format("dataset '{}'", name)};
+      // Integers count whole units of the time base.
+      return TimeBaseScan{n, floating ? 0.0 : 1.0};
+    };
+    const auto rate = time_base_rate(base);
+    return Rate{rate.fs, base.name, rate.tolerance};
   }
 
   // "HDF5 '/signal' (pdp-sim layout, uint8, normalised units)": the channel
@@ -1140,32 +1129,40 @@ class Hdf5Recording final : public Recording {
   void convert(std::size_t s, std::int64_t n, std::size_t first, std::size_t channels, std::span<float> out) {
     const auto& src = sources_[s];
     const auto width = static_cast<std::size_t>(src.channels);
-    const auto frames = static_cast<std::size_t>(n);
-    const auto* bytes = buffers_[s].data();
     const double quantum = info_.quantum;
-    for (std::size_t i = 0; i < frames; ++i) {
-      for (std::size_t c = 0; c < width; ++c) {
-        T v;
-        std::memcpy(&v, bytes + (src.transposed ? c * frames + i : i * width + c) * sizeof(T), sizeof(T));
-        float& o = out[i * channels + first + c];
-        if constexpr (std::is_integral_v<T>) {
-          o = static_cast<float>(static_cast<double>(v) * quantum);
-        } else {
-          o = static_cast<float>(v);
-          if (!std::isfinite(o)) [[unlikely]] {
-            fail(fmt::format("sample {} of '{}'{} is {}: the recording is damaged (or beyond single precision); "
-                             "repair or cut it before processing",
-                             position_ + static_cast<std::int64_t>(i), src.name,
-                             width > 1 ? fmt::format(" column {}", c) : std::string(),
-                             std::isnan(v) ? "NaN" : (std::isinf(v) ? "infinite" : "too large for a float")));
-          }
-        }
-      }
-    }
+    interleave(static_cast<std::size_t>(n), width, src.transposed, stored<T>(buffers_[s]), out, channels, first,
+               [&](T v, std::size_t i, std::size_t c) {
+                 if constexpr (std::is_integral_v<T>) {
+                   return static_cast<float>(static_cast<double>(v) * quantum);
+                 } else {
+                   const auto o = static_cast<float>(v);
+                   if (!std::isfinite(o)) [[unlikely]] {
+                     fail(fmt::format("sample {} of '{}'{} is {}: the recording is damaged (or beyond single "
+                                      "precision); repair or cut it before processing",
+                                      position_ + static_cast<std::int64_t>(i), src.name,
+                                      width > 1 ? fmt::format(" column {}", c) : std::string(),
+                                      std::isnan(v) ? "NaN" : (std::isinf(v) ? "infinite" : "too large for a float")));
+                   }
+                   return o;
+                 }
+               });
   }
 
-  Handle file_;
-  std::vector<Source> sources_;
+  // What the recording holds of libhdf5, released under the lock whether the
+  // recording ends or its constructor throws (after its own lock is gone).
+  struct Held {
+    Handle file;
+    std::vector<Source> sources;
+  };
+  struct ReleaseUnderLock {
+    void operator()(Held* held) const {
+      LibraryLock lock;
+      delete held;
+    }
+  };
+  std::unique_ptr<Held, ReleaseUnderLock> held_{new Held};
+  Handle& file_ = held_->file;
+  std::vector<Source>& sources_ = held_->sources;
   std::vector<std::vector<unsigned char>> buffers_;
   Kind kind_ = Kind::f64;
   bool pdpsim_ = false;

@@ -41,6 +41,8 @@
 #include <optional>
 #include <type_traits>
 
+#include "awcc/detail/columns.hpp"
+#include "awcc/detail/time_base.hpp"
 #include "awcc/units.hpp"
 #include "reader_support.hpp"
 
@@ -201,19 +203,6 @@ std::string class_name(int c, bool logical, bool complex) {
     default: return fmt::format("class {}", c);
   }
   return complex ? "complex " + name : name;
-}
-
-template <class T>
-T load(const unsigned char* p, bool swap) {
-  T v;
-  if (!swap) {
-    std::memcpy(&v, p, sizeof(T));
-  } else {
-    unsigned char b[sizeof(T)];
-    std::reverse_copy(p, p + sizeof(T), b);
-    std::memcpy(&v, b, sizeof(T));
-  }
-  return v;
 }
 
 template <class Out>
@@ -727,7 +716,6 @@ class MatRecording final : public Recording {
  public:
   MatRecording(const fs::path& path, const ReaderOptions& options) {
     info_.path = path;
-    info_.format = InputFormat::matlab;
     std::error_code ec;
     const std::uint64_t size = fs::file_size(path, ec);
     if (ec) reader_fail(path, fmt::format("cannot read: {}", ec.message()));
@@ -897,22 +885,18 @@ class MatRecording final : public Recording {
   void use_matrix(const fs::path& path, const Variable& v) {
     const auto rows = v.dims[0], cols = v.dims[1];
     vars_used_ = {&v};
-    if (rows >= cols) {
-      layout_ = Layout::matrix;
-      info_.frames = static_cast<std::int64_t>(rows);
-      info_.channels = static_cast<int>(std::min<std::uint64_t>(cols, INT_MAX));
-      for (std::uint64_t k = 1; k <= cols && k <= 1024; ++k) info_.channel_names.push_back(fmt::format("{}(:,{})", v.name, k));
-    } else if (rows <= 16) {
-      // More columns than rows, and few rows: MATLAB users often keep one
-      // channel per row (signals as row vectors stacked).
-      layout_ = Layout::transposed;
-      info_.frames = static_cast<std::int64_t>(cols);
-      info_.channels = static_cast<int>(rows);
-      for (std::uint64_t k = 1; k <= rows; ++k) info_.channel_names.push_back(fmt::format("{}({},:)", v.name, k));
-    } else {
-      reader_fail(path, fmt::format("variable '{}' is {} x {}: more columns than rows, but too many rows (more than 16) "
+    const auto shape = column_layout(rows, cols);
+    if (!shape) {
+      reader_fail(path, fmt::format("variable '{}' is {} x {}: more columns than rows, but too many rows (more than {}) "
                                     "to be channels; save it samples x channels",
-                                    v.name, rows, cols), "variables");
+                                    v.name, rows, cols, kMaxStackedChannels), "variables");
+    }
+    layout_ = shape->transposed ? Layout::transposed : Layout::matrix;
+    info_.frames = static_cast<std::int64_t>(shape->frames);
+    info_.channels = static_cast<int>(std::min<std::uint64_t>(shape->channels, INT_MAX));
+    for (std::uint64_t k = 1; k <= shape->channels && k <= 1024; ++k) {
+      info_.channel_names.push_back(shape->transposed ? fmt::format("{}({},:)", v.name, k)
+                                                      : fmt::format("{}(:,{})", v.name, k));
     }
     if (info_.channels > 1024) {
       reader_fail(path, fmt::format("variable '{}' ({}) would be {} channels: not a probe recording; name the "
@@ -1102,7 +1086,8 @@ class MatRecording final : public Recording {
         }
         reader_fail(path, what + "; state the sampling rate", "fs");
       }
-      info_.fs = stated_rate(path, options, rate_from_time(path, options, *v), fmt::format("its time variable '{}'", name));
+      const auto timed = rate_from_time(path, options, *v);
+      info_.fs = stated_rate(path, options, timed.fs, fmt::format("its time variable '{}'", name), timed.tolerance);
       rate_source_ = fmt::format("rate from time vector '{}'", name);
       return;
     }
@@ -1115,43 +1100,32 @@ class MatRecording final : public Recording {
                 "fs");
   }
 
-  // 1 / the mean step of a time vector, read once in blocks: its values must
-  // increase, and its first step agree with the mean to 0.1 %.
-  double rate_from_time(const fs::path& path, const ReaderOptions& options, const Variable& v) {
+  // The rate of a time vector by the time-base rule (awcc/detail/time_base.hpp).
+  TimeBaseRate rate_from_time(const fs::path& path, const ReaderOptions& options, const Variable& v) {
     auto source = source_for(path, v, 1);
     const std::uint64_t n = v.elements();
-    std::vector<double> block;
-    double first = 0.0, second = 0.0, previous = 0.0;
-    const auto refuse = [&](const std::string& what) {
-      reader_fail(path, fmt::format("time variable '{}': {}; {}", v.name, what,
-                                    options.fs > 0.0 ? "force the stated rate if the samples are evenly spaced"
-                                                     : "state the sampling rate if the samples are evenly spaced"),
-                  options.fs > 0.0 ? "override_fs" : "fs");
-    };
-    for (std::uint64_t at = 0; at < n; at += block.size()) {
-      block.resize(static_cast<std::size_t>(std::min<std::uint64_t>(n - at, 1 << 16)));
-      source->get(at, block.size(), block.data());
-      for (std::size_t i = 0; i < block.size(); ++i) {
-        const double t = block[i];
-        const std::uint64_t k = at + i;
-        if (!std::isfinite(t)) refuse(fmt::format("value {} is not finite", k + 1));
-        if (k == 0) first = t;
-        if (k == 1) second = t;
-        if (k > 0 && !(t > previous)) {
-          refuse(fmt::format("value {} ({} s) does not come after value {} ({} s): the times do not increase", k + 1, t,
-                             k, previous));
-        }
-        previous = t;
+    const Kind kind = *kind_of_class(v.cls);
+    const bool floating = kind == Kind::f32 || kind == Kind::f64;
+    TimeBase base;
+    base.path = path;
+    base.name = fmt::format("time variable '{}'", v.name);
+    // Counted from 1, as MATLAB counts.
+    base.where = [](std::uint64_t index) { return fmt::format("value {}", index + 1); };
+    base.float_bits = kind == Kind::f32 ? 24 : (floating ? 53 : 0);
+    base.fix = options.fs > 0.0 ? "force the stated rate if the samples are evenly spaced"
+                                : "state the sampling rate if the samples are evenly spaced";
+    base.quantity = options.fs > 0.0 ? "override_fs" : "fs";
+    base.scan = [&](const TimeBase::Sink& sink) {
+      std::vector<double> block;
+      for (std::uint64_t at = 0; at < n; at += block.size()) {
+        block.resize(static_cast<std::size_t>(std::min<std::uint64_t>(n - at, 1 << 16)));
+        source->get(at, block.size(), block.data());
+        sink(at, block);
       }
-    }
-    const double mean = (previous - first) / static_cast<double>(n - 1);
-    const double step = second - first;
-    if (std::fabs(step - mean) > 1e-3 * mean) {
-      refuse(fmt::format("its first step ({} s) and its mean step ({} s) differ by {:.2g} %: the samples are not "
-                         "evenly spaced",
-                         step, mean, 100.0 * std::fabs(step - mean) / mean));
-    }
-    return 1.0 / mean;
+      // Integers count whole units of the time base.
+      return TimeBaseScan{n, floating ? 0.0 : 1.0};
+    };
+    return time_base_rate(base);
   }
 
   void describe(const ReaderOptions& options) {
@@ -1211,10 +1185,12 @@ class MatRecording final : public Recording {
       case Layout::vectors: {
         auto& column = column_buffer<T>();
         column.resize(frames);
+        // One channel at a time: a compressed matrix inflates one stream per channel.
         for (std::size_t c = 0; c < channels; ++c) {
           if (layout_ == Layout::matrix) sources_[0]->get(c * rows_ + pos, frames, column.data());
           else sources_[c]->get(pos, frames, column.data());
-          for (std::size_t i = 0; i < frames; ++i) out[i * channels + c] = column[i];
+          interleave(frames, 1, false, [&column](std::size_t k) { return column[k]; }, std::span<T>(out, frames * channels),
+                     channels, c, [](T v, std::size_t, std::size_t) { return v; });
         }
         return;
       }
@@ -1244,10 +1220,7 @@ class MatRecording final : public Recording {
 }  // namespace
 
 bool matlab_magic(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char m[19] = {};
-  in.read(m, sizeof(m));
-  const std::string_view text(m, static_cast<std::size_t>(in.gcount()));
+  const std::string text = leading_bytes(path, 19);
   return text == "MATLAB 5.0 MAT-file" || text == "MATLAB 7.3 MAT-file";
 }
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "awcc/errors.hpp"
+#include "awcc/options.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -68,7 +69,7 @@ TEST(UqDat, ReadsCountsAsVolts) {
   ReaderOptions o;
   o.fs = 20e3;
   auto r = open_recording(p, o);
-  EXPECT_EQ(r->info().format, awcc::InputFormat::uq_dat);
+  EXPECT_EQ(r->info().format, "dat");
   EXPECT_EQ(r->info().channels, 2);
   EXPECT_EQ(r->info().frames, 3);
   const auto v = read_all(*r, 2);
@@ -99,7 +100,7 @@ TEST(UqDat, RefusesHeadersThatDoNotMatchTheData) {
 TEST(Raw, ReadsEveryLayout) {
   ReaderOptions o;
   o.fs = 1000;
-  o.format = awcc::InputFormat::raw;
+  o.format = "raw";
   o.raw.channels = 3;
   o.raw.header_bytes = 4;
   o.raw.volts_per_count = 0.5;
@@ -137,7 +138,7 @@ TEST(Raw, ReadsEveryLayout) {
 TEST(Raw, NaNAndInfinityAreRefusedWithTheirPosition) {
   ReaderOptions o;
   o.fs = 1000;
-  o.format = awcc::InputFormat::raw;
+  o.format = "raw";
   o.raw.channels = 2;
   o.raw.sample_type = awcc::SampleType::float32;
   const auto p = scratch("nan.raw");
@@ -157,7 +158,7 @@ TEST(Csv, HeaderTimeColumnAndSamplingRate) {
     for (int i = 0; i < 50; ++i) f << i * 1e-4 << "," << (i % 5 == 0 ? 0.2 : 4.0) << "," << 4.1 << "\n";
   }
   auto r = open_recording(p);
-  EXPECT_EQ(r->info().format, awcc::InputFormat::csv);
+  EXPECT_EQ(r->info().format, "csv");
   EXPECT_EQ(r->info().channels, 2);
   EXPECT_NEAR(r->info().fs, 1e4, 1e-6);
   const auto v = read_all(*r);
@@ -263,6 +264,75 @@ TEST(Detection, BadFilesGetClearMessages) {
   for (const auto& f : {no_fs, unknown}) EXPECT_EQ(error_of(f).find("--"), std::string::npos) << error_of(f);
 }
 
+// The format registry: the names `format` takes, the option's choices and
+// the message for an undetectable file come from one list.
+TEST(Registry, TheFormatOptionTakesExactlyTheRegisteredNames) {
+  const auto names = awcc::input_formats();
+  ASSERT_EQ(names.size(), 7u);
+  std::string listed = "auto";
+  for (auto n : names) listed += " | " + std::string(n);
+  const auto fields = awcc::reader_option_fields();
+  const auto field = std::find_if(fields.begin(), fields.end(), [](const auto& f) { return f.name == "format"; });
+  ASSERT_NE(field, fields.end());
+  EXPECT_NE(field->help.find(listed), std::string_view::npos) << field->help;
+  for (auto n : names) {
+    ReaderOptions o;
+    field->parse(o, n);
+    EXPECT_EQ(o.format, n);
+    EXPECT_EQ(field->format(o), n);
+  }
+  ReaderOptions o;
+  try {
+    field->parse(o, "wav");
+    ADD_FAILURE() << "'wav' accepted as a format";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(listed), std::string::npos) << e.what();
+  }
+  // Through the library without the option parser: refused with the names.
+  const auto p = scratch("registry_unknown.csv");
+  std::ofstream(p) << "1,2\n3,4\n";
+  o.format = "wav";
+  const auto message = error_of(p, o);
+  EXPECT_NE(message.find("'wav' is not a recording format; state one of auto, sndfile, dat, raw, csv, tdms, hdf5, mat"),
+            std::string::npos) << message;
+  EXPECT_NE(message.find("[format]"), std::string::npos) << message;
+}
+
+// Detection tries the formats by rank, each by extension or magic; a stated
+// format wins over both, and RecordingInfo::format is the registry's name.
+TEST(Registry, DetectionFollowsTheRanksAndAStatedFormatWins) {
+  const std::string text = "0.1,4.0\n4.1,0.2\n0.3,4.2\n";
+  ReaderOptions o;
+  o.fs = 1000;
+  for (const char* name : {"rows.txt", "rows.tsv", "rows.lvmx"}) {  // .lvmx: by its content (text)
+    const auto p = scratch(name);
+    std::ofstream(p, std::ios::binary) << text;
+    EXPECT_EQ(open_recording(p, o)->info().format, "csv") << name;
+  }
+  // The same bytes named .bin are raw (rank 5 before text): two int16 channels of counts.
+  const auto bin = scratch("rows.bin");
+  std::ofstream(bin, std::ios::binary) << text;
+  EXPECT_EQ(open_recording(bin, o)->info().format, "raw");
+  // Named .dat they are UQ's (rank 0, by extension alone), and refused as its header.
+  const auto dat = scratch("rows.dat");
+  std::ofstream(dat, std::ios::binary) << text;
+  EXPECT_NE(error_of(dat, o).find("not a UQ .dat header"), std::string::npos) << error_of(dat, o);
+  // Stated, the format wins over the extension.
+  ReaderOptions stated = o;
+  stated.format = "csv";
+  const auto r = open_recording(dat, stated);
+  EXPECT_EQ(r->info().format, "csv");
+  EXPECT_EQ(r->info().channels, 2);
+  // A TDMS lead-in behind a .wav name: the TDMS reader (rank 1) takes it before libsndfile (rank 4).
+  const auto tdms = scratch("lead_in.wav");
+  std::ofstream(tdms, std::ios::binary) << "TDSm and then nothing a TDMS file needs";
+  EXPECT_NE(error_of(tdms).find("segment 1"), std::string::npos) << error_of(tdms);
+  // Files a glob catches beside recordings are refused by name before any reader guesses.
+  const auto md = scratch("rows.md");
+  std::ofstream(md, std::ios::binary) << text;
+  EXPECT_NE(error_of(md).find("a .md file is not a recording [not_a_recording]"), std::string::npos) << error_of(md);
+}
+
 }  // namespace
 
 namespace {
@@ -345,3 +415,40 @@ TEST(Lvm, MultipleXColumnsAndDeltaX) {
   EXPECT_EQ(info.channel_names, (std::vector<std::string>{"Voltage", "Voltage_0"}));
   EXPECT_EQ(samples.size(), 200u);
 }
+
+// LabVIEW writes rows with and without the empty trailing Comment cell (and
+// files that mix them): every form reads as the same samples, rate and names.
+TEST(Lvm, RowsWithoutTheEmptyCommentCellReadLikeRowsWithIt) {
+  const std::string head = "LabVIEW Measurement\t\nWriter_Version\t2\nSeparator\tTab\nDecimal_Separator\t.\n"
+                           "***End_of_Header***\t\n\nChannels\t2\t\nDelta_X\t0.0001\t0.0001\t\n"
+                           "***End_of_Header***\t\nX_Value\tVoltage\tVoltage_0\tComment\n";
+  auto file = [&](const std::string& name, auto with_comment) {
+    std::string text = head;
+    for (int i = 0; i < 300; ++i) {
+      text += fmt::format("{:.6f}\t{}\t{}{}\n", i * 1e-4, i % 3 ? 4.125 : 0.25, i % 4 ? 3.5 : 0.5,
+                          with_comment(i) ? "\t" : "");
+    }
+    return read_columns(name, text);
+  };
+  const auto [kept_info, kept] = file("comment_kept.lvm", [](int) { return true; });
+  const auto [left_info, left] = file("comment_left_out.lvm", [](int) { return false; });
+  const auto [mixed_info, mixed] = file("comment_mixed.lvm", [](int i) { return i % 2 == 0; });
+  ASSERT_EQ(kept.size(), 600u);
+  EXPECT_EQ(kept[0], 0.25f);
+  EXPECT_EQ(kept[1], 0.5f);
+  EXPECT_EQ(kept[2 * 299], 4.125f);
+  EXPECT_EQ(kept[2 * 299 + 1], 3.5f);
+  for (const auto& [info, samples] : {std::pair{left_info, left}, std::pair{mixed_info, mixed}}) {
+    EXPECT_EQ(samples, kept);
+    EXPECT_EQ(info.fs, kept_info.fs);
+    EXPECT_EQ(info.channel_names, kept_info.channel_names);
+  }
+  EXPECT_DOUBLE_EQ(kept_info.fs, 10e3);
+  EXPECT_EQ(kept_info.channel_names, (std::vector<std::string>{"Voltage", "Voltage_0"}));
+  // A missing sample cell is no Comment left out: still refused.
+  const std::string broken = head + "0.000000\t4.1\t3.5\t\n0.000100\t4.1\t3.5\n0.000200\t4.1\n";
+  const auto p = scratch("comment_broken.lvm");
+  std::ofstream(p, std::ios::binary) << broken;
+  EXPECT_NE(error_of(p).find("line 13 has 2 cells where the first row has 4"), std::string::npos) << error_of(p);
+}
+

@@ -138,7 +138,6 @@ class TdmsRecording final : public Recording {
  public:
   TdmsRecording(const fs::path& path, const ReaderOptions& options) : in_(path, std::ios::binary) {
     info_.path = path;
-    info_.format = InputFormat::tdms;
     if (!in_) reader_fail(path, "cannot open for reading");
     const auto size = fs::file_size(path);
     parse(path, options, size);
@@ -487,12 +486,7 @@ class TdmsRecording final : public Recording {
 
 }  // namespace
 
-bool tdms_magic(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char m[4] = {0, 0, 0, 0};
-  in.read(m, 4);
-  return std::memcmp(m, "TDSm", 4) == 0;
-}
+bool tdms_magic(const fs::path& path) { return leading_bytes(path, 4) == "TDSm"; }
 
 std::unique_ptr<Recording> open_tdms(const fs::path& path, const ReaderOptions& options) {
   return std::make_unique<TdmsRecording>(path, options);

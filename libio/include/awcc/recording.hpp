@@ -8,8 +8,8 @@
 //  - headerless raw files with a stated layout (sample type, byte order,
 //    channels, header bytes, volts per count);
 //  - column files (CSV, TSV, semicolon-separated with decimal commas, LabVIEW
-//    .lvm text; header row optional, a time column found by name or by its
-//    values);
+//    .lvm text, its rows with or without the empty trailing Comment cell;
+//    header row optional, a time column found by name or by its values);
 //  - NI TDMS (LabVIEW's binary logger), written from NI's published format:
 //    segments of lead-in, metadata and raw data, interleaved or not, int16,
 //    int32, float32 and float64 channels with linear scaling properties,
@@ -22,6 +22,10 @@
 //  - MATLAB .mat, v5 and v7.3: the variables named (`variables`: one matrix
 //    samples x channels or one vector per channel), or the single numeric
 //    matrix with two or more columns.
+// A time base (a time column, dataset or variable) gives the rate by one rule
+// (awcc/detail/time_base.hpp): the mean step, every step within 0.1 % of it,
+// a stated rate agreeing within 0.1 %. The formats, their names, extensions
+// and detection are one registry (libio/src/formats.cpp).
 // Every reader hands out interleaved float volts (frames x channels) in
 // blocks, so memory does not depend on the file's length; rewind() starts
 // again for a second pass. Damaged input is refused with a message naming the
@@ -38,11 +42,17 @@
 
 namespace awcc {
 
-enum class InputFormat { automatic, sndfile, uq_dat, raw, csv, tdms, hdf5, matlab };
+/// The formats read, by name: "sndfile", "dat", "raw", "csv", "tdms", "hdf5",
+/// "mat", as listed to users; kAutomaticFormat is not among them. A name, not
+/// an enumeration: the registry (libio/src/formats.cpp) owns the list, so that
+/// a new format is its reader plus one row there.
+std::span<const std::string_view> input_formats();
+/// ReaderOptions::format for "detect it by extension and content".
+inline constexpr std::string_view kAutomaticFormat = "auto";
+
 enum class SampleType { int16, int32, float32, float64 };
 enum class ByteOrder { little, big };
 
-std::string_view to_string(InputFormat format);
 std::string_view to_string(SampleType type);
 
 /// Layout of a headerless raw file (all fields stated by the user).
@@ -61,7 +71,7 @@ struct CsvLayout {
 };
 
 struct ReaderOptions {
-  InputFormat format = InputFormat::automatic;
+  std::string format{kAutomaticFormat};  ///< an input_formats() name, or kAutomaticFormat
   RawLayout raw;
   CsvLayout csv;
   /// Hz; required for .dat, raw files and CSV without a time column. A file
@@ -88,7 +98,7 @@ struct ReaderOptions {
 
 struct RecordingInfo {
   std::filesystem::path path;
-  InputFormat format = InputFormat::automatic;
+  std::string format;              ///< the input_formats() name of the reader ("array" for memory)
   std::string description;         ///< e.g. "FLAC, int16", "UQ .dat", "CSV (3 columns, time in column 0)"
   int channels = 0;                ///< data channels (a CSV time column is not one)
   double fs = 0.0;                 ///< Hz
@@ -117,6 +127,10 @@ class Recording {
 
  protected:
   RecordingInfo info_;
+
+ private:
+  // The registry names the format it opened (RecordingInfo::format).
+  friend std::unique_ptr<Recording> open_recording(const std::filesystem::path& path, const ReaderOptions& options);
 };
 
 /// Opens a recording (detecting the format by content and extension unless

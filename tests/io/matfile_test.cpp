@@ -207,7 +207,7 @@ TEST(MatFile, ASamplesByTwoDoubleMatrixWithItsRateInEveryVersion) {
               {{"x", MAT_C_DOUBLE, MAT_T_DOUBLE, {n, 2}, x.data()}, {"fs", MAT_C_DOUBLE, MAT_T_DOUBLE, {1, 1}, &fs}});
     auto r = awcc::open_recording(p, {});
     const auto& info = r->info();
-    EXPECT_EQ(info.format, awcc::InputFormat::matlab);
+    EXPECT_EQ(info.format, "mat");
     EXPECT_EQ(info.channels, 2);
     EXPECT_EQ(info.frames, static_cast<std::int64_t>(n));
     EXPECT_DOUBLE_EQ(info.fs, 20000.0);
@@ -568,7 +568,7 @@ TEST(MatFile, FilesFoundByTheirHeaderAndOldOrForeignFilesRefused) {
   const auto p = scratch("rec.bin73");
   write_mat(p, MAT_FT_MAT73, MAT_COMPRESSION_NONE,
             {{"x", MAT_C_DOUBLE, MAT_T_DOUBLE, {20, 2}, x.data()}, {"fs", MAT_C_DOUBLE, MAT_T_DOUBLE, {1, 1}, &fs}});
-  EXPECT_EQ(awcc::open_recording(p, {})->info().format, awcc::InputFormat::matlab);
+  EXPECT_EQ(awcc::open_recording(p, {})->info().format, "mat");
   // A v4 MAT-file: five int32 (type 0000 = little-endian double, 2 rows, 1
   // column, real, name length 2), the name and the values.
   Bytes v4;

@@ -1,0 +1,213 @@
+// Audio containers through libsndfile (awcc/recording.hpp): WAV, W64, RF64,
+// FLAC, AIFF, ... A data chunk shorter than its header promises is checked
+// here, as libsndfile reads it as if it were whole.
+#include <sndfile.h>
+
+#include <bit>
+#include <cmath>
+#include <fmt/format.h>
+#include <fstream>
+#include <optional>
+
+#include "reader_support.hpp"
+
+namespace awcc::detail {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The data bytes a WAV (RIFF), RF64 or W64 header promises, and where the
+// data start; empty for other files or headers that do not say (streaming
+// writers leave 0 or 0xFFFFFFFF). libsndfile reads a truncated data chunk
+// as if it were whole, so the promise is checked here.
+struct DataChunk {
+  std::uint64_t offset = 0, declared = 0;
+};
+std::optional<DataChunk> declared_data(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  // n bytes from byte `at`, or false at the file's end.
+  const auto read_at = [&in](std::uint64_t at, char* out, std::streamsize n) {
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    in.read(out, n);
+    return in.gcount() == n;
+  };
+  char head[40] = {};
+  if (!read_at(0, head, 40)) return std::nullopt;
+  auto u32 = [](const char* p) { return load<std::uint32_t>(p, std::endian::native == std::endian::big); };
+  auto u64 = [](const char* p) { return load<std::uint64_t>(p, std::endian::native == std::endian::big); };
+  const std::string_view magic(head, 4);
+  if ((magic == "RIFF" || magic == "RF64") && std::string_view(head + 8, 4) == "WAVE") {
+    std::optional<std::uint64_t> ds64_data;
+    std::uint64_t pos = 12;
+    for (int chunks = 0; chunks < 64; ++chunks) {
+      char c[8];
+      if (!read_at(pos, c, 8)) return std::nullopt;
+      const std::string_view id(c, 4);
+      const std::uint64_t size = u32(c + 4);
+      if (id == "ds64") {
+        char d[16];
+        if (!read_at(pos + 8, d, 16)) return std::nullopt;
+        ds64_data = u64(d + 8);
+      }
+      if (id == "data") {
+        const std::uint64_t declared = (size == 0xFFFFFFFFu && ds64_data) ? *ds64_data : size;
+        if (declared == 0 || declared == 0xFFFFFFFFu) return std::nullopt;
+        return DataChunk{pos + 8, declared};
+      }
+      pos += 8 + size + (size & 1);
+    }
+    return std::nullopt;
+  }
+  static const unsigned char riff_guid[16] = {'r', 'i', 'f', 'f', 0x2E, 0x91, 0xCF, 0x11,
+                                              0xA5, 0xD6, 0x28, 0xDB, 0x04, 0xC1, 0x00, 0x00};
+  static const unsigned char data_guid[16] = {'d', 'a', 't', 'a', 0xF3, 0xAC, 0xD3, 0x11,
+                                              0x8C, 0xD1, 0x00, 0xC0, 0x4F, 0x8E, 0xDB, 0x8A};
+  if (std::memcmp(head, riff_guid, 16) == 0) {
+    std::uint64_t pos = 40;  // riff GUID, size, wave GUID
+    for (int chunks = 0; chunks < 64; ++chunks) {
+      char c[24];
+      if (!read_at(pos, c, 24)) return std::nullopt;
+      const std::uint64_t size = u64(c + 16);  // includes the 24-byte chunk header
+      if (size < 24) return std::nullopt;
+      if (std::memcmp(c, data_guid, 16) == 0) return DataChunk{pos + 24, size - 24};
+      pos += (size + 7) / 8 * 8;
+    }
+  }
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------
+// libsndfile containers.
+
+class SndfileRecording final : public Recording {
+ public:
+  SndfileRecording(const fs::path& path, const ReaderOptions& options) {
+    SF_INFO sf{};
+    // Owned from here: a refusal below (thrown from the constructor) closes it.
+    file_.reset(sf_open(path.c_str(), SFM_READ, &sf));
+    if (!file_) {
+      reader_fail(path, fmt::format("not a readable audio file (libsndfile: {}); check the file or state its format", 
+                             sf_strerror(nullptr)));
+    }
+    if (sf.channels <= 0 || sf.samplerate <= 0) reader_fail(path, "the audio header has no channels or no sampling rate");
+    info_.path = path;
+    info_.channels = sf.channels;
+    info_.fs = stated_rate(path, options, sf.samplerate, "the file header");
+    info_.frames = sf.frames;
+    SF_FORMAT_INFO major{};
+    major.format = sf.format & SF_FORMAT_TYPEMASK;
+    sf_command(file_.get(), SFC_GET_FORMAT_INFO, &major, sizeof(major));
+    int bits = 0;
+    switch (sf.format & SF_FORMAT_SUBMASK) {
+      case SF_FORMAT_PCM_S8: case SF_FORMAT_PCM_U8: bits = 8; break;
+      case SF_FORMAT_PCM_16: bits = 16; break;
+      case SF_FORMAT_PCM_24: bits = 24; break;
+      case SF_FORMAT_PCM_32: bits = 32; break;
+      default: bits = 0;
+    }
+    const int sub = sf.format & SF_FORMAT_SUBMASK;
+    floating_ = sub == SF_FORMAT_FLOAT || sub == SF_FORMAT_DOUBLE;
+    floating_double_ = sub == SF_FORMAT_DOUBLE;
+    int16_ = bits == 16;
+    // Companded or compressed samples (u-law, A-law, ADPCM, Vorbis, ...) have
+    // no volts: read normalised to full scale 1.
+    const bool coded = bits == 0 && !floating_;
+    // Values as counts for integer data, as stored for floating data.
+    sf_command(file_.get(), SFC_SET_NORM_FLOAT, nullptr, coded ? SF_TRUE : SF_FALSE);
+    const double vpc = options.volts_per_count;
+    info_.volts_known = !coded && (vpc > 0.0 || floating_);
+    if (coded) {
+      scale_ = 1.0;
+      info_.quantum = 0.0;
+    } else if (floating_) {
+      scale_ = vpc > 0.0 ? vpc : 1.0;
+      info_.quantum = 0.0;
+    } else {
+      // Unknown scale: full scale is 1 (normalised units).
+      scale_ = vpc > 0.0 ? vpc : 1.0 / std::ldexp(1.0, bits - 1);
+      info_.quantum = scale_;
+    }
+    check_complete(path, options, sf, bits);
+    info_.description = fmt::format("{} ({}, {})", major.name ? major.name : "audio",
+                                    floating_ ? "floating point"
+                                              : (coded ? "compressed" : fmt::format("{}-bit integer", bits)),
+                                    info_.volts_known ? "volts" : "normalised units");
+  }
+  // A data chunk shorter than the header promises is refused (or, when
+  // allowed, read with a warning naming the promised and present durations).
+  void check_complete(const fs::path& path, const ReaderOptions& options, const SF_INFO& sf, int bits) {
+    const auto chunk = declared_data(path);
+    if (!chunk) return;
+    std::error_code ec;
+    const std::uint64_t size = fs::file_size(path, ec);
+    const std::uint64_t present = size > chunk->offset ? size - chunk->offset : 0;
+    if (ec || present >= chunk->declared) return;
+    const double frame_bytes = static_cast<double>(sf.channels) * (bits > 0 ? bits / 8 : (floating_double_ ? 8 : 4));
+    const double rate = static_cast<double>(sf.samplerate);
+    const std::string what = fmt::format(
+        "the header promises {:.3f} s of data but the file holds {:.3f} s: it is truncated (a recording still being "
+        "written, or a copy cut short)",
+        static_cast<double>(chunk->declared) / frame_bytes / rate, static_cast<double>(present) / frame_bytes / rate);
+    if (!options.allow_truncated) reader_fail(path, what + "; recover the whole file, or process what is there", "truncated");
+    info_.warnings.push_back(what + "; only what is there was processed");
+  }
+
+
+  std::int64_t read(std::span<float> out, std::int64_t max_frames) override {
+    const sf_count_t got = sf_readf_float(file_.get(), out.data(), max_frames);
+    if (got < 0) reader_fail(info_.path, "read error");
+    const auto n = static_cast<std::size_t>(got) * static_cast<std::size_t>(info_.channels);
+    if (scale_ != 1.0) {
+      const auto s = static_cast<float>(scale_);
+      for (std::size_t i = 0; i < n; ++i) out[i] *= s;
+    }
+    if (floating_) check_finite(info_.path, out.first(n), position_, info_.channels);
+    position_ += got;
+    if (got == 0 && info_.frames >= 0 && position_ < info_.frames) {
+      reader_fail(info_.path, fmt::format("the header announces {} frames but the data ends after {}: the file is truncated",
+                                   info_.frames, position_));
+    }
+    return got;
+  }
+
+  void rewind() override {
+    sf_seek(file_.get(), 0, SEEK_SET);
+    position_ = 0;
+  }
+
+  [[nodiscard]] bool has_int16() const override { return int16_; }
+
+  std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
+    const sf_count_t got = sf_readf_short(file_.get(), out.data(), max_frames);
+    if (got < 0) reader_fail(info_.path, "read error");
+    position_ += got;
+    if (got == 0 && info_.frames >= 0 && position_ < info_.frames) {
+      reader_fail(info_.path, fmt::format("the header announces {} frames but the data ends after {}: the file is truncated",
+                                   info_.frames, position_));
+    }
+    return got;
+  }
+
+ private:
+  std::unique_ptr<SNDFILE, int (*)(SNDFILE*)> file_{nullptr, &sf_close};
+  bool floating_ = false;
+  bool floating_double_ = false;
+  bool int16_ = false;
+  double scale_ = 1.0;
+  std::int64_t position_ = 0;
+};
+}  // namespace
+
+bool audio_magic(const fs::path& path) {
+  const std::string s = leading_bytes(path, 4);
+  return s == "RIFF" || s == "RIFX" || s == "RF64" || s == "fLaC" || s == "FORM" || s == "riff" || s == "OggS" ||
+         s == "caff" || s == ".snd";
+}
+
+std::unique_ptr<Recording> open_sndfile(const fs::path& path, const ReaderOptions& options) {
+  return std::make_unique<SndfileRecording>(path, options);
+}
+
+}  // namespace awcc::detail
