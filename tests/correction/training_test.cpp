@@ -8,6 +8,7 @@
 #include <random>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -91,7 +92,7 @@ TEST(Training, LoadReadsTheProcessedGeometryAndOneProcessing) {
     (void)correction::load_training_set(
         {write("training_mixed.csv", header + "\n" + cells(0, "0.4") + cells(1, "0.3"))}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("training_mixed.csv:3"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("filter A: model 0.4, results 0.3"), std::string::npos) << e.what();
   }
@@ -102,7 +103,7 @@ TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
   try {
     (void)correction::load_training_set({write("training_dup.csv", csv)}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("training_dup.csv:3: run 0"), std::string::npos) << e.what();
   }
   auto bad = good(10, 9.5);
@@ -111,13 +112,13 @@ TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
   try {
     (void)correction::load_training_set({write("training_bad.csv", csv)}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("training_bad.csv:2: column awcc_count_rate = '3mm'"), std::string::npos) << e.what();
   }
   try {
     (void)correction::load_training_set({write("training_foreign.csv", "a,b\n1,2\n")}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no column 'study'"), std::string::npos) << e.what();
   }
 }

@@ -109,7 +109,7 @@ struct Threshold {
   std::string note;            ///< anything the user should know
 };
 
-/// Applies the rule to a channel's histogram. Throws std::runtime_error when
+/// Applies the rule to a channel's histogram. Throws InputError when
 /// no threshold can be found (e.g. no bin on one side for the felder rule).
 Threshold choose_threshold(const VoltageHistogram& histogram, const BinarisationOptions& options);
 

@@ -100,8 +100,8 @@ struct ProcessResult {
   [[nodiscard]] std::string report() const;
 };
 
-/// Reads and binarises the two tips' channels. Throws std::runtime_error
-/// naming the file and the problem.
+/// Reads and binarises the two tips' channels. Throws InputError naming the
+/// file and the problem, OptionError for options that cannot work.
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options);
 /// The same from an open recording (read from its start; options.reader is not used).
 BinarisedRecording binarise_recording(Recording& recording, const ProcessOptions& options);

@@ -66,7 +66,7 @@ struct TrainingSet {
   bool processing_assumed = false;      ///< the CSVs do not say: the default was assumed
 };
 
-/// Reads sweep CSVs (pdp sweep's columns); throws std::runtime_error naming
+/// Reads sweep CSVs (pdp sweep's columns); throws InputError naming
 /// the file, line and column when one is not such a CSV. A run index seen twice
 /// (e.g. the same shard given twice) is refused.
 TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows);
