@@ -189,33 +189,46 @@ const awcc::OptionField<T> kTraining[] = {
 
 std::span<const awcc::OptionField<TrainOptions>> training_option_fields() { return kTraining; }
 
-std::string TrainOptions::validate() const {
-  if (trees < 1) return fmt::format("trees {}: give at least 1", trees);
-  if (min_windows < 1) return fmt::format("minimum windows {}: give at least 1", min_windows);
-  if (!(held_out > 0.0 && held_out < 1.0)) return fmt::format("held-out fraction {}: give a fraction in (0, 1)", held_out);
-  if (folds == 1 || folds < 0) return fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds);
-  if (cv_trees < 1) return fmt::format("cross-validation trees {}: give at least 1", cv_trees);
-  if (min_leaf < 1) return fmt::format("min leaf {}: give at least 1", min_leaf);
-  if (!(calibration >= 0.0 && calibration < 1.0)) return fmt::format("calibration fraction {}: give a fraction in [0, 1)", calibration);
-  for (std::size_t i = 1; i < calibration_bands.size(); ++i)
-    if (calibration_bands[i] <= calibration_bands[i - 1]) return "calibration bands: give increasing window counts";
+awcc::Validation TrainOptions::validate() const {
+  using awcc::Validation;
+  if (trees < 1) return Validation::invalid("trees", fmt::format("trees {}: give at least 1", trees));
+  if (min_windows < 1)
+    return Validation::invalid("min-windows", fmt::format("minimum windows {}: give at least 1", min_windows));
+  if (!(held_out > 0.0 && held_out < 1.0))
+    return Validation::invalid("held-out", fmt::format("held-out fraction {}: give a fraction in (0, 1)", held_out));
+  if (folds == 1 || folds < 0)
+    return Validation::invalid("folds", fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds));
+  if (cv_trees < 1)
+    return Validation::invalid("cv-trees", fmt::format("cross-validation trees {}: give at least 1", cv_trees));
+  if (min_leaf < 1) return Validation::invalid("min-leaf", fmt::format("min leaf {}: give at least 1", min_leaf));
+  if (!(calibration >= 0.0 && calibration < 1.0)) {
+    return Validation::invalid("calibration",
+                               fmt::format("calibration fraction {}: give a fraction in [0, 1)", calibration));
+  }
+  for (std::size_t i = 1; i < calibration_bands.size(); ++i) {
+    if (calibration_bands[i] <= calibration_bands[i - 1])
+      return Validation::invalid("calibration-bands", "calibration bands: give increasing window counts");
+  }
   for (std::size_t i = 0; i < calibration_tu_bands.size(); ++i) {
     if (!std::isfinite(calibration_tu_bands[i]) || (i > 0 && calibration_tu_bands[i] <= calibration_tu_bands[i - 1])) {
-      return "calibration Tu bands: give increasing values of Tu";
+      return Validation::invalid("calibration-tu-bands", "calibration Tu bands: give increasing values of Tu");
     }
   }
   std::size_t features = 0;
   try {
     features = feature_set_names(feature_set).size();
   } catch (const std::invalid_argument& e) {
-    return e.what();
+    return Validation::invalid("feature-set", e.what());
   }
   for (int m : features_per_split_grid) {
-    if (m < 1 || static_cast<std::size_t>(m) > features)
-      return fmt::format("features per split {}: give 1 to {} (the {} feature set)", m, features, feature_set);
+    if (m < 1 || static_cast<std::size_t>(m) > features) {
+      return Validation::invalid("features-per-split", fmt::format("features per split {}: give 1 to {} (the {} feature set)",
+                                                                   m, features, feature_set));
+    }
   }
   if (features_per_split < 1 || static_cast<std::size_t>(features_per_split) > features) {
-    return fmt::format("features per split {}: give 1 to {}", features_per_split, features);
+    return Validation::invalid("features-per-split",
+                               fmt::format("features per split {}: give 1 to {}", features_per_split, features));
   }
   return {};
 }
@@ -659,7 +672,7 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
 }  // namespace
 
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
-  if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
+  o.validate().throw_if_failed();
   const auto names = feature_set_names(o.feature_set);
   // Held-out split by a hash of the run index: independent of file order.
   std::vector<TrainingRow> rows = set.rows;

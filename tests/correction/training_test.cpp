@@ -289,16 +289,19 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   EXPECT_LT(rmse[1], 0.02);
   EXPECT_LT(rmse[2], 0.02);
   o.feature_set = "extensive";
-  EXPECT_NE(o.validate().find("use measured"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("use measured"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "feature-set");
   o.feature_set = "measured";
   o.features_per_split_grid = {8};
-  EXPECT_NE(o.validate().find("give 1 to 7"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("give 1 to 7"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "features-per-split");
   o.features_per_split_grid = {3};
   o.features_per_split = 3;
-  EXPECT_EQ(o.validate(), "");
+  EXPECT_TRUE(o.validate().ok()) << o.validate().message;
   // Calibration Tu bands out of order are refused, not sorted silently.
   o.calibration_tu_bands = {0.2, 0.1};
-  EXPECT_NE(o.validate().find("calibration Tu bands"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("calibration Tu bands"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "calibration-tu-bands");
 }
 
 // A model of one varying feature (velocity 1-2 m/s) whose forest learnt

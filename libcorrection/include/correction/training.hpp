@@ -37,6 +37,7 @@
 #include <span>
 
 #include "awcc/option_field.hpp"
+#include "awcc/validation.hpp"
 #include "correction/model.hpp"
 
 namespace correction {
@@ -100,7 +101,7 @@ struct TrainOptions {
   /// calibrated by windows alone covered 92 % of the u of its least
   /// turbulent runs and 63 % of its most turbulent at nominal 80 %).
   std::vector<double> calibration_tu_bands{0.1, 0.2, 0.3};
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] awcc::Validation validate() const;
 };
 
 /// The declarations of the training options (awcc/option_field.hpp): names,
