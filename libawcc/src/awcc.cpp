@@ -49,20 +49,31 @@ AwccWorkspace::~AwccWorkspace() = default;
 AwccWorkspace::AwccWorkspace(AwccWorkspace&&) noexcept = default;
 AwccWorkspace& AwccWorkspace::operator=(AwccWorkspace&&) noexcept = default;
 
-std::string AwccOptions::validate() const {
-  if (auto why = probe_correction.validate(); !why.empty()) return why;
-  if (np < 1 || np > 1000) return fmt::format("np = {}: particles per window must lie in [1, 1000]", np);
-  if (!(filter_a >= 0.0 && filter_a <= 1.0)) return fmt::format("filter A = {} must lie in [0, 1]", filter_a);
+Validation AwccOptions::validate() const {
+  if (auto v = probe_correction.validate(); !v.ok()) return v;
+  if (np < 1 || np > 1000)
+    return Validation::invalid("np", fmt::format("np = {}: particles per window must lie in [1, 1000]", np));
+  if (!(filter_a >= 0.0 && filter_a <= 1.0))
+    return Validation::invalid("filter-a", fmt::format("filter A = {} must lie in [0, 1]", filter_a));
   if (!(prominence_fraction >= 0.0 && prominence_fraction <= 1.0))
-    return fmt::format("prominence fraction {} must lie in [0, 1]", prominence_fraction);
-  if (velocity_min.has_value() != velocity_max.has_value()) return "give both ends of the velocity range";
-  if (max_lag_samples < 1) return fmt::format("max lag {} samples must be >= 1", max_lag_samples);
-  if (velocity_min && !(*velocity_min > 0.0 && *velocity_max > *velocity_min))
-    return fmt::format("velocity range {} to {} m/s must satisfy 0 < min < max", *velocity_min, *velocity_max);
-  if (windows_reported < 2) return fmt::format("windows reported {}: moments need at least 2 windows", windows_reported);
-  if (windows_ok < windows_reported)
-    return fmt::format("windows ok {} must be at least windows reported {}", windows_ok, windows_reported);
-  if (!(yield_ok >= 0.0 && yield_ok <= 1.0)) return fmt::format("yield ok {} must lie in [0, 1]", yield_ok);
+    return Validation::invalid("", fmt::format("prominence fraction {} must lie in [0, 1]", prominence_fraction));
+  if (velocity_min.has_value() != velocity_max.has_value())
+    return Validation::invalid("velocity-range", "give both ends of the velocity range");
+  if (max_lag_samples < 1) return Validation::invalid("", fmt::format("max lag {} samples must be >= 1", max_lag_samples));
+  if (velocity_min && !(*velocity_min > 0.0 && *velocity_max > *velocity_min)) {
+    return Validation::invalid("velocity-range", fmt::format("velocity range {} to {} m/s must satisfy 0 < min < max",
+                                                             *velocity_min, *velocity_max));
+  }
+  if (windows_reported < 2) {
+    return Validation::invalid("windows-reported",
+                               fmt::format("windows reported {}: moments need at least 2 windows", windows_reported));
+  }
+  if (windows_ok < windows_reported) {
+    return Validation::invalid(
+        "windows-ok", fmt::format("windows ok {} must be at least windows reported {}", windows_ok, windows_reported));
+  }
+  if (!(yield_ok >= 0.0 && yield_ok <= 1.0))
+    return Validation::invalid("yield-ok", fmt::format("yield ok {} must lie in [0, 1]", yield_ok));
   return {};
 }
 
@@ -705,7 +716,7 @@ AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, doubl
 
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options,
                 AwccWorkspace& workspace) {
-  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  options.validate().throw_if_failed();
   if (options.signal != CorrelationSignal::binary) {
     throw std::invalid_argument("AWCC of air intervals correlates binary signals; raw voltages need the recording");
   }

@@ -24,17 +24,25 @@ std::string_view to_string(ThresholdRule rule) {
 
 std::string_view to_string(ProbeType probe) { return probe == ProbeType::conductivity ? "conductivity" : "optical"; }
 
-std::string BinarisationOptions::validate() const {
-  if (!(theta > 0.0 && theta < 1.0)) return fmt::format("threshold fraction {} must lie in (0, 1)", theta);
-  if (!(hysteresis_low > 0.0 && hysteresis_low < hysteresis_high && hysteresis_high < 1.0))
-    return fmt::format("hysteresis fractions {}, {} must satisfy 0 < low < high < 1", hysteresis_low, hysteresis_high);
-  if (!(bin_width >= 0.0 && std::isfinite(bin_width))) return fmt::format("histogram bin width {} V must be >= 0", bin_width);
+Validation BinarisationOptions::validate() const {
+  if (!(theta > 0.0 && theta < 1.0))
+    return Validation::invalid("threshold", fmt::format("threshold fraction {} must lie in (0, 1)", theta));
+  if (!(hysteresis_low > 0.0 && hysteresis_low < hysteresis_high && hysteresis_high < 1.0)) {
+    return Validation::invalid("threshold", fmt::format("hysteresis fractions {}, {} must satisfy 0 < low < high < 1",
+                                                        hysteresis_low, hysteresis_high));
+  }
+  if (!(bin_width >= 0.0 && std::isfinite(bin_width)))
+    return Validation::invalid("bin-width", fmt::format("histogram bin width {} V must be >= 0", bin_width));
   if (rule == ThresholdRule::fixed && !fixed_threshold)
-    return "the fixed threshold rule needs a threshold voltage (e.g. 2.5V)";
-  if (fixed_threshold && !std::isfinite(*fixed_threshold)) return "the fixed threshold must be finite";
-  if (fixed_threshold_trailing && rule != ThresholdRule::fixed)
-    return "a trailing tip's own threshold is a voltage of the fixed rule (--threshold-rule fixed)";
-  if (fixed_threshold_trailing && !std::isfinite(*fixed_threshold_trailing)) return "the trailing threshold must be finite";
+    return Validation::invalid("threshold", "the fixed threshold rule needs a threshold voltage (e.g. 2.5V)");
+  if (fixed_threshold && !std::isfinite(*fixed_threshold))
+    return Validation::invalid("threshold", "the fixed threshold must be finite");
+  if (fixed_threshold_trailing && rule != ThresholdRule::fixed) {
+    return Validation::invalid("threshold-rule",
+                               "a trailing tip's own threshold is a voltage of the fixed rule: set threshold-rule to fixed");
+  }
+  if (fixed_threshold_trailing && !std::isfinite(*fixed_threshold_trailing))
+    return Validation::invalid("threshold-trailing", "the trailing threshold must be finite");
   return {};
 }
 
@@ -196,7 +204,7 @@ Threshold kramer_threshold(const VoltageHistogram& h, const BinarisationOptions&
     }
     if (top < 0) throw InputError(fmt::format("kramer threshold: no histogram bin {} half the largest centre ({:.4g} V)",
                                               below ? "below" : "above", split),
-                                  "threshold");
+                                  "threshold-rule,threshold");
     double sum = 0.0;
     int n = 0;
     for (int k = 0; k < bins; ++k) {
@@ -259,7 +267,7 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
     else width = (hi - lo) / 100.0;
   }
   if (!(width > 0.0)) {
-    throw InputError("the signal has no spread: no threshold can be found", "threshold");
+    throw InputError("the signal has no spread: no threshold can be found", "threshold-rule,threshold");
   }
   const auto bins = h.regroup(width);
   if (bins.size() == 1) {
@@ -291,7 +299,7 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
     throw InputError(fmt::format("no {} mode found: the voltage histogram has no populated bin {} {:.3f} V; use a "
                                  "fixed threshold voltage",
                                  low_mode.count < 0 ? "low" : "high", low_mode.count < 0 ? "below" : "above", split),
-                     "threshold");
+                     "threshold-rule,threshold");
   }
   auto level = [&](std::int64_t bin) {
     return o.rule == ThresholdRule::felder ? static_cast<double>(bin + 1) * width

@@ -11,9 +11,10 @@
 
 namespace awcc {
 
-std::string FsccOptions::validate() const {
-  if (segments < 1) return fmt::format("segments = {}: at least 1", segments);
-  if (!felder_lags && !(max_lag > 0.0 && std::isfinite(max_lag))) return fmt::format("max lag {} s must be > 0", max_lag);
+Validation FsccOptions::validate() const {
+  if (segments < 1) return Validation::invalid("segments", fmt::format("segments = {}: at least 1", segments));
+  if (!felder_lags && !(max_lag > 0.0 && std::isfinite(max_lag)))
+    return Validation::invalid("max-lag", fmt::format("max lag {} s must be > 0", max_lag));
   return {};
 }
 
@@ -288,7 +289,7 @@ FsccLags fscc_lags(std::int64_t samples, double fs, const FsccOptions& options) 
 
 CorrelationFunctions correlation_functions(const AirIntervals& leading, const AirIntervals& trailing,
                                            const FsccOptions& options) {
-  if (const auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  options.validate().throw_if_failed();
   if (leading.sample_count != trailing.sample_count || leading.fs != trailing.fs) {
     throw std::invalid_argument("FSCC needs two signals of the same length and sampling rate");
   }
@@ -312,7 +313,7 @@ struct RawCorrelation::Segment {
 
 RawCorrelation::RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options, FftPlanCache& plans)
     : samples_(samples), fs_(fs), lags_(fscc_lags(samples, fs, options)), segments_(options.segments), plans_(plans) {
-  if (const auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  options.validate().throw_if_failed();
   length_ = samples / segments_;
   if (length_ - (lags_.r12_last - lags_.r12_first + 1) < 2) {
     throw std::invalid_argument(fmt::format("{} samples in {} segments leave no correlation window", samples, segments_));

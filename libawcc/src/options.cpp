@@ -427,65 +427,72 @@ std::span<const OptionField<StructureOptions>> structure_option_fields() { retur
 
 std::span<const PresetSetting> preset_settings(std::string_view name) {
   if (name == "felder") return kFelder;
-  throw std::invalid_argument(fmt::format("'{}' is not a preset; the presets are: felder", name));
+  throw OptionError(fmt::format("'{}' is not a preset; the presets are: felder", name), "preset");
 }
 
 namespace {
 
-// Applies the given (else the preset's) value of each field, in declaration order.
-template <class T>
-void apply_settings(std::span<const OptionField<T>> fields, std::span<const OptionSetting> settings,
-                    std::span<const PresetSetting> preset, std::string_view preset_name, T& target,
-                    std::vector<bool>& used) {
-  for (const auto& f : fields) {
-    std::optional<std::string_view> text;
-    bool from_preset = false;
-    for (std::size_t i = 0; i < settings.size(); ++i) {
-      if (settings[i].name != f.name) continue;
-      text = settings[i].value;  // the last given wins
-      used[i] = true;
-    }
-    if (!text) {
-      for (const auto& p : preset) {
-        if (p.name == f.name) text = p.value, from_preset = true;
-      }
-    }
-    if (!text) continue;
+// The settings as applied: the preset's values (origin "preset NAME") before
+// the user's, so that a setting the user gives wins (the last given wins).
+std::vector<OptionSetting> behind_preset(std::span<const OptionSetting> settings) {
+  const OptionSetting* preset = nullptr;
+  for (const auto& s : settings)
+    if (s.name == "preset") preset = &s;
+  std::vector<OptionSetting> out;
+  if (preset) {
+    std::span<const PresetSetting> values;
     try {
-      f.parse(target, *text);
+      values = preset_settings(preset->value);
     } catch (const std::invalid_argument& e) {
-      throw OptionError(from_preset ? fmt::format("preset {}: {} = {}: {}", preset_name, f.name, *text, e.what())
-                                    : fmt::format("{} = {}: {}", f.name, *text, e.what()),
-                        std::string(f.name));
+      throw setting_error(*preset, e.what());
+    }
+    for (const auto& v : values) out.push_back({std::string(v.name), std::string(v.value), "preset " + preset->value});
+  }
+  for (const auto& s : settings)
+    if (s.name != "preset") out.push_back(s);
+  return out;
+}
+
+void refuse_unknown(std::span<const OptionSetting> settings, const std::vector<bool>& used, std::string_view of) {
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    if (!used[i]) {
+      throw OptionError(fmt::format("'{}' is not the declared name of an option of {} (awcc/options.hpp lists them)",
+                                    settings[i].name, of),
+                        settings[i].name);
     }
   }
 }
 
+void apply_methods(std::span<const OptionSetting> settings, std::vector<bool>& used, AwccOptions& awcc,
+                   FsccOptions& fscc) {
+  apply_settings(fscc_option_fields(), settings, fscc, used);
+  apply_settings(awcc_option_fields(), settings, awcc, used);
+  fscc.subsample = awcc.subsample;  // the one owner of this rule (options.hpp)
+}
+
 }  // namespace
 
-ProcessOptions process_options(std::span<const OptionSetting> settings, std::string_view preset) {
-  const auto preset_values = preset.empty() ? std::span<const PresetSetting>() : preset_settings(preset);
+void method_options(std::span<const OptionSetting> settings, AwccOptions& awcc, FsccOptions& fscc) {
+  std::vector<bool> used(settings.size(), false);
+  apply_methods(settings, used, awcc, fscc);
+  refuse_unknown(settings, used, "AWCC or FSCC");
+  awcc.validate().throw_if_failed();
+  fscc.validate().throw_if_failed();
+}
+
+ProcessOptions process_options(std::span<const OptionSetting> given) {
+  const auto settings = behind_preset(given);
   std::vector<bool> used(settings.size(), false);
   ProcessOptions p;
-  apply_settings(process_option_fields(), settings, preset_values, preset, p, used);
-  apply_settings(reader_option_fields(), settings, preset_values, preset, p.reader, used);
-  apply_settings(binarisation_option_fields(), settings, preset_values, preset, p.binarisation, used);
-  apply_settings(fscc_option_fields(), settings, preset_values, preset, p.fscc_options, used);
-  apply_settings(awcc_option_fields(), settings, preset_values, preset, p.awcc_options, used);
-  apply_settings(structure_option_fields(), settings, preset_values, preset, p.structure, used);
-  for (std::size_t i = 0; i < settings.size(); ++i) {
-    if (!used[i]) {
-      throw OptionError(fmt::format("'{}' is not an option of a processing run; the options are listed by "
-                                    "`pdp process --help` (names without the leading --)",
-                                    settings[i].name),
-                        settings[i].name);
-    }
-  }
-  p.fscc_options.subsample = p.awcc_options.subsample;  // FSCC refines its peak as AWCC does (header above)
-  if (!p.allow_unusual) {
-    if (auto why = p.implausible(); !why.empty()) throw OptionError(why, "allow-unusual");
-  }
-  if (auto why = p.validate(); !why.empty()) throw std::invalid_argument(why);
+  apply_settings(process_option_fields(), std::span<const OptionSetting>(settings), p, used);
+  apply_settings(reader_option_fields(), std::span<const OptionSetting>(settings), p.reader, used);
+  apply_settings(binarisation_option_fields(), std::span<const OptionSetting>(settings), p.binarisation, used);
+  apply_methods(settings, used, p.awcc_options, p.fscc_options);
+  apply_settings(structure_option_fields(), std::span<const OptionSetting>(settings), p.structure, used);
+  refuse_unknown(settings, used, "a processing run");
+  // An implausible value is named before a combination it may cause.
+  if (!p.allow_unusual) p.implausible().throw_if_failed();
+  p.validate().throw_if_failed();
   return p;
 }
 

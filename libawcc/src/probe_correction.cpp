@@ -9,25 +9,35 @@
 
 namespace awcc {
 
-std::string ProbeCorrectionOptions::validate() const {
-  const std::array<std::pair<const char*, double>, 10> positive{{{"needle diameter", needle_diameter},
-                                                                {"water density", water_density},
-                                                                {"water viscosity", water_viscosity},
-                                                                {"air density", air_density},
-                                                                {"surface tension", surface_tension},
-                                                                {"gravity", gravity},
-                                                                {"contact factor", contact_factor + 1.0},
-                                                                {"virtual mass coefficient", virtual_mass + 1.0},
-                                                                {"impact pressure coefficient", impact_pressure + 1.0},
-                                                                {"void fraction limit", max_void_fraction}}};
-  for (const auto& [name, value] : positive) {
-    if (!(value > 0.0) || !std::isfinite(value)) return fmt::format("probe correction: the {} must be positive", name);
+Validation ProbeCorrectionOptions::validate() const {
+  struct Positive {
+    const char* option;  // the declared name; "" for a member no option sets
+    const char* name;
+    double value;
+  };
+  const std::array<Positive, 10> positive{{{"needle-diameter", "needle diameter", needle_diameter},
+                                           {"water-density", "water density", water_density},
+                                           {"water-viscosity", "water viscosity", water_viscosity},
+                                           {"air-density", "air density", air_density},
+                                           {"surface-tension", "surface tension", surface_tension},
+                                           {"", "gravity", gravity},
+                                           {"contact-factor", "contact factor", contact_factor + 1.0},
+                                           {"virtual-mass", "virtual mass coefficient", virtual_mass + 1.0},
+                                           {"impact-pressure", "impact pressure coefficient", impact_pressure + 1.0},
+                                           {"", "void fraction limit", max_void_fraction}}};
+  for (const auto& p : positive) {
+    if (!(p.value > 0.0) || !std::isfinite(p.value))
+      return Validation::invalid(p.option, fmt::format("probe correction: the {} must be positive", p.name));
   }
-  if (contact_factor < 0.0 || virtual_mass < 0.0 || impact_pressure < 0.0)
-    return "probe correction: the force coefficients must be >= 0";
-  if (!(air_density < water_density)) return "probe correction: the air must be lighter than the water";
-  if (!(std::fabs(probe_angle) <= std::numbers::pi)) return "probe correction: the probe angle must lie within +/-180 deg";
-  if (max_steps < 100) return "probe correction: allow at least 100 integration steps";
+  for (const auto& [option, value] : {std::pair{"contact-factor", contact_factor}, std::pair{"virtual-mass", virtual_mass},
+                                      std::pair{"impact-pressure", impact_pressure}}) {
+    if (value < 0.0) return Validation::invalid(option, "probe correction: the force coefficients must be >= 0");
+  }
+  if (!(air_density < water_density))
+    return Validation::invalid("air-density", "probe correction: the air must be lighter than the water");
+  if (!(std::fabs(probe_angle) <= std::numbers::pi))
+    return Validation::invalid("probe-angle", "probe correction: the probe angle must lie within +/-180 deg");
+  if (max_steps < 100) return Validation::invalid("", "probe correction: allow at least 100 integration steps");
   return {};
 }
 

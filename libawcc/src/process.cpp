@@ -17,38 +17,48 @@
 
 namespace awcc {
 
-std::string ProcessOptions::validate() const {
-  if (leading_channel < 0 || trailing_channel < 0) return "channel indices must be >= 0";
-  if (leading_channel == trailing_channel)
-    return fmt::format("the leading and trailing tips are both channel {}; choose two channels", leading_channel);
-  if (!(dx >= 0.0 && std::isfinite(dx))) return fmt::format("dx = {} m must be >= 0", dx);
-  if (auto why = binarisation.validate(); !why.empty()) return why;
-  if (auto why = fscc_options.validate(); !why.empty()) return why;
-  if (auto why = awcc_options.validate(); !why.empty()) return why;
-  if (auto why = structure.validate(); !why.empty()) return why;
-  if (auto why = spectrum.validate(); !why.empty()) return why;
-  if (block_frames < 1) return "block_frames must be >= 1";
+Validation ProcessOptions::validate() const {
+  if (leading_channel < 0) return Validation::invalid("leading-channel", "channel indices must be >= 0");
+  if (trailing_channel < 0) return Validation::invalid("trailing-channel", "channel indices must be >= 0");
+  if (leading_channel == trailing_channel) {
+    return Validation::invalid(
+        "leading-channel,trailing-channel",
+        fmt::format("the leading and trailing tips are both channel {}; choose two channels", leading_channel));
+  }
+  if (!(dx >= 0.0 && std::isfinite(dx))) return Validation::invalid("dx", fmt::format("dx = {} m must be >= 0", dx));
+  for (const auto& part : {binarisation.validate(), fscc_options.validate(), awcc_options.validate(),
+                           structure.validate(), spectrum.validate()}) {
+    if (!part.ok()) return part;
+  }
+  if (block_frames < 1) return Validation::invalid("", "block_frames must be >= 1");
   if (!allow_unusual) return implausible();
   return {};
 }
 
-std::string ProcessOptions::implausible() const {
+Validation ProcessOptions::implausible() const {
+  // The fix is the unit of the value named, or allow-unusual when it is right.
   if (dx != 0.0 && (dx < 0.1e-3 || dx > 100e-3)) {
-    return fmt::format("dx = {} lies outside 0.1 mm to 100 mm, the tip separations of phase-detection probes: check "
-                       "its unit, or allow unusual values",
-                       format_quantity(dx, Dimension::length));
+    return Validation::implausible(
+        "allow-unusual",
+        fmt::format("dx = {} lies outside 0.1 mm to 100 mm, the tip separations of phase-detection probes: check "
+                    "its unit, or allow unusual values",
+                    format_quantity(dx, Dimension::length)));
   }
   if (reader.fs > 0.0 && (reader.fs < plausible_fs_min || reader.fs > plausible_fs_max)) {
-    return fmt::format("fs = {} lies outside 1 kHz to 100 MHz, the sampling rates of probe recordings: check its "
-                       "unit, or allow unusual values",
-                       format_quantity(reader.fs, Dimension::frequency));
+    return Validation::implausible(
+        "allow-unusual",
+        fmt::format("fs = {} lies outside 1 kHz to 100 MHz, the sampling rates of probe recordings: check its unit, "
+                    "or allow unusual values",
+                    format_quantity(reader.fs, Dimension::frequency)));
   }
   const auto& a = awcc_options;
   for (const auto& v : {a.velocity_min, a.velocity_max}) {
     if (v && (*v < 0.01 || *v > 200.0)) {
-      return fmt::format("the velocity range end {} lies outside 0.01 m/s to 200 m/s, the velocities of air-water "
-                         "flows: check its unit, or allow unusual values",
-                         format_quantity(*v, Dimension::velocity));
+      return Validation::implausible(
+          "allow-unusual",
+          fmt::format("the velocity range end {} lies outside 0.01 m/s to 200 m/s, the velocities of air-water "
+                      "flows: check its unit, or allow unusual values",
+                      format_quantity(*v, Dimension::velocity)));
     }
   }
   return {};
@@ -253,13 +263,13 @@ std::optional<std::pair<std::int16_t, std::int16_t>> band_from(const std::int16_
 }  // namespace
 
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options) {
-  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  options.validate().throw_if_failed();
   auto recording = open_recording(path, options.reader);
   return binarise_recording(*recording, options);
 }
 
 BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& options) {
-  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  options.validate().throw_if_failed();
   Recording* recording = &opened;
   const RecordingInfo& info = recording->info();
   const std::filesystem::path& path = info.path;
@@ -269,7 +279,7 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
       throw InputError(fmt::format("{}: channel {} requested but the recording has {} channel{} (numbered from 0); "
                                    "choose the tips' channels within range",
                                    path.string(), c, channels, channels == 1 ? "" : "s"),
-                       "channels");
+                       "leading-channel,trailing-channel");
     }
   }
   const ChannelSelection ch{static_cast<std::size_t>(channels), static_cast<std::size_t>(options.leading_channel),
@@ -278,13 +288,13 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
     throw InputError(fmt::format("{}: the file records a sampling rate of {}, outside 1 kHz to 100 MHz: is it a probe "
                                  "recording? If so, allow unusual values",
                                  path.string(), format_quantity(info.fs, Dimension::frequency)),
-                     "allow_unusual");
+                     "allow-unusual");
   }
   if (options.binarisation.rule == ThresholdRule::fixed && !info.volts_known) {
     throw InputError(fmt::format("{}: a fixed threshold is a voltage, but the recording's samples are not in volts "
                                  "(its scale is unknown); state its volts per count",
                                  path.string()),
-                     "volts_per_count");
+                     "volts-per-count");
   }
   BinarisationOptions bopt = options.binarisation;
   if (!info.volts_known && bopt.bin_width > 0.0 && bopt.rule != ThresholdRule::felder) bopt.bin_width = 0.0;
@@ -538,7 +548,7 @@ AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const Pro
 AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options,
                     AwccWorkspace& workspace) {
   const AwccOptions& ao = options.awcc_options;
-  if (auto why = ao.validate(); !why.empty()) throw std::invalid_argument(why);
+  ao.validate().throw_if_failed();
   RawVoltageCorrelations voltages(recording, options);
   return detail::run_awcc(b.leading, options.dx, ao, voltages, workspace);
 }
@@ -603,7 +613,7 @@ ProcessResult process_recording(const std::filesystem::path& path, const Process
 
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options,
                                 ProcessWorkspace& workspace) {
-  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument(why);
+  options.validate().throw_if_failed();
   auto recording = open_recording(path, options.reader);
   return process_recording(*recording, options, workspace);
 }

@@ -4,22 +4,38 @@
 
 namespace awcc {
 
-std::string StructureOptions::validate() const {
-  if (!(voltage_bin > 0.0)) return fmt::format("voltage PDF bin {} V must be > 0", voltage_bin);
-  for (const auto* o : {&chord_time, &chord_length}) {
+Validation StructureOptions::validate() const {
+  if (!(voltage_bin > 0.0))
+    return Validation::invalid("voltage-pdf-bin", fmt::format("voltage PDF bin {} V must be > 0", voltage_bin));
+  struct Chord {
+    const ChordPdfOptions* options;
+    const char* bin;  // the declared names of its width and its range
+    const char* max;
+  };
+  for (const auto& [o, bin, max] : {Chord{&chord_time, "chord-time-bin", "chord-time-max"},
+                                    Chord{&chord_length, "chord-length-bin", "chord-length-max"}}) {
     if (!(o->bin_width > 0.0) || !(o->max >= o->bin_width) || o->max / o->bin_width > 1e6) {
-      return fmt::format("chord PDF bins: width {} and range {} must be > 0, the range at least one bin and at most a "
-                         "million bins",
-                         o->bin_width, o->max);
+      return Validation::invalid(
+          o->bin_width > 0.0 ? max : bin,
+          fmt::format("chord PDF bins: width {} and range {} must be > 0, the range at least one bin and at most a "
+                      "million bins",
+                      o->bin_width, o->max));
     }
   }
-  if (!(clusters.median_fraction > 0.0)) return "the median cluster criterion's fraction must be > 0";
-  if (!(clusters.constant_length > 0.0) || !(clusters.constant_time > 0.0)) return "the constant cluster criteria must be > 0";
-  if (!(arrivals.bin_width > 0.0) || arrivals.bins < 1) return "arrival-time bins: width > 0 and at least one bin";
-  for (const auto* limits : {&arrivals.length_classes, &arrivals.time_classes}) {
+  if (!(clusters.median_fraction > 0.0))
+    return Validation::invalid("cluster-median-fraction", "the median cluster criterion's fraction must be > 0");
+  if (!(clusters.constant_length > 0.0))
+    return Validation::invalid("cluster-constant-length", "the constant cluster criteria must be > 0");
+  if (!(clusters.constant_time > 0.0))
+    return Validation::invalid("cluster-constant-time", "the constant cluster criteria must be > 0");
+  if (!(arrivals.bin_width > 0.0))
+    return Validation::invalid("arrival-bin", "arrival-time bins: width > 0 and at least one bin");
+  if (arrivals.bins < 1) return Validation::invalid("arrival-bins", "arrival-time bins: width > 0 and at least one bin");
+  for (const auto& [limits, option] : {std::pair{&arrivals.length_classes, "arrival-length-classes"},
+                                       std::pair{&arrivals.time_classes, "arrival-time-classes"}}) {
     for (std::size_t i = 0; i < limits->size(); ++i) {
       if (!((*limits)[i] > 0.0) || (i > 0 && !((*limits)[i] > (*limits)[i - 1]))) {
-        return "arrival size classes: limits must be positive and increasing";
+        return Validation::invalid(option, "arrival size classes: limits must be positive and increasing");
       }
     }
   }

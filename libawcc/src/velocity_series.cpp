@@ -9,9 +9,10 @@
 
 namespace awcc {
 
-std::string SpectrumOptions::validate() const {
+Validation SpectrumOptions::validate() const {
   if (segment_length < 8 || segment_length > (1 << 24)) {
-    return fmt::format("spectrum segment length {} must lie in 8 to 16777216 points", segment_length);
+    return Validation::invalid("spectrum-segment",
+                               fmt::format("spectrum segment length {} must lie in 8 to 16777216 points", segment_length));
   }
   return {};
 }

@@ -18,9 +18,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include <stdexcept>
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
+#include <zlib.h>
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/csv.hpp"
@@ -188,111 +186,9 @@ QuantileForest read_forest_v2(Reader& r, const std::string& expected, TargetForm
 
 }  // namespace
 
-namespace {
-
-// Slicing by 8 (Kounavis and Berry): eight tables, eight bytes a step; the
-// same CRC as the byte-wise table, about six times faster. `c` is the
-// running register (initial 0xffffffff, final xor by the caller).
-std::uint32_t crc32_tables(std::uint32_t c, const std::uint8_t* data, std::size_t size) {
-  static const auto tables = [] {
-    std::array<std::array<std::uint32_t, 256>, 8> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t r = i;
-      for (int k = 0; k < 8; ++k) r = (r & 1u) ? 0xedb88320u ^ (r >> 1) : r >> 1;
-      t[0][i] = r;
-    }
-    for (std::size_t s = 1; s < 8; ++s)
-      for (std::size_t i = 0; i < 256; ++i) t[s][i] = (t[s - 1][i] >> 8) ^ t[0][t[s - 1][i] & 0xffu];
-    return t;
-  }();
-  std::size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    // Little-endian loads whatever the machine.
-    const std::uint32_t lo = c ^ (static_cast<std::uint32_t>(data[i]) | static_cast<std::uint32_t>(data[i + 1]) << 8 |
-                                  static_cast<std::uint32_t>(data[i + 2]) << 16 |
-                                  static_cast<std::uint32_t>(data[i + 3]) << 24);
-    const std::uint32_t hi = static_cast<std::uint32_t>(data[i + 4]) | static_cast<std::uint32_t>(data[i + 5]) << 8 |
-                             static_cast<std::uint32_t>(data[i + 6]) << 16 | static_cast<std::uint32_t>(data[i + 7]) << 24;
-    c = tables[7][lo & 0xffu] ^ tables[6][(lo >> 8) & 0xffu] ^ tables[5][(lo >> 16) & 0xffu] ^ tables[4][lo >> 24] ^
-        tables[3][hi & 0xffu] ^ tables[2][(hi >> 8) & 0xffu] ^ tables[1][(hi >> 16) & 0xffu] ^ tables[0][hi >> 24];
-  }
-  for (; i < size; ++i) c = tables[0][(c ^ data[i]) & 0xffu] ^ (c >> 8);
-  return c;
-}
-
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-// Folding with carry-less multiplication (Gopal et al., Intel 2009, "Fast
-// CRC computation for generic polynomials using PCLMULQDQ"; the constants
-// are the reflected ones of its appendix for 0x04C11DB7, as zlib's x86 code
-// uses): four 128-bit lanes folded 64 bytes a step, then into one lane,
-// then to 64 and 32 bits by Barrett reduction. `size` is a multiple of 16,
-// at least 64; `c` the running register. About 4 times the tables' speed,
-// which matters because reading a model checks its whole file.
-// (Helpers, not lambdas: a lambda does not inherit the target attribute.)
-__attribute__((target("pclmul,sse4.1"))) inline __m128i load16(const std::uint8_t* q) {
-  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
-}
-
-// x folded by the constants k onto the next 128 bits.
-__attribute__((target("pclmul,sse4.1"))) inline __m128i fold16(__m128i x, __m128i k, __m128i next) {
-  return _mm_xor_si128(_mm_xor_si128(_mm_clmulepi64_si128(x, k, 0x11), _mm_clmulepi64_si128(x, k, 0x00)), next);
-}
-
-__attribute__((target("pclmul,sse4.1"))) std::uint32_t crc32_folded(std::uint32_t c, const std::uint8_t* p,
-                                                                     std::size_t size) {
-  alignas(16) static const std::uint64_t k1k2[] = {0x0154442bd4, 0x01c6e41596};
-  alignas(16) static const std::uint64_t k3k4[] = {0x01751997d0, 0x00ccaa009e};
-  alignas(16) static const std::uint64_t k5k0[] = {0x0163cd6124, 0x0000000000};
-  alignas(16) static const std::uint64_t poly[] = {0x01db710641, 0x01f7011641};
-  __m128i x1 = load16(p), x2 = load16(p + 16), x3 = load16(p + 32), x4 = load16(p + 48);
-  x1 = _mm_xor_si128(x1, _mm_cvtsi32_si128(static_cast<int>(c)));
-  __m128i x0 = _mm_load_si128(reinterpret_cast<const __m128i*>(k1k2));
-  p += 64;
-  size -= 64;
-  for (; size >= 64; p += 64, size -= 64) {
-    x1 = fold16(x1, x0, load16(p));
-    x2 = fold16(x2, x0, load16(p + 16));
-    x3 = fold16(x3, x0, load16(p + 32));
-    x4 = fold16(x4, x0, load16(p + 48));
-  }
-  x0 = _mm_load_si128(reinterpret_cast<const __m128i*>(k3k4));
-  x1 = fold16(x1, x0, x2);
-  x1 = fold16(x1, x0, x3);
-  x1 = fold16(x1, x0, x4);
-  for (; size >= 16; p += 16, size -= 16) x1 = fold16(x1, x0, load16(p));
-  // 128 to 64 bits.
-  __m128i t = _mm_clmulepi64_si128(x1, x0, 0x10);
-  const __m128i mask32 = _mm_setr_epi32(~0, 0, ~0, 0);
-  x1 = _mm_xor_si128(_mm_srli_si128(x1, 8), t);
-  x0 = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(k5k0));
-  t = _mm_srli_si128(x1, 4);
-  x1 = _mm_xor_si128(_mm_clmulepi64_si128(_mm_and_si128(x1, mask32), x0, 0x00), t);
-  // Barrett reduction to 32 bits.
-  x0 = _mm_load_si128(reinterpret_cast<const __m128i*>(poly));
-  t = _mm_clmulepi64_si128(_mm_and_si128(x1, mask32), x0, 0x10);
-  t = _mm_clmulepi64_si128(_mm_and_si128(t, mask32), x0, 0x00);
-  return static_cast<std::uint32_t>(_mm_extract_epi32(_mm_xor_si128(x1, t), 1));
-}
-
-bool has_clmul() {
-  static const bool yes = __builtin_cpu_supports("pclmul") && __builtin_cpu_supports("sse4.1");
-  return yes;
-}
-#endif
-
-}  // namespace
-
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size) {
-  std::uint32_t c = 0xffffffffu;
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  if (size >= 64 && has_clmul()) {
-    const std::size_t folded = size & ~std::size_t{15};
-    c = crc32_folded(c, data, folded);
-    data += folded;
-    size -= folded;
-  }
-#endif
-  return crc32_tables(c, data, size) ^ 0xffffffffu;
+  // crc32_z, not crc32: its length is a size_t, not a 32-bit uInt.
+  return static_cast<std::uint32_t>(::crc32_z(0UL, data, size));
 }
 
 std::string_view to_string(TargetForm f) {

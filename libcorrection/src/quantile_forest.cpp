@@ -157,15 +157,20 @@ class TreeBuilder {
 
 }  // namespace
 
-std::string ForestOptions::validate() const {
-  if (trees < 1) return fmt::format("trees = {}: give at least 1", trees);
-  if (min_leaf < 1) return fmt::format("min_leaf = {}: give at least 1", min_leaf);
-  if (max_depth < 0) return fmt::format("max_depth = {}: give 0 (unlimited) or more", max_depth);
-  if (features_per_split < 0) return fmt::format("features_per_split = {}: give 0 (p/3) or more", features_per_split);
-  if (!(sample_fraction > 0.0 && sample_fraction <= 10.0)) {
-    return fmt::format("sample_fraction = {}: give a value in (0, 10]", sample_fraction);
+// The quantities are the training options' declared names that set these
+// (training_option_fields()); max_depth and sample_fraction have none.
+awcc::Validation ForestOptions::validate() const {
+  using awcc::Validation;
+  if (trees < 1) return Validation::invalid("trees", fmt::format("trees = {}: give at least 1", trees));
+  if (min_leaf < 1) return Validation::invalid("min-leaf", fmt::format("min_leaf = {}: give at least 1", min_leaf));
+  if (max_depth < 0) return Validation::invalid("", fmt::format("max_depth = {}: give 0 (unlimited) or more", max_depth));
+  if (features_per_split < 0) {
+    return Validation::invalid("features-per-split",
+                               fmt::format("features_per_split = {}: give 0 (p/3) or more", features_per_split));
   }
-  if (threads < 0) return fmt::format("threads = {}: give 0 (all cores) or more", threads);
+  if (!(sample_fraction > 0.0 && sample_fraction <= 10.0))
+    return Validation::invalid("", fmt::format("sample_fraction = {}: give a value in (0, 10]", sample_fraction));
+  if (threads < 0) return Validation::invalid("threads", fmt::format("threads = {}: give 0 (all cores) or more", threads));
   return {};
 }
 
@@ -194,7 +199,7 @@ double WeightedDistribution::quantile(double alpha) const {
 }
 
 QuantileForest QuantileForest::train(const TrainingData& data, const ForestOptions& options) {
-  if (auto why = options.validate(); !why.empty()) throw std::invalid_argument("forest options: " + why);
+  if (auto v = options.validate(); !v.ok()) throw awcc::OptionError("forest options: " + v.message, v.quantity);
   const auto n = data.rows();
   if (data.features < 1) throw std::invalid_argument("training data: no features");
   if (n == 0) throw std::invalid_argument("training data: no rows");

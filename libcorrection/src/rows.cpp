@@ -97,7 +97,7 @@ Correction correct_json_row(const CorrectionModel& model, const json& r, const R
     // The model learnt AWCC's bias on synthetic records without the needle:
     // a bubble-probe-corrected velocity is not what it corrects.
     result.status = CorrectionStatus::probe_corrected;
-    result.message = "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
+    result.message = "AWCC's velocity is bubble-probe corrected (probe-correction on): the model corrects the "
                      "uncorrected AWCC; process without the probe correction to correct it";
   }
   const bool awcc_usable = result.status == CorrectionStatus::corrected;
@@ -313,7 +313,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       result.message = "AWCC gave no velocity";
     } else if (probe == "1" || probe == "true") {
       result.status = CorrectionStatus::probe_corrected;
-      result.message = "AWCC's velocity is bubble-probe corrected (--probe-correction): the model corrects the "
+      result.message = "AWCC's velocity is bubble-probe corrected (probe-correction on): the model corrects the "
                        "uncorrected AWCC; process without the probe correction to correct it";
     }
     const bool awcc_usable = result.status == CorrectionStatus::corrected;

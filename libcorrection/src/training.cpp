@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/order_statistics.hpp"
 #include "awcc/parallel.hpp"
 #include "awcc/random.hpp"
@@ -45,9 +46,10 @@ std::vector<double> vector_of(const Features& f, const std::vector<std::string>&
   for (const auto& n : names) {
     const auto v = f.value(n);
     if (!v) {
-      throw std::runtime_error(fmt::format("a training run has no {} (the sweep CSV lacks the column, or the run has "
-                                           "no value): train another feature set, or give sweeps that record it",
-                                           n));
+      throw awcc::OptionError(fmt::format("a training run has no {} (the sweep CSV lacks the column, or the run has "
+                                          "no value): train another feature set, or give sweeps that record it",
+                                          n),
+                              "feature-set");
     }
     x.push_back(*v);
   }
@@ -187,33 +189,46 @@ const awcc::OptionField<T> kTraining[] = {
 
 std::span<const awcc::OptionField<TrainOptions>> training_option_fields() { return kTraining; }
 
-std::string TrainOptions::validate() const {
-  if (trees < 1) return fmt::format("trees {}: give at least 1", trees);
-  if (min_windows < 1) return fmt::format("minimum windows {}: give at least 1", min_windows);
-  if (!(held_out > 0.0 && held_out < 1.0)) return fmt::format("held-out fraction {}: give a fraction in (0, 1)", held_out);
-  if (folds == 1 || folds < 0) return fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds);
-  if (cv_trees < 1) return fmt::format("cross-validation trees {}: give at least 1", cv_trees);
-  if (min_leaf < 1) return fmt::format("min leaf {}: give at least 1", min_leaf);
-  if (!(calibration >= 0.0 && calibration < 1.0)) return fmt::format("calibration fraction {}: give a fraction in [0, 1)", calibration);
-  for (std::size_t i = 1; i < calibration_bands.size(); ++i)
-    if (calibration_bands[i] <= calibration_bands[i - 1]) return "calibration bands: give increasing window counts";
+awcc::Validation TrainOptions::validate() const {
+  using awcc::Validation;
+  if (trees < 1) return Validation::invalid("trees", fmt::format("trees {}: give at least 1", trees));
+  if (min_windows < 1)
+    return Validation::invalid("min-windows", fmt::format("minimum windows {}: give at least 1", min_windows));
+  if (!(held_out > 0.0 && held_out < 1.0))
+    return Validation::invalid("held-out", fmt::format("held-out fraction {}: give a fraction in (0, 1)", held_out));
+  if (folds == 1 || folds < 0)
+    return Validation::invalid("folds", fmt::format("folds {}: give 0 (no cross-validation) or at least 2", folds));
+  if (cv_trees < 1)
+    return Validation::invalid("cv-trees", fmt::format("cross-validation trees {}: give at least 1", cv_trees));
+  if (min_leaf < 1) return Validation::invalid("min-leaf", fmt::format("min leaf {}: give at least 1", min_leaf));
+  if (!(calibration >= 0.0 && calibration < 1.0)) {
+    return Validation::invalid("calibration",
+                               fmt::format("calibration fraction {}: give a fraction in [0, 1)", calibration));
+  }
+  for (std::size_t i = 1; i < calibration_bands.size(); ++i) {
+    if (calibration_bands[i] <= calibration_bands[i - 1])
+      return Validation::invalid("calibration-bands", "calibration bands: give increasing window counts");
+  }
   for (std::size_t i = 0; i < calibration_tu_bands.size(); ++i) {
     if (!std::isfinite(calibration_tu_bands[i]) || (i > 0 && calibration_tu_bands[i] <= calibration_tu_bands[i - 1])) {
-      return "calibration Tu bands: give increasing values of Tu";
+      return Validation::invalid("calibration-tu-bands", "calibration Tu bands: give increasing values of Tu");
     }
   }
   std::size_t features = 0;
   try {
     features = feature_set_names(feature_set).size();
   } catch (const std::invalid_argument& e) {
-    return e.what();
+    return Validation::invalid("feature-set", e.what());
   }
   for (int m : features_per_split_grid) {
-    if (m < 1 || static_cast<std::size_t>(m) > features)
-      return fmt::format("features per split {}: give 1 to {} (the {} feature set)", m, features, feature_set);
+    if (m < 1 || static_cast<std::size_t>(m) > features) {
+      return Validation::invalid("features-per-split", fmt::format("features per split {}: give 1 to {} (the {} feature set)",
+                                                                   m, features, feature_set));
+    }
   }
   if (features_per_split < 1 || static_cast<std::size_t>(features_per_split) > features) {
-    return fmt::format("features per split {}: give 1 to {}", features_per_split, features);
+    return Validation::invalid("features-per-split",
+                               fmt::format("features per split {}: give 1 to {}", features_per_split, features));
   }
   return {};
 }
@@ -224,9 +239,9 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
   bool processing_seen = false;
   for (const auto& path : csvs) {
     std::ifstream in(path);
-    if (!in) throw std::runtime_error(fmt::format("{}: cannot open the sweep CSV; check the path", path.string()));
+    if (!in) throw awcc::InputError(fmt::format("{}: cannot open the sweep CSV; check the path", path.string()));
     std::string line;
-    if (!std::getline(in, line)) throw std::runtime_error(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
+    if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
     const auto header = split_cells(line);
     std::map<std::string, std::size_t> col;
     for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
@@ -235,7 +250,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
                             "awcc_windows_accepted", "reason"};
     for (const char* name : needed) {
       if (!col.count(name)) {
-        throw std::runtime_error(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
+        throw awcc::InputError(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
       }
     }
     // The processing of the runs: every row must agree (the model learns one).
@@ -254,15 +269,16 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       if (line.empty()) continue;
       const auto cells = split_cells(line);
       if (cells.size() != header.size()) {
-        throw std::runtime_error(fmt::format("{}:{}: {} cells where the header has {}; a sweep CSV cut short? pdp sweep "
-                                             "resumes and repairs it",
-                                             path.string(), number, cells.size(), header.size()));
+        throw awcc::InputError(fmt::format("{}:{}: {} cells where the header has {}; a sweep CSV cut short? pdp sweep "
+                                           "resumes and repairs it",
+                                           path.string(), number, cells.size(), header.size()));
       }
       auto cell = [&](const char* name) -> const std::string& { return cells[col.at(name)]; };
       auto number_of = [&](const char* name) {
         const auto v = cell_number(cell(name));
         if (!v) {
-          throw std::runtime_error(fmt::format("{}:{}: column {} = '{}' is not a number", path.string(), number, name, cell(name)));
+          throw awcc::InputError(fmt::format("{}:{}: column {} = '{}' is not a number; give the CSV pdp sweep wrote",
+                                             path.string(), number, name, cell(name)));
         }
         return *v;
       };
@@ -270,8 +286,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       studies.insert(cell("study"));
       const auto run = static_cast<std::int64_t>(number_of("run"));
       if (!seen.insert({cell("study"), run}).second) {
-        throw std::runtime_error(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
-                                             path.string(), number, run, cell("study")));
+        throw awcc::InputError(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
+                                           path.string(), number, run, cell("study")));
       }
       // A failed run has no result at all (no truth); a run whose AWCC gave
       // no value has its truth but no AWCC velocity.
@@ -289,9 +305,9 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         if (!processing_seen) set.processing = p;
         processing_seen = true;
         if (const auto why = processing_mismatch(set.processing, p); !why.empty()) {
-          throw std::runtime_error(fmt::format("{}:{}: this run was processed differently from the first ({}); a model "
-                                               "learns one processing: train on sweeps run with the same method options",
-                                               path.string(), number, why));
+          throw awcc::InputError(fmt::format("{}:{}: this run was processed differently from the first ({}); a model "
+                                             "learns one processing: train on sweeps run with the same method options",
+                                             path.string(), number, why));
         }
       }
       TrainingRow r;
@@ -301,7 +317,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         r.study = std::stoull(cell("study"), &used);
         if (used != cell("study").size()) throw std::invalid_argument("trailing text");
       } catch (const std::exception&) {
-        throw std::runtime_error(fmt::format("{}:{}: study = '{}' is not a sweep study id", path.string(), number, cell("study")));
+        throw awcc::InputError(fmt::format("{}:{}: study = '{}' is not a sweep study id; give the CSV pdp sweep wrote",
+                                           path.string(), number, cell("study")));
       }
       Measurement m;
       if (!cell("awcc_velocity").empty()) m.velocity = number_of("awcc_velocity");
@@ -344,10 +361,12 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     for (const auto& s : studies) set.sources.push_back(fmt::format("{} (study {})", path.filename().string(), s));
   }
   if (set.rows.empty()) {
-    throw std::runtime_error(fmt::format("no usable runs in the sweep CSVs ({} read: {} failed, {} without an AWCC "
-                                         "velocity, {} with fewer than {} accepted windows)",
-                                         set.total, set.excluded_error, set.excluded_undefined, set.excluded_windows,
-                                         min_windows));
+    throw awcc::InputError(fmt::format("no usable runs in the sweep CSVs ({} read: {} failed, {} without an AWCC "
+                                       "velocity, {} with fewer than {} accepted windows): give sweeps with usable "
+                                       "runs, or lower min-windows",
+                                       set.total, set.excluded_error, set.excluded_undefined, set.excluded_windows,
+                                       min_windows),
+                           "min-windows");
   }
   return set;
 }
@@ -653,7 +672,7 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
 }  // namespace
 
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
-  if (auto why = o.validate(); !why.empty()) throw std::invalid_argument(why);
+  o.validate().throw_if_failed();
   const auto names = feature_set_names(o.feature_set);
   // Held-out split by a hash of the run index: independent of file order.
   std::vector<TrainingRow> rows = set.rows;

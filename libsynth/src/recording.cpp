@@ -108,9 +108,9 @@ void VoltageRenderer::render(const std::vector<std::span<const std::uint8_t>>& a
 void write_recording(const std::filesystem::path& path, const Scene& scene,
                      std::span<const awcc::AirIntervals> signals, const RecordingOptions& options) {
   const std::size_t channels = signals.size();
-  if (channels == 0) throw std::runtime_error(fmt::format("{}: no signal to write", path.string()));
+  if (channels == 0) throw awcc::OptionError(fmt::format("{}: no signal to write; give one per tip", path.string()));
   if (const auto why = check_recordable(scene, channels, options.format); !why.empty()) {
-    throw std::runtime_error(fmt::format("{}: {}", path.string(), why));
+    throw awcc::OptionError(fmt::format("{}: {}", path.string(), why));
   }
   if (options.format == FileFormat::hdf5) {
     awcc::write_atomically(path, [&](const std::filesystem::path& temporary) {
@@ -170,7 +170,7 @@ void write_recording(const std::filesystem::path& path, const Scene& scene,
 std::vector<std::int16_t> read_recording_int16(const std::filesystem::path& path, int& channels, double& fs) {
   SF_INFO info{};
   SNDFILE* file = sf_open(path.c_str(), SFM_READ, &info);
-  if (!file) throw std::runtime_error(fmt::format("{}: cannot open: {}", path.string(), sf_strerror(nullptr)));
+  if (!file) throw awcc::InputError(fmt::format("{}: cannot open: {}; check the path", path.string(), sf_strerror(nullptr)));
   channels = info.channels;
   fs = info.samplerate;
   std::vector<std::int16_t> data(static_cast<std::size_t>(info.frames) * static_cast<std::size_t>(info.channels));

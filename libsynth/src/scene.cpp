@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <stdexcept>
+#include "awcc/errors.hpp"
 #include "awcc/settings_file.hpp"
 
 namespace synth {
@@ -369,14 +370,14 @@ void load_scene_toml(const std::filesystem::path& path, Scene& scene) {
     if (!field) {
       std::string names;
       for (const auto& f : kFields) names += (names.empty() ? "" : ", ") + std::string(f.name);
-      throw std::runtime_error(fmt::format("{}:{}: unknown scene field '{}'; known fields: {}", path.string(),
-                                           setting.line, setting.key, names));
+      throw awcc::InputError(fmt::format("{}:{}: unknown scene field '{}'; use one of the known fields: {}",
+                                         path.string(), setting.line, setting.key, names));
     }
     try {
       field->parse(scene, setting.text);
     } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(
-          fmt::format("{}:{}: field '{}': {}", path.string(), setting.line, setting.key, e.what()));
+      throw awcc::InputError(fmt::format("{}:{}: field '{}': {}", path.string(), setting.line, setting.key, e.what()),
+                             setting.key);
     }
   }
 }

@@ -1,5 +1,7 @@
-"""The errors pdp raises: the library's message, and in ``quantity`` the
-setting (option name) that would fix the problem, or None."""
+"""The errors pdp raises: the library's message, ending with the keyword
+that would fix the problem ("(keyword filter_a)") when there is one, and in
+``quantity`` that option's declared name ("filter-a"; several
+comma-separated), or None."""
 
 
 class PdpError(Exception):

@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
@@ -40,9 +41,12 @@ namespace {
 
 using Settings = std::vector<std::pair<std::string, std::string>>;
 
-std::vector<awcc::OptionSetting> option_settings(const Settings& settings) {
+// Keyword options as settings by declared name (python/pdp/__init__.py maps
+// filter_a to filter-a); a preset is the setting "preset".
+std::vector<awcc::OptionSetting> option_settings(const Settings& settings, const std::string& preset = {}) {
   std::vector<awcc::OptionSetting> out;
-  for (const auto& [name, value] : settings) out.push_back({name, value});
+  for (const auto& [name, value] : settings) out.push_back({name, value, {}});
+  if (!preset.empty()) out.push_back({"preset", preset, {}});
   return out;
 }
 
@@ -287,7 +291,7 @@ py::dict binarise(const std::vector<py::array>& channels, double fs, std::option
 
 py::tuple process_arrays(const std::vector<py::array>& channels, double fs, std::optional<double> volts_per_count,
                          const Settings& settings, const std::string& preset) {
-  const auto o = awcc::process_options(option_settings(settings), preset);
+  const auto o = awcc::process_options(option_settings(settings, preset));
   auto recording = recording_of(channels, fs, volts_per_count);
   awcc::ProcessResult r;
   {
@@ -299,7 +303,7 @@ py::tuple process_arrays(const std::vector<py::array>& channels, double fs, std:
 
 // One recording as `pdp process FILE --json` gives it (provenance added by the caller).
 py::tuple process_file(const std::filesystem::path& path, const Settings& settings, const std::string& preset) {
-  auto o = awcc::process_options(option_settings(settings), preset);
+  auto o = awcc::process_options(option_settings(settings, preset));
   awcc::ProcessResult r;
   {
     py::gil_scoped_release unlocked;
@@ -314,7 +318,7 @@ py::tuple process_file(const std::filesystem::path& path, const Settings& settin
 
 py::object provenance(const std::vector<std::string>& inputs, const Settings& settings, const std::string& preset,
                       const std::string& call) {
-  const auto o = awcc::process_options(option_settings(settings), preset);
+  const auto o = awcc::process_options(option_settings(settings, preset));
   nlohmann::json j;
   {
     py::gil_scoped_release unlocked;
@@ -340,12 +344,11 @@ py::tuple correct(const std::string& json, const std::filesystem::path& model_pa
 
 py::dict synthesise(const Settings& settings, const std::string& signal) {
   synth::Scene scene;
-  for (const auto& [name, value] : settings) {
-    try {
-      synth::set_scene_field(scene, name, value);
-    } catch (const std::invalid_argument& e) {
-      throw awcc::OptionError(fmt::format("{} = {}: {}", name, value, e.what()), name);
-    }
+  const auto given = option_settings(settings);
+  std::vector<bool> used(given.size(), false);
+  awcc::apply_settings(synth::scene_fields(), std::span<const awcc::OptionSetting>(given), scene, used);
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    if (!used[i]) throw awcc::OptionError(fmt::format("unknown scene field '{}'", given[i].name), given[i].name);
   }
   if (const auto errors = scene.validate(); !errors.empty()) {
     std::string all;
@@ -404,9 +407,31 @@ py::dict synthesise(const Settings& settings, const std::string& signal) {
   return out;
 }
 
-// Library errors as Python exceptions with the library's message and the
-// setting that fixes them (`quantity`).
-void translate(const char* type, const std::string& message, const std::string& quantity) {
+// The keyword of a declared option: its name with underscores. The one
+// place the module spells the libraries' option names.
+std::string keyword_of(std::string name) {
+  std::replace(name.begin(), name.end(), '-', '_');
+  return name;
+}
+
+bool declared(std::string_view name) {
+  auto in = [&](auto fields) {
+    return std::any_of(fields.begin(), fields.end(), [&](const auto& f) { return f.name == name; });
+  };
+  return in(awcc::process_option_fields()) || in(awcc::reader_option_fields()) ||
+         in(awcc::binarisation_option_fields()) || in(awcc::fscc_option_fields()) ||
+         in(awcc::awcc_option_fields()) || in(awcc::structure_option_fields()) || in(synth::scene_fields());
+}
+
+// Library errors as Python exceptions with the library's message, the
+// keyword(s) that fix them appended (as the command line appends its flag),
+// and in `quantity` the declared name(s) of the option(s).
+void translate(const char* type, std::string message, const std::string& quantity) {
+  std::string keywords;
+  for (const auto& name : awcc::split_cells(quantity)) {
+    if (declared(name)) keywords += (keywords.empty() ? "" : ", ") + keyword_of(name);
+  }
+  if (!keywords.empty()) message += fmt::format(" (keyword {})", keywords);
   const auto error = py::module_::import("pdp._errors").attr(type)(message);
   error.attr("quantity") = quantity.empty() ? py::object(py::none()) : py::object(py::str(quantity));
   PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error.ptr())), error.ptr());

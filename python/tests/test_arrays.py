@@ -114,6 +114,11 @@ def test_bad_options_raise_naming_the_option():
     with pytest.raises(pdp.OptionError) as e:
         pdp.process(volts(lead), volts(trail), fs=FS, dx=7.15)  # metres, not millimetres
     assert e.value.quantity == "allow-unusual"
+    # The library names the option by its declared name; the module adds its keyword (the CLI its flag).
+    assert str(e.value).endswith("(keyword allow_unusual)") and "--" not in str(e.value)
+    with pytest.raises(pdp.OptionError) as e:
+        pdp.process(volts(lead), volts(trail), fs=FS, dx=DX, filter_a=2)
+    assert e.value.quantity == "filter-a" and str(e.value) == "filter-a: A = 2 must lie in [0, 1] (keyword filter_a)"
     with pytest.raises(pdp.OptionError):
         pdp.process(volts(lead), volts(trail[:-1]), fs=FS, dx=DX)  # lengths differ
     with pytest.raises(pdp.OptionError, match="fs"):

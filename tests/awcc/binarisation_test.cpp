@@ -144,12 +144,12 @@ TEST(Threshold, ConstantChannelIsWaterWithANote) {
 
 TEST(BinarisationOptions, Validation) {
   BinarisationOptions o;
-  EXPECT_TRUE(o.validate().empty());
+  EXPECT_TRUE(o.validate().ok());
   o.theta = 1.2;
-  EXPECT_FALSE(o.validate().empty());
+  EXPECT_FALSE(o.validate().ok());
   o = {};
   o.hysteresis_low = 0.7;
-  EXPECT_FALSE(o.validate().empty());
+  EXPECT_FALSE(o.validate().ok());
 }
 
 }  // namespace
@@ -200,13 +200,14 @@ TEST(BinarisationOptions, TheTrailingTipsOwnThresholdIsAFixedRuleVoltage) {
   o.rule = ThresholdRule::fixed;
   o.fixed_threshold = 2.7;
   o.fixed_threshold_trailing = 2.6;
-  EXPECT_TRUE(o.validate().empty());
+  EXPECT_TRUE(o.validate().ok());
   EXPECT_DOUBLE_EQ(*o.for_trailing_tip().fixed_threshold, 2.6);
   o.fixed_threshold_trailing.reset();
   EXPECT_DOUBLE_EQ(*o.for_trailing_tip().fixed_threshold, 2.7);
   o.rule = ThresholdRule::histogram;
   o.fixed_threshold_trailing = 2.6;
-  EXPECT_NE(o.validate().find("fixed rule"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("fixed rule"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "threshold-rule");
 }
 
 }  // namespace

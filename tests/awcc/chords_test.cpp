@@ -102,35 +102,35 @@ TEST(ChordPdf, FeldersNormalisesByHisBubbleCount) {
 // spectrum refuse values that cannot be meant, at and around their limits.
 TEST(NewOptions, ValidationRefusesWhatCannotBeMeant) {
   awcc::StructureOptions s;
-  EXPECT_TRUE(s.validate().empty());
+  EXPECT_TRUE(s.validate().ok());
   s.clusters.median_fraction = 0.0;
-  EXPECT_FALSE(s.validate().empty());
+  EXPECT_FALSE(s.validate().ok());
   s = {};
   s.chord_time.max = 0.5 * s.chord_time.bin_width;  // less than one bin
-  EXPECT_FALSE(s.validate().empty());
+  EXPECT_FALSE(s.validate().ok());
   s = {};
   s.arrivals.length_classes = {3e-3, 1e-3};  // not increasing
-  EXPECT_FALSE(s.validate().empty());
+  EXPECT_FALSE(s.validate().ok());
   s.arrivals.length_classes = {};
-  EXPECT_TRUE(s.validate().empty());  // one class: every particle
+  EXPECT_TRUE(s.validate().ok());  // one class: every particle
   awcc::ProbeCorrectionOptions p;
-  EXPECT_TRUE(p.validate().empty());
+  EXPECT_TRUE(p.validate().ok());
   p.needle_diameter = 0.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(p.validate().ok());
   p = {};
   p.air_density = p.water_density;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(p.validate().ok());
   p = {};
   p.contact_factor = -0.1;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(p.validate().ok());
   p = {};
   p.max_steps = 99;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(p.validate().ok());
   awcc::SpectrumOptions sp;
   sp.segment_length = 7;
-  EXPECT_FALSE(sp.validate().empty());
+  EXPECT_FALSE(sp.validate().ok());
   sp.segment_length = 8;
-  EXPECT_TRUE(sp.validate().empty());
+  EXPECT_TRUE(sp.validate().ok());
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ TOML
 "$pdp" --log-level warn synth --config "$dir/synth.toml" --fs 40kHz -o "$dir/b.flac" || fail "synth override"
 [[ $(json "$dir/b.truth.json" "j['scene']['fs']") == 40000.0 ]] || fail "synth: the command line does not win"
 printf 'duration = "fast"\n' >"$dir/bad.toml"
-expect 2 "bad.toml:1: --duration" "$pdp" synth --config "$dir/bad.toml" -o "$dir/c.flac"
+expect 2 "bad.toml:1: duration: " "$pdp" synth --config "$dir/bad.toml" -o "$dir/c.flac"
 [[ -e $dir/c.flac ]] && fail "synth wrote a file after a bad config"
 
 # process: positional files, options and outputs from the file.
@@ -53,7 +53,17 @@ TOML
 "$pdp" --log-level warn process --config "$dir/process.toml" --np 9 >/dev/null || fail "process override"
 [[ $(json "$dir/a.json" "j['awcc']['np']") == 9 ]] || fail "process: the command line does not win"
 printf 'filter-a = 2\n' >"$dir/bad-a.toml"
-expect 2 "bad-a.toml:1: --filter-a" "$pdp" process "$dir/a.flac" --dx 5mm --config "$dir/bad-a.toml"
+expect 2 "bad-a.toml:1: filter-a: A = 2 must lie in [0, 1] (--filter-a)" "$pdp" process "$dir/a.flac" --dx 5mm \
+  --config "$dir/bad-a.toml"
+# One value refused from the file and from the command line: the same message
+# (the option's declared name, its flag), the file's adding where it came from.
+from_line=$("$pdp" process "$dir/a.flac" --dx 5mm --filter-a 2 2>&1 >/dev/null)
+from_file=$("$pdp" process "$dir/a.flac" --dx 5mm --config "$dir/bad-a.toml" 2>&1 >/dev/null)
+[[ ${from_file/"$dir/bad-a.toml:1: "/} == "$from_line" ]] ||
+  fail "the file's and the command line's messages differ: '$from_file' / '$from_line'"
+printf 'preset = "nope"\n' >"$dir/bad-preset.toml"
+expect 2 "bad-preset.toml:1: preset: 'nope' is not a preset" "$pdp" process "$dir/a.flac" --dx 5mm \
+  --config "$dir/bad-preset.toml"
 expect 2 "files is required" "$pdp" process --dx 5mm
 
 # validate: scene fields and method options from the file.
@@ -92,7 +102,7 @@ printf 'quick = true\nseeds = 1\nscenes = "base"\nduration = "0.5s"\noutput = "%
 
 # train: a bad value from the file names the file and line.
 printf 'trees = 0\n' >"$dir/train.toml"
-expect 2 "train.toml:1: --trees" "$pdp" train "$dir/sweep.csv" -o "$dir/m.qrf" --config "$dir/train.toml"
+expect 2 "train.toml:1: trees: " "$pdp" train "$dir/sweep.csv" -o "$dir/m.qrf" --config "$dir/train.toml"
 
 # correct: a value the file lacks, from the config.
 printf 'dx = "fast"\n' >"$dir/correct.toml"

@@ -115,10 +115,8 @@ TEST(Correction, Crc32MatchesTheStandardCheckValue) {
 
 TEST(Correction, Crc32EqualsTheBitwiseDefinitionAtEveryLengthAndAlignment) {
   // The reflected polynomial 0xEDB88320 one bit at a time, against the
-  // checksum (carry-less folding from 64 bytes where the processor has it,
-  // sliced tables for the rest): every length 0-300 (one to four folded
-  // blocks, every 16-byte lane count and every tail), and long buffers,
-  // from odd offsets.
+  // model file's checksum (zlib's, whose fast paths work on blocks and
+  // tails): every length 0-300 and long buffers, from odd offsets.
   auto bitwise = [](const std::uint8_t* p, std::size_t n) {
     std::uint32_t c = 0xffffffffu;
     for (std::size_t i = 0; i < n; ++i) {

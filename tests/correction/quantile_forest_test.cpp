@@ -287,10 +287,14 @@ TEST(QuantileForest, DegenerateDataGivesSingleLeaves) {
 TEST(QuantileForest, RefusesBadOptionsAndData) {
   ForestOptions o;
   o.trees = 0;
-  EXPECT_NE(o.validate().find("trees"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("trees"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "trees");
+  o.trees = 1;  // the limit
+  EXPECT_TRUE(o.validate().ok());
   o = {};
   o.min_leaf = 0;
-  EXPECT_NE(o.validate().find("min_leaf"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("min_leaf"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "min-leaf");
   auto data = random_data(20, 2, 1);
   data.x[5] = std::nan("");
   EXPECT_THROW((void)QuantileForest::train(data, {}), std::invalid_argument);

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -91,7 +92,7 @@ TEST(Training, LoadReadsTheProcessedGeometryAndOneProcessing) {
     (void)correction::load_training_set(
         {write("training_mixed.csv", header + "\n" + cells(0, "0.4") + cells(1, "0.3"))}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("training_mixed.csv:3"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("filter A: model 0.4, results 0.3"), std::string::npos) << e.what();
   }
@@ -102,7 +103,7 @@ TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
   try {
     (void)correction::load_training_set({write("training_dup.csv", csv)}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("training_dup.csv:3: run 0"), std::string::npos) << e.what();
   }
   auto bad = good(10, 9.5);
@@ -111,13 +112,13 @@ TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
   try {
     (void)correction::load_training_set({write("training_bad.csv", csv)}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("training_bad.csv:2: column awcc_count_rate = '3mm'"), std::string::npos) << e.what();
   }
   try {
     (void)correction::load_training_set({write("training_foreign.csv", "a,b\n1,2\n")}, 100);
     FAIL();
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no column 'study'"), std::string::npos) << e.what();
   }
 }
@@ -288,16 +289,19 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   EXPECT_LT(rmse[1], 0.02);
   EXPECT_LT(rmse[2], 0.02);
   o.feature_set = "extensive";
-  EXPECT_NE(o.validate().find("use measured"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("use measured"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "feature-set");
   o.feature_set = "measured";
   o.features_per_split_grid = {8};
-  EXPECT_NE(o.validate().find("give 1 to 7"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("give 1 to 7"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "features-per-split");
   o.features_per_split_grid = {3};
   o.features_per_split = 3;
-  EXPECT_EQ(o.validate(), "");
+  EXPECT_TRUE(o.validate().ok()) << o.validate().message;
   // Calibration Tu bands out of order are refused, not sorted silently.
   o.calibration_tu_bands = {0.2, 0.1};
-  EXPECT_NE(o.validate().find("calibration Tu bands"), std::string::npos);
+  EXPECT_NE(o.validate().message.find("calibration Tu bands"), std::string::npos);
+  EXPECT_EQ(o.validate().quantity, "calibration-tu-bands");
 }
 
 // A model of one varying feature (velocity 1-2 m/s) whose forest learnt

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "awcc/errors.hpp"
 #include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
@@ -152,10 +153,13 @@ TEST(Recordability, AFailedWriteLeavesNoFile) {
   const auto synthesis = synth::synthesise(s);
   const fs::path path = pdp_test::temp_dir() / "refused.flac";
   fs::remove(path);
-  EXPECT_THROW(synth::write_recording(path, s, synthesis.signals, {}), std::runtime_error);
+  EXPECT_THROW(synth::write_recording(path, s, synthesis.signals, {}), awcc::OptionError);
   EXPECT_FALSE(fs::exists(path));
-  EXPECT_THROW(synth::write_recording(pdp_test::temp_dir() / "no-such-dir" / "x.wav", s, synthesis.signals, {}),
-               std::runtime_error);
+  // A recordable scene (WAV takes 700 kHz) into a missing folder: the output fails.
+  synth::RecordingOptions wav;
+  wav.format = synth::FileFormat::wav;
+  EXPECT_THROW(synth::write_recording(pdp_test::temp_dir() / "no-such-dir" / "x.wav", s, synthesis.signals, wav),
+               awcc::OutputError);
 }
 
 TEST(Sidecar, HoldsTheDocumentedKeys) {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 
+#include "awcc/errors.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -201,7 +202,7 @@ TEST(SceneToml, ErrorsNameTheFileTheLineAndTheField) {
   try {
     synth::load_scene_toml(path, s);
     FAIL() << "accepted 3 kg";
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("bad_scene.toml:2"), std::string::npos) << m;
     EXPECT_NE(m.find("bubble-diameter"), std::string::npos) << m;
@@ -213,14 +214,14 @@ TEST(SceneToml, ErrorsNameTheFileTheLineAndTheField) {
   try {
     synth::load_scene_toml(path, s);
     FAIL() << "accepted an unknown key";
-  } catch (const std::runtime_error& e) {
+  } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("unknown scene field 'velocty'"), std::string::npos) << e.what();
   }
   {
     std::ofstream f(path);
     f << "velocity = = 10\n";
   }
-  EXPECT_THROW(synth::load_scene_toml(path, s), std::runtime_error);
+  EXPECT_THROW(synth::load_scene_toml(path, s), awcc::InputError);
 }
 
 TEST(SceneToml, ShippedSamplesLoadAndValidate) {

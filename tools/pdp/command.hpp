@@ -36,11 +36,15 @@ void add_config_option(Command& command);
 /// the file, the line and the setting.
 void finish_parsing(Command& command);
 
-/// Logs the error (with the flag that fixes it, when the error names one) and
-/// returns its exit code.
+/// Logs the error (with the flag that fixes it, when the error names an
+/// option of the running command) and returns its exit code.
 int report_error(const std::exception& error);
 
-/// "FILE:LINE: " when the option `name` (without --) was given by a config
+/// The flag of a declared option: "--" + its name. The one place the command
+/// line spells a library's option names.
+std::string flag_of(std::string_view name);
+
+/// "FILE:LINE" when the option `name` (without --) was given by a config
 /// file, else empty: errors found later name where the value came from.
 std::string origin_of(std::string_view name);
 
@@ -49,7 +53,9 @@ std::string origin_of(std::string_view name);
 void set_command_line(int argc, char** argv);
 const std::string& command_line();
 
-/// The flag(s) that set a library quantity ("fs" -> "--fs"), or empty.
-std::string flag_for(const std::string& quantity);
+/// The flag(s) of an error's quantity, "--fs" or "--leading-channel/--trailing-channel"
+/// (a quantity names one declared option or several, comma-separated); only
+/// flags of the running command; empty when it has none.
+std::string flags_for(std::string_view quantity);
 
 }  // namespace pdp

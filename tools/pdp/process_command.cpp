@@ -72,26 +72,10 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
 
 namespace {
 
-awcc::ProcessOptions build_options(ProcessCommandOptions& o) {
-  awcc::ProcessOptions p;
-  if (!o.preset.empty()) {
-    try {
-      o.library.set_preset(o.preset, awcc::preset_settings(o.preset));
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(fmt::format("{}--preset: {}", origin_of("preset"), e.what()));
-    }
-  }
-  o.library.apply(awcc::process_option_fields(), p);
-  o.library.apply(awcc::reader_option_fields(), p.reader);
-  o.library.apply(awcc::binarisation_option_fields(), p.binarisation);
-  o.library.apply(awcc::fscc_option_fields(), p.fscc_options);
-  o.library.apply(awcc::awcc_option_fields(), p.awcc_options);
-  o.library.apply(awcc::structure_option_fields(), p.structure);
-  p.fscc_options.subsample = p.awcc_options.subsample;  // FSCC refines its peak as AWCC does
-  if (!p.allow_unusual) {
-    if (auto why = p.implausible(); !why.empty()) throw awcc::OptionError(why, "allow_unusual");
-  }
-  if (auto why = p.validate(); !why.empty()) throw std::invalid_argument(why);
+awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
+  auto settings = o.library.settings();
+  if (!o.preset.empty()) settings.push_back({"preset", o.preset, origin_of("preset")});
+  const auto p = awcc::process_options(settings);
   if (!o.windows.empty() && o.files.size() != 1) {
     throw std::invalid_argument("--windows writes the window table of one recording; give one file");
   }

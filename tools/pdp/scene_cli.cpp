@@ -14,7 +14,7 @@ void add_scene_options(CLI::App* cmd, SceneCli& cli) {
   cli.values.resize(fields.size());
   for (std::size_t i = 0; i < fields.size(); ++i) {
     const auto& f = fields[i];
-    auto* opt = cmd->add_option(fmt::format("--{}", f.name), cli.values[i],
+    auto* opt = cmd->add_option(flag_of(f.name), cli.values[i],
                                 fmt::format("{} [default: {}]", f.help, f.format(defaults)));
     opt->group("Scene (units allowed, e.g. 5mm, 500kHz, 300s)");
     cli.options.push_back(opt);
@@ -24,14 +24,13 @@ void add_scene_options(CLI::App* cmd, SceneCli& cli) {
 synth::Scene build_scene(const SceneCli& cli) {
   synth::Scene scene;
   const auto fields = synth::scene_fields();
+  std::vector<awcc::OptionSetting> settings;
   for (std::size_t i = 0; i < fields.size(); ++i) {
     if (cli.options[i]->count() == 0) continue;
-    try {
-      fields[i].parse(scene, cli.values[i]);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(fmt::format("{}--{}: {}", origin_of(fields[i].name), fields[i].name, e.what()));
-    }
+    settings.push_back({std::string(fields[i].name), cli.values[i], origin_of(fields[i].name)});
   }
+  std::vector<bool> used(settings.size(), false);
+  awcc::apply_settings(fields, std::span<const awcc::OptionSetting>(settings), scene, used);
   if (const auto errors = scene.validate(); !errors.empty()) {
     std::string all;
     for (const auto& e : errors) all += "\n  " + e;
@@ -55,11 +54,7 @@ void add_method_options(CLI::App* cmd, OptionSet& methods) {
 }
 
 void apply_method_options(const OptionSet& methods, StudyOptions& o) {
-  methods.apply(awcc::awcc_option_fields(), o.awcc);
-  methods.apply(awcc::fscc_option_fields(), o.fscc);
-  o.fscc.subsample = o.awcc.subsample;  // FSCC refines its peak as AWCC does
-  if (auto why = o.awcc.validate(); !why.empty()) throw std::invalid_argument(why);
-  if (auto why = o.fscc.validate(); !why.empty()) throw std::invalid_argument(why);
+  awcc::method_options(methods.settings(), o.awcc, o.fscc);
 }
 
 }  // namespace pdp

@@ -34,8 +34,10 @@ void setup_train(CLI::App& app, Command& command, TrainCommandOptions& o) {
 int run_train(const TrainCommandOptions& o) {
   correction::TrainOptions t;
   try {
-    o.training.apply(correction::training_option_fields(), t);
-    if (auto why = t.validate(); !why.empty()) throw std::invalid_argument(why);
+    const auto settings = o.training.settings();
+    std::vector<bool> used(settings.size(), false);
+    awcc::apply_settings(correction::training_option_fields(), std::span<const awcc::OptionSetting>(settings), t, used);
+    t.validate().throw_if_failed();
   } catch (const std::invalid_argument& e) {
     return report_error(e);
   }

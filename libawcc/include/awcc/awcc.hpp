@@ -110,7 +110,7 @@ struct AwccOptions {
   /// outlier cutoff and the moments (awcc/probe_correction.hpp); off by default.
   ProbeCorrectionOptions probe_correction;
 
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] Validation validate() const;
 };
 
 /// One window: where it is, what its correlation said, and its fate.

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "awcc/air_intervals.hpp"
+#include "awcc/validation.hpp"
 
 namespace awcc {
 
@@ -57,8 +58,7 @@ struct BinarisationOptions {
   double bin_width = 0.1;            ///< histogram: bin width, V; 0 = 100 bins over the observed range
   double felder_split = 3.0;         ///< felder: mode search boundary, V
 
-  /// Empty when valid, else what is wrong with which option.
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] Validation validate() const;
   /// The options of the trailing tip (its own fixed threshold, when given).
   [[nodiscard]] BinarisationOptions for_trailing_tip() const;
 };
@@ -109,7 +109,7 @@ struct Threshold {
   std::string note;            ///< anything the user should know
 };
 
-/// Applies the rule to a channel's histogram. Throws std::runtime_error when
+/// Applies the rule to a channel's histogram. Throws InputError when
 /// no threshold can be found (e.g. no bin on one side for the felder rule).
 Threshold choose_threshold(const VoltageHistogram& histogram, const BinarisationOptions& options);
 

@@ -45,6 +45,7 @@
 
 #include "awcc/air_intervals.hpp"
 #include "awcc/fft.hpp"
+#include "awcc/validation.hpp"
 
 namespace awcc {
 
@@ -62,7 +63,7 @@ struct FsccOptions {
   bool felder_scales = false;        ///< Felder's rules for the time scales (see above)
   Subsample subsample = Subsample::none;
 
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] Validation validate() const;
 };
 
 /// Whether FSCC gave a velocity, and if not why; callers branch on this.

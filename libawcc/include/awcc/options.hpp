@@ -1,11 +1,10 @@
 #pragma once
 // The declarations of every option of the processing library
-// (awcc/option_field.hpp): name, unit, help, default. The pdp command line,
-// settings files and the Python module register and read options from these
-// lists and restate none of them. Apply fields in list order: a later field
-// may read an earlier one (the threshold's meaning depends on the rule).
-// After applying AWCC's fields, FSCC refines its peak as AWCC does
-// (`subsample` is declared once, with AWCC's options).
+// (awcc/option_field.hpp): name, unit, help, default; and the one way they
+// are applied (process_options, method_options), which the pdp command line,
+// its settings files and the Python module all use. Fields are applied in
+// list order: a later field may read an earlier one (the threshold's meaning
+// depends on the rule).
 
 #include <span>
 #include <string_view>
@@ -28,26 +27,30 @@ std::span<const OptionField<AwccOptions>> awcc_option_fields();
 std::span<const OptionField<ProcessOptions>> process_option_fields();
 std::span<const OptionField<StructureOptions>> structure_option_fields();
 
-/// A named set of option values (`--preset felder`): applied before what the
-/// user gives, which overrides it.
+/// A named set of option values (the setting `preset = felder`): applied to
+/// the options the user does not give.
 struct PresetSetting {
   std::string_view name;   ///< an option's declared name
   std::string_view value;  ///< as a user would type it
 };
-/// The settings of a preset; throws std::invalid_argument for an unknown name.
+/// The settings of a preset; throws OptionError (quantity "preset") for an unknown name.
 std::span<const PresetSetting> preset_settings(std::string_view name);
 
-/// A setting as a user types it: {"dx", "7.15mm"}, {"method", "awcc"}.
-struct OptionSetting {
-  std::string name;
-  std::string value;
-};
-/// The options of a processing run from settings by their declared names, a
-/// preset's values first for the options not given (as `pdp process`
-/// applies them, in the same order), then checked: implausible values unless
-/// allow-unusual, then validate(). Throws OptionError naming the option
-/// (quantity() = its name) for an unknown name, a bad value or an
-/// implausible one, std::invalid_argument for a combination that cannot work.
-ProcessOptions process_options(std::span<const OptionSetting> settings, std::string_view preset = {});
+/// The options of a processing run from settings by their declared names
+/// ({"dx", "7.15mm"}, {"method", "awcc"}); a setting named "preset" names a
+/// preset whose values apply to the options not given. Then checked:
+/// implausible values unless allow-unusual, then validate(). Throws
+/// OptionError whose quantity() is the declared name of the option that
+/// fixes it: an unknown name, a refused value (message "[origin: ]name:
+/// why"), an implausible value ("allow-unusual") or a combination that
+/// cannot work.
+ProcessOptions process_options(std::span<const OptionSetting> settings);
+
+/// AWCC's and FSCC's options from settings by their declared names (a
+/// study's methods), over `awcc` and `fscc` as given, then validated. Throws
+/// OptionError as process_options does. FSCC refines its peak as AWCC does:
+/// `subsample` is declared once, with AWCC's options, and this is where FSCC
+/// gets it (process_options applies the methods through it too).
+void method_options(std::span<const OptionSetting> settings, AwccOptions& awcc, FsccOptions& fscc);
 
 }  // namespace awcc

@@ -34,6 +34,8 @@
 #include <optional>
 #include <string>
 
+#include "awcc/validation.hpp"
+
 namespace awcc {
 
 struct ProbeCorrectionOptions {
@@ -53,7 +55,7 @@ struct ProbeCorrectionOptions {
   /// Runge-Kutta steps allowed per integration: a bound on the time per window.
   int max_steps = 20000;
 
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] Validation validate() const;
 };
 
 enum class CorrectionOutcome {

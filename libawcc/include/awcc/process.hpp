@@ -51,12 +51,13 @@ struct ProcessOptions {
   /// cache then overlaps with the work on the samples).
   bool read_ahead = true;
 
-  /// Empty when valid, else what is wrong; includes implausible() unless allow_unusual.
-  [[nodiscard]] std::string validate() const;
-  /// Empty when every stated value is plausible for a phase-detection probe:
+  /// Every part's validate(), then implausible() unless allow_unusual.
+  [[nodiscard]] Validation validate() const;
+  /// Ok when every stated value is plausible for a phase-detection probe:
   /// dx 0.1-100 mm (or 0: no velocity), fs 1 kHz-100 MHz, a velocity range
-  /// within 0.01-200 m/s; else the value, its range and the likely slip.
-  [[nodiscard]] std::string implausible() const;
+  /// within 0.01-200 m/s; else status implausible, quantity allow-unusual,
+  /// and the value, its range and the likely slip.
+  [[nodiscard]] Validation implausible() const;
 };
 
 /// The plausible sampling rates of a probe recording, Hz (a file's own rate is checked too).
@@ -101,8 +102,8 @@ struct ProcessResult {
   [[nodiscard]] std::string report() const;
 };
 
-/// Reads and binarises the two tips' channels. Throws std::runtime_error
-/// naming the file and the problem.
+/// Reads and binarises the two tips' channels. Throws InputError naming the
+/// file and the problem, OptionError for options that cannot work.
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options);
 /// The same from an open recording (read from its start; options.reader is not used).
 BinarisedRecording binarise_recording(Recording& recording, const ProcessOptions& options);

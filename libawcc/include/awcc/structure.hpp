@@ -31,7 +31,7 @@ struct StructureOptions {
   ClusterOptions clusters;
   ArrivalOptions arrivals;
 
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] Validation validate() const;
 };
 
 struct StructureResult {

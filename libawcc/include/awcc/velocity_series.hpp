@@ -44,7 +44,7 @@ struct SpectrumOptions {
   /// Welch segment length in resampled points: longer resolves lower
   /// frequencies, shorter averages more segments (less noise).
   int segment_length = 256;
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] Validation validate() const;
 };
 
 /// A regularly sampled series.

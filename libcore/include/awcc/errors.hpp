@@ -4,13 +4,15 @@
 // message text:
 //  - std::invalid_argument (OptionError when the quantity is known): an option
 //    or parameter is wrong or missing (a bad value, a combination that cannot
-//    work). The message names the option by the quantity it sets, not by a
-//    command-line flag.
+//    work). The message names the option by its declared name
+//    (awcc/option_field.hpp), never by a command-line flag.
 //  - InputError: input data cannot be used (a recording, a model file, a
 //    results file): the message names the file, what is wrong, where, and the
-//    fix; quantity() names the setting that would fix it, if any ("fs",
-//    "format", "channels", "raw_layout", "time_column", "threshold"), so that
-//    a front end can name its own flag for it.
+//    fix.
+//  quantity() is the declared name of the option that would fix the problem
+//  ("fs", "filter-a", "allow-unusual"), several comma-separated when it
+//  takes more than one ("leading-channel,trailing-channel"), or empty: a
+//  front end names its own flag (--fs) or keyword (fs=) for it.
 //  - OutputError: an output cannot be written.
 // Anything else escaping the libraries is a defect.
 
@@ -30,8 +32,7 @@ class InputError : public std::runtime_error {
   std::string quantity_;
 };
 
-/// An option or parameter that is wrong or missing, naming the quantity
-/// (quantity() as for InputError) so that a front end can name its flag.
+/// An option or parameter that is wrong or missing; quantity() as above.
 class OptionError : public std::invalid_argument {
  public:
   explicit OptionError(const std::string& message, std::string quantity = {})

@@ -209,7 +209,7 @@ std::string correction_csv_cells(const Correction& c);
 /// {"status", "in_range", "reason", "velocity": {"measured", "median", "quantiles": {"0.025": ...}}, "turbulence_intensity": ...}
 nlohmann::json to_json(const Correction& c);
 
-/// CRC-32 (IEEE 802.3, reflected, as zlib's crc32).
+/// The model file's checksum: CRC-32 (IEEE 802.3, reflected), zlib's.
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size);
 
 }  // namespace correction

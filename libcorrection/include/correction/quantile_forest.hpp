@@ -31,6 +31,8 @@
 #include <utility>
 #include <vector>
 
+#include "awcc/validation.hpp"
+
 namespace correction {
 
 struct ForestOptions {
@@ -42,7 +44,7 @@ struct ForestOptions {
   std::uint64_t seed = 1;           ///< a seed gives the same forest
   int threads = 0;                  ///< training threads; 0 = all cores
 
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] awcc::Validation validate() const;
 };
 
 /// Training rows: features row-major (rows x features), one target per row.

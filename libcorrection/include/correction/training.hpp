@@ -37,6 +37,7 @@
 #include <span>
 
 #include "awcc/option_field.hpp"
+#include "awcc/validation.hpp"
 #include "correction/model.hpp"
 
 namespace correction {
@@ -66,7 +67,7 @@ struct TrainingSet {
   bool processing_assumed = false;      ///< the CSVs do not say: the default was assumed
 };
 
-/// Reads sweep CSVs (pdp sweep's columns); throws std::runtime_error naming
+/// Reads sweep CSVs (pdp sweep's columns); throws InputError naming
 /// the file, line and column when one is not such a CSV. A run index seen twice
 /// (e.g. the same shard given twice) is refused.
 TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows);
@@ -100,7 +101,7 @@ struct TrainOptions {
   /// calibrated by windows alone covered 92 % of the u of its least
   /// turbulent runs and 63 % of its most turbulent at nominal 80 %).
   std::vector<double> calibration_tu_bands{0.1, 0.2, 0.3};
-  [[nodiscard]] std::string validate() const;
+  [[nodiscard]] awcc::Validation validate() const;
 };
 
 /// The declarations of the training options (awcc/option_field.hpp): names,

@@ -66,7 +66,8 @@ class VoltageRenderer {
 };
 
 /// Writes the signals to `path` (atomically: temporary name, then rename).
-/// Throws std::runtime_error naming the file and the fix on failure.
+/// Throws OptionError (a scene or format this container cannot hold) or
+/// OutputError, naming the file and the fix.
 void write_recording(const std::filesystem::path& path, const Scene& scene,
                      std::span<const awcc::AirIntervals> signals, const RecordingOptions& options = {});
 

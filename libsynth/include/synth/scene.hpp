@@ -117,8 +117,8 @@ void set_scene_field(Scene& scene, std::string_view name, std::string_view text)
 
 /// Reads a scene TOML file over `scene` (fields absent from the file keep their
 /// values). Keys are the field names; values are numbers in SI units or strings
-/// with units ("5mm"). Throws std::runtime_error naming the file, the key and
-/// the fix. Does not validate: call Scene::validate() afterwards.
+/// with units ("5mm"). Throws InputError naming the file, the line, the key
+/// and the fix (quantity(): the field). Does not validate: call Scene::validate() afterwards.
 void load_scene_toml(const std::filesystem::path& path, Scene& scene);
 
 std::string_view to_string(ArrivalRule rule);
