@@ -13,10 +13,10 @@
 #include "awcc/version.hpp"
 #include "correction/features.hpp"
 #include "correction/model.hpp"
-#include "design.hpp"
 #include "report_command.hpp"
+#include "study/clock.hpp"
+#include "study/design.hpp"
 #include "sweep_engine.hpp"
-#include "terminal.hpp"
 
 namespace pdp {
 
@@ -54,13 +54,13 @@ std::string runs_default(const std::string& output) {
 
 int run_design(const DesignOptions& o) {
   const MpiSession mpi;
-  DesignDefinition d;
+  study::DesignDefinition d;
   std::int64_t shard = 0, shards = 1;
   std::optional<correction::CorrectionModel> model;
   std::string model_note;
   const awcc::AwccOptions processing;  // AWCC as pdp process runs it by default
   try {
-    d = load_design(o.config);
+    d = study::load_design(o.config);
     if (!o.shard.empty()) std::tie(shard, shards) = parse_shard(o.shard);
     std::string model_path = o.model;
     if (model_path.empty() && !d.model.empty()) {
@@ -99,7 +99,7 @@ int run_design(const DesignOptions& o) {
       return exit_bad_usage;
     }
   }
-  const std::uint64_t id = design_id(d);
+  const std::uint64_t id = study::design_id(d);
   const std::vector<std::string> runs = o.runs.empty() ? std::vector<std::string>{runs_default(o.output)} : o.runs;
   const std::int64_t per_task = d.rows_per_task();
   std::set<std::int64_t> done;
@@ -110,23 +110,23 @@ int run_design(const DesignOptions& o) {
       if (!o.report.empty()) awcc::check_output_folder(o.report);
       std::map<std::int64_t, std::int64_t> counts;
       for (const auto& file : runs) {
-        for (const auto& r : read_design_rows(file, id)) ++counts[r.task];
+        for (const auto& r : study::read_design_rows(file, id)) ++counts[r.task];
       }
       std::set<std::int64_t> partial;
       for (const auto& [task, n] : counts) (n == per_task ? done : partial).insert(task);
       // A task is written in one write: a crash inside it leaves it partial.
       // Its rows go, and the task runs again.
       if (!partial.empty()) {
-        const auto rows = read_design_rows(runs.front(), id);
-        std::string text = design_rows_header() + "\n";
+        const auto rows = study::read_design_rows(runs.front(), id);
+        std::string text = study::design_rows_header() + "\n";
         for (const auto& r : rows)
-          if (!partial.count(r.task)) text += design_row_text(r, id) + "\n";
+          if (!partial.count(r.task)) text += study::design_row_text(r, id) + "\n";
         awcc::write_text_atomically(runs.front(), text);
         spdlog::warn("{}: {} records were cut short by an interruption; they run again", runs.front(), partial.size());
       }
       std::error_code ec;
       if (!std::filesystem::exists(runs.front(), ec) || std::filesystem::file_size(runs.front(), ec) == 0) {
-        awcc::write_text_atomically(runs.front(), design_rows_header() + "\n");
+        awcc::write_text_atomically(runs.front(), study::design_rows_header() + "\n");
       }
     } catch (const std::exception& e) {
       refused = report_error(e);
@@ -156,11 +156,11 @@ int run_design(const DesignOptions& o) {
         short_task.scene.duration = std::min(pilot_seconds, task.duration);
         const auto start = std::chrono::steady_clock::now();
         try {
-          (void)run_design_task(d, short_task, m, processing);
+          (void)study::run_design_task(d, short_task, m, processing);
         } catch (const std::exception&) {
           // The record itself will say what is wrong.
         }
-        pilot[key] = seconds_since(start) / short_task.scene.duration;
+        pilot[key] = study::seconds_since(start) / short_task.scene.duration;
       }
       double total = 0.0;
       for (auto t : pending) {
@@ -178,7 +178,7 @@ int run_design(const DesignOptions& o) {
     const auto task = d.task(t);
     std::string text;
     try {
-      for (const auto& r : run_design_task(d, task, m, processing)) text += design_row_text(r, id) + "\n";
+      for (const auto& r : study::run_design_task(d, task, m, processing)) text += study::design_row_text(r, id) + "\n";
     } catch (const std::exception& e) {
       // A record that cannot be simulated is the design's fault: say which.
       throw awcc::InputError(fmt::format("{}: condition {} record {}: {}", o.config, d.conditions[task.condition].name,
@@ -191,9 +191,9 @@ int run_design(const DesignOptions& o) {
   }
   if (mpi.rank() != 0) return exit_ok;
   try {
-    std::vector<DesignRow> rows;
+    std::vector<study::DesignRow> rows;
     for (const auto& file : runs) {
-      auto more = read_design_rows(file, id);
+      auto more = study::read_design_rows(file, id);
       rows.insert(rows.end(), more.begin(), more.end());
     }
     std::set<std::int64_t> tasks_present;
@@ -204,9 +204,9 @@ int run_design(const DesignOptions& o) {
                    tasks_present.size(), d.tasks());
       return exit_ok;
     }
-    const auto ranked = rank_candidates(d, rows);
-    awcc::write_text_atomically(o.output, ranked_csv(ranked, d));
-    fmt::print("{}", design_summary(ranked, d, model_note));
+    const auto ranked = study::rank_candidates(d, rows);
+    awcc::write_text_atomically(o.output, study::ranked_csv(ranked, d));
+    fmt::print("{}", study::design_summary(ranked, d, model_note));
     spdlog::info("{}: {} candidates ranked", o.output, ranked.size());
     if (!o.report.empty()) {
       return write_report({o.output, "--config", o.config, "-o", o.report, "--pdp-version", awcc::version},

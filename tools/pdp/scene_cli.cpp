@@ -4,7 +4,6 @@
 
 #include "awcc/options.hpp"
 #include "command.hpp"
-#include "study.hpp"
 
 namespace pdp {
 
@@ -49,12 +48,12 @@ const std::vector<std::string_view> kStudyAwcc{"np", "filter-a", "roc", "weighti
 }  // namespace
 
 void add_method_options(CLI::App* cmd, OptionSet& methods) {
-  const StudyOptions defaults;
+  const study::RunOptions defaults;
   methods.add(cmd, awcc::awcc_option_fields(), defaults.awcc, "Methods", kStudyAwcc);
   methods.add(cmd, awcc::fscc_option_fields(), defaults.fscc, "Methods");
 }
 
-void apply_method_options(const OptionSet& methods, StudyOptions& o) {
+void apply_method_options(const OptionSet& methods, study::RunOptions& o) {
   methods.apply(awcc::awcc_option_fields(), o.awcc);
   methods.apply(awcc::fscc_option_fields(), o.fscc);
   o.fscc.subsample = o.awcc.subsample;  // FSCC refines its peak as AWCC does

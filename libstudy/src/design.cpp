@@ -1,4 +1,4 @@
-#include "design.hpp"
+#include "study/design.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,15 +13,14 @@
 #include "awcc/random.hpp"
 #include "awcc/settings_file.hpp"
 #include "awcc/units.hpp"
-#include "awcc/fscc.hpp"
-#include "awcc/phase_statistics.hpp"
 #include "awcc/probe_correction.hpp"
-#include "study.hpp"
+#include "correction/features.hpp"
+#include "study/clock.hpp"
+#include "study/run.hpp"
 #include "synth/random.hpp"
 #include "synth/synthesiser.hpp"
-#include "terminal.hpp"
 
-namespace pdp {
+namespace study {
 namespace {
 
 // The flow quantities of a condition that may be ranges.
@@ -63,13 +62,13 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   DesignDefinition d;
   const std::string file = path.string();
   auto fail = [&](const std::string& where, const std::string& what) -> void {
-    throw std::runtime_error(fmt::format("{}: {}: {}", file, where, what));
+    throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
   };
   std::vector<awcc::SettingTable> tables;
   try {
     tables = awcc::read_setting_tables(path, {"conditions"});
   } catch (const awcc::InputError& e) {
-    throw std::runtime_error(e.what());
+    throw std::invalid_argument(e.what());
   }
   auto quantity = [&](const std::string& where, const std::string& text, awcc::Dimension dim) {
     try {
@@ -120,7 +119,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
       }
       for (const auto& s : t.settings) {
         const std::string where = "[" + t.name + "] " + s.key;
-        if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use the names of pdp synth --help or anisotropy");
+        if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, bubble-diameter, ...) or anisotropy");
         if (s.key == "seed" || s.key == "dx" || s.key == "dy" || s.key == "dz" || s.key == "tips" || s.key == "fs" ||
             s.key == "duration") {
           fail(where, "the probe and the record are candidates: give them in [candidates]");
@@ -326,15 +325,15 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
                                        const correction::CorrectionModel* model, const awcc::AwccOptions& processing) {
   synth::Synthesis syn;
   const double seconds_synth = cost([&] { syn = synth::synthesise(task.scene); });
-  const auto& lead = syn.signals.at(0);
-  const auto phase = awcc::phase_statistics(lead);
   std::vector<DesignRow> rows;
   for (std::size_t g = 0; g < d.geometries.size(); ++g) {
-    // Plain copies: lambdas below capture them (clang 14 cannot capture bindings).
     const double dx = d.geometries[g].first, dy = d.geometries[g].second;
-    const auto& trail = syn.signals.at(g + 1);
-    std::optional<awcc::FsccResult> fscc;  // once per pair, and only when the FSCC forest needs it
+    const auto record = binarised_recording(syn.signals.at(0), syn.signals.at(g + 1));
     for (int np : d.nps) {
+      RunOptions run;
+      run.awcc = processing;
+      run.awcc.np = np;
+      const auto options = processing_options(run, dx, dy);
       DesignRow r;
       r.task = task.index;
       r.condition = d.conditions[task.condition].name;
@@ -343,31 +342,22 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
       r.candidate = {dx, dy, np, task.fs, task.duration};
       r.truth_velocity = syn.truth.realised.mean_velocity[0];
       r.truth_turbulence_intensity = syn.truth.realised.turbulence_intensity[0];
-      r.void_fraction = phase.void_fraction;
-      r.count_rate = phase.bubble_count_rate;
       r.seconds_synth = seconds_synth;
-      awcc::AwccOptions options = processing;
-      options.np = np;
-      awcc::AwccResult res;
-      r.seconds_awcc = cost([&] { res = awcc::awcc(lead, trail, dx, options); });
-      if (res.ok()) {
-        r.awcc_velocity = res.velocity;
-        r.awcc_turbulence_intensity = res.turbulence_intensity;
+      awcc::ProcessResult res;
+      r.seconds_awcc = cost([&] { res = awcc::process_binarised(record, options); });
+      const auto& lead = res.tips.at(0).phase;
+      r.void_fraction = lead.void_fraction;
+      r.count_rate = lead.bubble_count_rate;
+      const auto& a = *res.awcc;
+      if (a.ok()) {
+        r.awcc_velocity = a.velocity;
+        r.awcc_turbulence_intensity = a.turbulence_intensity;
       }
-      r.windows_accepted = res.windows_accepted;
-      r.windows_total = res.windows_total;
+      r.windows_accepted = a.windows_accepted;
+      r.windows_total = a.windows_total;
       if (model) {
-        auto m = awcc_measurement(res, phase, dx, dy, np, task.fs, task.duration);
         correction::Correction c;
-        r.seconds_awcc += cost([&] { c = model->correct(m); });
-        if (!c.corrected() && model->falls_back_to_fscc(c.status)) {
-          if (!fscc) r.seconds_awcc += cost([&] { fscc = awcc::fscc(lead, trail, dx, {}); });
-          if (fscc->ok()) {
-            m.fscc_velocity = fscc->velocity;
-            m.r12_max = fscc->r12_max;
-            r.seconds_awcc += cost([&] { c = model->correct(m); });
-          }
-        }
+        r.seconds_awcc += cost([&] { c = model->correct(correction::measurement_of(res)); });
         r.correction_status = std::string(correction::to_string(c.status));
         if (c.corrected()) {
           r.correction_forest = c.forest;
@@ -415,8 +405,8 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     ++line_number;
     if (line_number == 1) {
       if (line != design_rows_header()) {
-        throw awcc::InputError(fmt::format("{}: not the runs file of pdp design (its header differs); give another -o or "
-                                           "remove the file",
+        throw awcc::InputError(fmt::format("{}: not the runs file of pdp design (its header differs); write the runs to "
+                                           "another file or remove this one",
                                            file));
       }
       continue;
@@ -435,7 +425,7 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     };
     if (cells[0] != std::to_string(design)) {
       throw awcc::InputError(fmt::format("{}: a row of another design ({}); the definition changed since these rows "
-                                         "were written: give another -o or remove the file",
+                                         "were written: write the runs to another file or remove this one",
                                          where, cells[0]));
     }
     DesignRow r;
@@ -722,4 +712,4 @@ std::string design_summary(const std::vector<RankedCandidate>& ranked, const Des
   return out;
 }
 
-}  // namespace pdp
+}  // namespace study
