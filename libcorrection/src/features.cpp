@@ -133,7 +133,8 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
     out.message = "AWCC gave no velocity: " + r.awcc->message;
   } else if (r.awcc->probe_corrected) {
     out.status = CorrectionStatus::probe_corrected;
-    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC";
+    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC; process "
+                  "without the probe correction to correct it";
   } else {
     m.velocity = r.awcc->velocity;
     m.turbulence_intensity = r.awcc->turbulence_intensity;

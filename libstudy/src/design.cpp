@@ -1,6 +1,7 @@
 #include "study/design.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fmt/format.h>
 #include <fstream>
@@ -8,6 +9,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "awcc/atomic_output.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/random.hpp"
@@ -451,6 +453,54 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     out.push_back(std::move(r));
   }
   return out;
+}
+
+DesignResume resume_design(const DesignDefinition& d, const std::vector<std::filesystem::path>& runs,
+                           std::uint64_t design) {
+  DesignResume out;
+  std::map<std::int64_t, std::int64_t> counts;
+  for (const auto& file : runs)
+    for (const auto& r : read_design_rows(file, design)) ++counts[r.task];
+  std::set<std::int64_t> partial;
+  for (const auto& [task, n] : counts) (n == d.rows_per_task() ? out.done : partial).insert(task);
+  out.cut_short = static_cast<std::int64_t>(partial.size());
+  if (runs.empty()) return out;
+  const auto& first = runs.front();
+  if (!partial.empty()) {
+    std::string text = design_rows_header() + "\n";
+    for (const auto& r : read_design_rows(first, design))
+      if (!partial.count(r.task)) text += design_row_text(r, design) + "\n";
+    awcc::write_text_atomically(first, text);
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(first, ec) || std::filesystem::file_size(first, ec) == 0) {
+    awcc::write_text_atomically(first, design_rows_header() + "\n");
+  }
+  return out;
+}
+
+double estimate_design_seconds(const DesignDefinition& d, const std::vector<std::int64_t>& tasks,
+                               const correction::CorrectionModel* model, const awcc::AwccOptions& processing,
+                               double pilot_seconds) {
+  std::map<std::pair<std::size_t, double>, double> pilot;  // seconds per simulated second
+  double total = 0.0;
+  for (auto t : tasks) {
+    const auto task = d.task(t);
+    const auto key = std::pair{task.condition, task.fs};
+    if (!pilot.count(key)) {
+      auto short_task = task;
+      short_task.scene.duration = std::min(pilot_seconds, task.duration);
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        (void)run_design_task(d, short_task, model, processing);
+      } catch (const std::exception&) {
+        // The record itself will say what is wrong.
+      }
+      pilot[key] = seconds_since(start) / short_task.scene.duration;
+    }
+    total += pilot[key] * task.duration;
+  }
+  return total;
 }
 
 ErrorStats error_stats(const std::vector<double>& errors) {

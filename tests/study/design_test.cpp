@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
 
 #include "awcc/errors.hpp"
 #include "awcc/probe_correction.hpp"
@@ -122,7 +123,7 @@ TEST(DesignScores, ErrorStatisticsAreTheDefinitions) {
 
 // Rows of two conditions for candidates with planted errors: u = (1 + eu) u_true, Tu = (1 + et) Tu_true.
 study::DesignRow planted(const study::DesignCandidate& c, const std::string& condition, double eu, double et,
-                       double seconds = 0.01) {
+                         double seconds = 0.01) {
   study::DesignRow r;
   r.condition = condition;
   r.candidate = c;
@@ -279,6 +280,37 @@ TEST(DesignRows, WrittenRowsReadBackAndForeignOnesAreRefused) {
   EXPECT_EQ(rows[1].correction_forest, "");
   EXPECT_THROW((void)study::read_design_rows(path, 98), awcc::InputError);
   EXPECT_TRUE(study::read_design_rows(pdp_test::test_file("absent.csv"), 99).empty());
+}
+
+TEST(DesignRows, AnInterruptedDesignResumesWithoutItsCutShortRecords) {
+  const auto d = study::load_design(write("resume.toml", kTwoConditions));
+  ASSERT_EQ(d.rows_per_task(), 8);
+  const auto path = pdp_test::test_file("resume.runs.csv");
+  std::string text = study::design_rows_header() + "\n";
+  // Tasks 0 and 2 whole, task 5 cut short after three of its eight rows.
+  for (const auto& [task, rows] : {std::pair{0, 8}, std::pair{2, 8}, std::pair{5, 3}}) {
+    for (int k = 0; k < rows; ++k) {
+      auto r = planted({3e-3, 0.5e-3, 10, 1e5, 20}, "wall", 0.01 * k, 0.0);
+      r.task = task;
+      text += study::design_row_text(r, 42) + "\n";
+    }
+  }
+  std::ofstream(path) << text;
+  const auto resumed = study::resume_design(d, {path}, 42);
+  EXPECT_EQ(resumed.done, (std::set<std::int64_t>{0, 2}));
+  EXPECT_EQ(resumed.cut_short, 1);
+  const auto kept = study::read_design_rows(path, 42);
+  EXPECT_EQ(kept.size(), 16u);
+  for (const auto& r : kept) EXPECT_NE(r.task, 5);
+  // A fresh file gets its header; a second look finds the same.
+  const auto fresh = pdp_test::test_file("fresh.runs.csv");
+  std::filesystem::remove(fresh);
+  EXPECT_TRUE(study::resume_design(d, {fresh}, 42).done.empty());
+  std::ifstream in(fresh);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, study::design_rows_header());
+  EXPECT_EQ(study::resume_design(d, {path}, 42).done, resumed.done);
 }
 
 TEST(DesignRecords, EveryPairOfTheMultiTipProbeRecoversThePlantedVelocity) {

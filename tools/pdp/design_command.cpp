@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <chrono>
-#include <map>
 #include <set>
 
 #include "awcc/atomic_output.hpp"
@@ -101,32 +99,16 @@ int run_design(const DesignOptions& o) {
   }
   const std::uint64_t id = study::design_id(d);
   const std::vector<std::string> runs = o.runs.empty() ? std::vector<std::string>{runs_default(o.output)} : o.runs;
-  const std::int64_t per_task = d.rows_per_task();
   std::set<std::int64_t> done;
   int refused = 0;
   if (mpi.rank() == 0) {
     try {
       awcc::check_output_folder(o.output);
       if (!o.report.empty()) awcc::check_output_folder(o.report);
-      std::map<std::int64_t, std::int64_t> counts;
-      for (const auto& file : runs) {
-        for (const auto& r : study::read_design_rows(file, id)) ++counts[r.task];
-      }
-      std::set<std::int64_t> partial;
-      for (const auto& [task, n] : counts) (n == per_task ? done : partial).insert(task);
-      // A task is written in one write: a crash inside it leaves it partial.
-      // Its rows go, and the task runs again.
-      if (!partial.empty()) {
-        const auto rows = study::read_design_rows(runs.front(), id);
-        std::string text = study::design_rows_header() + "\n";
-        for (const auto& r : rows)
-          if (!partial.count(r.task)) text += study::design_row_text(r, id) + "\n";
-        awcc::write_text_atomically(runs.front(), text);
-        spdlog::warn("{}: {} records were cut short by an interruption; they run again", runs.front(), partial.size());
-      }
-      std::error_code ec;
-      if (!std::filesystem::exists(runs.front(), ec) || std::filesystem::file_size(runs.front(), ec) == 0) {
-        awcc::write_text_atomically(runs.front(), study::design_rows_header() + "\n");
+      const auto resumed = study::resume_design(d, {runs.begin(), runs.end()}, id);
+      done = resumed.done;
+      if (resumed.cut_short > 0) {
+        spdlog::warn("{}: {} records were cut short by an interruption; they run again", runs.front(), resumed.cut_short);
       }
     } catch (const std::exception& e) {
       refused = report_error(e);
@@ -145,28 +127,8 @@ int run_design(const DesignOptions& o) {
                  o.config, d.conditions.size(), d.candidates().size(), d.tasks(), done.size(), runs.front(),
                  d.geometries.size(), d.nps.size());
     if (!pending.empty()) {
-      // A 2 s pilot of each condition and setting, scaled to the records to run.
-      std::map<std::pair<std::size_t, double>, double> pilot;  // seconds per simulated second
-      const double pilot_seconds = 2.0;
-      for (auto t : pending) {
-        const auto task = d.task(t);
-        const auto key = std::pair{task.condition, task.fs};
-        if (pilot.count(key)) continue;
-        auto short_task = task;
-        short_task.scene.duration = std::min(pilot_seconds, task.duration);
-        const auto start = std::chrono::steady_clock::now();
-        try {
-          (void)study::run_design_task(d, short_task, m, processing);
-        } catch (const std::exception&) {
-          // The record itself will say what is wrong.
-        }
-        pilot[key] = study::seconds_since(start) / short_task.scene.duration;
-      }
-      double total = 0.0;
-      for (auto t : pending) {
-        const auto task = d.task(t);
-        total += pilot[{task.condition, task.fs}] * task.duration;
-      }
+      constexpr double pilot_seconds = 2.0;
+      const double total = study::estimate_design_seconds(d, pending, m, processing, pilot_seconds);
       const double workers = mpi.on() && mpi.size() > 1 ? mpi.size() - 1 : awcc::thread_count(o.threads, pending.size());
       const double estimate = total / workers;
       spdlog::info("about {} on {} {} (from a {:g} s pilot of each condition)",

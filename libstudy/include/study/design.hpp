@@ -164,6 +164,24 @@ std::string design_row_text(const DesignRow& row, std::uint64_t design);
 /// design refused; a partial last line cut off).
 std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::uint64_t design);
 
+/// Where an interrupted design stands.
+struct DesignResume {
+  std::set<std::int64_t> done;   ///< tasks whose every row is in the runs files
+  std::int64_t cut_short = 0;    ///< tasks an interruption cut short: their rows removed, they run again
+};
+/// Reads the runs files of this design (rows of another design refused), and
+/// prepares the first for appending: a task is written in one write, so a
+/// crash inside it leaves it partial, and its rows go; an absent or empty
+/// file gets the header.
+DesignResume resume_design(const DesignDefinition& d, const std::vector<std::filesystem::path>& runs,
+                           std::uint64_t design);
+
+/// Seconds the tasks take on one thread, from a pilot of each condition and
+/// rate (its first task, `pilot_seconds` of record) scaled by record length.
+double estimate_design_seconds(const DesignDefinition& d, const std::vector<std::int64_t>& tasks,
+                               const correction::CorrectionModel* model, const awcc::AwccOptions& processing,
+                               double pilot_seconds = 2.0);
+
 /// Error statistics of one quantity over the records.
 struct ErrorStats {
   std::int64_t count = 0;
