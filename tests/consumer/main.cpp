@@ -1,8 +1,9 @@
 // A downstream program built against the installed package: it synthesises a
 // short scene (synth::synth), processes it (awcc::awcc), trains a small
 // correction model on synthetic runs, saves it, loads it back and corrects a
-// measurement (correction::correction), and checks a property of each step so
-// that linking alone is not mistaken for success.
+// measurement (correction::correction), runs the same scene as a study
+// (awcc::study), and checks a property of each step so that linking alone is
+// not mistaken for success.
 #include <awcc/awcc.hpp>
 #include <awcc/units.hpp>
 #include <awcc/version.hpp>
@@ -10,6 +11,7 @@
 #include <correction/training.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <study/run.hpp>
 #include <synth/synthesiser.hpp>
 #include <vector>
 
@@ -22,6 +24,10 @@ int main(int argc, char** argv) {
   const double c = result.signals.at(0).void_fraction();
   const auto a = awcc::awcc(result.signals[0], result.signals[1], scene.streamwise_separation());
   const bool awcc_ok = a.ok() && a.velocity > 5.0 && a.velocity < 15.0;
+  // The study synthesises the same record and processes it as pdp process: the same AWCC.
+  const auto run = study::run_scene(scene, {});
+  const bool study_ok = run.processed.awcc && run.processed.awcc->ok() && run.processed.awcc->velocity == a.velocity &&
+                        run.measurement.measurement.velocity == a.velocity;
 
   // Training rows: truth = 0.9 x measured, Tu truth = measured + 0.05.
   std::vector<correction::TrainingRow> rows;
@@ -61,8 +67,9 @@ int main(int argc, char** argv) {
   const auto corrected = loaded.correct(m);
   const bool correction_ok = corrected.corrected() && std::abs(corrected.velocity->median() - 3.6) < 1e-9 &&
                              std::abs(corrected.turbulence_intensity->median() - 0.2) < 1e-9;
-  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s)\n", awcc::version, c,
-              a.velocity, awcc_ok ? "ok" : "wrong", corrected.velocity ? corrected.velocity->median() : 0.0,
-              correction_ok ? "ok" : "wrong");
-  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok) ? 0 : 1;
+  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s), study (%s)\n",
+              awcc::version, c, a.velocity, awcc_ok ? "ok" : "wrong",
+              corrected.velocity ? corrected.velocity->median() : 0.0, correction_ok ? "ok" : "wrong",
+              study_ok ? "ok" : "wrong");
+  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok && study_ok) ? 0 : 1;
 }
