@@ -2,10 +2,8 @@
 
 #include <chrono>
 #include <fmt/format.h>
-#include <stdexcept>
 
 #include "study/clock.hpp"
-#include "synth/synthesiser.hpp"
 
 namespace study {
 
@@ -33,11 +31,7 @@ Comparison compare_recording(const std::filesystem::path& file, const awcc::Proc
 }
 
 Comparison compare_scene(const synth::Scene& scene, const RunOptions& options) {
-  if (scene.probe_tips().size() < 2) {
-    throw std::invalid_argument(fmt::format("tips: the scene has {} tip; FSCC and AWCC need two (give tips or dx)",
-                                            scene.probe_tips().size()));
-  }
-  auto syn = synth::synthesise(scene);
+  auto syn = synthesise_pair(scene);
   auto c = compare(binarised_recording(std::move(syn.signals[0]), std::move(syn.signals[1])), options,
                    scene.streamwise_separation(), scene.lateral_separation());
   c.what = fmt::format("synthetic scene (seed {})", scene.seed);

@@ -1,5 +1,7 @@
 #include "study/design.hpp"
 
+#include "definition.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -29,26 +31,8 @@ namespace {
 const std::set<std::string> kRangeable{"velocity", "tu", "anisotropy", "time-scale", "void-fraction",
                                        "bubble-diameter"};
 
-bool is_scene_field(const std::string& name) {
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return true;
-  return false;
-}
-
-awcc::Dimension dimension_of(const std::string& name) {
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return f.dimension;
-  return awcc::Dimension::dimensionless;
-}
-
-std::uint64_t fnv(std::string_view text) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
+using detail::dimension_of;
+using detail::is_scene_field;
 
 std::string num(double v) { return fmt::format("{:.10g}", v); }
 std::string num(const std::optional<double>& v) { return v ? num(*v) : std::string(); }
@@ -66,12 +50,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   auto fail = [&](const std::string& where, const std::string& what) -> void {
     throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
   };
-  std::vector<awcc::SettingTable> tables;
-  try {
-    tables = awcc::read_setting_tables(path, {"conditions"});
-  } catch (const awcc::InputError& e) {
-    throw std::invalid_argument(e.what());
-  }
+  const auto tables = detail::definition_tables(path, {"conditions"});
   auto quantity = [&](const std::string& where, const std::string& text, awcc::Dimension dim) {
     try {
       return awcc::parse_quantity(text, dim);
@@ -255,7 +234,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   return d;
 }
 
-std::uint64_t design_id(const DesignDefinition& d) { return fnv(d.canonical) >> 1; }
+std::uint64_t design_id(const DesignDefinition& d) { return detail::definition_id(d.canonical); }
 
 std::int64_t DesignDefinition::tasks() const {
   return static_cast<std::int64_t>(conditions.size() * fss.size() * durations.size()) * seeds;
@@ -289,7 +268,7 @@ DesignTask DesignDefinition::task(std::int64_t index) const {
   const auto& c = conditions.at(t.condition);
   // The record's flow and bubbles depend on the condition and the record
   // number only: every setting and geometry sees the same flow.
-  const std::uint64_t key = seed ^ fnv(c.name);
+  const std::uint64_t key = seed ^ detail::fnv1a(c.name);
   synth::Scene s;
   for (const auto& [k, v] : c.values) {
     if (k == "anisotropy") t.anisotropy = awcc::parse_quantity(v, awcc::Dimension::dimensionless);

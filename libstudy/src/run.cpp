@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "study/clock.hpp"
-#include "synth/synthesiser.hpp"
 
 namespace study {
 
@@ -70,19 +69,23 @@ awcc::ProcessResult process_synthesis(awcc::AirIntervals leading, awcc::AirInter
                                  options);
 }
 
-RunResult run_scene(const synth::Scene& scene, const RunOptions& options) {
+synth::Synthesis synthesise_pair(const synth::Scene& scene, const synth::SynthesisOptions& options) {
   // Processing correlates the first two tips: a study needs them (a one-tip
   // scene is fine for pdp synth, not here).
   if (scene.probe_tips().size() < 2) {
     throw std::invalid_argument(fmt::format("tips: the scene has {} tip; FSCC and AWCC need two (give tips or dx)",
                                             scene.probe_tips().size()));
   }
+  return synth::synthesise(scene, options);
+}
+
+RunResult run_scene(const synth::Scene& scene, const RunOptions& options) {
   RunResult r;
   r.scene = scene;
   synth::SynthesisOptions so;
   so.keep_velocity_history = options.window_truth && options.run_awcc;
   auto start = std::chrono::steady_clock::now();
-  auto syn = synth::synthesise(scene, so);
+  auto syn = synthesise_pair(scene, so);
   r.seconds_synth = seconds_since(start);
   const auto& truth = syn.truth;
   r.truth_velocity = truth.realised.mean_velocity[0];

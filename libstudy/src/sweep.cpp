@@ -1,5 +1,7 @@
 #include "study/sweep.hpp"
 
+#include "definition.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
@@ -17,12 +19,9 @@
 namespace study {
 namespace {
 
-bool is_field(const std::string& name) {
-  if (name == "np" || name == "anisotropy") return true;
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return true;
-  return false;
-}
+using detail::dimension_of;
+
+bool is_field(const std::string& name) { return name == "np" || name == "anisotropy" || detail::is_scene_field(name); }
 
 // Applies one value (text) of a field or of np/anisotropy to a run.
 void apply(SweepRun& run, const std::string& name, const std::string& text) {
@@ -40,12 +39,6 @@ void apply(SweepRun& run, const std::string& name, const std::string& text) {
 constexpr const char* kUnknownField = "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, "
                                       "bubble-diameter, dx, fs, duration, ...), np or anisotropy";
 
-awcc::Dimension dimension_of(const std::string& name) {
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return f.dimension;
-  return awcc::Dimension::dimensionless;
-}
-
 }  // namespace
 
 SweepDefinition load_sweep(const std::filesystem::path& path) {
@@ -54,12 +47,7 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
   auto fail = [&](const std::string& where, const std::string& what) -> void {
     throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
   };
-  std::vector<awcc::SettingTable> tables;
-  try {
-    tables = awcc::read_setting_tables(path);
-  } catch (const awcc::InputError& e) {
-    throw std::invalid_argument(e.what());
-  }
+  const auto tables = detail::definition_tables(path);
   std::map<std::string, const awcc::SettingTable*> by_name;
   for (const auto& t : tables) {
     if (t.name.empty()) {
@@ -219,14 +207,7 @@ std::vector<SweepRun> SweepDefinition::expand() const {
   return out;
 }
 
-std::uint64_t study_id(const SweepDefinition& d) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : d.canonical) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h >> 1;
-}
+std::uint64_t study_id(const SweepDefinition& d) { return detail::definition_id(d.canonical); }
 
 namespace {
 

@@ -29,7 +29,7 @@ Comparison compare(const awcc::BinarisedRecording& record, const RunOptions& opt
 Comparison compare_recording(const std::filesystem::path& file, const awcc::ProcessOptions& reading,
                              const RunOptions& options);
 
-/// Both methods on a synthesised scene of at least two tips (the first two).
+/// Both methods on a synthesised scene (synthesise_pair).
 Comparison compare_scene(const synth::Scene& scene, const RunOptions& options);
 
 /// The side-by-side table.

@@ -16,6 +16,7 @@
 #include "awcc/process.hpp"
 #include "correction/features.hpp"
 #include "synth/scene.hpp"
+#include "synth/synthesiser.hpp"
 
 namespace study {
 
@@ -42,6 +43,10 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
 /// `binarisation` is the processing's (it names the rule in the thresholds).
 awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
                                              const awcc::BinarisationOptions& binarisation = {});
+
+/// Synthesises a scene for a study: it needs two tips, the first two being
+/// the pair processed (throws std::invalid_argument naming the tips otherwise).
+synth::Synthesis synthesise_pair(const synth::Scene& scene, const synth::SynthesisOptions& options = {});
 
 /// awcc::process_binarised of the two signals. Throws std::invalid_argument
 /// when the options correlate raw voltages (a synthesised record in memory
@@ -84,8 +89,7 @@ struct RunResult {
   double seconds_process = 0.0;         ///< wall seconds of the processing (FSCC and AWCC together, as pdp process)
 };
 
-/// Synthesises and processes a scene of at least two tips (the first two are
-/// the pair processed). Throws std::invalid_argument for fewer tips.
+/// Synthesises (synthesise_pair) and processes a scene.
 RunResult run_scene(const synth::Scene& scene, const RunOptions& options);
 
 /// JSON of one run: truth, phase, fscc, awcc, error and windows objects (docs/output.md).
