@@ -1,5 +1,6 @@
-// One study run end to end (docs/performance.md, issue 17): synthesis, FSCC
-// and AWCC of the base case (METHOD 5) as pdp sweep runs it, on one thread.
+// One study run end to end (docs/performance.md, issue 17): synthesis and
+// processing (phase statistics, FSCC and AWCC together, as pdp process) of
+// the base case (METHOD 5) as pdp sweep runs it, on one thread.
 //
 //   run_bench [--scene FILE.toml] [--duration SECONDS] [--repeat N] [--seed S]
 //
@@ -18,7 +19,7 @@
 
 #include "awcc/sha256.hpp"
 #include "bench_util.hpp"
-#include "study.hpp"
+#include "study/run.hpp"
 
 namespace {
 
@@ -33,15 +34,16 @@ void show(const Stage& s) {
   std::printf("  %-10s median %.3f s  (%.3f-%.3f)\n", s.name, v[v.size() / 2], v.front(), v.back());
 }
 
-std::string fingerprint(const pdp::RunResult& r) {
+std::string fingerprint(const study::RunResult& r) {
   std::string text = fmt::format("truth u {:.17g} Tu {:.17g} c {:.17g} F {:.17g}\n", r.truth_velocity,
                                  r.truth_turbulence_intensity, r.truth_void_fraction, r.truth_count_rate);
-  text += fmt::format("phase c {:.17g} F {:.17g}\n", r.void_fraction, r.count_rate);
-  if (r.fscc) text += fmt::format("fscc u {:.17g} lag {:.17g} r12 {:.17g}\n", r.fscc->velocity, r.fscc->lag,
-                                  r.fscc->r12_max);
-  if (r.awcc) {
-    text += fmt::format("awcc u {:.17g} Tu {:.17g} windows {} accepted {}\n", r.awcc->velocity,
-                        r.awcc->turbulence_intensity, r.awcc->windows_total, r.awcc->windows_accepted);
+  const auto& p = r.processed;
+  text += fmt::format("phase c {:.17g} F {:.17g}\n", p.tips[0].phase.void_fraction, p.tips[0].phase.bubble_count_rate);
+  if (p.fscc) text += fmt::format("fscc u {:.17g} lag {:.17g} r12 {:.17g}\n", p.fscc->velocity, p.fscc->lag,
+                                  p.fscc->r12_max);
+  if (p.awcc) {
+    text += fmt::format("awcc u {:.17g} Tu {:.17g} windows {} accepted {}\n", p.awcc->velocity,
+                        p.awcc->turbulence_intensity, p.awcc->windows_total, p.awcc->windows_accepted);
   }
   return text;
 }
@@ -63,16 +65,15 @@ int main(int argc, char** argv) {
   if (scene_file) synth::load_scene_toml(scene_file, scene);
   scene.duration = duration;
   scene.seed = seed;
-  pdp::StudyOptions options;  // as pdp sweep: FSCC and AWCC, window truth kept
-  Stage synth{"synthesis", {}}, fscc{"FSCC", {}}, awcc{"AWCC", {}}, total{"total", {}};
+  study::RunOptions options;  // as pdp sweep: FSCC and AWCC, window truth kept
+  Stage synth{"synthesis", {}}, process{"processing", {}}, total{"total", {}};
   std::string first;
   for (int k = 0; k < repeat; ++k) {
     const double t0 = bench::now();
-    const auto r = pdp::run_scene(scene, options);
+    const auto r = study::run_scene(scene, options);
     total.seconds.push_back(bench::now() - t0);
     synth.seconds.push_back(r.seconds_synth);
-    fscc.seconds.push_back(r.seconds_fscc);
-    awcc.seconds.push_back(r.seconds_awcc);
+    process.seconds.push_back(r.seconds_process);
     const auto text = fingerprint(r);
     if (k == 0) first = text;
     else if (text != first) {
@@ -83,7 +84,7 @@ int main(int argc, char** argv) {
   std::printf("%s, %.0f s at %.0f kHz, seed %llu, %d runs (one thread):\n", scene_file ? scene_file : "base case",
               duration, scene.fs / 1e3,
               static_cast<unsigned long long>(seed), repeat);
-  for (const auto* s : {&synth, &fscc, &awcc, &total}) show(*s);
+  for (const auto* s : {&synth, &process, &total}) show(*s);
   awcc::Sha256 hash;
   hash.update({reinterpret_cast<const std::uint8_t*>(first.data()), first.size()});
   std::printf("results:\n%sfingerprint %s\n", first.c_str(), hash.hex().substr(0, 16).c_str());

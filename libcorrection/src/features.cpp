@@ -132,8 +132,11 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
     out.status = CorrectionStatus::no_awcc_velocity;
     out.message = "AWCC gave no velocity: " + r.awcc->message;
   } else if (r.awcc->probe_corrected) {
+    // The model learnt AWCC's bias on synthetic records without the needle:
+    // a bubble-probe-corrected velocity is not what it corrects.
     out.status = CorrectionStatus::probe_corrected;
-    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC";
+    out.message = "AWCC's velocity is bubble-probe corrected: the model corrects the uncorrected AWCC; process "
+                  "without the probe correction to correct it";
   } else {
     m.velocity = r.awcc->velocity;
     m.turbulence_intensity = r.awcc->turbulence_intensity;

@@ -63,84 +63,85 @@ void check_processing(const CorrectionModel& model, const std::optional<Processi
   }
 }
 
+// A status of the process JSON (FSCC's or AWCC's) by its text. A file written
+// before the key existed says only whether the method gave a value
+// ("defined"); not ok is then the result's default status: the measurement
+// reads whether a result is ok, never why.
+template <class Status>
+Status status_of(const json& j, Status not_ok, const std::string& file, const char* where) {
+  if (j.contains("status") && j["status"].is_string()) {
+    const auto text = j["status"].get<std::string>();
+    for (int k = 0; k < 64; ++k) {
+      const auto status = static_cast<Status>(k);
+      const auto name = awcc::to_string(status);
+      if (name == "?") break;
+      if (name == text) return status;
+    }
+    throw awcc::InputError(fmt::format("{}: {}.status = '{}' is not a status pdp writes; give a JSON written by pdp "
+                                       "process",
+                                       file, where, text));
+  }
+  return j.value("defined", false) ? Status::ok : not_ok;
+}
+
+std::optional<double> number(const json& j, const char* key) {
+  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
+  return j[key].get<double>();
+}
+
+double required(const json& j, const char* key, const char* where, const std::string& file) {
+  const auto v = number(j, key);
+  if (!v) throw awcc::InputError(fmt::format("{}: no number '{}' in {}; give a JSON written by pdp process", file, key, where));
+  return *v;
+}
+
+const json& awcc_object(const json& r) {
+  static const json none = json::object();
+  return r.contains("awcc") && r["awcc"].is_object() ? r["awcc"] : none;
+}
+
+// A result of the process JSON is read back into the fields of the
+// awcc::ProcessResult that awcc::to_json wrote it from, as far as
+// measurement_of reads them: the one builder then makes the measurement of a
+// file's row as of a result in memory, status rules included, so that the
+// two cannot disagree. First AWCC's outcome (all the status needs).
+awcc::ProcessResult awcc_outcome_of(const json& r, const std::string& file) {
+  awcc::ProcessResult p;
+  if (r.contains("awcc") && r["awcc"].is_object()) {
+    const auto& a = r["awcc"];
+    awcc::AwccResult res;
+    res.status = status_of(a, res.status, file, "awcc");
+    if (a.contains("reason") && a["reason"].is_string()) res.message = a["reason"].get<std::string>();
+    res.probe_corrected = a.value("probe_corrected", false);
+    p.awcc = std::move(res);
+  }
+  return p;
+}
+
 Correction correct_json_row(const CorrectionModel& model, const json& r, const RowDefaults& d, const std::string& file,
                             std::vector<std::string>& warnings) {
-  auto number = [](const json& j, const char* key) -> std::optional<double> {
-    if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
-    return j[key].get<double>();
-  };
-  auto required = [&](const json& j, const char* key, const char* where) {
-    const auto v = number(j, key);
-    if (!v) {
-      throw awcc::InputError(
-          fmt::format("{}: no number '{}' in {}; give a JSON written by pdp process", file, key, where));
-    }
-    return *v;
-  };
   // AWCC's status first: a row AWCC cannot serve needs nothing else unless
   // the model's FSCC forest may correct it.
-  MeasurementResult result;
-  Measurement& m = result.measurement;
-  const bool has_awcc = r.contains("awcc") && r["awcc"].is_object();
-  const json none = json::object();
-  const auto& a = has_awcc ? r["awcc"] : none;
-  auto text = [&](const char* key) {
-    return a.contains(key) && a[key].is_string() ? a[key].get<std::string>() : std::string();
-  };
-  if (!has_awcc) {
-    result.status = CorrectionStatus::awcc_not_run;
-    result.message = "AWCC was not run";
-  } else if (!a.value("defined", false)) {
-    result.status = CorrectionStatus::no_awcc_velocity;
-    result.message = "AWCC gave no velocity: " + text("reason");
-  } else if (a.value("probe_corrected", false)) {
-    // The model learnt AWCC's bias on synthetic records without the needle:
-    // a bubble-probe-corrected velocity is not what it corrects.
-    result.status = CorrectionStatus::probe_corrected;
-    result.message = "AWCC's velocity is bubble-probe corrected (probe-correction on): the model corrects the "
-                     "uncorrected AWCC; process without the probe correction to correct it";
-  }
-  const bool awcc_usable = result.status == CorrectionStatus::corrected;
-  if (!awcc_usable && !model.falls_back_to_fscc(result.status)) return not_corrected(result.status, result.message);
-  // What every forest shares and FSCC's own.
-  auto gather = [&] {
-    if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
-      throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
-    }
-    const auto& lead = r["tips"][0];
-    m.void_fraction = required(lead, "void_fraction", "tips[0]");
-    m.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]");
-    m.fs = number(r, "fs").value_or(d.fs.value_or(0.0));
-    m.duration = number(r, "duration").value_or(d.duration.value_or(0.0));
-    if (r.contains("fscc") && r["fscc"].is_object() && r["fscc"].value("defined", false)) {
-      m.fscc_velocity = number(r["fscc"], "velocity");
-      m.r12_max = number(r["fscc"], "r12_max");
-    }
-    if (const auto w = number(a, "windows_accepted")) m.windows_accepted = whole(*w, file, "awcc.windows_accepted");
-    if (const auto w = number(a, "windows_total")) m.windows_total = whole(*w, file, "awcc.windows_total");
-    m.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
-    m.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
-  };
-  if (!awcc_usable) {
+  const auto outcome = measurement_of(awcc_outcome_of(r, file));
+  if (outcome.status != CorrectionStatus::corrected) {
+    if (!model.falls_back_to_fscc(outcome.status)) return not_corrected(outcome.status, outcome.message);
+    MeasurementResult result;
     try {
-      gather();
+      result = measurement_of_json(r, d, file);
     } catch (const std::exception& e) {  // the FSCC forest cannot have the row: AWCC's status stands
-      return not_corrected(result.status, fmt::format("{}; FSCC forest: {}", result.message, e.what()));
+      return not_corrected(outcome.status, fmt::format("{}; FSCC forest: {}", outcome.message, e.what()));
     }
     return model.correct(result);
   }
-  gather();
+  const auto result = measurement_of_json(r, d, file);
+  const auto& a = awcc_object(r);
   std::optional<Processing> processing;
   if (a.contains("options") && a["options"].is_object()) {
     const auto& o = a["options"];
-    processing = parse_processing(required(o, "filter_a", "awcc.options"), o.value("roc", true) ? "on" : "off",
+    processing = parse_processing(required(o, "filter_a", "awcc.options", file), o.value("roc", true) ? "on" : "off",
                                   o.value("weighting", ""), o.value("signal", ""), o.value("subsample", ""));
   }
   check_processing(model, processing, file, warnings);
-  m.velocity = required(a, "velocity", "awcc");
-  m.turbulence_intensity = required(a, "turbulence_intensity", "awcc");
-  m.windows_accepted = whole(required(a, "windows_accepted", "awcc"), file, "awcc.windows_accepted");
-  m.np = static_cast<int>(whole(need(number(a, "np"), default_np(d), file, "np", "particles per window"), file, "np"));
   return model.correct(result);
 }
 
@@ -235,6 +236,53 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
 }
 
 }  // namespace
+
+MeasurementResult measurement_of_json(const nlohmann::json& r, const RowDefaults& d, const std::string& file) {
+  auto p = awcc_outcome_of(r, file);
+  const bool awcc_usable = measurement_of(p).status == CorrectionStatus::corrected;
+  const auto& a = awcc_object(r);
+  // What every forest shares and FSCC's own.
+  if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
+    throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
+  }
+  const auto& lead = r["tips"][0];
+  awcc::TipResult tip;
+  tip.phase.void_fraction = required(lead, "void_fraction", "tips[0]", file);
+  tip.phase.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]", file);
+  p.tips = {tip};
+  const auto fs = number(r, "fs"), samples = number(r, "samples");
+  p.info.fs = fs.value_or(d.fs.value_or(0.0));
+  if (fs && samples) p.info.frames = whole(*samples, file, "samples");
+  if (r.contains("fscc") && r["fscc"].is_object()) {
+    const auto& f = r["fscc"];
+    awcc::FsccResult res;
+    res.status = status_of(f, res.status, file, "fscc");
+    res.velocity = number(f, "velocity").value_or(0.0);
+    res.r12_max = number(f, "r12_max").value_or(0.0);
+    p.fscc = std::move(res);
+  }
+  if (p.awcc) {
+    if (const auto w = number(a, "windows_accepted")) p.awcc->windows_accepted = whole(*w, file, "awcc.windows_accepted");
+    if (const auto w = number(a, "windows_total")) p.awcc->windows_total = whole(*w, file, "awcc.windows_total");
+    p.awcc->np = static_cast<int>(number(a, "np").value_or(d.np.value_or(0)));
+  }
+  p.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
+  p.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
+  if (awcc_usable) {
+    p.awcc->velocity = required(a, "velocity", "awcc", file);
+    p.awcc->turbulence_intensity = required(a, "turbulence_intensity", "awcc", file);
+    p.awcc->windows_accepted = whole(required(a, "windows_accepted", "awcc", file), file, "awcc.windows_accepted");
+    p.awcc->np = static_cast<int>(whole(need(number(a, "np"), default_np(d), file, "np", "particles per window"), file, "np"));
+  }
+  auto result = measurement_of(p);
+  // What the file does not give: the duration it (or the defaults) states
+  // where it lacks the samples or the rate, and windows not known.
+  auto& m = result.measurement;
+  if (!(fs && samples)) m.duration = number(r, "duration").value_or(d.duration.value_or(0.0));
+  if (!number(a, "windows_accepted")) m.windows_accepted = -1;
+  if (!number(a, "windows_total")) m.windows_total = -1;
+  return result;
+}
 
 FileCorrection correct_process_json(const CorrectionModel& model, const std::string& text, const RowDefaults& d,
                                     const std::string& file, const std::string& model_name) {

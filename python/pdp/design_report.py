@@ -5,7 +5,7 @@ geometry and settings measure a flow best, and why.
     (or: pdp design --config DESIGN.toml -o RANKED.csv --report design.html)
 
 It reads the ranked CSV pdp design writes (one row per candidate and
-condition, best first; docs in tools/pdp/design.hpp; the needle column,
+condition, best first; docs in libstudy/include/study/design.hpp; the needle column,
 the leading needle's diameter in m, 0 for point tips, is optional) and shows:
 
 - the recommended candidate (rank 1) with its errors in every condition, and

@@ -2,8 +2,9 @@
 // short scene (synth::synth), reads samples through a recording (awcc::io),
 // processes it (awcc::awcc), trains a small
 // correction model on synthetic runs, saves it, loads it back and corrects a
-// measurement (correction::correction), and checks a property of each step so
-// that linking alone is not mistaken for success.
+// measurement (correction::correction), runs the same scene as a study
+// (awcc::study), and checks a property of each step so that linking alone is
+// not mistaken for success.
 #include <awcc/awcc.hpp>
 #include <awcc/recording.hpp>
 #include <awcc/units.hpp>
@@ -12,6 +13,7 @@
 #include <correction/training.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <study/run.hpp>
 #include <synth/synthesiser.hpp>
 #include <vector>
 
@@ -24,6 +26,10 @@ int main(int argc, char** argv) {
   const double c = result.signals.at(0).void_fraction();
   const auto a = awcc::awcc(result.signals[0], result.signals[1], scene.streamwise_separation());
   const bool awcc_ok = a.ok() && a.velocity > 5.0 && a.velocity < 15.0;
+  // The study synthesises the same record and processes it as pdp process: the same AWCC.
+  const auto run = study::run_scene(scene, {});
+  const bool study_ok = run.processed.awcc && run.processed.awcc->ok() && run.processed.awcc->velocity == a.velocity &&
+                        run.measurement.measurement.velocity == a.velocity;
 
   // awcc::io: two channels of frames handed back interleaved as given.
   const auto recording = awcc::memory_recording(std::vector<float>{0.25f, 4.0f, 0.5f, 3.5f}, 2, 1000.0);
@@ -69,9 +75,11 @@ int main(int argc, char** argv) {
   const auto corrected = loaded.correct(m);
   const bool correction_ok = corrected.corrected() && std::abs(corrected.velocity->median() - 3.6) < 1e-9 &&
                              std::abs(corrected.turbulence_intensity->median() - 0.2) < 1e-9;
-  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s), recording read (%s)\n",
+  std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s), recording read (%s), "
+              "study (%s)
+",
               awcc::version, c, a.velocity, awcc_ok ? "ok" : "wrong",
               corrected.velocity ? corrected.velocity->median() : 0.0, correction_ok ? "ok" : "wrong",
-              io_ok ? "ok" : "wrong");
-  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok && io_ok) ? 0 : 1;
+              io_ok ? "ok" : "wrong", study_ok ? "ok" : "wrong");
+  return (c > 0.0 && c < 1.0 && awcc_ok && correction_ok && io_ok && study_ok) ? 0 : 1;
 }

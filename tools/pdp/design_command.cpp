@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <chrono>
-#include <map>
 #include <set>
 
 #include "awcc/atomic_output.hpp"
@@ -13,10 +11,10 @@
 #include "awcc/version.hpp"
 #include "correction/features.hpp"
 #include "correction/model.hpp"
-#include "design.hpp"
 #include "report_command.hpp"
+#include "study/clock.hpp"
+#include "study/design.hpp"
 #include "sweep_engine.hpp"
-#include "terminal.hpp"
 
 namespace pdp {
 
@@ -54,13 +52,13 @@ std::string runs_default(const std::string& output) {
 
 int run_design(const DesignOptions& o) {
   const MpiSession mpi;
-  DesignDefinition d;
+  study::DesignDefinition d;
   std::int64_t shard = 0, shards = 1;
   std::optional<correction::CorrectionModel> model;
   std::string model_note;
   const awcc::AwccOptions processing;  // AWCC as pdp process runs it by default
   try {
-    d = load_design(o.config);
+    d = study::load_design(o.config);
     if (!o.shard.empty()) std::tie(shard, shards) = parse_shard(o.shard);
     std::string model_path = o.model;
     if (model_path.empty() && !d.model.empty()) {
@@ -99,34 +97,18 @@ int run_design(const DesignOptions& o) {
       return exit_bad_usage;
     }
   }
-  const std::uint64_t id = design_id(d);
+  const std::uint64_t id = study::design_id(d);
   const std::vector<std::string> runs = o.runs.empty() ? std::vector<std::string>{runs_default(o.output)} : o.runs;
-  const std::int64_t per_task = d.rows_per_task();
   std::set<std::int64_t> done;
   int refused = 0;
   if (mpi.rank() == 0) {
     try {
       awcc::check_output_folder(o.output);
       if (!o.report.empty()) awcc::check_output_folder(o.report);
-      std::map<std::int64_t, std::int64_t> counts;
-      for (const auto& file : runs) {
-        for (const auto& r : read_design_rows(file, id)) ++counts[r.task];
-      }
-      std::set<std::int64_t> partial;
-      for (const auto& [task, n] : counts) (n == per_task ? done : partial).insert(task);
-      // A task is written in one write: a crash inside it leaves it partial.
-      // Its rows go, and the task runs again.
-      if (!partial.empty()) {
-        const auto rows = read_design_rows(runs.front(), id);
-        std::string text = design_rows_header() + "\n";
-        for (const auto& r : rows)
-          if (!partial.count(r.task)) text += design_row_text(r, id) + "\n";
-        awcc::write_text_atomically(runs.front(), text);
-        spdlog::warn("{}: {} records were cut short by an interruption; they run again", runs.front(), partial.size());
-      }
-      std::error_code ec;
-      if (!std::filesystem::exists(runs.front(), ec) || std::filesystem::file_size(runs.front(), ec) == 0) {
-        awcc::write_text_atomically(runs.front(), design_rows_header() + "\n");
+      const auto resumed = study::resume_design(d, {runs.begin(), runs.end()}, id);
+      done = resumed.done;
+      if (resumed.cut_short > 0) {
+        spdlog::warn("{}: {} records were cut short by an interruption; they run again", runs.front(), resumed.cut_short);
       }
     } catch (const std::exception& e) {
       refused = report_error(e);
@@ -145,28 +127,8 @@ int run_design(const DesignOptions& o) {
                  o.config, d.conditions.size(), d.candidates().size(), d.tasks(), done.size(), runs.front(),
                  d.geometries.size(), d.nps.size());
     if (!pending.empty()) {
-      // A 2 s pilot of each condition and setting, scaled to the records to run.
-      std::map<std::pair<std::size_t, double>, double> pilot;  // seconds per simulated second
-      const double pilot_seconds = 2.0;
-      for (auto t : pending) {
-        const auto task = d.task(t);
-        const auto key = std::pair{task.condition, task.fs};
-        if (pilot.count(key)) continue;
-        auto short_task = task;
-        short_task.scene.duration = std::min(pilot_seconds, task.duration);
-        const auto start = std::chrono::steady_clock::now();
-        try {
-          (void)run_design_task(d, short_task, m, processing);
-        } catch (const std::exception&) {
-          // The record itself will say what is wrong.
-        }
-        pilot[key] = seconds_since(start) / short_task.scene.duration;
-      }
-      double total = 0.0;
-      for (auto t : pending) {
-        const auto task = d.task(t);
-        total += pilot[{task.condition, task.fs}] * task.duration;
-      }
+      constexpr double pilot_seconds = 2.0;
+      const double total = study::estimate_design_seconds(d, pending, m, processing, pilot_seconds);
       const double workers = mpi.on() && mpi.size() > 1 ? mpi.size() - 1 : awcc::thread_count(o.threads, pending.size());
       const double estimate = total / workers;
       spdlog::info("about {} on {} {} (from a {:g} s pilot of each condition)",
@@ -178,7 +140,7 @@ int run_design(const DesignOptions& o) {
     const auto task = d.task(t);
     std::string text;
     try {
-      for (const auto& r : run_design_task(d, task, m, processing)) text += design_row_text(r, id) + "\n";
+      for (const auto& r : study::run_design_task(d, task, m, processing)) text += study::design_row_text(r, id) + "\n";
     } catch (const std::exception& e) {
       // A record that cannot be simulated is the design's fault: say which.
       throw awcc::InputError(fmt::format("{}: condition {} record {}: {}", o.config, d.conditions[task.condition].name,
@@ -191,9 +153,9 @@ int run_design(const DesignOptions& o) {
   }
   if (mpi.rank() != 0) return exit_ok;
   try {
-    std::vector<DesignRow> rows;
+    std::vector<study::DesignRow> rows;
     for (const auto& file : runs) {
-      auto more = read_design_rows(file, id);
+      auto more = study::read_design_rows(file, id);
       rows.insert(rows.end(), more.begin(), more.end());
     }
     std::set<std::int64_t> tasks_present;
@@ -204,9 +166,9 @@ int run_design(const DesignOptions& o) {
                    tasks_present.size(), d.tasks());
       return exit_ok;
     }
-    const auto ranked = rank_candidates(d, rows);
-    awcc::write_text_atomically(o.output, ranked_csv(ranked, d));
-    fmt::print("{}", design_summary(ranked, d, model_note));
+    const auto ranked = study::rank_candidates(d, rows);
+    awcc::write_text_atomically(o.output, study::ranked_csv(ranked, d));
+    fmt::print("{}", study::design_summary(ranked, d, model_note));
     spdlog::info("{}: {} candidates ranked", o.output, ranked.size());
     if (!o.report.empty()) {
       return write_report({o.output, "--config", o.config, "-o", o.report, "--pdp-version", awcc::version},

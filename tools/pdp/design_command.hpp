@@ -1,6 +1,6 @@
 #pragma once
 // pdp design: ranks probe geometries and settings (dx, dy, Np, fs, record
-// length) for the lab's own flow by simulating it (design.hpp says how).
+// length) for the lab's own flow by simulating it (study/design.hpp says how).
 // A sweep underneath: threads, resume, shards and MPI as pdp sweep.
 
 #include <CLI/CLI.hpp>

@@ -4,7 +4,6 @@
 
 #include "awcc/options.hpp"
 #include "command.hpp"
-#include "study.hpp"
 
 namespace pdp {
 
@@ -48,12 +47,12 @@ const std::vector<std::string_view> kStudyAwcc{"np", "filter-a", "roc", "weighti
 }  // namespace
 
 void add_method_options(CLI::App* cmd, OptionSet& methods) {
-  const StudyOptions defaults;
+  const study::RunOptions defaults;
   methods.add(cmd, awcc::awcc_option_fields(), defaults.awcc, "Methods", kStudyAwcc);
   methods.add(cmd, awcc::fscc_option_fields(), defaults.fscc, "Methods");
 }
 
-void apply_method_options(const OptionSet& methods, StudyOptions& o) {
+void apply_method_options(const OptionSet& methods, study::RunOptions& o) {
   awcc::method_options(methods.settings(), o.awcc, o.fscc);
 }
 

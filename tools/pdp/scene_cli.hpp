@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_options.hpp"
+#include "study/run.hpp"
 #include "synth/scene.hpp"
 
 namespace pdp {
@@ -28,8 +29,7 @@ synth::Scene build_scene(const SceneCli& cli);
 
 /// The AWCC and FSCC options of the studies (validate, compare, sweep, bench).
 void add_method_options(CLI::App* cmd, OptionSet& methods);
-struct StudyOptions;
 /// Applies them; throws std::invalid_argument naming the option.
-void apply_method_options(const OptionSet& methods, StudyOptions& options);
+void apply_method_options(const OptionSet& methods, study::RunOptions& options);
 
 }  // namespace pdp

@@ -4,12 +4,8 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/atomic_output.hpp"
-#include "awcc/errors.hpp"
-#include "awcc/parallel.hpp"
-#include "awcc/units.hpp"
-#include "sweep.hpp"
+#include "study/sweep.hpp"
 #include "sweep_engine.hpp"
-#include "terminal.hpp"
 
 
 namespace pdp {
@@ -31,22 +27,22 @@ void setup_sweep(CLI::App& app, Command& command, SweepOptions& o) {
 
 int run_sweep(const SweepOptions& o) {
   const MpiSession mpi;
-  SweepDefinition definition;
-  std::vector<SweepRun> runs;
-  StudyOptions study;
+  study::SweepDefinition definition;
+  std::vector<study::SweepRun> runs;
+  study::RunOptions options;
   std::int64_t shard = 0, shards = 1;
   try {
-    definition = load_sweep(o.study);
+    definition = study::load_sweep(o.study);
     runs = definition.expand();
-    apply_method_options(o.methods, study);
+    apply_method_options(o.methods, options);
     // A method option of the command line applies to every run, unless the
     // study sets it: then the two conflict.
     if (o.methods.given("np")) {
-      if (sets(definition, "np")) {
+      if (study::sets(definition, "np")) {
         throw std::invalid_argument(fmt::format("--np {} conflicts with np set in {}; give it in one place",
-                                                study.awcc.np, o.study));
+                                                options.awcc.np, o.study));
       }
-      for (auto& run : runs) run.np = study.awcc.np;
+      for (auto& run : runs) run.np = options.awcc.np;
     }
     if (!o.shard.empty()) std::tie(shard, shards) = parse_shard(o.shard);
   } catch (const std::exception& e) {
@@ -60,15 +56,15 @@ int run_sweep(const SweepOptions& o) {
       return exit_bad_usage;
     }
   }
-  const std::uint64_t id = study_id(definition);
+  const std::uint64_t id = study::study_id(definition);
   std::set<std::int64_t> done;
   int refused = 0;
   if (mpi.rank() == 0) {
     try {
-      done = finished_runs(o.output, id);
+      done = study::finished_runs(o.output, id);
       std::error_code ec;
       if (!std::filesystem::exists(o.output, ec) || std::filesystem::file_size(o.output, ec) == 0) {
-        awcc::write_text_atomically(o.output, sweep_header() + "\n");
+        awcc::write_text_atomically(o.output, study::sweep_header() + "\n");
       }
     } catch (const std::exception& e) {
       refused = report_error(e);
@@ -86,15 +82,7 @@ int run_sweep(const SweepOptions& o) {
                  o.output, pending.size(), shards > 1 ? fmt::format(" (shard {}/{})", shard, shards) : "");
   }
   auto compute_row = [&](std::int64_t i) {
-    const SweepRun& run = runs[static_cast<std::size_t>(i)];
-    StudyOptions options = study;
-    options.awcc.np = run.np;
-    try {
-      const RunResult r = run_scene(run.scene, options);
-      return sweep_row(run, &r, "", id, options.awcc) + "\n";
-    } catch (const std::exception& e) {
-      return sweep_row(run, nullptr, e.what(), id, options.awcc) + "\n";
-    }
+    return study::run_sweep_row(runs[static_cast<std::size_t>(i)], options, id);
   };
   const int status = run_tasks(pending, compute_row, o.output, o.threads, "sweeping", mpi);
   if (status == exit_ok && mpi.rank() == 0 && !(mpi.on() && mpi.size() > 1)) {

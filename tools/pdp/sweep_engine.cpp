@@ -1,21 +1,12 @@
 #include "sweep_engine.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <atomic>
-#include <cerrno>
 #include <cstdlib>
-#include <cstring>
-#include <fmt/format.h>
-#include <mutex>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
-#include "awcc/errors.hpp"
-#include "awcc/parallel.hpp"
 #include "awcc/units.hpp"
 #include "command.hpp"
+#include "study/tasks.hpp"
 #include "terminal.hpp"
 
 #ifdef PDP_WITH_MPI
@@ -65,26 +56,15 @@ std::pair<std::int64_t, std::int64_t> parse_shard(const std::string& text) {
 
 namespace {
 
-void write_all(int fd, const std::string& text, const std::string& path) {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throw awcc::OutputError(fmt::format("{}: write failed: {}", path, std::strerror(errno)));
-    }
-    done += static_cast<std::size_t>(n);
-  }
-}
-
 #ifdef PDP_WITH_MPI
 // Rank 0 is the one writer and hands out tasks one at a time; the other
 // ranks compute them and send their text back. Every rank reads the same
 // study, so a task index is all a message needs.
-int run_over_ranks(const std::vector<std::int64_t>& tasks, const std::function<std::string(std::int64_t)>& compute,
-                   int fd, const std::string& output, const std::string& label, const MpiSession& mpi) {
+void run_over_ranks(const std::vector<std::int64_t>& tasks, const std::function<std::string(std::int64_t)>& compute,
+                    const std::string& output, const std::string& label, const MpiSession& mpi) {
   constexpr int kText = 1, kTask = 2;
   if (mpi.rank() == 0) {
+    study::AppendFile file(output);
     std::size_t next = 0, written = 0;
     int active = mpi.size() - 1;
     Progress progress(label);
@@ -96,8 +76,7 @@ int run_over_ranks(const std::vector<std::int64_t>& tasks, const std::function<s
       std::string text(static_cast<std::size_t>(length), '\0');
       MPI_Recv(text.data(), length, MPI_CHAR, status.MPI_SOURCE, kText, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
       if (!text.empty()) {
-        write_all(fd, text, output);
-        ::fdatasync(fd);
+        file.append(text);
         progress(static_cast<double>(++written) / static_cast<double>(tasks.size()));
       }
       std::int64_t task = next < tasks.size() ? static_cast<std::int64_t>(next++) : -1;
@@ -115,7 +94,6 @@ int run_over_ranks(const std::vector<std::int64_t>& tasks, const std::function<s
       text = compute(tasks[static_cast<std::size_t>(task)]);
     }
   }
-  return exit_ok;
 }
 #endif
 
@@ -123,41 +101,19 @@ int run_over_ranks(const std::vector<std::int64_t>& tasks, const std::function<s
 
 int run_tasks(const std::vector<std::int64_t>& tasks, const std::function<std::string(std::int64_t)>& compute,
               const std::string& output, int threads, const std::string& label, const MpiSession& mpi) {
-  const int fd = mpi.rank() == 0 ? ::open(output.c_str(), O_WRONLY | O_APPEND) : -1;
-  if (mpi.rank() == 0 && fd < 0) {
-    spdlog::error("{}: cannot open for appending: {}", output, std::strerror(errno));
-    return exit_output_failed;
-  }
-#ifdef PDP_WITH_MPI
-  if (mpi.on() && mpi.size() > 1) {
-    int status = exit_ok;
-    try {
-      status = run_over_ranks(tasks, compute, fd, output, label, mpi);
-    } catch (const std::exception& e) {
-      status = report_error(e);
-    }
-    if (fd >= 0) ::close(fd);
-    return status;
-  }
-#endif
-  std::atomic<std::size_t> finished{0};
-  std::mutex write_mutex;
   try {
+#ifdef PDP_WITH_MPI
+    if (mpi.on() && mpi.size() > 1) {
+      run_over_ranks(tasks, compute, output, label, mpi);
+      return exit_ok;
+    }
+#endif
+    (void)mpi;
     Progress progress(label);
-    awcc::parallel_for(tasks.size(), threads, [&](std::size_t i) {
-      const std::string text = compute(tasks[i]);
-      std::lock_guard lock(write_mutex);
-      // One write per task, then to disk: a crash loses no finished task. A
-      // failed write stops the study (the pool hands out no further task).
-      write_all(fd, text, output);
-      ::fdatasync(fd);
-      progress(static_cast<double>(++finished) / static_cast<double>(tasks.size()));
-    });
+    study::run_tasks(tasks, compute, output, threads, [&](double fraction) { progress(fraction); });
   } catch (const std::exception& e) {
-    ::close(fd);
     return report_error(e);
   }
-  ::close(fd);
   return exit_ok;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
-// The engine under pdp sweep and pdp design: tasks, named by index, computed
-// on threads (or MPI ranks), each task's text (whole CSV lines) appended to
-// one file in one write and flushed to disk, so that an interrupted study
-// loses no finished task and resumes from what the file holds.
+// pdp sweep's and pdp design's tasks on threads (study::run_tasks) or over
+// MPI ranks: MPI lives here, in the program that owns the process (its
+// start and end), not in the study library a script or the Python module
+// links.
 
 #include <cstdint>
 #include <functional>
@@ -35,10 +35,9 @@ class MpiSession {
 /// "i/n" of --shard: (i, n) with 0 <= i < n; throws std::invalid_argument.
 std::pair<std::int64_t, std::int64_t> parse_shard(const std::string& text);
 
-/// Appends compute(task) for every task to `output` (which exists), on
-/// `threads` threads (0 = all cores), or over the ranks when `mpi` has more
-/// than one (rank 0 writes and hands out tasks one at a time). Progress on a
-/// terminal under `label`. Returns an exit code (README, "Exit status").
+/// study::run_tasks, or over the ranks when `mpi` has more than one (rank 0
+/// writes and hands out tasks one at a time). Progress on a terminal under
+/// `label`. Returns an exit code (README, "Exit status").
 int run_tasks(const std::vector<std::int64_t>& tasks, const std::function<std::string(std::int64_t)>& compute,
               const std::string& output, int threads, const std::string& label, const MpiSession& mpi);
 

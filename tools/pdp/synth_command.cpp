@@ -6,6 +6,7 @@
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/json_text.hpp"
+#include "study/clock.hpp"
 #include "synth/recording.hpp"
 #include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
@@ -69,7 +70,7 @@ int run_synth(const SynthOptions& options) {
       so.progress = [&progress](double f) { progress(f); };
       synthesis = synth::synthesise(scene, so);
     }
-    const double t_synth = seconds_since(start);
+    const double t_synth = study::seconds_since(start);
     if (synthesis.truth.reentries_missed > 0) {
       spdlog::warn("{} steps where the flow reversed beyond the bubble retirement allowance; some piercings may be "
                    "missing",
@@ -87,7 +88,7 @@ int run_synth(const SynthOptions& options) {
       });
       spdlog::info("wrote {} and {}", out.string(), sidecar.string());
     }
-    spdlog::info("synthesis {:.2f} s, file {:.2f} s, peak memory {:.0f} MB", t_synth, seconds_since(write_start),
+    spdlog::info("synthesis {:.2f} s, file {:.2f} s, peak memory {:.0f} MB", t_synth, study::seconds_since(write_start),
                  peak_memory_mb());
     if (!options.quiet) fmt::print("{}", synthesis.truth.report());
   } catch (const std::exception& e) {

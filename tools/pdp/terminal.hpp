@@ -1,10 +1,10 @@
 #pragma once
 // What the pdp subcommands share about the terminal: progress on stderr when
-// it is a terminal, and resource figures for the log.
+// it is a terminal, and resource figures for the log (the clocks of the
+// studies are the study library's: study/clock.hpp).
 
 #include <chrono>
 #include <string>
-#include <string_view>
 
 namespace pdp {
 
@@ -25,20 +25,5 @@ class Progress {
 
 /// Peak resident memory of this process, MB.
 double peak_memory_mb();
-
-/// Seconds since `start`.
-double seconds_since(std::chrono::steady_clock::time_point start);
-
-/// CPU seconds of the calling thread: a method's cost, unaffected by other
-/// threads sharing the machine.
-double thread_seconds();
-
-/// The CPU seconds f() takes on this thread.
-template <class F>
-double cost(F&& f) {
-  const double t0 = thread_seconds();
-  f();
-  return thread_seconds() - t0;
-}
 
 }  // namespace pdp

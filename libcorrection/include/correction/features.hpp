@@ -135,6 +135,9 @@ struct MeasurementResult {
   std::string message;
   Measurement measurement;
 };
+/// The one builder: pdp process --correct, pdp correct (through
+/// measurement_of_json, correction/rows.hpp) and every study (awcc::study)
+/// make their measurements with it.
 MeasurementResult measurement_of(const awcc::ProcessResult& result);
 
 /// The AWCC settings a model's bias depends on.

@@ -29,6 +29,16 @@ struct FileCorrection {
   std::vector<std::string> warnings;  ///< e.g. rows whose processing the file does not record
 };
 
+/// The measurement of one result of a process JSON (a recording's object,
+/// or one entry of a profile), made by measurement_of from the fields of the
+/// awcc::ProcessResult the JSON was written from: the same as of the result
+/// in memory. Values the file lacks come from `defaults` (dx, dy, np, fs,
+/// duration) or are unknown (windows). Throws awcc::InputError (a missing
+/// or mistyped key, an unknown status) or awcc::OptionError (dx, dy or np
+/// needed and neither in the file nor the defaults).
+MeasurementResult measurement_of_json(const nlohmann::json& result, const RowDefaults& defaults,
+                                      const std::string& file);
+
 /// Adds a "correction" object to every result of a process JSON. Throws
 /// awcc::InputError (not such a JSON, processed differently from the model)
 /// or awcc::OptionError (a value the file lacks and `defaults` does not give:

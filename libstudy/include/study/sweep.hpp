@@ -1,10 +1,11 @@
 #pragma once
 // Studies over many synthetic scenes: a sweep definition (TOML), its
-// expansion into runs, and the run rows of the append-only CSV.
+// expansion into runs, and the run rows of the append-only CSV (each run
+// processed by run_scene, as pdp process processes a recording).
 //
 // Definition:
 //   [sweep]  mode = "grid" | "monte-carlo", runs (monte-carlo), repeat, seed
-//   [base]   fixed scene fields (the names of pdp synth, numbers in SI or
+//   [base]   fixed scene fields (synth::scene_fields' names, numbers in SI or
 //            strings with units), plus np and anisotropy (Tu_y/Tu_x = Tu_z/Tu_x,
 //            applied when tu-y/tu-z are not set; default 0.5)
 //   [grid]   a list of values per field: the runs are their Cartesian product
@@ -23,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "study.hpp"
+#include "study/run.hpp"
 
-namespace pdp {
+namespace study {
 
 struct SweepRun {
   std::int64_t index = 0;
@@ -49,8 +50,8 @@ struct SweepDefinition {
   std::set<std::string> log_ranges;
 };
 
-/// Reads and checks a sweep file; throws std::runtime_error naming the file,
-/// the table and key, and the fix.
+/// Reads and checks a sweep file; throws std::invalid_argument (a definition
+/// that cannot be run) naming the file, the table and key, and the fix.
 SweepDefinition load_sweep(const std::filesystem::path& path);
 
 /// True when the definition sets `name` (in [base], [grid] or [ranges]).
@@ -59,16 +60,25 @@ SweepDefinition load_sweep(const std::filesystem::path& path);
 /// The CSV header and one row: the scene, np and anisotropy, the truth, the
 /// estimates, the probe geometry processed (probe_dx, probe_dy), run times,
 /// the reason a run failed, and the AWCC processing (awcc_filter_a ...).
+/// What the correction reads (awcc_velocity, awcc_turbulence_intensity,
+/// awcc_void_fraction, awcc_count_rate, the windows, fscc_velocity, probe_dx,
+/// probe_dy) is the run's measurement (RunResult::measurement): empty where
+/// it has none, with the reason. `result` is null for a run that failed
+/// (`error` says why).
 std::string sweep_header();
 std::string sweep_row(const SweepRun& run, const RunResult* result, const std::string& error, std::uint64_t study,
                       const awcc::AwccOptions& processing);
+
+/// Runs one sweep run (its np applied to `options`) and returns its CSV
+/// row with a line break: a run that throws is a row with the reason.
+std::string run_sweep_row(const SweepRun& run, const RunOptions& options, std::uint64_t study);
 
 /// Study id of a definition (FNV-1a of its canonical text).
 std::uint64_t study_id(const SweepDefinition& d);
 
 /// Runs already in an existing CSV of this study. A partial last line (a
-/// crash while writing) is cut off. Throws std::runtime_error when the file is
+/// crash while writing) is cut off. Throws awcc::InputError when the file is
 /// not such a CSV (foreign header, malformed row, rows of another study).
 std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint64_t study);
 
-}  // namespace pdp
+}  // namespace study

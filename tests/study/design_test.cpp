@@ -1,9 +1,10 @@
-#include "design.hpp"
+#include "study/design.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
+#include <set>
 
 #include "awcc/errors.hpp"
 #include "awcc/probe_correction.hpp"
@@ -28,7 +29,7 @@ const std::string kTwoConditions =
 
 std::string error_of(const std::string& text) {
   try {
-    (void)pdp::load_design(write("bad.toml", text));
+    (void)study::load_design(write("bad.toml", text));
   } catch (const std::exception& e) {
     return e.what();
   }
@@ -36,14 +37,14 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(DesignFile, ReadsConditionsCandidatesAndTheCurrentProbe) {
-  const auto d = pdp::load_design(write("two.toml", kTwoConditions + "[current]\ndx = \"7mm\"\ndy = \"1mm\"\nnp = 10\n"
+  const auto d = study::load_design(write("two.toml", kTwoConditions + "[current]\ndx = \"7mm\"\ndy = \"1mm\"\nnp = 10\n"
                                                                       "fs = \"100kHz\"\nduration = \"20s\"\n"));
   EXPECT_EQ(d.seeds, 3);
   ASSERT_EQ(d.conditions.size(), 2u);
   EXPECT_EQ(d.conditions[0].name, "upper");
   EXPECT_EQ(d.conditions[1].name, "wall");
   // Conditions keep the file's order, not their names'.
-  const auto z = pdp::load_design(write("order.toml", "[conditions.z]\ntu = 0.2\n[conditions.a]\ntu = 0.3\n"));
+  const auto z = study::load_design(write("order.toml", "[conditions.z]\ntu = 0.2\n[conditions.a]\ntu = 0.3\n"));
   EXPECT_EQ(z.conditions[0].name, "z");
   EXPECT_EQ(d.conditions[1].ranges.at("velocity"), (std::pair{2.0, 4.0}));
   EXPECT_TRUE(d.conditions[1].log_ranges.count("void-fraction"));
@@ -71,7 +72,7 @@ TEST(DesignFile, BadDefinitionsNameTheTableTheKeyAndTheFix) {
 }
 
 TEST(DesignTasks, EveryRecordDrawsItsFlowFromItsConditionAndNumberOnly) {
-  const auto d = pdp::load_design(write("two.toml", kTwoConditions));
+  const auto d = study::load_design(write("two.toml", kTwoConditions));
   // Task order: condition, fs, duration, record.
   const auto t = d.task((0 * 2 + 1) * 3 + 1);  // condition 0 (upper), second duration, record 1
   EXPECT_EQ(t.condition, 0u);
@@ -101,8 +102,8 @@ TEST(DesignTasks, EveryRecordDrawsItsFlowFromItsConditionAndNumberOnly) {
   // Another candidate list draws the same flows and seeds.
   auto more = kTwoConditions;
   more.replace(more.find("dx = [\"2mm\", \"5mm\"]"), 19, "dx = [\"1mm\", \"2mm\", \"5mm\"]");
-  const auto e = pdp::load_design(write("more.toml", more));
-  EXPECT_NE(pdp::design_id(e), pdp::design_id(d));
+  const auto e = study::load_design(write("more.toml", more));
+  EXPECT_NE(study::design_id(e), study::design_id(d));
   for (std::int64_t i = 0; i < d.tasks(); ++i) {
     EXPECT_EQ(e.task(i).scene.seed, d.task(i).scene.seed);
     EXPECT_EQ(e.task(i).scene.void_fraction, d.task(i).scene.void_fraction);
@@ -110,20 +111,20 @@ TEST(DesignTasks, EveryRecordDrawsItsFlowFromItsConditionAndNumberOnly) {
 }
 
 TEST(DesignScores, ErrorStatisticsAreTheDefinitions) {
-  const auto s = pdp::error_stats({0.1, -0.1, 0.3});
+  const auto s = study::error_stats({0.1, -0.1, 0.3});
   EXPECT_EQ(s.count, 3);
   EXPECT_NEAR(s.bias, 0.1, 1e-15);
   EXPECT_NEAR(s.spread, 0.2, 1e-15);  // sqrt((0 + 0.04 + 0.04) / 2)
   EXPECT_NEAR(s.rms, std::sqrt((0.01 + 0.01 + 0.09) / 3), 1e-15);
   // rms^2 = bias^2 + (n - 1) / n spread^2
   EXPECT_NEAR(s.rms * s.rms, s.bias * s.bias + 2.0 / 3.0 * s.spread * s.spread, 1e-15);
-  EXPECT_EQ(pdp::error_stats({}).count, 0);
+  EXPECT_EQ(study::error_stats({}).count, 0);
 }
 
 // Rows of two conditions for candidates with planted errors: u = (1 + eu) u_true, Tu = (1 + et) Tu_true.
-pdp::DesignRow planted(const pdp::DesignCandidate& c, const std::string& condition, double eu, double et,
-                       double seconds = 0.01) {
-  pdp::DesignRow r;
+study::DesignRow planted(const study::DesignCandidate& c, const std::string& condition, double eu, double et,
+                         double seconds = 0.01) {
+  study::DesignRow r;
   r.condition = condition;
   r.candidate = c;
   r.truth_velocity = 4.0;
@@ -139,16 +140,16 @@ pdp::DesignRow planted(const pdp::DesignCandidate& c, const std::string& conditi
 }
 
 TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord) {
-  auto d = pdp::load_design(write("rank.toml", "[conditions.a]\ntu = 0.2\n[conditions.b]\ntu = 0.2\n"
+  auto d = study::load_design(write("rank.toml", "[conditions.a]\ntu = 0.2\n[conditions.b]\ntu = 0.2\n"
                                                "[candidates]\nprobes = [\"2mm,0mm\", \"5mm,0mm\", \"9mm,0mm\"]\n"
                                                "np = [10]\nfs = [\"100kHz\"]\nduration = [\"20s\", \"30s\"]\n"));
   auto all = d.candidates();
   ASSERT_EQ(all.size(), 6u);
   // Rows for four of them: 2 mm at 20 s, 5 mm at 30 s, 9 mm at 20 s, 5 mm at 20 s.
-  const std::vector<pdp::DesignCandidate> c{all[0], all[3], all[4], all[2]};
+  const std::vector<study::DesignCandidate> c{all[0], all[3], all[4], all[2]};
   ASSERT_EQ(c[1].duration, 30.0);
   ASSERT_EQ(c[2].duration, 20.0);
-  std::vector<pdp::DesignRow> rows;
+  std::vector<study::DesignRow> rows;
   // Candidate 0: 0.2 in a, 0.0 in b (worst 0.2); candidate 1: 0.1 in both (worst 0.1, mean 0.1);
   // candidate 2: as 1 but a shorter record; candidate 3: perfect but one record without a value.
   for (int k = 0; k < 2; ++k) {
@@ -163,7 +164,7 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   }
   rows.back().awcc_velocity.reset();
   rows.back().corrected_velocity.reset();
-  const auto ranked = pdp::rank_candidates(d, rows);
+  const auto ranked = study::rank_candidates(d, rows);
   ASSERT_EQ(ranked.size(), 6u);
   // Corrected values: errors halved; score = |u| + |Tu| RMS.
   EXPECT_EQ(ranked[0].candidate, c[2]);  // the same errors as c[1], a shorter record
@@ -184,10 +185,10 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   // The mean over conditions puts candidate 0 (mean 0.1) level with 1 and
   // ahead of 2 (cost); raw values double every score.
   d.objective = "mean";
-  const auto mean = pdp::rank_candidates(d, rows);
+  const auto mean = study::rank_candidates(d, rows);
   EXPECT_NEAR(mean[0].objective, 0.1, 1e-12);
   d.values = "raw";
-  const auto raw = pdp::rank_candidates(d, rows);
+  const auto raw = study::rank_candidates(d, rows);
   EXPECT_NEAR(raw[0].objective, 0.2, 1e-12);
   // Records that disagree: c[1] and c[2] swap their corrected errors (5 and
   // 15 %) between the two records, and c[3]'s record without a value is
@@ -205,7 +206,7 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
       r.corrected_velocity = 4.0 * (1 + e), r.corrected_turbulence_intensity = 0.2 * (1 + e);
     }
   }
-  const auto shares = pdp::rank_candidates(d, noisy);
+  const auto shares = study::rank_candidates(d, noisy);
   double total = 0.0;
   for (const auto& r : shares) total += r.best_share;
   EXPECT_NEAR(total, 1.0, 1e-12);
@@ -221,16 +222,16 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   auto with_needle = d;
   with_needle.needles = {0.0, 1e-3};
   for (auto& r : rows) r.void_fraction = 0.1, r.count_rate = 80.0;
-  const auto needled = pdp::rank_candidates(with_needle, rows);
+  const auto needled = study::rank_candidates(with_needle, rows);
   ASSERT_EQ(needled.size(), 12u);
   for (const auto& n : needled) {
     if (n.candidate.needle == 0.0 || n.candidate.dx != c[1].dx || n.candidate.duration != c[1].duration) continue;
-    const double ratio = pdp::needle_velocity_ratio(4.0, 0.1, 80.0, c[1].dx, 1e-3);
+    const double ratio = study::needle_velocity_ratio(4.0, 0.1, 80.0, c[1].dx, 1e-3);
     EXPECT_NEAR(n.conditions[0].raw_u.bias, ratio * 1.1 - 1.0, 1e-12);
     EXPECT_NEAR(n.conditions[0].raw_tu.bias, 0.1, 1e-12);  // Tu is left alone
   }
   // The ranked CSV: one row per candidate and condition, best first.
-  const auto csv = pdp::ranked_csv(ranked, d);
+  const auto csv = study::ranked_csv(ranked, d);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6 * 2);
   EXPECT_EQ(csv.substr(csv.find('\n') + 1, 2), "1,");
 }
@@ -239,7 +240,7 @@ TEST(DesignScores, TheNeedlesSlowingIsTheInverseOfTheProbeCorrection) {
   // u_m = ratio u0 is the measured velocity whose correction (METHOD 9)
   // gives back u0: by construction, to the bisection's tolerance.
   const double u0 = 3.0, c = 0.08, f = 60.0, dx = 5e-3;
-  const double r = pdp::needle_velocity_ratio(u0, c, f, dx, 0.6e-3);
+  const double r = study::needle_velocity_ratio(u0, c, f, dx, 0.6e-3);
   EXPECT_LT(r, 1.0);
   EXPECT_GT(r, 0.8);
   awcc::ProbeCorrectionOptions o;
@@ -249,49 +250,80 @@ TEST(DesignScores, TheNeedlesSlowingIsTheInverseOfTheProbeCorrection) {
   ASSERT_EQ(back.outcome, awcc::CorrectionOutcome::corrected);
   EXPECT_NEAR(back.velocity, u0, 1e-6 * u0);
   // A thicker needle slows more; no needle, or c above 0.3 (not bubbly), not at all.
-  EXPECT_LT(pdp::needle_velocity_ratio(u0, c, f, dx, 1.2e-3), r);
-  EXPECT_EQ(pdp::needle_velocity_ratio(u0, c, f, dx, 0.0), 1.0);
-  EXPECT_EQ(pdp::needle_velocity_ratio(u0, 0.35, f, dx, 0.6e-3), 1.0);
+  EXPECT_LT(study::needle_velocity_ratio(u0, c, f, dx, 1.2e-3), r);
+  EXPECT_EQ(study::needle_velocity_ratio(u0, c, f, dx, 0.0), 1.0);
+  EXPECT_EQ(study::needle_velocity_ratio(u0, 0.35, f, dx, 0.6e-3), 1.0);
 }
 
 TEST(DesignRows, WrittenRowsReadBackAndForeignOnesAreRefused) {
-  pdp::DesignRow r = planted({3e-3, 0.5e-3, 10, 1e5, 20}, "wall", 0.05, -0.1);
+  study::DesignRow r = planted({3e-3, 0.5e-3, 10, 1e5, 20}, "wall", 0.05, -0.1);
   r.task = 4;
   r.record = 1;
   r.seed = 18446744073709551615ull;
   r.correction_status = "corrected";
   r.correction_forest = "awcc";
-  pdp::DesignRow failed = r;
+  study::DesignRow failed = r;
   failed.awcc_velocity.reset();
   failed.corrected_velocity.reset();
   failed.correction_forest.clear();
   const auto path = pdp_test::test_file("runs.csv");
-  std::ofstream(path) << pdp::design_rows_header() << "\n"
-                      << pdp::design_row_text(r, 99) << "\n"
-                      << pdp::design_row_text(failed, 99) << "\n"
-                      << pdp::design_row_text(r, 99).substr(0, 30);  // cut short by a crash
-  const auto rows = pdp::read_design_rows(path, 99);
+  std::ofstream(path) << study::design_rows_header() << "\n"
+                      << study::design_row_text(r, 99) << "\n"
+                      << study::design_row_text(failed, 99) << "\n"
+                      << study::design_row_text(r, 99).substr(0, 30);  // cut short by a crash
+  const auto rows = study::read_design_rows(path, 99);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].seed, r.seed);
   EXPECT_EQ(rows[0].candidate, r.candidate);
   EXPECT_DOUBLE_EQ(*rows[0].awcc_velocity, *r.awcc_velocity);
   EXPECT_FALSE(rows[1].awcc_velocity);
   EXPECT_EQ(rows[1].correction_forest, "");
-  EXPECT_THROW((void)pdp::read_design_rows(path, 98), awcc::InputError);
-  EXPECT_TRUE(pdp::read_design_rows(pdp_test::test_file("absent.csv"), 99).empty());
+  EXPECT_THROW((void)study::read_design_rows(path, 98), awcc::InputError);
+  EXPECT_TRUE(study::read_design_rows(pdp_test::test_file("absent.csv"), 99).empty());
+}
+
+TEST(DesignRows, AnInterruptedDesignResumesWithoutItsCutShortRecords) {
+  const auto d = study::load_design(write("resume.toml", kTwoConditions));
+  ASSERT_EQ(d.rows_per_task(), 8);
+  const auto path = pdp_test::test_file("resume.runs.csv");
+  std::string text = study::design_rows_header() + "\n";
+  // Tasks 0 and 2 whole, task 5 cut short after three of its eight rows.
+  for (const auto& [task, rows] : {std::pair{0, 8}, std::pair{2, 8}, std::pair{5, 3}}) {
+    for (int k = 0; k < rows; ++k) {
+      auto r = planted({3e-3, 0.5e-3, 10, 1e5, 20}, "wall", 0.01 * k, 0.0);
+      r.task = task;
+      text += study::design_row_text(r, 42) + "\n";
+    }
+  }
+  std::ofstream(path) << text;
+  const auto resumed = study::resume_design(d, {path}, 42);
+  EXPECT_EQ(resumed.done, (std::set<std::int64_t>{0, 2}));
+  EXPECT_EQ(resumed.cut_short, 1);
+  const auto kept = study::read_design_rows(path, 42);
+  EXPECT_EQ(kept.size(), 16u);
+  for (const auto& r : kept) EXPECT_NE(r.task, 5);
+  // A fresh file gets its header; a second look finds the same.
+  const auto fresh = pdp_test::test_file("fresh.runs.csv");
+  std::filesystem::remove(fresh);
+  EXPECT_TRUE(study::resume_design(d, {fresh}, 42).done.empty());
+  std::ifstream in(fresh);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, study::design_rows_header());
+  EXPECT_EQ(study::resume_design(d, {path}, 42).done, resumed.done);
 }
 
 TEST(DesignRecords, EveryPairOfTheMultiTipProbeRecoversThePlantedVelocity) {
   // A short record of a steady, gently turbulent flow: every trailing tip
   // sees the leading tip's bubbles, and AWCC recovers the planted 4 m/s
   // within its lag quantisation (1 sample of 10 us at 2 mm is 2 % of u).
-  const auto d = pdp::load_design(write("steady.toml",
+  const auto d = study::load_design(write("steady.toml",
                                         "[design]\nseeds = 2\n[conditions.steady]\nvelocity = \"4m/s\"\ntu = 0.05\n"
                                         "void-fraction = 0.1\nbubble-diameter = \"3mm\"\ntime-scale = \"50ms\"\n"
                                         "[candidates]\ndx = [\"2mm\", \"5mm\"]\ndy = [\"0mm\", \"0.5mm\"]\nnp = [5, 10]\n"
                                         "fs = [\"100kHz\"]\nduration = [\"4s\"]\n"));
   const auto task = d.task(1);
-  const auto rows = pdp::run_design_task(d, task, nullptr, {});
+  const auto rows = study::run_design_task(d, task, nullptr, {});
   ASSERT_EQ(rows.size(), 8u);
   for (const auto& r : rows) {
     EXPECT_EQ(r.truth_velocity, rows[0].truth_velocity);  // one flow for every pair
@@ -303,7 +335,7 @@ TEST(DesignRecords, EveryPairOfTheMultiTipProbeRecoversThePlantedVelocity) {
   // Rows in geometry, then Np order; the same task gives the same numbers.
   EXPECT_EQ(rows[1].candidate.np, 10);
   EXPECT_EQ(rows[2].candidate.dy, 0.5e-3);
-  const auto again = pdp::run_design_task(d, task, nullptr, {});
+  const auto again = study::run_design_task(d, task, nullptr, {});
   for (std::size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(again[i].awcc_velocity, rows[i].awcc_velocity);
     EXPECT_EQ(again[i].awcc_turbulence_intensity, rows[i].awcc_turbulence_intensity);

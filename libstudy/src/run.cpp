@@ -1,88 +1,91 @@
-#include "study.hpp"
+#include "study/run.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
+#include <stdexcept>
 
-#include "awcc/phase_statistics.hpp"
-#include "terminal.hpp"
-#include "synth/synthesiser.hpp"
+#include "study/clock.hpp"
 
-namespace pdp {
+namespace study {
 
 std::optional<double> Score::error() const {
   if (!value || !(truth != 0.0)) return std::nullopt;
   return *value / truth - 1.0;
 }
 
+awcc::ProcessOptions processing_options(const RunOptions& options, double dx, double dy) {
+  awcc::ProcessOptions p;
+  p.dx = dx;
+  p.dy = dy;
+  p.fscc = options.run_fscc;
+  p.awcc = options.run_awcc;
+  p.fscc_options = options.fscc;
+  p.awcc_options = options.awcc;
+  p.structure.enabled = false;
+  p.velocity_spectrum = false;
+  return p;
+}
 
 namespace {
 
-// Student t 0.975 quantile for df degrees of freedom.
-double t975(std::int64_t df) {
-  static const double table[] = {0, 12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
-                                 2.201, 2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
-                                 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
-  if (df <= 0) return 0.0;
-  if (df <= 30) return table[df];
-  return 1.96 + 2.4 / static_cast<double>(df);  // within 0.002 of the exact quantile above 30
+// A binary channel as process.cpp reads one (TwoLevelScan): the histogram of
+// its two levels, 0 water and 1 air (volts unknown, one count per level).
+awcc::VoltageHistogram two_levels(const awcc::AirIntervals& signal) {
+  awcc::VoltageHistogram h(1.0);
+  const std::int64_t air = signal.air_samples();
+  const std::int64_t counts[2] = {signal.sample_count - air, air};
+  h.add_counts(counts, 0);
+  return h;
 }
 
 }  // namespace
 
-Summary95 summarise95(const std::vector<double>& values) {
-  Summary95 s;
-  s.count = static_cast<std::int64_t>(values.size());
-  if (values.empty()) return s;
-  double sum = 0;
-  for (double v : values) sum += v;
-  s.mean = sum / static_cast<double>(values.size());
-  if (values.size() < 2) {
-    s.lower = s.upper = s.mean;
-    return s;
-  }
-  double ss = 0;
-  for (double v : values) ss += (v - s.mean) * (v - s.mean);
-  const double sd = std::sqrt(ss / static_cast<double>(values.size() - 1));
-  const double half = t975(s.count - 1) * sd / std::sqrt(static_cast<double>(values.size()));
-  s.lower = s.mean - half;
-  s.upper = s.mean + half;
-  return s;
+awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
+                                             const awcc::BinarisationOptions& binarisation) {
+  awcc::BinarisedRecording out;
+  out.info.description = "synthesised binary signals";
+  out.info.channels = 2;
+  out.info.fs = leading.fs;
+  out.info.frames = leading.sample_count;
+  out.info.quantum = 1.0;
+  out.leading_histogram = two_levels(leading);
+  out.trailing_histogram = two_levels(trailing);
+  out.leading_threshold = awcc::choose_threshold(*out.leading_histogram, binarisation);
+  out.trailing_threshold = awcc::choose_threshold(*out.trailing_histogram, binarisation.for_trailing_tip());
+  out.leading = std::move(leading);
+  out.trailing = std::move(trailing);
+  return out;
 }
 
-correction::Measurement awcc_measurement(const awcc::AwccResult& result, const awcc::PhaseStatistics& lead,
-                                         double dx, double dy, int np, double fs, double duration) {
-  correction::Measurement m;
-  if (result.ok()) {
-    m.velocity = result.velocity;
-    m.turbulence_intensity = result.turbulence_intensity;
+awcc::ProcessResult process_synthesis(awcc::AirIntervals leading, awcc::AirIntervals trailing,
+                                      const awcc::ProcessOptions& options) {
+  if (options.awcc_options.signal != awcc::CorrelationSignal::binary) {
+    throw std::invalid_argument(
+        "signal = raw: a synthesised record in memory holds binary signals only; write it as a voltage recording "
+        "(synth::write_recording) and process the file");
   }
-  m.void_fraction = lead.void_fraction;
-  m.bubble_count_rate = lead.bubble_count_rate;
-  m.dx = dx;
-  m.dy = dy;
-  m.np = np;
-  m.windows_accepted = result.windows_accepted;
-  m.windows_total = result.windows_total;
-  m.fs = fs;
-  m.duration = duration;
-  return m;
+  return awcc::process_binarised(binarised_recording(std::move(leading), std::move(trailing), options.binarisation),
+                                 options);
 }
 
-RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
+synth::Synthesis synthesise_pair(const synth::Scene& scene, const synth::SynthesisOptions& options) {
   // Processing correlates the first two tips: a study needs them (a one-tip
   // scene is fine for pdp synth, not here).
   if (scene.probe_tips().size() < 2) {
     throw std::invalid_argument(fmt::format("tips: the scene has {} tip; FSCC and AWCC need two (give tips or dx)",
                                             scene.probe_tips().size()));
   }
+  return synth::synthesise(scene, options);
+}
+
+RunResult run_scene(const synth::Scene& scene, const RunOptions& options) {
   RunResult r;
   r.scene = scene;
   synth::SynthesisOptions so;
   so.keep_velocity_history = options.window_truth && options.run_awcc;
   auto start = std::chrono::steady_clock::now();
-  const auto syn = synth::synthesise(scene, so);
+  auto syn = synthesise_pair(scene, so);
   r.seconds_synth = seconds_since(start);
   const auto& truth = syn.truth;
   r.truth_velocity = truth.realised.mean_velocity[0];
@@ -95,50 +98,36 @@ RunResult run_scene(const synth::Scene& scene, const StudyOptions& options) {
     r.truth_d32 = scene.bubble_diameter * std::exp(2.5 * s * s);
     if (s == 0.0) r.truth_d32 = scene.bubble_diameter;
   }
-  const auto& lead = syn.signals[0];
-  const auto& trail = syn.signals[1];
   r.dx = scene.streamwise_separation();
   r.dy = scene.lateral_separation();
-  const double dx = r.dx;
 
   start = std::chrono::steady_clock::now();
-  const auto phase = awcc::phase_statistics(lead);
-  r.void_fraction = phase.void_fraction;
-  r.count_rate = phase.bubble_count_rate;
-  if (options.run_fscc) {
-    const auto t = std::chrono::steady_clock::now();
-    r.fscc = awcc::fscc(lead, trail, dx, options.fscc);
-    r.seconds_fscc = seconds_since(t);
-  }
-  if (options.run_awcc) {
-    const auto t = std::chrono::steady_clock::now();
-    r.awcc = awcc::awcc(lead, trail, dx, options.awcc);
-    r.seconds_awcc = seconds_since(t);
-  }
+  r.processed = process_synthesis(std::move(syn.signals[0]), std::move(syn.signals[1]),
+                                  processing_options(options, r.dx, r.dy));
   r.seconds_process = seconds_since(start);
+  r.measurement = correction::measurement_of(r.processed);
 
-  auto d32 = [&](double u) -> std::optional<double> {
-    if (!(r.count_rate > 0.0)) return std::nullopt;
-    return 1.5 * u * r.void_fraction / r.count_rate;
-  };
-  r.void_fraction_score = {r.void_fraction, r.truth_void_fraction};
-  r.count_rate_score = {r.count_rate, r.truth_count_rate};
+  const auto& p = r.processed;
+  const auto& lead = p.tips.at(0).phase;
+  r.void_fraction = {lead.void_fraction, r.truth_void_fraction};
+  r.count_rate = {lead.bubble_count_rate, r.truth_count_rate};
   r.fscc_velocity.truth = r.awcc_velocity.truth = r.truth_velocity;
   r.fscc_turbulence_intensity.truth = r.awcc_turbulence_intensity.truth = r.truth_turbulence_intensity;
   r.fscc_d32.truth = r.awcc_d32.truth = r.truth_d32;
-  if (r.fscc && r.fscc->ok()) {
-    r.fscc_velocity.value = r.fscc->velocity;
-    r.fscc_turbulence_intensity.value = r.fscc->turbulence_intensity_chanson;
-    r.fscc_d32.value = d32(r.fscc->velocity);
+  if (p.fscc && p.fscc->ok()) {
+    r.fscc_velocity.value = p.fscc->velocity;
+    r.fscc_turbulence_intensity.value = p.fscc->turbulence_intensity_chanson;
   }
-  if (r.awcc && r.awcc->ok()) {
-    r.awcc_velocity.value = r.awcc->velocity;
-    r.awcc_turbulence_intensity.value = r.awcc->turbulence_intensity;
-    r.awcc_d32.value = d32(r.awcc->velocity);
+  if (p.awcc && p.awcc->ok()) {
+    r.awcc_velocity.value = p.awcc->velocity;
+    r.awcc_turbulence_intensity.value = p.awcc->turbulence_intensity;
   }
-  if (r.awcc && syn.history) {
+  const auto source = p.velocity_source();
+  if (source == awcc::VelocitySource::fscc) r.fscc_d32.value = lead.sauter_diameter;
+  if (source == awcc::VelocitySource::awcc) r.awcc_d32.value = lead.sauter_diameter;
+  if (p.awcc && syn.history) {
     std::vector<double> diff, accepted, rejected;
-    for (const auto& w : r.awcc->windows) {
+    for (const auto& w : p.awcc->windows) {
       const double t = syn.history->mean_velocity(w.start_time, w.start_time + w.duration);
       if (w.fate == awcc::WindowFate::accepted) {
         diff.push_back(w.velocity - t);
@@ -177,6 +166,7 @@ json spread_json(const awcc::Summary& s) {
 }  // namespace
 
 json run_to_json(const RunResult& r) {
+  const auto& p = r.processed;
   json out;
   out["seed"] = r.scene.seed;
   out["truth"] = {{"velocity", r.truth_velocity},
@@ -184,30 +174,28 @@ json run_to_json(const RunResult& r) {
                   {"void_fraction", r.truth_void_fraction},
                   {"bubble_count_rate", r.truth_count_rate},
                   {"d32", r.truth_d32}};
-  out["phase"] = {{"void_fraction", r.void_fraction}, {"bubble_count_rate", r.count_rate}};
-  if (r.fscc) {
-    out["fscc"] = {{"status", awcc::to_string(r.fscc->status)},
-                   {"defined", r.fscc->ok()},
-                   {"reason", r.fscc->ok() ? json(nullptr) : json(r.fscc->message)},
+  out["phase"] = {{"void_fraction", opt(r.void_fraction.value)}, {"bubble_count_rate", opt(r.count_rate.value)}};
+  if (p.fscc) {
+    out["fscc"] = {{"status", awcc::to_string(p.fscc->status)},
+                   {"defined", p.fscc->ok()},
+                   {"reason", p.fscc->ok() ? json(nullptr) : json(p.fscc->message)},
                    {"velocity", opt(r.fscc_velocity.value)},
                    {"turbulence_intensity_chanson", opt(r.fscc_turbulence_intensity.value)},
-                   {"r12_max", r.fscc->r12_max},
-                   {"d32", opt(r.fscc_d32.value)},
-                   {"seconds", r.seconds_fscc}};
+                   {"r12_max", p.fscc->r12_max},
+                   {"d32", opt(r.fscc_d32.value)}};
   }
-  if (r.awcc) {
-    out["awcc"] = {{"status", awcc::to_string(r.awcc->status)},
-                   {"defined", r.awcc->ok()},
-                   {"reason", r.awcc->ok() ? json(nullptr) : json(r.awcc->message)},
+  if (p.awcc) {
+    out["awcc"] = {{"status", awcc::to_string(p.awcc->status)},
+                   {"defined", p.awcc->ok()},
+                   {"reason", p.awcc->ok() ? json(nullptr) : json(p.awcc->message)},
                    {"velocity", opt(r.awcc_velocity.value)},
                    {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},
                    {"d32", opt(r.awcc_d32.value)},
-                   {"windows_total", r.awcc->windows_total},
-                   {"windows_accepted", r.awcc->windows_accepted},
-                   {"seconds", r.seconds_awcc}};
+                   {"windows_total", p.awcc->windows_total},
+                   {"windows_accepted", p.awcc->windows_accepted}};
   }
-  out["error"] = {{"void_fraction", opt(r.void_fraction_score.error())},
-                  {"bubble_count_rate", opt(r.count_rate_score.error())},
+  out["error"] = {{"void_fraction", opt(r.void_fraction.error())},
+                  {"bubble_count_rate", opt(r.count_rate.error())},
                   {"fscc", {{"velocity", opt(r.fscc_velocity.error())},
                             {"turbulence_intensity", opt(r.fscc_turbulence_intensity.error())},
                             {"d32", opt(r.fscc_d32.error())}}},
@@ -224,6 +212,7 @@ json run_to_json(const RunResult& r) {
 }
 
 std::string run_report(const RunResult& r) {
+  const auto& p = r.processed;
   std::string out;
   auto val = [](const std::optional<double>& v, const char* f) {
     return v ? fmt::format(fmt::runtime(f), *v) : std::string("n/a");
@@ -232,6 +221,7 @@ std::string run_report(const RunResult& r) {
     const auto e = s.error();
     return e ? fmt::format("{:+.2f} %", 100.0 * *e) : std::string("n/a");
   };
+  auto mm = [](const std::optional<double>& v) { return v ? std::optional(*v * 1e3) : std::nullopt; };
   out += fmt::format("{:<26}{:>12}{:>12}{:>10}{:>12}{:>10}\n", "quantity", "truth", "FSCC", "error", "AWCC", "error");
   out += fmt::format("{:<26}{:>12.4f}{:>12}{:>10}{:>12}{:>10}\n", "mean velocity (m/s)", r.truth_velocity,
                      val(r.fscc_velocity.value, "{:.4f}"), err(r.fscc_velocity), val(r.awcc_velocity.value, "{:.4f}"),
@@ -240,21 +230,22 @@ std::string run_report(const RunResult& r) {
                      val(r.fscc_turbulence_intensity.value, "{:.4f}"), err(r.fscc_turbulence_intensity),
                      val(r.awcc_turbulence_intensity.value, "{:.4f}"), err(r.awcc_turbulence_intensity));
   out += fmt::format("{:<26}{:>12.3f}{:>12}{:>10}{:>12}{:>10}\n", "d32 (mm)", r.truth_d32 * 1e3,
-                     val(r.fscc_d32.value ? std::optional(*r.fscc_d32.value * 1e3) : std::nullopt, "{:.3f}"),
-                     err(r.fscc_d32), val(r.awcc_d32.value ? std::optional(*r.awcc_d32.value * 1e3) : std::nullopt, "{:.3f}"),
+                     val(mm(r.fscc_d32.value), "{:.3f}"), err(r.fscc_d32), val(mm(r.awcc_d32.value), "{:.3f}"),
                      err(r.awcc_d32));
-  out += fmt::format("{:<26}{:>12.5f}{:>12.5f}{:>10}   (phase statistics, both methods)\n", "void fraction",
-                     r.truth_void_fraction, r.void_fraction, err(r.void_fraction_score));
-  out += fmt::format("{:<26}{:>12.2f}{:>12.2f}{:>10}   (phase statistics, both methods)\n", "bubble count rate (1/s)",
-                     r.truth_count_rate, r.count_rate, err(r.count_rate_score));
-  out += "(FSCC turbulence intensity: Chanson's estimate)\n";
-  if (r.fscc && !r.fscc->ok()) out += "FSCC undefined: " + r.fscc->message + "\n";
-  if (r.awcc) {
-    if (!r.awcc->ok()) out += "AWCC undefined: " + r.awcc->message + "\n";
+  out += fmt::format("{:<26}{:>12.5f}{:>12}{:>10}   (phase statistics, both methods)\n", "void fraction",
+                     r.truth_void_fraction, val(r.void_fraction.value, "{:.5f}"), err(r.void_fraction));
+  out += fmt::format("{:<26}{:>12.2f}{:>12}{:>10}   (phase statistics, both methods)\n", "bubble count rate (1/s)",
+                     r.truth_count_rate, val(r.count_rate.value, "{:.2f}"), err(r.count_rate));
+  out += "(FSCC turbulence intensity: Chanson's estimate; d32 from the velocity pdp process chooses: AWCC's of "
+         "quality ok, else FSCC's)\n";
+  if (p.fscc && !p.fscc->ok()) out += "FSCC undefined: " + p.fscc->message + "\n";
+  if (p.awcc) {
+    const auto& a = *p.awcc;
+    if (!a.ok()) out += "AWCC undefined: " + a.message + "\n";
     out += fmt::format("AWCC windows: {} accepted of {} ({} correlation, {} lag, {} outlier cutoff, {} constant)\n",
-                       r.awcc->windows_accepted, r.awcc->windows_total, r.awcc->count(awcc::WindowFate::correlation),
-                       r.awcc->count(awcc::WindowFate::lag), r.awcc->count(awcc::WindowFate::roc),
-                       r.awcc->count(awcc::WindowFate::constant));
+                       a.windows_accepted, a.windows_total, a.count(awcc::WindowFate::correlation),
+                       a.count(awcc::WindowFate::lag), a.count(awcc::WindowFate::roc),
+                       a.count(awcc::WindowFate::constant));
     if (r.window_bias) {
       out += fmt::format("window level: AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms {:.4f} m/s\n",
                          *r.window_bias, *r.window_rms);
@@ -264,9 +255,9 @@ std::string run_report(const RunResult& r) {
                          label, s->mean, s->std, s->percentiles[2], s->median, s->percentiles[4], s->count);
     }
   }
-  out += fmt::format("run time: synthesis {:.3f} s, processing {:.3f} s (FSCC {:.3f} s, AWCC {:.3f} s)\n",
-                     r.seconds_synth, r.seconds_process, r.seconds_fscc, r.seconds_awcc);
+  out += fmt::format("run time: synthesis {:.3f} s, processing {:.3f} s (phase statistics, FSCC and AWCC, as pdp process)\n",
+                     r.seconds_synth, r.seconds_process);
   return out;
 }
 
-}  // namespace pdp
+}  // namespace study

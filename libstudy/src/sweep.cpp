@@ -1,4 +1,6 @@
-#include "sweep.hpp"
+#include "study/sweep.hpp"
+
+#include "definition.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,21 +9,19 @@
 #include <sstream>
 #include <stdexcept>
 #include "awcc/errors.hpp"
+#include "correction/features.hpp"
 #include "awcc/settings_file.hpp"
 
 #include "awcc/units.hpp"
 #include "awcc/random.hpp"
 #include "synth/random.hpp"
 
-namespace pdp {
+namespace study {
 namespace {
 
-bool is_field(const std::string& name) {
-  if (name == "np" || name == "anisotropy") return true;
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return true;
-  return false;
-}
+using detail::dimension_of;
+
+bool is_field(const std::string& name) { return name == "np" || name == "anisotropy" || detail::is_scene_field(name); }
 
 // Applies one value (text) of a field or of np/anisotropy to a run.
 void apply(SweepRun& run, const std::string& name, const std::string& text) {
@@ -36,11 +36,8 @@ void apply(SweepRun& run, const std::string& name, const std::string& text) {
   }
 }
 
-awcc::Dimension dimension_of(const std::string& name) {
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return f.dimension;
-  return awcc::Dimension::dimensionless;
-}
+constexpr const char* kUnknownField = "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, "
+                                      "bubble-diameter, dx, fs, duration, ...), np or anisotropy";
 
 }  // namespace
 
@@ -48,14 +45,9 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
   SweepDefinition d;
   const std::string file = path.string();
   auto fail = [&](const std::string& where, const std::string& what) -> void {
-    throw std::runtime_error(fmt::format("{}: {}: {}", file, where, what));
+    throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
   };
-  std::vector<awcc::SettingTable> tables;
-  try {
-    tables = awcc::read_setting_tables(path);
-  } catch (const awcc::InputError& e) {
-    throw std::runtime_error(e.what());
-  }
+  const auto tables = detail::definition_tables(path);
   std::map<std::string, const awcc::SettingTable*> by_name;
   for (const auto& t : tables) {
     if (t.name.empty()) {
@@ -98,12 +90,12 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
     }
   };
   for (const auto& s : table("base")) {
-    if (!is_field(s.key)) fail("[base] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
+    if (!is_field(s.key)) fail("[base] " + s.key, kUnknownField);
     check_value("[base] " + s.key, s.key, s.text);
     d.base[s.key] = s.text;
   }
   for (const auto& s : table("grid")) {
-    if (!is_field(s.key)) fail("[grid] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
+    if (!is_field(s.key)) fail("[grid] " + s.key, kUnknownField);
     if (s.items.empty()) fail("[grid] " + s.key, "must be a non-empty list of values");
     for (const auto& text : s.items) {
       check_value("[grid] " + s.key, s.key, text);
@@ -115,7 +107,7 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
                 {"void-fraction", {0.005, 0.4}}, {"bubble-diameter", {0.5e-3, 20e-3}}, {"dx", {0.5e-3, 10e-3}}};
   }
   for (const auto& s : table("ranges")) {
-    if (!is_field(s.key)) fail("[ranges] " + s.key, "unknown field; use the names of pdp synth --help, np or anisotropy");
+    if (!is_field(s.key)) fail("[ranges] " + s.key, kUnknownField);
     const bool log = s.items.size() == 3 && s.items[2] == "log";
     if (s.items.size() != 2 && !log) fail("[ranges] " + s.key, "must be [min, max], or [min, max, \"log\"] for a log-uniform draw");
     double ends[2];
@@ -215,14 +207,7 @@ std::vector<SweepRun> SweepDefinition::expand() const {
   return out;
 }
 
-std::uint64_t study_id(const SweepDefinition& d) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : d.canonical) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h >> 1;
-}
+std::uint64_t study_id(const SweepDefinition& d) { return detail::definition_id(d.canonical); }
 
 namespace {
 
@@ -290,36 +275,52 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
     row += ',';
     row += clean(v);
   }
-  auto opt = [](bool ok, double v) { return ok ? std::optional<double>(v) : std::nullopt; };
   row += fmt::format(",{},{:.10g}", run.np, run.anisotropy);
-  const std::string trailing =
-      fmt::format(",{:.10g},{:.10g},{:.10g},{},{},{},{}", run.scene.streamwise_separation(),
-                  run.scene.lateral_separation(), processing.filter_a,
-                  processing.roc ? "on" : "off", awcc::to_string(processing.weighting), awcc::to_string(processing.signal),
-                  awcc::to_string(processing.subsample));
+  auto trailing = [&](double dx, double dy) {
+    return fmt::format(",{:.10g},{:.10g},{:.10g},{},{},{},{}", dx, dy, processing.filter_a, processing.roc ? "on" : "off",
+                       awcc::to_string(processing.weighting), awcc::to_string(processing.signal),
+                       awcc::to_string(processing.subsample));
+  };
   if (!r) {
     for (std::size_t i = 2; i + 1 + kTrailingColumns < std::size(kResultColumns); ++i) row += ",";
     row += "," + clean(error);
-    return row + trailing;
+    return row + trailing(run.scene.streamwise_separation(), run.scene.lateral_separation());
   }
-  const bool a = r->awcc && r->awcc->ok();
-  const bool f = r->fscc && r->fscc->ok();
+  // What the correction reads is the measurement's; the scores are of what
+  // pdp process reports.
+  const auto& m = r->measurement.measurement;
+  const auto& fscc = r->processed.fscc;
+  const auto& awcc = r->processed.awcc;
+  auto count = [](std::int64_t n) { return n >= 0 ? std::to_string(n) : std::string(); };
   std::string reason = error;
-  if (r->awcc && !r->awcc->ok()) reason += "awcc: " + r->awcc->message;
+  if (awcc && !awcc->ok()) reason += "awcc: " + awcc->message;
+  else if (r->measurement.status == correction::CorrectionStatus::probe_corrected) reason += "awcc: " + r->measurement.message;
   row += "," + num(r->truth_velocity) + "," + num(r->truth_turbulence_intensity) + "," + num(r->truth_void_fraction) +
          "," + num(r->truth_count_rate) + "," + num(r->truth_d32);
-  row += "," + num(opt(a, a ? r->awcc->velocity : 0)) + "," + num(opt(a, a ? r->awcc->turbulence_intensity : 0)) + "," +
-         num(r->void_fraction) + "," + num(r->count_rate) + "," + num(r->awcc_d32.value);
-  row += "," + (r->awcc ? std::to_string(r->awcc->windows_accepted) : std::string()) + "," +
-         (r->awcc ? std::to_string(r->awcc->windows_total) : std::string());
+  row += "," + num(m.velocity) + "," + num(m.turbulence_intensity) + "," + num(m.void_fraction) + "," +
+         num(m.bubble_count_rate) + "," + num(r->awcc_d32.value);
+  row += "," + count(m.windows_accepted) + "," + count(m.windows_total);
   row += "," + num(r->awcc_velocity.error()) + "," + num(r->awcc_turbulence_intensity.error()) + "," +
          num(r->awcc_d32.error());
-  row += "," + num(opt(f, f ? r->fscc->velocity : 0)) + "," + num(r->fscc ? r->fscc->turbulence_intensity_chanson : std::nullopt) +
-         "," + num(r->fscc ? std::optional(r->fscc->r12_max) : std::nullopt) + "," + num(r->fscc_velocity.error());
+  row += "," + num(m.fscc_velocity) + "," + num(fscc ? fscc->turbulence_intensity_chanson : std::nullopt) + "," +
+         num(fscc ? std::optional(fscc->r12_max) : std::nullopt) + "," + num(r->fscc_velocity.error());
   row += "," + num(r->window_bias) + "," + num(r->window_rms);
-  row += fmt::format(",{:.4f},{:.4f},{:.4f},{:.4f}", r->seconds_synth, r->seconds_process, r->seconds_fscc, r->seconds_awcc);
+  // FSCC and AWCC run together, as in pdp process: their own seconds are not
+  // measured (seconds_fscc and seconds_awcc stay empty).
+  row += fmt::format(",{:.4f},{:.4f},,", r->seconds_synth, r->seconds_process);
   row += "," + clean(reason);
-  return row + trailing;
+  return row + trailing(m.dx, m.dy);
+}
+
+std::string run_sweep_row(const SweepRun& run, const RunOptions& options, std::uint64_t study) {
+  RunOptions o = options;
+  o.awcc.np = run.np;
+  try {
+    const RunResult r = run_scene(run.scene, o);
+    return sweep_row(run, &r, "", study, o.awcc) + "\n";
+  } catch (const std::exception& e) {
+    return sweep_row(run, nullptr, e.what(), study, o.awcc) + "\n";
+  }
 }
 
 std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint64_t study) {
@@ -336,8 +337,9 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
   const std::string header = sweep_header();
   const auto first_newline = content.find('\n');
   if (first_newline == std::string::npos || content.substr(0, first_newline) != header) {
-    throw std::runtime_error(fmt::format(
-        "{}: not a pdp sweep CSV (its header differs); refusing to append to it: choose another -o file or remove it",
+    throw awcc::InputError(fmt::format(
+        "{}: not a pdp sweep CSV (its header differs); refusing to append to it: write the study to another file or "
+        "remove this one",
         csv.string()));
   }
   // A crash can leave a partial last row: cut it off.
@@ -364,14 +366,14 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
       run = -1;
     }
     if (cells != columns || run < 0 || c1 == std::string_view::npos) {
-      throw std::runtime_error(fmt::format("{}:{}: malformed row; the file is not a sweep CSV written by pdp; refusing "
-                                           "to append to it",
-                                           csv.string(), line));
+      throw awcc::InputError(fmt::format("{}:{}: malformed row; the file is not a sweep CSV written by pdp; refusing "
+                                         "to append to it",
+                                         csv.string(), line));
     }
     if (id != study) {
-      throw std::runtime_error(fmt::format("{}:{}: the row belongs to another study (its sweep definition differs); "
-                                           "write this study to another -o file",
-                                           csv.string(), line));
+      throw awcc::InputError(fmt::format("{}:{}: the row belongs to another study (its sweep definition differs); "
+                                         "write this study to another file",
+                                         csv.string(), line));
     }
     done.insert(run);
     pos = end + 1;
@@ -379,4 +381,4 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
   return done;
 }
 
-}  // namespace pdp
+}  // namespace study

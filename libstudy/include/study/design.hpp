@@ -9,14 +9,14 @@
 //                       over the conditions, default) or "mean"; values:
 //                       "corrected" (default: the model's median where it
 //                       corrects, AWCC's value elsewhere) or "raw"; model: the
-//                       correction model (.qrf; the command line's --model wins)
+//                       correction model (.qrf; a model the caller gives wins)
 //   [conditions.NAME]   the flow at one place, in the quantities a lab can
 //                       estimate before measuring: velocity, tu, anisotropy
 //                       (Tu_y/Tu_x = Tu_z/Tu_x, default 0.5), time-scale,
 //                       void-fraction, bubble-diameter; each a value, a range
 //                       [min, max] (uniform) or [min, max, "log"] (log-uniform):
 //                       each record draws its own values. Other scene fields
-//                       (pdp synth --help) as values. At least one condition.
+//                       (synth::scene_fields) as values. At least one condition.
 //   [candidates]        dx and dy: lists whose grid is tried (default 1, 2,
 //                       3, 5, 7.5, 10 mm x 0, 0.5, 1, 2 mm), or probes = list of
 //                       "dx,dy" (existing probes) instead; np (5, 10, 20); fs
@@ -30,10 +30,12 @@
 // that every geometry sees the same bubbles and velocity (common random
 // numbers: the differences between candidates carry less noise than
 // independent records would). The velocity step is the one the closest pair
-// alone would get (METHOD 5: it resolves the shortest transit). AWCC then
-// processes the leading tip with each trailing tip at each Np, and the model
-// corrects each result; FSCC runs only for a result the AWCC forest cannot
-// take when the model's FSCC forest could. Record k of a condition has seed
+// alone would get (METHOD 5: it resolves the shortest transit). Each pair
+// (the leading tip with one trailing tip) is processed at each Np as pdp
+// process processes a recording (awcc::process_binarised: phase statistics,
+// FSCC, AWCC and the tip-order rule), and the model corrects each result's
+// measurement (correction::measurement_of), with its FSCC forest where the
+// AWCC forest cannot take it. Record k of a condition has seed
 // derive_seed(seed, k) mixed with the condition's name, and draws its flow
 // from that seed, whatever the candidates, fs or duration: adding a
 // candidate changes no other row.
@@ -41,8 +43,8 @@
 // Scores of a candidate in a condition, over its records: the error of the
 // mean velocity (u / u_true - 1) and of Tu (Tu / Tu_true - 1, relative as the
 // paper's +/- 20 % is), each as bias (mean), spread (sd, n - 1) and RMS
-// (sqrt(bias^2 + (n - 1)/n sd^2)); the data yield; AWCC's CPU seconds per
-// record. The score of a candidate in a condition is RMS_u + RMS_Tu of the
+// (sqrt(bias^2 + (n - 1)/n sd^2)); the data yield; the CPU seconds of the
+// processing and correction per record. The score of a candidate in a condition is RMS_u + RMS_Tu of the
 // values ranked on; its objective the worst (or the mean) over conditions.
 // The needle (optional): the synthetic tips are points, so a needle is not
 // simulated; its slowing of the pierced bubbles (METHOD 9) is predicted per
@@ -71,7 +73,7 @@
 #include "correction/model.hpp"
 #include "synth/scene.hpp"
 
-namespace pdp {
+namespace study {
 
 struct DesignCondition {
   std::string name;
@@ -125,7 +127,7 @@ struct DesignDefinition {
   [[nodiscard]] std::int64_t rows_per_task() const;
 };
 
-/// Reads and checks a design file; throws std::runtime_error naming the
+/// Reads and checks a design file; throws std::invalid_argument naming the
 /// file, the table and key, and the fix.
 DesignDefinition load_design(const std::filesystem::path& path);
 
@@ -145,13 +147,14 @@ struct DesignRow {
   std::int64_t windows_accepted = 0, windows_total = 0;
   std::optional<double> corrected_velocity, corrected_turbulence_intensity;
   std::string correction_status, correction_forest;  ///< forest empty when not corrected
-  double seconds_awcc = 0.0;   ///< CPU seconds of AWCC (and FSCC where the FSCC forest needed it)
+  double seconds_awcc = 0.0;   ///< CPU seconds of the processing (FSCC and AWCC) and the correction
   double seconds_synth = 0.0;  ///< the record's synthesis, shared by its rows
 };
 
 /// Simulates one task's record and processes every pair at every Np (the
-/// AWCC settings of `processing` otherwise), correcting with `model` when
-/// given. Rows in geometry, then Np order.
+/// AWCC settings of `processing` otherwise; FSCC with its defaults), as pdp
+/// process would, correcting with `model` when given. Rows in geometry, then
+/// Np order.
 std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTask& task,
                                        const correction::CorrectionModel* model, const awcc::AwccOptions& processing);
 
@@ -160,6 +163,24 @@ std::string design_row_text(const DesignRow& row, std::uint64_t design);
 /// The rows of this design in a runs CSV (header checked; rows of another
 /// design refused; a partial last line cut off).
 std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::uint64_t design);
+
+/// Where an interrupted design stands.
+struct DesignResume {
+  std::set<std::int64_t> done;   ///< tasks whose every row is in the runs files
+  std::int64_t cut_short = 0;    ///< tasks an interruption cut short: their rows removed, they run again
+};
+/// Reads the runs files of this design (rows of another design refused), and
+/// prepares the first for appending: a task is written in one write, so a
+/// crash inside it leaves it partial, and its rows go; an absent or empty
+/// file gets the header.
+DesignResume resume_design(const DesignDefinition& d, const std::vector<std::filesystem::path>& runs,
+                           std::uint64_t design);
+
+/// Seconds the tasks take on one thread, from a pilot of each condition and
+/// rate (its first task, `pilot_seconds` of record) scaled by record length.
+double estimate_design_seconds(const DesignDefinition& d, const std::vector<std::int64_t>& tasks,
+                               const correction::CorrectionModel* model, const awcc::AwccOptions& processing,
+                               double pilot_seconds = 2.0);
 
 /// Error statistics of one quantity over the records.
 struct ErrorStats {
@@ -214,4 +235,4 @@ std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignD
 std::string design_summary(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d,
                            const std::string& model_note);
 
-}  // namespace pdp
+}  // namespace study

@@ -1,6 +1,9 @@
-#include "design.hpp"
+#include "study/design.hpp"
+
+#include "definition.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fmt/format.h>
 #include <fstream>
@@ -8,46 +11,28 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "awcc/atomic_output.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/random.hpp"
 #include "awcc/settings_file.hpp"
 #include "awcc/units.hpp"
-#include "awcc/fscc.hpp"
-#include "awcc/phase_statistics.hpp"
 #include "awcc/probe_correction.hpp"
-#include "study.hpp"
+#include "correction/features.hpp"
+#include "study/clock.hpp"
+#include "study/run.hpp"
 #include "synth/random.hpp"
 #include "synth/synthesiser.hpp"
-#include "terminal.hpp"
 
-namespace pdp {
+namespace study {
 namespace {
 
 // The flow quantities of a condition that may be ranges.
 const std::set<std::string> kRangeable{"velocity", "tu", "anisotropy", "time-scale", "void-fraction",
                                        "bubble-diameter"};
 
-bool is_scene_field(const std::string& name) {
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return true;
-  return false;
-}
-
-awcc::Dimension dimension_of(const std::string& name) {
-  for (const auto& f : synth::scene_fields())
-    if (f.name == name) return f.dimension;
-  return awcc::Dimension::dimensionless;
-}
-
-std::uint64_t fnv(std::string_view text) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
+using detail::dimension_of;
+using detail::is_scene_field;
 
 std::string num(double v) { return fmt::format("{:.10g}", v); }
 std::string num(const std::optional<double>& v) { return v ? num(*v) : std::string(); }
@@ -63,14 +48,9 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   DesignDefinition d;
   const std::string file = path.string();
   auto fail = [&](const std::string& where, const std::string& what) -> void {
-    throw std::runtime_error(fmt::format("{}: {}: {}", file, where, what));
+    throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
   };
-  std::vector<awcc::SettingTable> tables;
-  try {
-    tables = awcc::read_setting_tables(path, {"conditions"});
-  } catch (const awcc::InputError& e) {
-    throw std::runtime_error(e.what());
-  }
+  const auto tables = detail::definition_tables(path, {"conditions"});
   auto quantity = [&](const std::string& where, const std::string& text, awcc::Dimension dim) {
     try {
       return awcc::parse_quantity(text, dim);
@@ -120,7 +100,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
       }
       for (const auto& s : t.settings) {
         const std::string where = "[" + t.name + "] " + s.key;
-        if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use the names of pdp synth --help or anisotropy");
+        if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, bubble-diameter, ...) or anisotropy");
         if (s.key == "seed" || s.key == "dx" || s.key == "dy" || s.key == "dz" || s.key == "tips" || s.key == "fs" ||
             s.key == "duration") {
           fail(where, "the probe and the record are candidates: give them in [candidates]");
@@ -254,7 +234,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   return d;
 }
 
-std::uint64_t design_id(const DesignDefinition& d) { return fnv(d.canonical) >> 1; }
+std::uint64_t design_id(const DesignDefinition& d) { return detail::definition_id(d.canonical); }
 
 std::int64_t DesignDefinition::tasks() const {
   return static_cast<std::int64_t>(conditions.size() * fss.size() * durations.size()) * seeds;
@@ -288,7 +268,7 @@ DesignTask DesignDefinition::task(std::int64_t index) const {
   const auto& c = conditions.at(t.condition);
   // The record's flow and bubbles depend on the condition and the record
   // number only: every setting and geometry sees the same flow.
-  const std::uint64_t key = seed ^ fnv(c.name);
+  const std::uint64_t key = seed ^ detail::fnv1a(c.name);
   synth::Scene s;
   for (const auto& [k, v] : c.values) {
     if (k == "anisotropy") t.anisotropy = awcc::parse_quantity(v, awcc::Dimension::dimensionless);
@@ -326,15 +306,15 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
                                        const correction::CorrectionModel* model, const awcc::AwccOptions& processing) {
   synth::Synthesis syn;
   const double seconds_synth = cost([&] { syn = synth::synthesise(task.scene); });
-  const auto& lead = syn.signals.at(0);
-  const auto phase = awcc::phase_statistics(lead);
   std::vector<DesignRow> rows;
   for (std::size_t g = 0; g < d.geometries.size(); ++g) {
-    // Plain copies: lambdas below capture them (clang 14 cannot capture bindings).
     const double dx = d.geometries[g].first, dy = d.geometries[g].second;
-    const auto& trail = syn.signals.at(g + 1);
-    std::optional<awcc::FsccResult> fscc;  // once per pair, and only when the FSCC forest needs it
+    const auto record = binarised_recording(syn.signals.at(0), syn.signals.at(g + 1));
     for (int np : d.nps) {
+      RunOptions run;
+      run.awcc = processing;
+      run.awcc.np = np;
+      const auto options = processing_options(run, dx, dy);
       DesignRow r;
       r.task = task.index;
       r.condition = d.conditions[task.condition].name;
@@ -343,31 +323,22 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
       r.candidate = {dx, dy, np, task.fs, task.duration};
       r.truth_velocity = syn.truth.realised.mean_velocity[0];
       r.truth_turbulence_intensity = syn.truth.realised.turbulence_intensity[0];
-      r.void_fraction = phase.void_fraction;
-      r.count_rate = phase.bubble_count_rate;
       r.seconds_synth = seconds_synth;
-      awcc::AwccOptions options = processing;
-      options.np = np;
-      awcc::AwccResult res;
-      r.seconds_awcc = cost([&] { res = awcc::awcc(lead, trail, dx, options); });
-      if (res.ok()) {
-        r.awcc_velocity = res.velocity;
-        r.awcc_turbulence_intensity = res.turbulence_intensity;
+      awcc::ProcessResult res;
+      r.seconds_awcc = cost([&] { res = awcc::process_binarised(record, options); });
+      const auto& lead = res.tips.at(0).phase;
+      r.void_fraction = lead.void_fraction;
+      r.count_rate = lead.bubble_count_rate;
+      const auto& a = *res.awcc;
+      if (a.ok()) {
+        r.awcc_velocity = a.velocity;
+        r.awcc_turbulence_intensity = a.turbulence_intensity;
       }
-      r.windows_accepted = res.windows_accepted;
-      r.windows_total = res.windows_total;
+      r.windows_accepted = a.windows_accepted;
+      r.windows_total = a.windows_total;
       if (model) {
-        auto m = awcc_measurement(res, phase, dx, dy, np, task.fs, task.duration);
         correction::Correction c;
-        r.seconds_awcc += cost([&] { c = model->correct(m); });
-        if (!c.corrected() && model->falls_back_to_fscc(c.status)) {
-          if (!fscc) r.seconds_awcc += cost([&] { fscc = awcc::fscc(lead, trail, dx, {}); });
-          if (fscc->ok()) {
-            m.fscc_velocity = fscc->velocity;
-            m.r12_max = fscc->r12_max;
-            r.seconds_awcc += cost([&] { c = model->correct(m); });
-          }
-        }
+        r.seconds_awcc += cost([&] { c = model->correct(correction::measurement_of(res)); });
         r.correction_status = std::string(correction::to_string(c.status));
         if (c.corrected()) {
           r.correction_forest = c.forest;
@@ -415,8 +386,8 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     ++line_number;
     if (line_number == 1) {
       if (line != design_rows_header()) {
-        throw awcc::InputError(fmt::format("{}: not the runs file of pdp design (its header differs); give another -o or "
-                                           "remove the file",
+        throw awcc::InputError(fmt::format("{}: not the runs file of pdp design (its header differs); write the runs to "
+                                           "another file or remove this one",
                                            file));
       }
       continue;
@@ -435,7 +406,7 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     };
     if (cells[0] != std::to_string(design)) {
       throw awcc::InputError(fmt::format("{}: a row of another design ({}); the definition changed since these rows "
-                                         "were written: give another -o or remove the file",
+                                         "were written: write the runs to another file or remove this one",
                                          where, cells[0]));
     }
     DesignRow r;
@@ -461,6 +432,54 @@ std::vector<DesignRow> read_design_rows(const std::filesystem::path& csv, std::u
     out.push_back(std::move(r));
   }
   return out;
+}
+
+DesignResume resume_design(const DesignDefinition& d, const std::vector<std::filesystem::path>& runs,
+                           std::uint64_t design) {
+  DesignResume out;
+  std::map<std::int64_t, std::int64_t> counts;
+  for (const auto& file : runs)
+    for (const auto& r : read_design_rows(file, design)) ++counts[r.task];
+  std::set<std::int64_t> partial;
+  for (const auto& [task, n] : counts) (n == d.rows_per_task() ? out.done : partial).insert(task);
+  out.cut_short = static_cast<std::int64_t>(partial.size());
+  if (runs.empty()) return out;
+  const auto& first = runs.front();
+  if (!partial.empty()) {
+    std::string text = design_rows_header() + "\n";
+    for (const auto& r : read_design_rows(first, design))
+      if (!partial.count(r.task)) text += design_row_text(r, design) + "\n";
+    awcc::write_text_atomically(first, text);
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(first, ec) || std::filesystem::file_size(first, ec) == 0) {
+    awcc::write_text_atomically(first, design_rows_header() + "\n");
+  }
+  return out;
+}
+
+double estimate_design_seconds(const DesignDefinition& d, const std::vector<std::int64_t>& tasks,
+                               const correction::CorrectionModel* model, const awcc::AwccOptions& processing,
+                               double pilot_seconds) {
+  std::map<std::pair<std::size_t, double>, double> pilot;  // seconds per simulated second
+  double total = 0.0;
+  for (auto t : tasks) {
+    const auto task = d.task(t);
+    const auto key = std::pair{task.condition, task.fs};
+    if (!pilot.count(key)) {
+      auto short_task = task;
+      short_task.scene.duration = std::min(pilot_seconds, task.duration);
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        (void)run_design_task(d, short_task, model, processing);
+      } catch (const std::exception&) {
+        // The record itself will say what is wrong.
+      }
+      pilot[key] = seconds_since(start) / short_task.scene.duration;
+    }
+    total += pilot[key] * task.duration;
+  }
+  return total;
 }
 
 ErrorStats error_stats(const std::vector<double>& errors) {
@@ -722,4 +741,4 @@ std::string design_summary(const std::vector<RankedCandidate>& ranked, const Des
   return out;
 }
 
-}  // namespace pdp
+}  // namespace study

@@ -1,0 +1,114 @@
+// Sweep rows and the task engine of the study library.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <set>
+#include <fmt/format.h>
+#include <sstream>
+
+#include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
+#include "study/sweep.hpp"
+#include "study/tasks.hpp"
+#include "test_paths.hpp"
+
+namespace {
+
+std::vector<std::string> cells_of(std::string line) {
+  if (!line.empty() && line.back() == '\n') line.pop_back();
+  return awcc::split_cells(line);
+}
+
+std::string cell(const std::string& row, const std::string& column) {
+  const auto header = cells_of(study::sweep_header());
+  const auto cells = cells_of(row);
+  const auto at = std::find(header.begin(), header.end(), column) - header.begin();
+  return cells.at(static_cast<std::size_t>(at));
+}
+
+TEST(SweepRows, AFailedRunIsAFullRowWithItsReason) {
+  study::SweepRun run;
+  run.index = 4;
+  run.scene.tips = {{0.0, 0.0, 0.0}};  // one tip: nothing to correlate
+  const auto row = study::run_sweep_row(run, {}, 9);
+  EXPECT_EQ(cells_of(row).size(), cells_of(study::sweep_header()).size());
+  EXPECT_EQ(cell(row, "truth_velocity"), "");
+  EXPECT_NE(cell(row, "reason").find("FSCC and AWCC need two"), std::string::npos) << row;
+  EXPECT_EQ(cell(row, "run"), "4");
+}
+
+TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
+  study::SweepRun run;
+  run.index = 0;
+  run.np = 6;
+  run.scene.fs = 50e3;
+  run.scene.duration = 2.0;
+  run.scene.dx = 3e-3;
+  run.scene.dy = 0.5e-3;
+  run.scene.seed = 21;
+  study::RunOptions options;
+  options.awcc.np = 6;
+  const auto r = study::run_scene(run.scene, options);
+  const auto& m = r.measurement.measurement;
+  const auto row = study::sweep_row(run, &r, "", 1, options.awcc);
+  ASSERT_TRUE(m.velocity && m.fscc_velocity);
+  EXPECT_EQ(cell(row, "awcc_velocity"), fmt::format("{:.10g}", *m.velocity));
+  EXPECT_EQ(cell(row, "awcc_turbulence_intensity"), fmt::format("{:.10g}", *m.turbulence_intensity));
+  EXPECT_EQ(cell(row, "awcc_void_fraction"), fmt::format("{:.10g}", m.void_fraction));
+  EXPECT_EQ(cell(row, "awcc_count_rate"), fmt::format("{:.10g}", m.bubble_count_rate));
+  EXPECT_EQ(cell(row, "awcc_windows_accepted"), std::to_string(m.windows_accepted));
+  EXPECT_EQ(cell(row, "awcc_windows_total"), std::to_string(m.windows_total));
+  EXPECT_EQ(cell(row, "fscc_velocity"), fmt::format("{:.10g}", *m.fscc_velocity));
+  EXPECT_EQ(cell(row, "probe_dx"), "0.003");
+  EXPECT_EQ(cell(row, "probe_dy"), "0.0005");
+  EXPECT_EQ(cell(row, "np"), "6");
+  // The run's processing: pdp process's, the leading tip's phase statistics included.
+  EXPECT_EQ(m.void_fraction, r.processed.tips[0].phase.void_fraction);
+  EXPECT_EQ(m.windows_accepted, r.processed.awcc->windows_accepted);
+  // Both methods run together: no time of their own.
+  EXPECT_EQ(cell(row, "seconds_fscc"), "");
+  EXPECT_EQ(cell(row, "seconds_awcc"), "");
+}
+
+TEST(Tasks, EveryTaskIsAppendedOnceWhateverTheThreads) {
+  std::vector<std::int64_t> tasks;
+  for (std::int64_t t = 0; t < 40; ++t) tasks.push_back(3 * t);
+  auto text = [](std::int64_t t) { return fmt::format("{},{}\n{},{}\n", t, t * t, t, -t); };
+  for (int threads : {1, 3}) {
+    const auto file = pdp_test::test_file(fmt::format("tasks{}.csv", threads));
+    std::ofstream(file) << "head\n";
+    double last = 0.0;
+    int calls = 0;
+    study::run_tasks(tasks, text, file.string(), threads, [&](double f) {
+      EXPECT_GE(f, last);
+      last = f;
+      ++calls;
+    });
+    EXPECT_EQ(calls, 40);
+    EXPECT_EQ(last, 1.0);
+    std::ifstream in(file);
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "head");
+    std::multiset<std::string> seen;
+    // A task's two lines stay together (one write per task).
+    while (std::getline(in, line)) {
+      std::string second;
+      ASSERT_TRUE(std::getline(in, second));
+      const auto t = std::stoll(line.substr(0, line.find(',')));
+      EXPECT_EQ(line + "\n" + second + "\n", text(t));
+      seen.insert(line);
+    }
+    EXPECT_EQ(seen.size(), tasks.size());
+    for (auto t : tasks) EXPECT_EQ(seen.count(fmt::format("{},{}", t, t * t)), 1u);
+  }
+}
+
+TEST(Tasks, AFileThatCannotBeOpenedIsAnOutputError) {
+  EXPECT_THROW(study::run_tasks({1}, [](std::int64_t) { return std::string("x\n"); },
+                                (pdp_test::temp_dir() / "no-such-folder" / "x.csv").string(), 1),
+               awcc::OutputError);
+}
+
+}  // namespace
