@@ -76,8 +76,7 @@ int main(int argc, char** argv) {
   const bool correction_ok = corrected.corrected() && std::abs(corrected.velocity->median() - 3.6) < 1e-9 &&
                              std::abs(corrected.turbulence_intensity->median() - 0.2) < 1e-9;
   std::printf("awcc %s: void fraction %.3f, AWCC %.3f m/s (%s), corrected velocity %.3f m/s (%s), recording read (%s), "
-              "study (%s)
-",
+              "study (%s)\n",
               awcc::version, c, a.velocity, awcc_ok ? "ok" : "wrong",
               corrected.velocity ? corrected.velocity->median() : 0.0, correction_ok ? "ok" : "wrong",
               io_ok ? "ok" : "wrong", study_ok ? "ok" : "wrong");
