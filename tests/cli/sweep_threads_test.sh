@@ -7,8 +7,7 @@ set -u
 pdp=$1
 dir=$2/sweep_threads
 rm -rf "$dir" && mkdir -p "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+source "$(dirname "$0")/lib.sh"
 cat >"$dir/grid.toml" <<'TOML'
 [sweep]
 mode = "grid"
@@ -22,20 +21,9 @@ np = 10
 tu = [0.1, 0.3]
 dy = ["0mm", "1mm"]
 TOML
-# Rows without the run-time columns, sorted by run.
-canonical() {
-  /usr/bin/python3 - "$1" <<'PY'
-import csv, sys
-rows = list(csv.reader(open(sys.argv[1])))
-header, body = rows[0], rows[1:]
-keep = [i for i, h in enumerate(header) if not h.startswith("seconds_")]
-for r in sorted(body, key=lambda r: int(r[1])):
-    print(",".join(r[i] for i in keep))
-PY
-}
 "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/two.csv" --threads 2 || fail "sweep, 2 threads"
 "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/one.csv" --threads 1 || fail "sweep, 1 thread"
 [[ $(($(wc -l <"$dir/two.csv") - 1)) -eq 8 ]] || fail "expected 8 rows"
-[[ "$(canonical "$dir/one.csv")" == "$(canonical "$dir/two.csv")" ]] || fail "1 and 2 threads differ"
+[[ "$(sweep_rows "$dir/one.csv")" == "$(sweep_rows "$dir/two.csv")" ]] || fail "1 and 2 threads differ"
 ((failures == 0)) && echo "sweep_threads_test: ok"
 exit $((failures > 0))
