@@ -367,8 +367,8 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       if (!v) throw awcc::InputError(fmt::format("{}: column {} = '{}' is not a number", where, name, t));
       return v;
     };
-    const std::string line_number = where.substr(file.size() + 1);
-    auto at = [&](std::string_view name) { return awcc::WrittenAt{file, "line " + line_number, name}; };
+    const std::string line_label = "line " + where.substr(file.size() + 1);
+    auto at = [&](std::string_view name) { return awcc::WrittenAt{file, line_label, name}; };
     // The row read back into the fields of the awcc::ProcessResult that
     // profile_csv_row wrote it from, as far as measurement_of reads them (as
     // the JSON's, measurement_of_json): AWCC's outcome first. An empty
