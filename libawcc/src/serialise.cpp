@@ -46,15 +46,55 @@ std::string window_count_key(WindowFate fate) {
 
 namespace {
 
-// The inverse of an enum's to_string over its listed values: the names are
-// to_string's, so a renamed value is read as it is written.
+// Each enum's values: its parser reads, and written_values lists, their
+// to_string texts, so that a renamed value is read as it is written.
+constexpr PhaseStatus kPhaseStatuses[] = {PhaseStatus::ok, PhaseStatus::no_air, PhaseStatus::all_air,
+                                          PhaseStatus::too_few_chords};
+constexpr FsccStatus kFsccStatuses[] = {FsccStatus::ok,
+                                        FsccStatus::constant_leading,
+                                        FsccStatus::constant_trailing,
+                                        FsccStatus::no_common_segment,
+                                        FsccStatus::no_positive_peak,
+                                        FsccStatus::non_positive_lag,
+                                        FsccStatus::tips_swapped,
+                                        FsccStatus::peak_at_lag_range_end,
+                                        FsccStatus::no_tip_separation};
+constexpr AwccStatus kAwccStatuses[] = {AwccStatus::ok,           AwccStatus::too_few_particles,
+                                        AwccStatus::delay_below_one_sample, AwccStatus::too_few_windows,
+                                        AwccStatus::tips_swapped, AwccStatus::no_tip_separation};
+constexpr AwccQuality kAwccQualities[] = {AwccQuality::ok, AwccQuality::low, AwccQuality::insufficient};
+constexpr Weighting kWeightings[] = {Weighting::duration, Weighting::none};
+constexpr CorrelationSignal kSignals[] = {CorrelationSignal::binary, CorrelationSignal::raw};
+constexpr Subsample kSubsamples[] = {Subsample::none, Subsample::parabolic};
+constexpr WindowFate kWindowFates[] = {WindowFate::accepted, WindowFate::correlation, WindowFate::lag,
+                                       WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
+                                       WindowFate::correction};
+constexpr VelocitySource kVelocitySources[] = {VelocitySource::none, VelocitySource::awcc, VelocitySource::fscc};
+
+// A switch as profile_csv_row writes it.
+std::string_view switch_text(bool on) { return on ? "on" : "off"; }
+constexpr bool kSwitches[] = {true, false};
+
+template <class E>
+std::string_view text_of(E v) {
+  return to_string(v);
+}
+std::string_view text_of(bool on) { return switch_text(on); }
+
+template <class E, std::size_t N>
+std::vector<std::string_view> texts(const E (&values)[N]) {
+  std::vector<std::string_view> out;
+  for (const E v : values) out.push_back(text_of(v));
+  return out;
+}
+
 template <class E, std::size_t N>
 E parse_written(std::string_view text, const E (&values)[N], const WrittenAt& at) {
-  std::string known;
   for (const E v : values) {
-    if (to_string(v) == text) return v;
-    known += fmt::format("{}{}", known.empty() ? "" : ", ", to_string(v));
+    if (text_of(v) == text) return v;
   }
+  std::string known;
+  for (const auto t : texts(values)) known += fmt::format("{}{}", known.empty() ? "" : ", ", t);
   throw InputError(fmt::format("{}: {}: {} = '{}' is not a value pdp writes ({}); give a file written by pdp process",
                                at.file, at.row, at.field, text, known));
 }
@@ -62,74 +102,41 @@ E parse_written(std::string_view text, const E (&values)[N], const WrittenAt& at
 }  // namespace
 
 PhaseStatus parse_phase_status(std::string_view text, const WrittenAt& at) {
-  constexpr PhaseStatus values[] = {PhaseStatus::ok, PhaseStatus::no_air, PhaseStatus::all_air,
-                                    PhaseStatus::too_few_chords};
-  return parse_written(text, values, at);
+  return parse_written(text, kPhaseStatuses, at);
 }
-
 FsccStatus parse_fscc_status(std::string_view text, const WrittenAt& at) {
-  constexpr FsccStatus values[] = {FsccStatus::ok,
-                                   FsccStatus::constant_leading,
-                                   FsccStatus::constant_trailing,
-                                   FsccStatus::no_common_segment,
-                                   FsccStatus::no_positive_peak,
-                                   FsccStatus::non_positive_lag,
-                                   FsccStatus::tips_swapped,
-                                   FsccStatus::peak_at_lag_range_end,
-                                   FsccStatus::no_tip_separation};
-  return parse_written(text, values, at);
+  return parse_written(text, kFsccStatuses, at);
 }
-
 AwccStatus parse_awcc_status(std::string_view text, const WrittenAt& at) {
-  constexpr AwccStatus values[] = {AwccStatus::ok,           AwccStatus::too_few_particles,
-                                   AwccStatus::delay_below_one_sample, AwccStatus::too_few_windows,
-                                   AwccStatus::tips_swapped, AwccStatus::no_tip_separation};
-  return parse_written(text, values, at);
+  return parse_written(text, kAwccStatuses, at);
 }
-
 AwccQuality parse_awcc_quality(std::string_view text, const WrittenAt& at) {
-  constexpr AwccQuality values[] = {AwccQuality::ok, AwccQuality::low, AwccQuality::insufficient};
-  return parse_written(text, values, at);
+  return parse_written(text, kAwccQualities, at);
 }
-
-Weighting parse_weighting(std::string_view text, const WrittenAt& at) {
-  constexpr Weighting values[] = {Weighting::duration, Weighting::none};
-  return parse_written(text, values, at);
-}
-
+Weighting parse_weighting(std::string_view text, const WrittenAt& at) { return parse_written(text, kWeightings, at); }
 CorrelationSignal parse_correlation_signal(std::string_view text, const WrittenAt& at) {
-  constexpr CorrelationSignal values[] = {CorrelationSignal::binary, CorrelationSignal::raw};
-  return parse_written(text, values, at);
+  return parse_written(text, kSignals, at);
 }
-
-Subsample parse_subsample(std::string_view text, const WrittenAt& at) {
-  constexpr Subsample values[] = {Subsample::none, Subsample::parabolic};
-  return parse_written(text, values, at);
-}
-
+Subsample parse_subsample(std::string_view text, const WrittenAt& at) { return parse_written(text, kSubsamples, at); }
 WindowFate parse_window_fate(std::string_view text, const WrittenAt& at) {
-  constexpr WindowFate values[] = {WindowFate::accepted, WindowFate::correlation, WindowFate::lag,
-                                   WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
-                                   WindowFate::correction};
-  return parse_written(text, values, at);
+  return parse_written(text, kWindowFates, at);
 }
-
 VelocitySource parse_velocity_source(std::string_view text, const WrittenAt& at) {
-  constexpr VelocitySource values[] = {VelocitySource::none, VelocitySource::awcc, VelocitySource::fscc};
-  return parse_written(text, values, at);
+  return parse_written(text, kVelocitySources, at);
 }
+bool parse_switch(std::string_view text, const WrittenAt& at) { return parse_written(text, kSwitches, at); }
 
-namespace {
-// A switch as profile_csv_row writes it.
-std::string_view switch_text(bool on) { return on ? "on" : "off"; }
-}  // namespace
-
-bool parse_switch(std::string_view text, const WrittenAt& at) {
-  if (text == switch_text(true)) return true;
-  if (text == switch_text(false)) return false;
-  throw InputError(fmt::format("{}: {}: {} = '{}' is not a value pdp writes (on, off); give a file written by pdp "
-                               "process",
-                               at.file, at.row, at.field, text));
+std::vector<std::string_view> written_values(std::string_view column) {
+  namespace c = profile_column;
+  if (column == c::fscc_status) return texts(kFsccStatuses);
+  if (column == c::awcc_status) return texts(kAwccStatuses);
+  if (column == c::awcc_quality) return texts(kAwccQualities);
+  if (column == c::awcc_weighting) return texts(kWeightings);
+  if (column == c::awcc_signal) return texts(kSignals);
+  if (column == c::awcc_subsample) return texts(kSubsamples);
+  if (column == c::chord_velocity_source) return texts(kVelocitySources);
+  if (column == c::awcc_roc || column == c::awcc_probe_corrected) return texts(kSwitches);
+  return {};
 }
 
 std::span<const WindowColumn> awcc_window_columns() {

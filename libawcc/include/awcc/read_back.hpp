@@ -8,6 +8,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "awcc/awcc.hpp"
 #include "awcc/fscc.hpp"
@@ -36,6 +37,11 @@ VelocitySource parse_velocity_source(std::string_view text, const WrittenAt& at)
 /// A switch of the profile CSV ("on"/"off", as profile_csv_row writes a JSON
 /// true/false).
 bool parse_switch(std::string_view text, const WrittenAt& at);
+
+/// The texts a profile CSV column may hold, by its name: an enum's values
+/// (by its to_string) or a switch's on/off; empty for a number or free text.
+/// The Python module hands them to the report (pdp.profile_columns()).
+std::vector<std::string_view> written_values(std::string_view column);
 
 /// The keys of the process JSON that are read back (docs/output.md). A
 /// recording's object:
