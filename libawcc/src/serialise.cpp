@@ -8,7 +8,9 @@
 #include <span>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/options.hpp"
+#include "awcc/read_back.hpp"
 #include "awcc/sha256.hpp"
 #include "awcc/version.hpp"
 
@@ -37,10 +39,105 @@ constexpr WindowColumnFormat kWindowColumns[] = {
 
 // The JSON's count of the windows of a fate: windows_accepted, windows_rejected_<fate>.
 std::string window_count_key(WindowFate fate) {
-  return fate == WindowFate::accepted ? "windows_accepted" : fmt::format("windows_rejected_{}", to_string(fate));
+  return fate == WindowFate::accepted ? std::string(process_key::windows_accepted) : fmt::format("windows_rejected_{}", to_string(fate));
 }
 
 }  // namespace
+
+namespace {
+
+// Each enum's values: its parser reads, and written_values lists, their
+// to_string texts, so that a renamed value is read as it is written.
+constexpr PhaseStatus kPhaseStatuses[] = {PhaseStatus::ok, PhaseStatus::no_air, PhaseStatus::all_air,
+                                          PhaseStatus::too_few_chords};
+constexpr FsccStatus kFsccStatuses[] = {FsccStatus::ok,
+                                        FsccStatus::constant_leading,
+                                        FsccStatus::constant_trailing,
+                                        FsccStatus::no_common_segment,
+                                        FsccStatus::no_positive_peak,
+                                        FsccStatus::non_positive_lag,
+                                        FsccStatus::tips_swapped,
+                                        FsccStatus::peak_at_lag_range_end,
+                                        FsccStatus::no_tip_separation};
+constexpr AwccStatus kAwccStatuses[] = {AwccStatus::ok,           AwccStatus::too_few_particles,
+                                        AwccStatus::delay_below_one_sample, AwccStatus::too_few_windows,
+                                        AwccStatus::tips_swapped, AwccStatus::no_tip_separation};
+constexpr AwccQuality kAwccQualities[] = {AwccQuality::ok, AwccQuality::low, AwccQuality::insufficient};
+constexpr Weighting kWeightings[] = {Weighting::duration, Weighting::none};
+constexpr CorrelationSignal kSignals[] = {CorrelationSignal::binary, CorrelationSignal::raw};
+constexpr Subsample kSubsamples[] = {Subsample::none, Subsample::parabolic};
+constexpr WindowFate kWindowFates[] = {WindowFate::accepted, WindowFate::correlation, WindowFate::lag,
+                                       WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
+                                       WindowFate::correction};
+constexpr VelocitySource kVelocitySources[] = {VelocitySource::none, VelocitySource::awcc, VelocitySource::fscc};
+
+// A switch as profile_csv_row writes it.
+std::string_view switch_text(bool on) { return on ? "on" : "off"; }
+constexpr bool kSwitches[] = {true, false};
+
+template <class E>
+std::string_view text_of(E v) {
+  return to_string(v);
+}
+std::string_view text_of(bool on) { return switch_text(on); }
+
+template <class E, std::size_t N>
+std::vector<std::string_view> texts(const E (&values)[N]) {
+  std::vector<std::string_view> out;
+  for (const E v : values) out.push_back(text_of(v));
+  return out;
+}
+
+template <class E, std::size_t N>
+E parse_written(std::string_view text, const E (&values)[N], const WrittenAt& at) {
+  for (const E v : values) {
+    if (text_of(v) == text) return v;
+  }
+  std::string known;
+  for (const auto t : texts(values)) known += fmt::format("{}{}", known.empty() ? "" : ", ", t);
+  throw InputError(fmt::format("{}: {}: {} = '{}' is not a value pdp writes ({}); give a file written by pdp process",
+                               at.file, at.row, at.field, text, known));
+}
+
+}  // namespace
+
+PhaseStatus parse_phase_status(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kPhaseStatuses, at);
+}
+FsccStatus parse_fscc_status(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kFsccStatuses, at);
+}
+AwccStatus parse_awcc_status(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kAwccStatuses, at);
+}
+AwccQuality parse_awcc_quality(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kAwccQualities, at);
+}
+Weighting parse_weighting(std::string_view text, const WrittenAt& at) { return parse_written(text, kWeightings, at); }
+CorrelationSignal parse_correlation_signal(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kSignals, at);
+}
+Subsample parse_subsample(std::string_view text, const WrittenAt& at) { return parse_written(text, kSubsamples, at); }
+WindowFate parse_window_fate(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kWindowFates, at);
+}
+VelocitySource parse_velocity_source(std::string_view text, const WrittenAt& at) {
+  return parse_written(text, kVelocitySources, at);
+}
+bool parse_switch(std::string_view text, const WrittenAt& at) { return parse_written(text, kSwitches, at); }
+
+std::vector<std::string_view> written_values(std::string_view column) {
+  namespace c = profile_column;
+  if (column == c::fscc_status) return texts(kFsccStatuses);
+  if (column == c::awcc_status) return texts(kAwccStatuses);
+  if (column == c::awcc_quality) return texts(kAwccQualities);
+  if (column == c::awcc_weighting) return texts(kWeightings);
+  if (column == c::awcc_signal) return texts(kSignals);
+  if (column == c::awcc_subsample) return texts(kSubsamples);
+  if (column == c::chord_velocity_source) return texts(kVelocitySources);
+  if (column == c::awcc_roc || column == c::awcc_probe_corrected) return texts(kSwitches);
+  return {};
+}
 
 std::span<const WindowColumn> awcc_window_columns() {
   static const auto columns = [] {
@@ -129,12 +226,12 @@ json provenance_json(const ProcessOptions& options, const std::vector<std::strin
 }
 
 json to_json(const AwccOptions& o) {
-  return json{{"np", o.np},
-              {"filter_a", o.filter_a},
-              {"roc", o.roc},
-              {"weighting", to_string(o.weighting)},
-              {"signal", to_string(o.signal)},
-              {"subsample", to_string(o.subsample)},
+  return json{{process_key::np, o.np},
+              {process_key::filter_a, o.filter_a},
+              {process_key::roc, o.roc},
+              {process_key::weighting, to_string(o.weighting)},
+              {process_key::signal, to_string(o.signal)},
+              {process_key::subsample, to_string(o.subsample)},
               {"prominence_fraction", o.prominence_fraction},
               {"velocity_min", optional(o.velocity_min)},
               {"velocity_max", optional(o.velocity_max)}};
@@ -247,11 +344,11 @@ json to_json(const ProcessResult& r) {
     json tip{
         {"channel", t.channel},
         {"name", t.name.empty() ? json(nullptr) : json(t.name)},
-        {"status", to_string(p.status)},
+        {process_key::status, to_string(p.status)},
         {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
-        {"void_fraction", p.void_fraction},
+        {process_key::void_fraction, p.void_fraction},
         {"void_fraction_ci95", ci(p.void_fraction_ci95)},
-        {"bubble_count_rate", p.bubble_count_rate},
+        {process_key::bubble_count_rate, p.bubble_count_rate},
         {"bubble_count_rate_ci95", ci(p.bubble_count_rate_ci95)},
         {"chord_time_mean", p.air_chord_time.mean},
         {"chord_time_median", p.air_chord_time.median},
@@ -269,26 +366,25 @@ json to_json(const ProcessResult& r) {
   json out{
       {"file", r.info.path.string()},
       {"format", r.info.description},
-      {"fs", r.info.fs},
-      {"samples", r.info.frames},
-      {"duration", r.info.fs > 0 ? static_cast<double>(r.info.frames) / r.info.fs : 0.0},
-      {"dx", r.dx},
-      {"dy", r.dy},
-      {"tips", tips},
+      {process_key::fs, r.info.fs},
+      {process_key::samples, r.info.frames},
+      {process_key::duration, r.info.fs > 0 ? static_cast<double>(r.info.frames) / r.info.fs : 0.0},
+      {process_key::dx, r.dx},
+      {process_key::dy, r.dy},
+      {process_key::tips, tips},
       {"warnings", r.info.warnings},
       {"chord_velocity_source", to_string(r.velocity_source())},
       {"chord_velocity", optional(r.velocity())},
   };
   if (r.fscc) {
     const auto& f = *r.fscc;
-    out["fscc"] = json{
-        {"status", to_string(f.status)},
-        {"defined", f.ok()},
-        {"reason", f.ok() ? json(nullptr) : json(f.message)},
-        {"velocity", f.ok() ? json(f.velocity) : json(nullptr)},
+    out[process_key::fscc] = json{
+        {process_key::status, to_string(f.status)},
+        {process_key::reason, f.ok() ? json(nullptr) : json(f.message)},
+        {process_key::velocity, f.ok() ? json(f.velocity) : json(nullptr)},
         {"lag", f.lag},
         {"lag_samples", f.lag_samples},
-        {"r12_max", f.r12_max},
+        {process_key::r12_max, f.r12_max},
         {"t05", optional(f.t05)},
         {"tau05", optional(f.tau05)},
         {"txx", optional(f.txx)},
@@ -296,7 +392,7 @@ json to_json(const ProcessResult& r) {
         {"turbulence_intensity_chanson", optional(f.turbulence_intensity_chanson)},
         {"note", f.note.empty() ? json(nullptr) : json(f.note)},
         {"warnings", f.warnings},
-        {"signal", to_string(f.signal)},
+        {process_key::signal, to_string(f.signal)},
         {"segments_used", f.segments_used},
         {"t_r11_zero", optional(f.t_r11_zero)},
         {"t_r11_min", optional(f.t_r11_min)},
@@ -308,14 +404,14 @@ json to_json(const ProcessResult& r) {
     };
     json notes = json::object();
     for (const auto& [name, why] : f.scale_notes) notes[name] = why;
-    out["fscc"]["scale_notes"] = notes;
+    out[process_key::fscc]["scale_notes"] = notes;
   }
   if (r.structure) out["structure"] = to_json(*r.structure);
   if (r.spectrum) {
     const auto& v = *r.spectrum;
     const bool ok = v.status == SpectrumStatus::ok;
-    out["velocity_spectrum"] = json{{"status", to_string(v.status)},
-                                    {"reason", v.message.empty() ? json(nullptr) : json(v.message)},
+    out["velocity_spectrum"] = json{{process_key::status, to_string(v.status)},
+                                    {process_key::reason, v.message.empty() ? json(nullptr) : json(v.message)},
                                     {"mean_window_duration", ok ? json(v.mean_window_duration) : json(nullptr)},
                                     {"resample_rate", ok ? json(v.resample_rate) : json(nullptr)},
                                     {"resolvable_frequency", ok ? json(v.resolvable_frequency) : json(nullptr)},
@@ -329,25 +425,24 @@ json to_json(const ProcessResult& r) {
     const auto& a = *r.awcc;
     auto value = [&](double v) { return a.ok() ? json(v) : json(nullptr); };
     auto interval = [&](const Interval95& i) { return a.ok() ? ci(i) : json(nullptr); };
-    out["awcc"] = json{
-        {"status", to_string(a.status)},
-        {"defined", a.ok()},
-        {"reason", a.ok() ? json(nullptr) : json(a.message)},
-        {"np", a.np},
-        {"options", to_json(a.options)},
-        {"velocity", value(a.velocity)},
+    out[process_key::awcc] = json{
+        {process_key::status, to_string(a.status)},
+        {process_key::reason, a.ok() ? json(nullptr) : json(a.message)},
+        {process_key::np, a.np},
+        {process_key::options, to_json(a.options)},
+        {process_key::velocity, value(a.velocity)},
         {"velocity_ci95", interval(a.velocity_ci95)},
         {"velocity_rms", value(a.velocity_rms)},
         {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
-        {"turbulence_intensity", value(a.turbulence_intensity)},
+        {process_key::turbulence_intensity, value(a.turbulence_intensity)},
         {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
-        {"windows_total", a.windows_total},
+        {process_key::windows_total, a.windows_total},
         {"windows_lag_zero", a.lag_zero_windows},
         {"roc_iterations", a.roc_iterations},
         {"windows_negative_lag", a.negative_lag_windows},
         {"quality", to_string(a.quality)},
         {"quality_reason", a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
-        {"probe_corrected", a.probe_corrected},
+        {process_key::probe_corrected, a.probe_corrected},
         {"velocity_measured", a.probe_corrected ? value(a.velocity_measured) : json(nullptr)},
         {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
         {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
@@ -360,7 +455,7 @@ json to_json(const ProcessResult& r) {
     // file reads as when they were listed by hand).
     for (std::size_t i = 0; i < window_fate_count; ++i) {
       const auto fate = static_cast<WindowFate>(i);
-      out["awcc"][window_count_key(fate)] = a.count(fate);
+      out[process_key::awcc][window_count_key(fate)] = a.count(fate);
     }
   }
   return out;
@@ -370,40 +465,40 @@ std::span<const ProfileColumn> profile_csv_columns() {
   static constexpr ProfileColumn columns[] = {
       {"file", "", "/file", "the recording's file name"},
       {"position", "m", "/position", "position of the probe in the profile"},
-      {"void_fraction", "-", "/tips/0/void_fraction", "void fraction c, leading tip"},
-      {"bubble_count_rate", "1/s", "/tips/0/bubble_count_rate", "bubble count rate F, leading tip"},
+      {profile_column::void_fraction, "-", "/tips/0/void_fraction", "void fraction c, leading tip"},
+      {profile_column::bubble_count_rate, "1/s", "/tips/0/bubble_count_rate", "bubble count rate F, leading tip"},
       {"chord_time_mean", "s", "/tips/0/chord_time_mean", "mean air chord time, leading tip"},
       {"chord_time_median", "s", "/tips/0/chord_time_median", "median air chord time, leading tip"},
       {"threshold", "V", "/tips/0/threshold", "binarisation threshold, leading tip"},
       {"void_fraction_trailing", "-", "/tips/1/void_fraction", "void fraction c, trailing tip"},
       {"bubble_count_rate_trailing", "1/s", "/tips/1/bubble_count_rate", "bubble count rate F, trailing tip"},
-      {"fscc_velocity", "m/s", "/fscc/velocity", "FSCC velocity dx / lag"},
+      {profile_column::fscc_velocity, "m/s", "/fscc/velocity", "FSCC velocity dx / lag"},
       {"fscc_lag", "s", "/fscc/lag", "lag of the R12 peak"},
-      {"fscc_r12_max", "-", "/fscc/r12_max", "peak cross-correlation R12max"},
+      {profile_column::fscc_r12_max, "-", "/fscc/r12_max", "peak cross-correlation R12max"},
       {"fscc_t05", "s", "/fscc/t05", "T05: R11 first at or below 0.5"},
       {"fscc_tau05", "s", "/fscc/tau05", "tau05: half-width of R12 right of its peak"},
       {"fscc_turbulence_intensity_chanson", "-", "/fscc/turbulence_intensity_chanson", "Chanson's Tu from T05 and tau05"},
       {"sauter_diameter", "m", "/tips/0/sauter_diameter", "Sauter diameter d32 = 1.5 u c / F"},
       {"fscc_reason", "", "/fscc/reason", "why FSCC has no velocity"},
-      {"awcc_velocity", "m/s", "/awcc/velocity", "AWCC mean interfacial velocity"},
+      {profile_column::awcc_velocity, "m/s", "/awcc/velocity", "AWCC mean interfacial velocity"},
       {"awcc_velocity_rms", "m/s", "/awcc/velocity_rms", "AWCC velocity fluctuation u_rms"},
-      {"awcc_turbulence_intensity", "-", "/awcc/turbulence_intensity", "AWCC turbulence intensity Tu = u_rms / u"},
-      {"awcc_windows_accepted", "-", "/awcc/windows_accepted", "AWCC windows accepted"},
-      {"awcc_windows_total", "-", "/awcc/windows_total", "AWCC windows formed"},
-      {"awcc_reason", "", "/awcc/reason", "why AWCC has no figures"},
-      {"fscc_status", "", "/fscc/status", "FSCC status"},
-      {"awcc_status", "", "/awcc/status", "AWCC status"},
-      {"dx", "m", "/dx", "streamwise tip separation"},
-      {"dy", "m", "/dy", "lateral tip separation"},
-      {"np", "-", "/awcc/options/np", "particles per AWCC window"},
-      {"awcc_filter_a", "-", "/awcc/options/filter_a", "AWCC correlation/SPR filter A"},
-      {"awcc_roc", "", "/awcc/options/roc", "AWCC robust outlier cutoff"},
-      {"awcc_weighting", "", "/awcc/options/weighting", "AWCC window weighting"},
-      {"awcc_signal", "", "/awcc/options/signal", "signal AWCC correlated"},
-      {"awcc_subsample", "", "/awcc/options/subsample", "AWCC peak refinement"},
-      {"fs", "Hz", "/fs", "sampling rate"},
-      {"duration", "s", "/duration", "record duration"},
-      {"awcc_quality", "", "/awcc/quality", "AWCC quality level: ok, low or insufficient"},
+      {profile_column::awcc_turbulence_intensity, "-", "/awcc/turbulence_intensity", "AWCC turbulence intensity Tu = u_rms / u"},
+      {profile_column::awcc_windows_accepted, "-", "/awcc/windows_accepted", "AWCC windows accepted"},
+      {profile_column::awcc_windows_total, "-", "/awcc/windows_total", "AWCC windows formed"},
+      {profile_column::awcc_reason, "", "/awcc/reason", "why AWCC has no figures"},
+      {profile_column::fscc_status, "", "/fscc/status", "FSCC status"},
+      {profile_column::awcc_status, "", "/awcc/status", "AWCC status"},
+      {profile_column::dx, "m", "/dx", "streamwise tip separation"},
+      {profile_column::dy, "m", "/dy", "lateral tip separation"},
+      {profile_column::np, "-", "/awcc/options/np", "particles per AWCC window"},
+      {profile_column::awcc_filter_a, "-", "/awcc/options/filter_a", "AWCC correlation/SPR filter A"},
+      {profile_column::awcc_roc, "", "/awcc/options/roc", "AWCC robust outlier cutoff"},
+      {profile_column::awcc_weighting, "", "/awcc/options/weighting", "AWCC window weighting"},
+      {profile_column::awcc_signal, "", "/awcc/options/signal", "signal AWCC correlated"},
+      {profile_column::awcc_subsample, "", "/awcc/options/subsample", "AWCC peak refinement"},
+      {profile_column::fs, "Hz", "/fs", "sampling rate"},
+      {profile_column::duration, "s", "/duration", "record duration"},
+      {profile_column::awcc_quality, "", "/awcc/quality", "AWCC quality level: ok, low or insufficient"},
       {"awcc_quality_reason", "", "/awcc/quality_reason", "why the quality is not ok"},
       {"void_fraction_ci95_lower", "-", "/tips/0/void_fraction_ci95/0", "void fraction, 95 % interval, lower"},
       {"void_fraction_ci95_upper", "-", "/tips/0/void_fraction_ci95/1", "void fraction, 95 % interval, upper"},
@@ -415,10 +510,10 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"awcc_velocity_rms_ci95_upper", "m/s", "/awcc/velocity_rms_ci95/1", "u_rms, 95 % interval, upper"},
       {"awcc_turbulence_intensity_ci95_lower", "-", "/awcc/turbulence_intensity_ci95/0", "AWCC Tu, 95 % interval, lower"},
       {"awcc_turbulence_intensity_ci95_upper", "-", "/awcc/turbulence_intensity_ci95/1", "AWCC Tu, 95 % interval, upper"},
-      {"chord_velocity_source", "", "/chord_velocity_source", "the velocity of the chord lengths and d32"},
+      {profile_column::chord_velocity_source, "", "/chord_velocity_source", "the velocity of the chord lengths and d32"},
       {"pdp_version", "", "", "pdp version (the provenance's)"},
       {"warnings", "", "/warnings", "what the reader accepted but you must know; FSCC's plausibility warnings"},
-      {"awcc_probe_corrected", "", "/awcc/probe_corrected", "bubble-probe interaction correction applied"},
+      {profile_column::awcc_probe_corrected, "", "/awcc/probe_corrected", "bubble-probe interaction correction applied"},
       {"awcc_velocity_measured", "m/s", "/awcc/velocity_measured", "AWCC velocity before the probe correction"},
       {"awcc_velocity_rms_measured", "m/s", "/awcc/velocity_rms_measured", "u_rms before the probe correction"},
       {"awcc_turbulence_intensity_measured", "-", "/awcc/turbulence_intensity_measured", "Tu before the probe correction"},
@@ -462,7 +557,7 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
                      number(r.dy));
   if (a) {
     const auto& o = a->options;
-    out += fmt::format(",{},{},{},{},{},{}", o.np, number(o.filter_a), o.roc ? "on" : "off", to_string(o.weighting),
+    out += fmt::format(",{},{},{},{},{},{}", o.np, number(o.filter_a), switch_text(o.roc), to_string(o.weighting),
                        to_string(o.signal), to_string(o.subsample));
   } else {
     out += ",,,,,,";
@@ -485,7 +580,7 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   }
   out += "," + csv_cell(warnings);
   const bool corrected = awcc_ok && a->probe_corrected;
-  out += fmt::format(",{},{},{},{}", a ? (a->probe_corrected ? "on" : "off") : "",
+  out += fmt::format(",{},{},{},{}", a ? switch_text(a->probe_corrected) : "",
                      csv_number(corrected ? std::optional(a->velocity_measured) : std::nullopt),
                      csv_number(corrected ? std::optional(a->velocity_rms_measured) : std::nullopt),
                      csv_number(corrected ? std::optional(a->turbulence_intensity_measured) : std::nullopt));

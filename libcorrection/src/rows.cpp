@@ -10,6 +10,7 @@
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/json_text.hpp"
+#include "awcc/read_back.hpp"
 
 namespace correction {
 
@@ -38,17 +39,6 @@ std::optional<double> default_np(const RowDefaults& d) {
   return d.np ? std::optional<double>(*d.np) : std::nullopt;
 }
 
-Processing parse_processing(double filter_a, const std::string& roc, const std::string& weighting,
-                            const std::string& signal, const std::string& subsample) {
-  Processing p;
-  p.filter_a = filter_a;
-  p.roc = roc == "on" || roc == "true";
-  p.weighting = weighting == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
-  p.signal = signal == "raw" ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
-  p.subsample = subsample == "parabolic" ? awcc::Subsample::parabolic : awcc::Subsample::none;
-  return p;
-}
-
 void check_processing(const CorrectionModel& model, const std::optional<Processing>& results, const std::string& where,
                       std::vector<std::string>& warnings) {
   if (!results) {
@@ -63,41 +53,47 @@ void check_processing(const CorrectionModel& model, const std::optional<Processi
   }
 }
 
-// A status of the process JSON (FSCC's or AWCC's) by its text. A file written
-// before the key existed says only whether the method gave a value
-// ("defined"); not ok is then the result's default status: the measurement
-// reads whether a result is ok, never why.
-template <class Status>
-Status status_of(const json& j, Status not_ok, const std::string& file, const char* where) {
-  if (j.contains("status") && j["status"].is_string()) {
-    const auto text = j["status"].get<std::string>();
-    for (int k = 0; k < 64; ++k) {
-      const auto status = static_cast<Status>(k);
-      const auto name = awcc::to_string(status);
-      if (name == "?") break;
-      if (name == text) return status;
-    }
-    throw awcc::InputError(fmt::format("{}: {}.status = '{}' is not a status pdp writes; give a JSON written by pdp "
-                                       "process",
-                                       file, where, text));
-  }
-  return j.value("defined", false) ? Status::ok : not_ok;
+namespace key = awcc::process_key;
+namespace column = awcc::profile_column;
+
+bool has(const json& j, std::string_view k) { return j.is_object() && j.contains(k); }
+
+std::optional<double> number(const json& j, std::string_view k) {
+  if (!has(j, k) || !j[k].is_number()) return std::nullopt;
+  return j[k].get<double>();
 }
 
-std::optional<double> number(const json& j, const char* key) {
-  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nullopt;
-  return j[key].get<double>();
-}
-
-double required(const json& j, const char* key, const char* where, const std::string& file) {
-  const auto v = number(j, key);
-  if (!v) throw awcc::InputError(fmt::format("{}: no number '{}' in {}; give a JSON written by pdp process", file, key, where));
+double required(const json& j, std::string_view k, const std::string& row, const std::string& file) {
+  const auto v = number(j, k);
+  if (!v) throw awcc::InputError(fmt::format("{}: no number '{}' in {}; give a JSON written by pdp process", file, k, row));
   return *v;
+}
+
+// The text of an enum's key, or the file is refused: no key falls back to a default.
+std::string text(const json& j, std::string_view k, const std::string& row, const std::string& file) {
+  if (!has(j, k) || !j[k].is_string()) {
+    throw awcc::InputError(fmt::format("{}: {}: no text '{}'; give a JSON written by pdp process", file, row, k));
+  }
+  return j[k].get<std::string>();
+}
+
+// FSCC's or AWCC's status by its text (the owner's parser). A file written
+// before the status keys existed (issue 12) says only whether the method
+// gave a value ("defined", retired by issue 28; docs/output.md): it is read
+// as ok, or else as the result's default status, because the measurement
+// reads whether a result is ok, never why.
+template <class Status, class Parse>
+Status status_of(const json& j, Status not_ok, Parse parse, const std::string& row, const std::string& file) {
+  if (has(j, key::status)) return parse(text(j, key::status, row, file), awcc::WrittenAt{file, row, key::status});
+  if (has(j, key::retired_defined) && j[key::retired_defined].is_boolean()) {
+    return j[key::retired_defined].get<bool>() ? Status::ok : not_ok;
+  }
+  throw awcc::InputError(fmt::format("{}: {}: no '{}'; give a JSON written by pdp process", file, row, key::status));
 }
 
 const json& awcc_object(const json& r) {
   static const json none = json::object();
-  return r.contains("awcc") && r["awcc"].is_object() ? r["awcc"] : none;
+  return has(r, key::awcc) && r[key::awcc].is_object() ? r[key::awcc] : none;
 }
 
 // A result of the process JSON is read back into the fields of the
@@ -105,43 +101,52 @@ const json& awcc_object(const json& r) {
 // measurement_of reads them: the one builder then makes the measurement of a
 // file's row as of a result in memory, status rules included, so that the
 // two cannot disagree. First AWCC's outcome (all the status needs).
-awcc::ProcessResult awcc_outcome_of(const json& r, const std::string& file) {
+awcc::ProcessResult awcc_outcome_of(const json& r, const std::string& row, const std::string& file) {
   awcc::ProcessResult p;
-  if (r.contains("awcc") && r["awcc"].is_object()) {
-    const auto& a = r["awcc"];
+  if (has(r, key::awcc) && r[key::awcc].is_object()) {
+    const auto& a = r[key::awcc];
     awcc::AwccResult res;
-    res.status = status_of(a, res.status, file, "awcc");
-    if (a.contains("reason") && a["reason"].is_string()) res.message = a["reason"].get<std::string>();
-    res.probe_corrected = a.value("probe_corrected", false);
+    res.status = status_of(a, res.status, awcc::parse_awcc_status, row + "/awcc", file);
+    if (has(a, key::reason) && a[key::reason].is_string()) res.message = a[key::reason].get<std::string>();
+    res.probe_corrected = a.value(key::probe_corrected, false);
     p.awcc = std::move(res);
   }
   return p;
 }
 
-Correction correct_json_row(const CorrectionModel& model, const json& r, const RowDefaults& d, const std::string& file,
-                            std::vector<std::string>& warnings) {
-  // AWCC's status first: a row AWCC cannot serve needs nothing else unless
-  // the model's FSCC forest may correct it.
-  const auto outcome = measurement_of(awcc_outcome_of(r, file));
+// AWCC's processing as the JSON's awcc.options records it.
+std::optional<Processing> processing_of_json(const json& r, const std::string& row, const std::string& file) {
+  const auto& a = awcc_object(r);
+  if (!has(a, key::options) || !a[key::options].is_object()) return std::nullopt;
+  const auto& o = a[key::options];
+  const std::string at = row + "/awcc/options";
+  Processing p;
+  p.filter_a = required(o, key::filter_a, at, file);
+  p.roc = o.value(key::roc, true);
+  p.weighting = awcc::parse_weighting(text(o, key::weighting, at, file), {file, at, key::weighting});
+  p.signal = awcc::parse_correlation_signal(text(o, key::signal, at, file), {file, at, key::signal});
+  p.subsample = awcc::parse_subsample(text(o, key::subsample, at, file), {file, at, key::subsample});
+  return p;
+}
+
+// One row of either file: AWCC's outcome first; a row AWCC cannot serve needs
+// nothing else unless the model's FSCC forest may correct it. `measurement`
+// reads the whole row, `processing` how AWCC was processed.
+template <class Measure, class Processed>
+Correction correct_row(const CorrectionModel& model, const MeasurementResult& outcome, Measure&& measurement,
+                       Processed&& processing, const std::string& where, std::vector<std::string>& warnings) {
   if (outcome.status != CorrectionStatus::corrected) {
     if (!model.falls_back_to_fscc(outcome.status)) return not_corrected(outcome.status, outcome.message);
     MeasurementResult result;
     try {
-      result = measurement_of_json(r, d, file);
+      result = measurement();
     } catch (const std::exception& e) {  // the FSCC forest cannot have the row: AWCC's status stands
       return not_corrected(outcome.status, fmt::format("{}; FSCC forest: {}", outcome.message, e.what()));
     }
     return model.correct(result);
   }
-  const auto result = measurement_of_json(r, d, file);
-  const auto& a = awcc_object(r);
-  std::optional<Processing> processing;
-  if (a.contains("options") && a["options"].is_object()) {
-    const auto& o = a["options"];
-    processing = parse_processing(required(o, "filter_a", "awcc.options", file), o.value("roc", true) ? "on" : "off",
-                                  o.value("weighting", ""), o.value("signal", ""), o.value("subsample", ""));
-  }
-  check_processing(model, processing, file, warnings);
+  const auto result = measurement();
+  check_processing(model, processing(), where, warnings);
   return model.correct(result);
 }
 
@@ -237,50 +242,54 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
 
 }  // namespace
 
-MeasurementResult measurement_of_json(const nlohmann::json& r, const RowDefaults& d, const std::string& file) {
-  auto p = awcc_outcome_of(r, file);
+MeasurementResult measurement_of_json(const nlohmann::json& r, const RowDefaults& d, const std::string& file,
+                                      const std::string& row) {
+  auto p = awcc_outcome_of(r, row, file);
   const bool awcc_usable = measurement_of(p).status == CorrectionStatus::corrected;
   const auto& a = awcc_object(r);
+  const std::string at_awcc = row + "/awcc";
   // What every forest shares and FSCC's own.
-  if (!r.contains("tips") || !r["tips"].is_array() || r["tips"].empty()) {
-    throw awcc::InputError(fmt::format("{}: a result without 'tips'; give a JSON written by pdp process", file));
+  if (!has(r, key::tips) || !r[key::tips].is_array() || r[key::tips].empty()) {
+    throw awcc::InputError(fmt::format("{}: {}: a result without '{}'; give a JSON written by pdp process", file, row,
+                                       key::tips));
   }
-  const auto& lead = r["tips"][0];
+  const auto& lead = r[key::tips][0];
   awcc::TipResult tip;
-  tip.phase.void_fraction = required(lead, "void_fraction", "tips[0]", file);
-  tip.phase.bubble_count_rate = required(lead, "bubble_count_rate", "tips[0]", file);
+  tip.phase.void_fraction = required(lead, key::void_fraction, row + "/tips/0", file);
+  tip.phase.bubble_count_rate = required(lead, key::bubble_count_rate, row + "/tips/0", file);
   p.tips = {tip};
-  const auto fs = number(r, "fs"), samples = number(r, "samples");
+  const auto fs = number(r, key::fs), samples = number(r, key::samples);
   p.info.fs = fs.value_or(d.fs.value_or(0.0));
   if (fs && samples) p.info.frames = whole(*samples, file, "samples");
-  if (r.contains("fscc") && r["fscc"].is_object()) {
-    const auto& f = r["fscc"];
+  if (has(r, key::fscc) && r[key::fscc].is_object()) {
+    const auto& f = r[key::fscc];
     awcc::FsccResult res;
-    res.status = status_of(f, res.status, file, "fscc");
-    res.velocity = number(f, "velocity").value_or(0.0);
-    res.r12_max = number(f, "r12_max").value_or(0.0);
+    res.status = status_of(f, res.status, awcc::parse_fscc_status, row + "/fscc", file);
+    res.velocity = number(f, key::velocity).value_or(0.0);
+    res.r12_max = number(f, key::r12_max).value_or(0.0);
     p.fscc = std::move(res);
   }
   if (p.awcc) {
-    if (const auto w = number(a, "windows_accepted")) p.awcc->windows_accepted = whole(*w, file, "awcc.windows_accepted");
-    if (const auto w = number(a, "windows_total")) p.awcc->windows_total = whole(*w, file, "awcc.windows_total");
-    p.awcc->np = static_cast<int>(number(a, "np").value_or(d.np.value_or(0)));
+    if (const auto w = number(a, key::windows_accepted)) p.awcc->windows_accepted = whole(*w, file, "awcc.windows_accepted");
+    if (const auto w = number(a, key::windows_total)) p.awcc->windows_total = whole(*w, file, "awcc.windows_total");
+    p.awcc->np = static_cast<int>(number(a, key::np).value_or(d.np.value_or(0)));
   }
-  p.dx = need(number(r, "dx"), d.dx, file, "dx", "streamwise tip separation");
-  p.dy = need(number(r, "dy"), d.dy, file, "dy", "lateral tip separation");
+  p.dx = need(number(r, key::dx), d.dx, file, "dx", "streamwise tip separation");
+  p.dy = need(number(r, key::dy), d.dy, file, "dy", "lateral tip separation");
   if (awcc_usable) {
-    p.awcc->velocity = required(a, "velocity", "awcc", file);
-    p.awcc->turbulence_intensity = required(a, "turbulence_intensity", "awcc", file);
-    p.awcc->windows_accepted = whole(required(a, "windows_accepted", "awcc", file), file, "awcc.windows_accepted");
-    p.awcc->np = static_cast<int>(whole(need(number(a, "np"), default_np(d), file, "np", "particles per window"), file, "np"));
+    p.awcc->velocity = required(a, key::velocity, at_awcc, file);
+    p.awcc->turbulence_intensity = required(a, key::turbulence_intensity, at_awcc, file);
+    p.awcc->windows_accepted = whole(required(a, key::windows_accepted, at_awcc, file), file, "awcc.windows_accepted");
+    p.awcc->np =
+        static_cast<int>(whole(need(number(a, key::np), default_np(d), file, "np", "particles per window"), file, "np"));
   }
   auto result = measurement_of(p);
   // What the file does not give: the duration it (or the defaults) states
   // where it lacks the samples or the rate, and windows not known.
   auto& m = result.measurement;
-  if (!(fs && samples)) m.duration = number(r, "duration").value_or(d.duration.value_or(0.0));
-  if (!number(a, "windows_accepted")) m.windows_accepted = -1;
-  if (!number(a, "windows_total")) m.windows_total = -1;
+  if (!(fs && samples)) m.duration = number(r, key::duration).value_or(d.duration.value_or(0.0));
+  if (!number(a, key::windows_accepted)) m.windows_accepted = -1;
+  if (!number(a, key::windows_total)) m.windows_total = -1;
   return result;
 }
 
@@ -294,16 +303,21 @@ FileCorrection correct_process_json(const CorrectionModel& model, const std::str
     throw awcc::InputError(
         fmt::format("{}: not valid JSON ({}); give a pdp process JSON or profile CSV", file, e.what()));
   }
-  auto add = [&](json& row) {
-    auto c = to_json(correct_json_row(model, row, d, file, out.warnings));
+  // A row is named by its JSON pointer: "" for a recording's file, "/profile/3" in a profile.
+  auto add = [&](json& r, const std::string& row) {
+    const auto outcome = measurement_of(awcc_outcome_of(r, row, file));
+    auto c = to_json(correct_row(
+        model, outcome, [&] { return measurement_of_json(r, d, file, row); },
+        [&] { return processing_of_json(r, row, file); }, file, out.warnings));
     c["model"] = model_name;
-    row["correction"] = c;
+    r["correction"] = c;
   };
   try {
-    if (j.is_object() && j.contains("profile") && j["profile"].is_array()) {
-      for (auto& row : j["profile"]) add(row);
-    } else if (j.is_object() && j.contains("tips")) {
-      add(j);
+    if (has(j, key::profile) && j[key::profile].is_array()) {
+      auto& rows = j[key::profile];
+      for (std::size_t i = 0; i < rows.size(); ++i) add(rows[i], fmt::format("/{}/{}", key::profile, i));
+    } else if (has(j, key::tips)) {
+      add(j, "");
     } else {
       throw awcc::InputError(fmt::format(
           "{}: neither a recording's result (tips) nor a profile; give a JSON written by pdp process", file));
@@ -324,11 +338,11 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
   if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file", file));
   if (!line.empty() && line.back() == '\r') line.pop_back();
   const auto header = awcc::split_cells(line);
-  std::map<std::string, std::size_t> col;
+  std::map<std::string, std::size_t, std::less<>> col;
   for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  if (!col.count("awcc_velocity") && col.count("u [m/s]")) return correct_tool_csv(model, text, d, file);
-  for (const char* name :
-       {"void_fraction", "bubble_count_rate", "awcc_velocity", "awcc_turbulence_intensity", "awcc_windows_accepted"}) {
+  if (!col.count(column::awcc_velocity) && col.count("u [m/s]")) return correct_tool_csv(model, text, d, file);
+  for (const auto name : {column::void_fraction, column::bubble_count_rate, column::awcc_velocity,
+                          column::awcc_turbulence_intensity, column::awcc_windows_accepted, column::awcc_status}) {
     if (!col.count(name)) {
       throw awcc::InputError(fmt::format("{}: no column '{}': not a layout pdp corrects. {}", file, name, kLayouts));
     }
@@ -336,71 +350,85 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
   if (col.count("correction_in_range")) {
     throw awcc::InputError(fmt::format("{}: already corrected (correction columns present)", file));
   }
-  const bool has_processing = col.count("awcc_filter_a") && col.count("awcc_roc") && col.count("awcc_weighting") &&
-                              col.count("awcc_signal") && col.count("awcc_subsample");
+  const bool has_processing = col.count(column::awcc_filter_a) && col.count(column::awcc_roc) &&
+                              col.count(column::awcc_weighting) && col.count(column::awcc_signal) &&
+                              col.count(column::awcc_subsample);
   out.text = line + "," + correction_csv_header() + "\n";
   for_each_row(in, file, header.size(), [&](const std::string& row, const std::vector<std::string>& cells,
                                             const std::string& where) {
-    auto text_of = [&](const char* name) -> std::string {
+    auto text_of = [&](std::string_view name) -> std::string {
       const auto it = col.find(name);
       return it == col.end() ? std::string() : cells[it->second];
     };
-    auto value = [&](const char* name) -> std::optional<double> {
+    auto value = [&](std::string_view name) -> std::optional<double> {
       const std::string t = text_of(name);
       if (t.empty()) return std::nullopt;
       const auto v = awcc::cell_number(t);
       if (!v) throw awcc::InputError(fmt::format("{}: column {} = '{}' is not a number", where, name, t));
       return v;
     };
-    MeasurementResult result;
-    Measurement& m = result.measurement;
-    const auto u = value("awcc_velocity"), tu = value("awcc_turbulence_intensity");
-    const std::string probe = text_of("awcc_probe_corrected");
-    if (!u || !tu) {
-      result.status = CorrectionStatus::no_awcc_velocity;
-      result.message = "AWCC gave no velocity";
-    } else if (probe == "1" || probe == "true") {
-      result.status = CorrectionStatus::probe_corrected;
-      result.message = "AWCC's velocity is bubble-probe corrected (probe-correction on): the model corrects the "
-                       "uncorrected AWCC; process without the probe correction to correct it";
+    const std::string line_label = "line " + where.substr(file.size() + 1);
+    auto at = [&](std::string_view name) { return awcc::WrittenAt{file, line_label, name}; };
+    // The row read back into the fields of the awcc::ProcessResult that
+    // profile_csv_row wrote it from, as far as measurement_of reads them (as
+    // the JSON's, measurement_of_json): AWCC's outcome first. An empty
+    // status is a recording AWCC was not run on.
+    awcc::ProcessResult p;
+    if (const auto status = text_of(column::awcc_status); !status.empty()) {
+      awcc::AwccResult a;
+      a.status = awcc::parse_awcc_status(status, at(column::awcc_status));
+      a.message = text_of(column::awcc_reason);
+      const auto probe = text_of(column::awcc_probe_corrected);
+      a.probe_corrected = !probe.empty() && awcc::parse_switch(probe, at(column::awcc_probe_corrected));
+      p.awcc = std::move(a);
     }
-    const bool awcc_usable = result.status == CorrectionStatus::corrected;
-    // What every forest shares and FSCC's own.
-    auto gather = [&] {
-      m.void_fraction = value("void_fraction").value_or(0.0);
-      m.bubble_count_rate = value("bubble_count_rate").value_or(0.0);
-      m.dx = need(value("dx"), d.dx, where, "dx", "streamwise tip separation");
-      m.dy = need(value("dy"), d.dy, where, "dy", "lateral tip separation");
-      if (const auto w = value("awcc_windows_accepted")) m.windows_accepted = whole(*w, where, "awcc_windows_accepted");
-      if (const auto w = value("awcc_windows_total")) m.windows_total = whole(*w, where, "awcc_windows_total");
-      m.fs = value("fs").value_or(d.fs.value_or(0.0));
-      m.duration = value("duration").value_or(d.duration.value_or(0.0));
-      m.fscc_velocity = value("fscc_velocity");
-      m.r12_max = value("fscc_r12_max");
+    const auto outcome = measurement_of(p);
+    auto measurement = [&] {
+      awcc::TipResult tip;
+      tip.phase.void_fraction = value(column::void_fraction).value_or(0.0);
+      tip.phase.bubble_count_rate = value(column::bubble_count_rate).value_or(0.0);
+      p.tips = {tip};
+      p.dx = need(value(column::dx), d.dx, where, "dx", "streamwise tip separation");
+      p.dy = need(value(column::dy), d.dy, where, "dy", "lateral tip separation");
+      if (const auto status = text_of(column::fscc_status); !status.empty()) {
+        awcc::FsccResult f;
+        f.status = awcc::parse_fscc_status(status, at(column::fscc_status));
+        f.velocity = value(column::fscc_velocity).value_or(0.0);
+        f.r12_max = value(column::fscc_r12_max).value_or(0.0);
+        p.fscc = std::move(f);
+      }
+      const auto accepted = value(column::awcc_windows_accepted), total = value(column::awcc_windows_total);
+      if (p.awcc) {
+        if (accepted) p.awcc->windows_accepted = whole(*accepted, where, "awcc_windows_accepted");
+        if (total) p.awcc->windows_total = whole(*total, where, "awcc_windows_total");
+        if (outcome.status == CorrectionStatus::corrected) {
+          p.awcc->velocity = *value(column::awcc_velocity);
+          p.awcc->turbulence_intensity = *value(column::awcc_turbulence_intensity);
+          p.awcc->np = static_cast<int>(
+              whole(need(value(column::np), default_np(d), where, "np", "particles per window"), where, "np"));
+        }
+      }
+      auto result = measurement_of(p);
+      // What the file does not give: the record's rate and length it (or the
+      // defaults) states, and windows not known.
+      auto& m = result.measurement;
+      m.fs = value(column::fs).value_or(d.fs.value_or(0.0));
+      m.duration = value(column::duration).value_or(d.duration.value_or(0.0));
+      if (!accepted) m.windows_accepted = -1;
+      if (!total) m.windows_total = -1;
+      return result;
     };
-    Correction c;
-    if (!awcc_usable && !model.falls_back_to_fscc(result.status)) {
-      c = not_corrected(result.status, result.message);
-    } else if (!awcc_usable) {
-      try {
-        gather();
-        c = model.correct(result);
-      } catch (const std::exception& e) {  // the FSCC forest cannot have the row: AWCC's status stands
-        c = not_corrected(result.status, fmt::format("{}; FSCC forest: {}", result.message, e.what()));
-      }
-    } else {
-      std::optional<Processing> processing;
-      if (has_processing && value("awcc_filter_a")) {
-        processing = parse_processing(*value("awcc_filter_a"), text_of("awcc_roc"), text_of("awcc_weighting"),
-                                      text_of("awcc_signal"), text_of("awcc_subsample"));
-      }
-      check_processing(model, processing, where, out.warnings);
-      m.velocity = u;
-      m.turbulence_intensity = tu;
-      gather();
-      m.np = static_cast<int>(whole(need(value("np"), default_np(d), where, "np", "particles per window"), where, "np"));
-      c = model.correct(result);
-    }
+    auto processing = [&]() -> std::optional<Processing> {
+      if (!has_processing || !value(column::awcc_filter_a)) return std::nullopt;
+      Processing pr;
+      pr.filter_a = *value(column::awcc_filter_a);
+      pr.roc = awcc::parse_switch(text_of(column::awcc_roc), at(column::awcc_roc));
+      pr.weighting = awcc::parse_weighting(text_of(column::awcc_weighting), at(column::awcc_weighting));
+      pr.signal = awcc::parse_correlation_signal(text_of(column::awcc_signal), at(column::awcc_signal));
+      pr.subsample = awcc::parse_subsample(text_of(column::awcc_subsample), at(column::awcc_subsample));
+      return pr;
+    };
+    const auto c = correct_row(model, outcome, measurement, processing, where, out.warnings);
     out.text += row + "," + correction_csv_cells(c) + "\n";
   });
   return out;

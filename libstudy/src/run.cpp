@@ -177,7 +177,6 @@ json run_to_json(const RunResult& r) {
   out["phase"] = {{"void_fraction", opt(r.void_fraction.value)}, {"bubble_count_rate", opt(r.count_rate.value)}};
   if (p.fscc) {
     out["fscc"] = {{"status", awcc::to_string(p.fscc->status)},
-                   {"defined", p.fscc->ok()},
                    {"reason", p.fscc->ok() ? json(nullptr) : json(p.fscc->message)},
                    {"velocity", opt(r.fscc_velocity.value)},
                    {"turbulence_intensity_chanson", opt(r.fscc_turbulence_intensity.value)},
@@ -186,7 +185,6 @@ json run_to_json(const RunResult& r) {
   }
   if (p.awcc) {
     out["awcc"] = {{"status", awcc::to_string(p.awcc->status)},
-                   {"defined", p.awcc->ok()},
                    {"reason", p.awcc->ok() ? json(nullptr) : json(p.awcc->message)},
                    {"velocity", opt(r.awcc_velocity.value)},
                    {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},

@@ -105,7 +105,9 @@ def profile_columns():
     """The profile CSV's columns, then the correction's: ``name``, ``unit``
     ("" for text, "-" when dimensionless), ``pointer`` (RFC 6901: where the
     same value is in a recording's result; "" for the version, which is in the
-    provenance) and ``meaning``, as the libraries declare them."""
+    provenance), ``meaning`` and ``values`` (the texts an enum or on/off
+    column may hold; empty for numbers and free text), as the libraries
+    declare them."""
     return [Result(c) for c in _pdp.profile_columns()]
 
 

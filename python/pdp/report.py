@@ -88,6 +88,20 @@ def pointer_value(obj, pointer):
     return obj
 
 
+def check_written_values(path, data, rows, columns):
+    """Every text the columns declare values for (statuses, the quality, the
+    weighting, ...: pdp.profile_columns()' "values", the libraries' own
+    lists) is one pdp writes; another is refused naming the file, the row's
+    JSON pointer and the value, never drawn as a default."""
+    for i, row in enumerate(rows):
+        where = f"/profile/{i}" if "profile" in data else ""
+        for c in columns:
+            value = pointer_value(row, c["pointer"]) if c.get("values") else None
+            if isinstance(value, str) and value not in c["values"]:
+                raise InputProblem(f"{path}: {where}{c['pointer']} = '{value}' is not a value pdp writes "
+                                   f"({', '.join(c['values'])}); give the file pdp process --json wrote")
+
+
 def cell_value(row, column, provenance):
     if column["name"] == "pdp_version":
         return provenance.get("pdp_version")
@@ -282,6 +296,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     import pdp
 
     data, rows, digest = load(json_path)
+    columns = pdp.profile_columns()
+    check_written_values(json_path, data, rows, columns)
     provenance = data.get("provenance") or {}
     have_positions = all(plotting.number(r.get("position")) is not None for r in rows)
     ys, _ = plotting.positions_mm(rows)
@@ -298,7 +314,6 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
             return None, None
     profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs, per_position=detail)
 
-    columns = pdp.profile_columns()
     text_columns = [c for c in columns if c["name"].endswith("reason") or c["name"] == "warnings"]
     gaps, table = {}, []
     for c in columns:

@@ -26,6 +26,7 @@
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
 #include "awcc/process.hpp"
+#include "awcc/read_back.hpp"
 #include "awcc/serialise.hpp"
 #include "awcc/version.hpp"
 #include "correction/model.hpp"
@@ -458,8 +459,11 @@ PYBIND11_MODULE(_pdp, m) {
     py::list out;
     auto add = [&](std::span<const awcc::ProfileColumn> columns) {
       for (const auto& c : columns) {
+        py::list values;
+        for (const auto v : awcc::written_values(c.name)) values.append(std::string(v));
         out.append(py::dict(py::arg("name") = std::string(c.name), py::arg("unit") = std::string(c.unit),
-                            py::arg("pointer") = std::string(c.json_pointer), py::arg("meaning") = std::string(c.meaning)));
+                            py::arg("pointer") = std::string(c.json_pointer), py::arg("meaning") = std::string(c.meaning),
+                            py::arg("values") = values));
       }
     };
     add(awcc::profile_csv_columns());

@@ -320,6 +320,22 @@ def test_bad_json_is_refused_with_no_page(tmp_path, content, code, message):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.json"]
 
 
+def test_a_value_pdp_does_not_write_is_refused_naming_file_row_and_value(synthetic, tmp_path):
+    # The report reads the enums' values from the libraries' declaration
+    # (pdp.profile_columns()), as pdp correct does: no value is drawn as a default.
+    columns = {c["name"]: c for c in pdp.profile_columns()}
+    assert columns["awcc_quality"]["values"] == ["ok", "low", "insufficient"]
+    assert columns["awcc_roc"]["values"] == ["on", "off"] and columns["void_fraction"]["values"] == []
+    data = load(synthetic / "profile.json")
+    data["profile"][1]["awcc"]["quality"] = "good"
+    (tmp_path / "in.json").write_text(json.dumps(data))
+    done = run("report", tmp_path / "in.json", "-o", tmp_path / "out.html")
+    assert done.returncode == 1, done.stderr
+    for part in (str(tmp_path / "in.json"), "/profile/1/awcc/quality", "'good'", "ok, low, insufficient"):
+        assert part in done.stderr, (part, done.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.json"]
+
+
 def test_usage_and_output_errors_have_their_exit_status(synthetic, tmp_path):
     done = run("report", synthetic / "profile.json", "-o", tmp_path / "no" / "such" / "folder.html")
     assert done.returncode == 3 and "cannot write" in done.stderr

@@ -123,7 +123,7 @@ expect 3 "does not exist" "$pdp" process "$dir/a.flac" "$dir/a.flac" --dx 5mm --
   --csv "$dir/no/such/folder/b.csv"
 [[ -e $dir/b.json ]] && fail "a JSON was written although the CSV could not be"
 printf '{"tips": [{"void_fraction": "x"}], "awcc": {"defined": true, "velocity": 1, "turbulence_intensity": 0.1, "windows_accepted": "many", "options": {"filter_a": 0.4, "roc": "on"}}}' >"$dir/typed.json"
-expect 1 "no number 'void_fraction' in tips[0]" "$pdp" correct "$dir/typed.json" -m "$src/samples/model/awcc.qrf" --dx 5mm \
+expect 1 "no number 'void_fraction' in /tips/0" "$pdp" correct "$dir/typed.json" -m "$src/samples/model/awcc.qrf" --dx 5mm \
   --dy 0 --np 10
 
 [[ $failures -eq 0 ]] && echo "config CLI: all checks passed"

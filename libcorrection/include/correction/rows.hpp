@@ -1,7 +1,8 @@
 #pragma once
 // Correcting results that were written to files: the process JSON (one
 // recording or a profile) and the profile CSV of pdp process. Each row's
-// measurement is read by the names of awcc/serialise.hpp, its features made
+// measurement is read by the names of awcc/read_back.hpp (enums by their
+// parsers there), its features made
 // by the one contract (correction/features.hpp), and its processing checked
 // against the model's: results processed differently are refused.
 
@@ -34,10 +35,12 @@ struct FileCorrection {
 /// awcc::ProcessResult the JSON was written from: the same as of the result
 /// in memory. Values the file lacks come from `defaults` (dx, dy, np, fs,
 /// duration) or are unknown (windows). Throws awcc::InputError (a missing
-/// or mistyped key, an unknown status) or awcc::OptionError (dx, dy or np
-/// needed and neither in the file nor the defaults).
+/// or mistyped key, an unknown status: naming the file, the row's JSON
+/// pointer `row`, "" for a recording's file, and the value) or
+/// awcc::OptionError (dx, dy or np needed and neither in the file nor the
+/// defaults).
 MeasurementResult measurement_of_json(const nlohmann::json& result, const RowDefaults& defaults,
-                                      const std::string& file);
+                                      const std::string& file, const std::string& row = "");
 
 /// Adds a "correction" object to every result of a process JSON. Throws
 /// awcc::InputError (not such a JSON, processed differently from the model)

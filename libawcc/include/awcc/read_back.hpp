@@ -1,0 +1,111 @@
+#pragma once
+// Reading back what awcc/serialise.hpp writes. The process JSON's keys that
+// other parts read and the profile CSV's columns are named here once; the
+// writer writes by these names and every reader (libcorrection's rows, the
+// Python module) reads by them. Each enum of a result has one parser, the
+// inverse of its to_string: a text pdp does not write is an InputError
+// naming the file, the row and the value, never a default.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "awcc/awcc.hpp"
+#include "awcc/fscc.hpp"
+#include "awcc/phase_statistics.hpp"
+#include "awcc/process.hpp"
+
+namespace awcc {
+
+/// Where a text was read: the file, the row (a JSON pointer such as
+/// "/profile/3/awcc", or "line 7" of a CSV) and the key or column.
+struct WrittenAt {
+  std::string_view file;
+  std::string_view row;
+  std::string_view field;
+};
+
+PhaseStatus parse_phase_status(std::string_view text, const WrittenAt& at);
+FsccStatus parse_fscc_status(std::string_view text, const WrittenAt& at);
+AwccStatus parse_awcc_status(std::string_view text, const WrittenAt& at);
+AwccQuality parse_awcc_quality(std::string_view text, const WrittenAt& at);
+Weighting parse_weighting(std::string_view text, const WrittenAt& at);
+CorrelationSignal parse_correlation_signal(std::string_view text, const WrittenAt& at);
+Subsample parse_subsample(std::string_view text, const WrittenAt& at);
+WindowFate parse_window_fate(std::string_view text, const WrittenAt& at);
+VelocitySource parse_velocity_source(std::string_view text, const WrittenAt& at);
+/// A switch of the profile CSV ("on"/"off", as profile_csv_row writes a JSON
+/// true/false).
+bool parse_switch(std::string_view text, const WrittenAt& at);
+
+/// The texts a profile CSV column may hold, by its name: an enum's values
+/// (by its to_string) or a switch's on/off; empty for a number or free text.
+/// The Python module hands them to the report (pdp.profile_columns()).
+std::vector<std::string_view> written_values(std::string_view column);
+
+/// The keys of the process JSON that are read back (docs/output.md). A
+/// recording's object:
+namespace process_key {
+inline constexpr std::string_view profile = "profile";  ///< a profile's list of recordings' objects
+inline constexpr std::string_view tips = "tips";
+inline constexpr std::string_view fscc = "fscc";
+inline constexpr std::string_view awcc = "awcc";
+inline constexpr std::string_view fs = "fs";
+inline constexpr std::string_view samples = "samples";
+inline constexpr std::string_view duration = "duration";
+inline constexpr std::string_view dx = "dx";
+inline constexpr std::string_view dy = "dy";
+// In a tip's, FSCC's or AWCC's object:
+inline constexpr std::string_view status = "status";
+inline constexpr std::string_view reason = "reason";
+inline constexpr std::string_view void_fraction = "void_fraction";
+inline constexpr std::string_view bubble_count_rate = "bubble_count_rate";
+inline constexpr std::string_view velocity = "velocity";
+inline constexpr std::string_view r12_max = "r12_max";
+inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
+inline constexpr std::string_view windows_accepted = "windows_accepted";
+inline constexpr std::string_view windows_total = "windows_total";
+inline constexpr std::string_view np = "np";
+inline constexpr std::string_view probe_corrected = "probe_corrected";
+inline constexpr std::string_view options = "options";
+// In AWCC's options (to_json(AwccOptions)):
+inline constexpr std::string_view filter_a = "filter_a";
+inline constexpr std::string_view roc = "roc";
+inline constexpr std::string_view weighting = "weighting";
+inline constexpr std::string_view signal = "signal";
+inline constexpr std::string_view subsample = "subsample";
+/// Retired by issue 28: a JSON written before the "status" keys existed says
+/// only whether FSCC or AWCC gave a value (docs/output.md).
+inline constexpr std::string_view retired_defined = "defined";
+}  // namespace process_key
+
+/// The profile CSV's columns that are read back; profile_csv_columns
+/// declares them (with units and meanings) by these names.
+namespace profile_column {
+inline constexpr std::string_view void_fraction = "void_fraction";
+inline constexpr std::string_view bubble_count_rate = "bubble_count_rate";
+inline constexpr std::string_view fscc_velocity = "fscc_velocity";
+inline constexpr std::string_view fscc_r12_max = "fscc_r12_max";
+inline constexpr std::string_view awcc_velocity = "awcc_velocity";
+inline constexpr std::string_view awcc_turbulence_intensity = "awcc_turbulence_intensity";
+inline constexpr std::string_view awcc_windows_accepted = "awcc_windows_accepted";
+inline constexpr std::string_view awcc_windows_total = "awcc_windows_total";
+inline constexpr std::string_view fscc_status = "fscc_status";
+inline constexpr std::string_view awcc_status = "awcc_status";
+inline constexpr std::string_view awcc_reason = "awcc_reason";
+inline constexpr std::string_view dx = "dx";
+inline constexpr std::string_view dy = "dy";
+inline constexpr std::string_view np = "np";
+inline constexpr std::string_view awcc_filter_a = "awcc_filter_a";
+inline constexpr std::string_view awcc_roc = "awcc_roc";
+inline constexpr std::string_view awcc_weighting = "awcc_weighting";
+inline constexpr std::string_view awcc_signal = "awcc_signal";
+inline constexpr std::string_view awcc_subsample = "awcc_subsample";
+inline constexpr std::string_view fs = "fs";
+inline constexpr std::string_view duration = "duration";
+inline constexpr std::string_view awcc_quality = "awcc_quality";
+inline constexpr std::string_view chord_velocity_source = "chord_velocity_source";
+inline constexpr std::string_view awcc_probe_corrected = "awcc_probe_corrected";
+}  // namespace profile_column
+
+}  // namespace awcc
