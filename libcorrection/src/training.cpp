@@ -22,6 +22,7 @@
 #include "awcc/random.hpp"
 #include "awcc/units.hpp"
 #include "awcc/version.hpp"
+#include "correction/sweep_columns.hpp"
 
 namespace correction {
 
@@ -243,25 +244,32 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     std::string line;
     if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
     const auto header = split_cells(line);
-    std::map<std::string, std::size_t> col;
+    std::map<std::string, std::size_t, std::less<>> col;
     for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-    const char* needed[] = {"study", "run", "dx", "dy", "np", "truth_velocity", "truth_turbulence_intensity",
-                            "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate",
-                            "awcc_windows_accepted", "reason"};
-    for (const char* name : needed) {
+    using C = SweepColumn;
+    using Scene = SweepSceneColumns;
+    const std::string_view needed[] = {sweep_key_columns[0].name, sweep_key_columns[1].name, Scene::dx, Scene::dy,
+                                       column_name(C::np), column_name(C::truth_velocity),
+                                       column_name(C::truth_turbulence_intensity), column_name(C::awcc_velocity),
+                                       column_name(C::awcc_turbulence_intensity), column_name(C::awcc_void_fraction),
+                                       column_name(C::awcc_count_rate), column_name(C::awcc_windows_accepted),
+                                       column_name(C::reason)};
+    for (const auto name : needed) {
       if (!col.count(name)) {
         throw awcc::InputError(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
       }
     }
     // The processing of the runs: every row must agree (the model learns one).
-    const char* processing_columns[] = {"awcc_filter_a", "awcc_roc", "awcc_weighting", "awcc_signal", "awcc_subsample"};
+    // Sweeps written before these columns existed have none of them.
+    const C processing_columns[] = {C::awcc_filter_a, C::awcc_roc, C::awcc_weighting, C::awcc_signal, C::awcc_subsample};
     const bool has_processing = std::all_of(std::begin(processing_columns), std::end(processing_columns),
-                                            [&](const char* c) { return col.count(c) > 0; });
+                                            [&](C c) { return col.count(column_name(c)) > 0; });
     if (!has_processing) set.processing_assumed = true;
     // The geometry processed; older CSVs have only the scene's dx and dy
     // (the same unless the scene gave explicit tips).
-    const char* dx_column = col.count("probe_dx") ? "probe_dx" : "dx";
-    const char* dy_column = col.count("probe_dy") ? "probe_dy" : "dy";
+    const std::string_view dx_column = col.count(column_name(C::probe_dx)) ? column_name(C::probe_dx) : Scene::dx;
+    const std::string_view dy_column = col.count(column_name(C::probe_dy)) ? column_name(C::probe_dy) : Scene::dy;
+    const std::string_view study_column = sweep_key_columns[0].name, run_column = sweep_key_columns[1].name;
     std::set<std::string> studies;
     std::int64_t number = 1;
     while (std::getline(in, line)) {
@@ -273,8 +281,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
                                            "resumes and repairs it",
                                            path.string(), number, cells.size(), header.size()));
       }
-      auto cell = [&](const char* name) -> const std::string& { return cells[col.at(name)]; };
-      auto number_of = [&](const char* name) {
+      auto cell = [&](std::string_view name) -> const std::string& { return cells[col.find(name)->second]; };
+      auto number_of = [&](std::string_view name) {
         const auto v = cell_number(cell(name));
         if (!v) {
           throw awcc::InputError(fmt::format("{}:{}: column {} = '{}' is not a number; give the CSV pdp sweep wrote",
@@ -283,25 +291,36 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         return *v;
       };
       ++set.total;
-      studies.insert(cell("study"));
-      const auto run = static_cast<std::int64_t>(number_of("run"));
-      if (!seen.insert({cell("study"), run}).second) {
+      studies.insert(cell(study_column));
+      const auto run = static_cast<std::int64_t>(number_of(run_column));
+      if (!seen.insert({cell(study_column), run}).second) {
         throw awcc::InputError(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
-                                           path.string(), number, run, cell("study")));
+                                           path.string(), number, run, cell(study_column)));
       }
       // A failed run has no result at all (no truth); a run whose AWCC gave
       // no value has its truth but no AWCC velocity.
-      if (cell("truth_velocity").empty()) {
+      if (cell(column_name(C::truth_velocity)).empty()) {
         ++set.excluded_error;
         continue;
       }
       if (has_processing) {
+        // An enum cell that names no value is refused: a default would train
+        // a model on a processing the runs did not have.
+        auto named = [&](C column, auto parse, std::string_view values) {
+          const auto v = parse(cell(column_name(column)));
+          if (!v) {
+            throw awcc::InputError(fmt::format("{}:{}: column {} = '{}' is not one of {}; give the CSV pdp sweep wrote",
+                                               path.string(), number, column_name(column), cell(column_name(column)),
+                                               values));
+          }
+          return *v;
+        };
         Processing p;
-        p.filter_a = number_of("awcc_filter_a");
-        p.roc = cell("awcc_roc") == "on";
-        p.weighting = cell("awcc_weighting") == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
-        p.signal = cell("awcc_signal") == "raw" ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
-        p.subsample = cell("awcc_subsample") == "parabolic" ? awcc::Subsample::parabolic : awcc::Subsample::none;
+        p.filter_a = number_of(column_name(C::awcc_filter_a));
+        p.roc = named(C::awcc_roc, roc_of, "on, off");
+        p.weighting = named(C::awcc_weighting, weighting_of, "duration, none");
+        p.signal = named(C::awcc_signal, signal_of, "binary, raw");
+        p.subsample = named(C::awcc_subsample, subsample_of, "none, parabolic");
         if (!processing_seen) set.processing = p;
         processing_seen = true;
         if (const auto why = processing_mismatch(set.processing, p); !why.empty()) {
@@ -314,33 +333,35 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       r.run = run;
       try {
         std::size_t used = 0;
-        r.study = std::stoull(cell("study"), &used);
-        if (used != cell("study").size()) throw std::invalid_argument("trailing text");
+        r.study = std::stoull(cell(study_column), &used);
+        if (used != cell(study_column).size()) throw std::invalid_argument("trailing text");
       } catch (const std::exception&) {
         throw awcc::InputError(fmt::format("{}:{}: study = '{}' is not a sweep study id; give the CSV pdp sweep wrote",
-                                           path.string(), number, cell("study")));
+                                           path.string(), number, cell(study_column)));
       }
       Measurement m;
-      if (!cell("awcc_velocity").empty()) m.velocity = number_of("awcc_velocity");
-      if (!cell("awcc_turbulence_intensity").empty()) m.turbulence_intensity = number_of("awcc_turbulence_intensity");
-      auto optional_number = [&](const char* name) -> std::optional<double> {
+      if (!cell(column_name(C::awcc_velocity)).empty()) m.velocity = number_of(column_name(C::awcc_velocity));
+      if (!cell(column_name(C::awcc_turbulence_intensity)).empty())
+        m.turbulence_intensity = number_of(column_name(C::awcc_turbulence_intensity));
+      auto optional_number = [&](std::string_view name) -> std::optional<double> {
         return col.count(name) && !cell(name).empty() ? std::optional(number_of(name)) : std::nullopt;
       };
       // The phase statistics and the record are there for every run that did not fail.
-      m.void_fraction = optional_number("awcc_void_fraction").value_or(0.0);
-      m.bubble_count_rate = optional_number("awcc_count_rate").value_or(0.0);
+      m.void_fraction = optional_number(column_name(C::awcc_void_fraction)).value_or(0.0);
+      m.bubble_count_rate = optional_number(column_name(C::awcc_count_rate)).value_or(0.0);
       m.dx = number_of(dx_column);
       m.dy = number_of(dy_column);
-      m.np = static_cast<int>(number_of("np"));
-      m.windows_accepted = static_cast<std::int64_t>(optional_number("awcc_windows_accepted").value_or(-1.0));
-      m.windows_total = static_cast<std::int64_t>(optional_number("awcc_windows_total").value_or(-1.0));
-      m.fs = optional_number("fs").value_or(0.0);
-      m.duration = optional_number("duration").value_or(0.0);
-      m.fscc_velocity = optional_number("fscc_velocity");
-      m.r12_max = optional_number("fscc_r12_max");
+      m.np = static_cast<int>(number_of(column_name(C::np)));
+      m.windows_accepted =
+          static_cast<std::int64_t>(optional_number(column_name(C::awcc_windows_accepted)).value_or(-1.0));
+      m.windows_total = static_cast<std::int64_t>(optional_number(column_name(C::awcc_windows_total)).value_or(-1.0));
+      m.fs = optional_number(Scene::fs).value_or(0.0);
+      m.duration = optional_number(Scene::duration).value_or(0.0);
+      m.fscc_velocity = optional_number(column_name(C::fscc_velocity));
+      m.r12_max = optional_number(column_name(C::fscc_r12_max));
       const auto features = make_features(m);
-      r.true_velocity = number_of("truth_velocity");
-      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
+      r.true_velocity = number_of(column_name(C::truth_velocity));
+      r.true_turbulence_intensity = number_of(column_name(C::truth_turbulence_intensity));
       if (fscc_unusable(features.features).empty() && features.features.fs > 0.0 && features.features.duration > 0.0) {
         TrainingRow f = r;
         f.features = features.features;

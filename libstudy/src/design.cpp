@@ -48,7 +48,7 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   DesignDefinition d;
   const std::string file = path.string();
   auto fail = [&](const std::string& where, const std::string& what) -> void {
-    throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
+    throw awcc::OptionError(fmt::format("{}: {}: {}", file, where, what));
   };
   const auto tables = detail::definition_tables(path, {"conditions"});
   auto quantity = [&](const std::string& where, const std::string& text, awcc::Dimension dim) {
@@ -671,21 +671,61 @@ std::string stats_cells(const ErrorStats& s) {
 
 }  // namespace
 
+namespace {
+
+const RankedColumn kRankedColumns[] = {
+    {"rank", "-", "the candidate's rank, 1 = recommended"},
+    {"objective", "-", "what the candidates are ranked on: the score's worst or mean over the conditions (ranking)"},
+    {"ranking", "text", "worst-case (the largest score over the conditions) or mean: the design's objective"},
+    {"values", "text", "corrected (the model's median where it corrects, AWCC's elsewhere) or raw: the values ranked on"},
+    {"failures", "-", "records without a value, over the conditions"},
+    {"best_share", "-", "share of the bootstrap resamples of the records in which the candidate ranks first"},
+    {"current", "-", "1 for the lab's current probe, else 0"},
+    {"dx", "m", "streamwise tip separation"},
+    {"dy", "m", "lateral tip separation"},
+    {"np", "-", "points per AWCC window"},
+    {"fs", "Hz", "sampling rate"},
+    {"duration", "s", "record duration"},
+    {"needle", "m", "the leading needle's diameter, 0 for point tips"},
+    {"seconds_awcc", "s", "mean AWCC CPU seconds per record (differs from run to run; not ranked on)"},
+    {"condition", "text", "the condition's name; the columns after it are the condition's"},
+    {"records", "-", "records simulated in the condition"},
+    {"condition_failures", "-", "records of the condition without a value"},
+    {"score", "-", "RMS_u + RMS_Tu of the values ranked on, relative"},
+    {"u_bias", "-", "bias of the velocity ranked on, relative"},
+    {"u_spread", "-", "spread of the velocity ranked on, relative"},
+    {"u_rms", "-", "RMS error of the velocity ranked on, relative"},
+    {"tu_bias", "-", "bias of Tu ranked on, relative"},
+    {"tu_spread", "-", "spread of Tu ranked on, relative"},
+    {"tu_rms", "-", "RMS error of Tu ranked on, relative"},
+    {"raw_u_bias", "-", "raw AWCC's velocity bias, relative"},
+    {"raw_u_spread", "-", "raw AWCC's velocity spread, relative"},
+    {"raw_u_rms", "-", "raw AWCC's velocity RMS error, relative"},
+    {"raw_tu_bias", "-", "raw AWCC's Tu bias, relative"},
+    {"raw_tu_spread", "-", "raw AWCC's Tu spread, relative"},
+    {"raw_tu_rms", "-", "raw AWCC's Tu RMS error, relative"},
+    {"corrected_fraction", "-", "share of the records the model corrected"},
+    {"data_yield", "-", "mean accepted / formed AWCC windows"},
+};
+
+}  // namespace
+
+std::span<const RankedColumn> ranked_columns() { return kRankedColumns; }
+
 std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d) {
-  std::string out =
-      "rank,objective,failures,best_share,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,condition_failures,score,"
-      "u_bias,u_spread,u_rms,tu_bias,tu_spread,tu_rms,raw_u_bias,raw_u_spread,raw_u_rms,raw_tu_bias,raw_tu_spread,"
-      "raw_tu_rms,corrected_fraction,data_yield\n";
+  std::string out;
+  for (const auto& c : kRankedColumns) out += (out.empty() ? "" : ",") + std::string(c.name);
+  out += "\n";
   const bool corrected = d.values == "corrected";
   for (const auto& r : ranked) {
     for (const auto& c : r.conditions) {
       const auto& u = corrected ? c.corrected_u : c.raw_u;
       const auto& t = corrected ? c.corrected_tu : c.raw_tu;
-      out += fmt::format("{},{},{},{:.3g},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
-                         num(r.objective), r.failures, r.best_share, r.current ? 1 : 0, num(r.candidate.dx), num(r.candidate.dy),
-                         r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), num(r.candidate.needle),
-                         r.seconds, c.condition,
-                         c.records, c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
+      out += fmt::format("{},{},{},{},{},{:.3g},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
+                         num(r.objective), d.objective, d.values, r.failures, r.best_share, r.current ? 1 : 0,
+                         num(r.candidate.dx), num(r.candidate.dy), r.candidate.np, num(r.candidate.fs),
+                         num(r.candidate.duration), num(r.candidate.needle), r.seconds, c.condition, c.records,
+                         c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
                          stats_cells(c.raw_tu), c.corrected_fraction, c.data_yield);
     }
   }

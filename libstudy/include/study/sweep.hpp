@@ -50,7 +50,7 @@ struct SweepDefinition {
   std::set<std::string> log_ranges;
 };
 
-/// Reads and checks a sweep file; throws std::invalid_argument (a definition
+/// Reads and checks a sweep file; throws awcc::OptionError (a definition
 /// that cannot be run) naming the file, the table and key, and the fix.
 SweepDefinition load_sweep(const std::filesystem::path& path);
 
