@@ -7,11 +7,13 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include "awcc/errors.hpp"
 #include "correction/features.hpp"
 #include "correction/sweep_columns.hpp"
+#include "awcc/option_field.hpp"
 #include "awcc/settings_file.hpp"
 
 #include "awcc/units.hpp"
@@ -23,20 +25,40 @@ namespace {
 
 using detail::dimension_of;
 
-bool is_field(const std::string& name) { return name == "np" || name == "anisotropy" || detail::is_scene_field(name); }
+// The run's own fields beside the scene's (synth::scene_fields).
+const awcc::OptionField<SweepRun> kRunFields[] = {
+    {"np", "-", "points per AWCC window",
+     [](SweepRun& run, std::string_view text) {
+       const double v = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
+       if (v != std::floor(v) || v < 1 || v > 1000) {
+         throw std::invalid_argument(fmt::format("{} must be a whole number in [1, 1000]", text));
+       }
+       run.np = static_cast<int>(v);
+     },
+     [](const SweepRun& run) { return std::to_string(run.np); }},
+    {"anisotropy", "-", "Tu_y/Tu_x = Tu_z/Tu_x, applied when tu-y and tu-z are not set",
+     [](SweepRun& run, std::string_view text) {
+       run.anisotropy = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
+     },
+     [](const SweepRun& run) { return fmt::format("{:g}", run.anisotropy); }},
+};
 
-// Applies one value (text) of a field or of np/anisotropy to a run.
-void apply(SweepRun& run, const std::string& name, const std::string& text) {
-  if (name == "np") {
-    const double v = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
-    if (v != std::floor(v) || v < 1 || v > 1000) throw awcc::OptionError(fmt::format("np = {} must be a whole number in [1, 1000]", text), "np");
-    run.np = static_cast<int>(v);
-  } else if (name == "anisotropy") {
-    run.anisotropy = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
-  } else {
-    synth::set_scene_field(run.scene, name, text);
-  }
+bool is_field(const std::string& name) {
+  return std::any_of(std::begin(kRunFields), std::end(kRunFields), [&](const auto& f) { return f.name == name; }) ||
+         detail::is_scene_field(name);
 }
+
+// Applies one value of a field (the run's or the scene's) through the one
+// application path; a refused value is awcc::setting_error's, naming
+// setting.origin and the field.
+void apply(SweepRun& run, const awcc::OptionSetting& setting) {
+  const std::span<const awcc::OptionSetting> one(&setting, 1);
+  std::vector<bool> used(1, false);
+  awcc::apply_settings(std::span<const awcc::OptionField<SweepRun>>(kRunFields), one, run, used);
+  if (!used[0]) awcc::apply_settings(synth::scene_fields(), one, run.scene, used);
+}
+
+void apply(SweepRun& run, const std::string& name, const std::string& text) { apply(run, {name, text, {}}); }
 
 constexpr const char* kUnknownField = "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, "
                                       "bubble-diameter, dx, fs, duration, ...), np or anisotropy";
@@ -83,24 +105,26 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
   }
   if (d.mode == "monte-carlo" && d.runs < 1) fail("[sweep] runs", "monte-carlo needs runs >= 1");
   SweepRun probe;
-  auto check_value = [&](const std::string& where, const std::string& name, const std::string& text) {
+  // A refused value names the file and the table (the field is the
+  // setting's); the quantity stays empty: it is fixed in the file.
+  auto check_value = [&](const std::string& in_table, const std::string& name, const std::string& text) {
     SweepRun copy = probe;
     try {
-      apply(copy, name, text);
+      apply(copy, {name, text, file + ": " + in_table});
     } catch (const std::exception& e) {
-      fail(where, e.what());
+      throw awcc::OptionError(e.what());
     }
   };
   for (const auto& s : table("base")) {
     if (!is_field(s.key)) fail("[base] " + s.key, kUnknownField);
-    check_value("[base] " + s.key, s.key, s.text);
+    check_value("[base]", s.key, s.text);
     d.base[s.key] = s.text;
   }
   for (const auto& s : table("grid")) {
     if (!is_field(s.key)) fail("[grid] " + s.key, kUnknownField);
     if (s.items.empty()) fail("[grid] " + s.key, "must be a non-empty list of values");
     for (const auto& text : s.items) {
-      check_value("[grid] " + s.key, s.key, text);
+      check_value("[grid]", s.key, text);
       d.grid[s.key].push_back(text);
     }
   }
