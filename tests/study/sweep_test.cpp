@@ -30,6 +30,18 @@ std::string cell(const std::string& row, const std::string& column) {
   return cells.at(static_cast<std::size_t>(at));
 }
 
+// A short run with enough bubbles for AWCC windows.
+study::SweepRun short_run() {
+  study::SweepRun run;
+  run.np = 6;
+  run.scene.fs = 50e3;
+  run.scene.duration = 2.0;
+  run.scene.dx = 3e-3;
+  run.scene.dy = 0.5e-3;
+  run.scene.seed = 21;
+  return run;
+}
+
 TEST(SweepRows, AFailedRunIsAFullRowWithItsReason) {
   study::SweepRun run;
   run.index = 4;
@@ -42,16 +54,9 @@ TEST(SweepRows, AFailedRunIsAFullRowWithItsReason) {
 }
 
 TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
-  study::SweepRun run;
-  run.index = 0;
-  run.np = 6;
-  run.scene.fs = 50e3;
-  run.scene.duration = 2.0;
-  run.scene.dx = 3e-3;
-  run.scene.dy = 0.5e-3;
-  run.scene.seed = 21;
+  const auto run = short_run();
   study::RunOptions options;
-  options.awcc.np = 6;
+  options.awcc.np = run.np;
   const auto r = study::run_scene(run.scene, options);
   const auto& m = r.measurement.measurement;
   const auto row = study::sweep_row(run, &r, "", 1, options.awcc);
@@ -87,15 +92,9 @@ TEST(SweepRows, WhatTheWriterWritesTrainingReadsBack) {
   EXPECT_EQ(header, declared);
   EXPECT_EQ(std::set<std::string>(header.begin(), header.end()).size(), header.size()) << "a column twice";
 
-  study::SweepRun run;
-  run.np = 6;
-  run.scene.fs = 50e3;
-  run.scene.duration = 2.0;
-  run.scene.dx = 3e-3;
-  run.scene.dy = 0.5e-3;
-  run.scene.seed = 21;
+  const auto run = short_run();
   study::RunOptions options;
-  options.awcc.np = 6;
+  options.awcc.np = run.np;
   // Every processing column away from its default, so that a default read is caught.
   options.awcc.filter_a = 0.3;
   options.awcc.roc = false;
