@@ -22,6 +22,7 @@
 #include "awcc/random.hpp"
 #include "awcc/units.hpp"
 #include "awcc/version.hpp"
+#include "correction/sweep_columns.hpp"
 
 namespace correction {
 
@@ -243,25 +244,32 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     std::string line;
     if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
     const auto header = split_cells(line);
-    std::map<std::string, std::size_t> col;
+    std::map<std::string, std::size_t, std::less<>> col;
     for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-    const char* needed[] = {"study", "run", "dx", "dy", "np", "truth_velocity", "truth_turbulence_intensity",
-                            "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate",
-                            "awcc_windows_accepted", "reason"};
-    for (const char* name : needed) {
+    using C = SweepColumn;
+    using Scene = SweepSceneColumns;
+    const std::string_view needed[] = {sweep_key_columns[0].name, sweep_key_columns[1].name, Scene::dx, Scene::dy,
+                                       column_name(C::np), column_name(C::truth_velocity),
+                                       column_name(C::truth_turbulence_intensity), column_name(C::awcc_velocity),
+                                       column_name(C::awcc_turbulence_intensity), column_name(C::awcc_void_fraction),
+                                       column_name(C::awcc_count_rate), column_name(C::awcc_windows_accepted),
+                                       column_name(C::reason)};
+    for (const auto name : needed) {
       if (!col.count(name)) {
         throw awcc::InputError(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
       }
     }
     // The processing of the runs: every row must agree (the model learns one).
-    const char* processing_columns[] = {"awcc_filter_a", "awcc_roc", "awcc_weighting", "awcc_signal", "awcc_subsample"};
+    // Sweeps written before these columns existed have none of them.
+    const C processing_columns[] = {C::awcc_filter_a, C::awcc_roc, C::awcc_weighting, C::awcc_signal, C::awcc_subsample};
     const bool has_processing = std::all_of(std::begin(processing_columns), std::end(processing_columns),
-                                            [&](const char* c) { return col.count(c) > 0; });
+                                            [&](C c) { return col.count(column_name(c)) > 0; });
     if (!has_processing) set.processing_assumed = true;
     // The geometry processed; older CSVs have only the scene's dx and dy
     // (the same unless the scene gave explicit tips).
-    const char* dx_column = col.count("probe_dx") ? "probe_dx" : "dx";
-    const char* dy_column = col.count("probe_dy") ? "probe_dy" : "dy";
+    const std::string_view dx_column = col.count(column_name(C::probe_dx)) ? column_name(C::probe_dx) : Scene::dx;
+    const std::string_view dy_column = col.count(column_name(C::probe_dy)) ? column_name(C::probe_dy) : Scene::dy;
+    const std::string_view study_column = sweep_key_columns[0].name, run_column = sweep_key_columns[1].name;
     std::set<std::string> studies;
     std::int64_t number = 1;
     while (std::getline(in, line)) {
@@ -273,8 +281,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
                                            "resumes and repairs it",
                                            path.string(), number, cells.size(), header.size()));
       }
-      auto cell = [&](const char* name) -> const std::string& { return cells[col.at(name)]; };
-      auto number_of = [&](const char* name) {
+      auto cell = [&](std::string_view name) -> const std::string& { return cells[col.find(name)->second]; };
+      auto number_of = [&](std::string_view name) {
         const auto v = cell_number(cell(name));
         if (!v) {
           throw awcc::InputError(fmt::format("{}:{}: column {} = '{}' is not a number; give the CSV pdp sweep wrote",
@@ -283,25 +291,36 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         return *v;
       };
       ++set.total;
-      studies.insert(cell("study"));
-      const auto run = static_cast<std::int64_t>(number_of("run"));
-      if (!seen.insert({cell("study"), run}).second) {
+      studies.insert(cell(study_column));
+      const auto run = static_cast<std::int64_t>(number_of(run_column));
+      if (!seen.insert({cell(study_column), run}).second) {
         throw awcc::InputError(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
-                                           path.string(), number, run, cell("study")));
+                                           path.string(), number, run, cell(study_column)));
       }
       // A failed run has no result at all (no truth); a run whose AWCC gave
       // no value has its truth but no AWCC velocity.
-      if (cell("truth_velocity").empty()) {
+      if (cell(column_name(C::truth_velocity)).empty()) {
         ++set.excluded_error;
         continue;
       }
       if (has_processing) {
+        // An enum cell that names no value is refused: a default would train
+        // a model on a processing the runs did not have.
+        auto named = [&](C column, auto parse, std::string_view values) {
+          const auto v = parse(cell(column_name(column)));
+          if (!v) {
+            throw awcc::InputError(fmt::format("{}:{}: column {} = '{}' is not one of {}; give the CSV pdp sweep wrote",
+                                               path.string(), number, column_name(column), cell(column_name(column)),
+                                               values));
+          }
+          return *v;
+        };
         Processing p;
-        p.filter_a = number_of("awcc_filter_a");
-        p.roc = cell("awcc_roc") == "on";
-        p.weighting = cell("awcc_weighting") == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
-        p.signal = cell("awcc_signal") == "raw" ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
-        p.subsample = cell("awcc_subsample") == "parabolic" ? awcc::Subsample::parabolic : awcc::Subsample::none;
+        p.filter_a = number_of(column_name(C::awcc_filter_a));
+        p.roc = named(C::awcc_roc, roc_of, "on, off");
+        p.weighting = named(C::awcc_weighting, weighting_of, "duration, none");
+        p.signal = named(C::awcc_signal, signal_of, "binary, raw");
+        p.subsample = named(C::awcc_subsample, subsample_of, "none, parabolic");
         if (!processing_seen) set.processing = p;
         processing_seen = true;
         if (const auto why = processing_mismatch(set.processing, p); !why.empty()) {
@@ -314,33 +333,35 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       r.run = run;
       try {
         std::size_t used = 0;
-        r.study = std::stoull(cell("study"), &used);
-        if (used != cell("study").size()) throw std::invalid_argument("trailing text");
+        r.study = std::stoull(cell(study_column), &used);
+        if (used != cell(study_column).size()) throw std::invalid_argument("trailing text");
       } catch (const std::exception&) {
         throw awcc::InputError(fmt::format("{}:{}: study = '{}' is not a sweep study id; give the CSV pdp sweep wrote",
-                                           path.string(), number, cell("study")));
+                                           path.string(), number, cell(study_column)));
       }
       Measurement m;
-      if (!cell("awcc_velocity").empty()) m.velocity = number_of("awcc_velocity");
-      if (!cell("awcc_turbulence_intensity").empty()) m.turbulence_intensity = number_of("awcc_turbulence_intensity");
-      auto optional_number = [&](const char* name) -> std::optional<double> {
+      if (!cell(column_name(C::awcc_velocity)).empty()) m.velocity = number_of(column_name(C::awcc_velocity));
+      if (!cell(column_name(C::awcc_turbulence_intensity)).empty())
+        m.turbulence_intensity = number_of(column_name(C::awcc_turbulence_intensity));
+      auto optional_number = [&](std::string_view name) -> std::optional<double> {
         return col.count(name) && !cell(name).empty() ? std::optional(number_of(name)) : std::nullopt;
       };
       // The phase statistics and the record are there for every run that did not fail.
-      m.void_fraction = optional_number("awcc_void_fraction").value_or(0.0);
-      m.bubble_count_rate = optional_number("awcc_count_rate").value_or(0.0);
+      m.void_fraction = optional_number(column_name(C::awcc_void_fraction)).value_or(0.0);
+      m.bubble_count_rate = optional_number(column_name(C::awcc_count_rate)).value_or(0.0);
       m.dx = number_of(dx_column);
       m.dy = number_of(dy_column);
-      m.np = static_cast<int>(number_of("np"));
-      m.windows_accepted = static_cast<std::int64_t>(optional_number("awcc_windows_accepted").value_or(-1.0));
-      m.windows_total = static_cast<std::int64_t>(optional_number("awcc_windows_total").value_or(-1.0));
-      m.fs = optional_number("fs").value_or(0.0);
-      m.duration = optional_number("duration").value_or(0.0);
-      m.fscc_velocity = optional_number("fscc_velocity");
-      m.r12_max = optional_number("fscc_r12_max");
+      m.np = static_cast<int>(number_of(column_name(C::np)));
+      m.windows_accepted =
+          static_cast<std::int64_t>(optional_number(column_name(C::awcc_windows_accepted)).value_or(-1.0));
+      m.windows_total = static_cast<std::int64_t>(optional_number(column_name(C::awcc_windows_total)).value_or(-1.0));
+      m.fs = optional_number(Scene::fs).value_or(0.0);
+      m.duration = optional_number(Scene::duration).value_or(0.0);
+      m.fscc_velocity = optional_number(column_name(C::fscc_velocity));
+      m.r12_max = optional_number(column_name(C::fscc_r12_max));
       const auto features = make_features(m);
-      r.true_velocity = number_of("truth_velocity");
-      r.true_turbulence_intensity = number_of("truth_turbulence_intensity");
+      r.true_velocity = number_of(column_name(C::truth_velocity));
+      r.true_turbulence_intensity = number_of(column_name(C::truth_turbulence_intensity));
       if (fscc_unusable(features.features).empty() && features.features.fs > 0.0 && features.features.duration > 0.0) {
         TrainingRow f = r;
         f.features = features.features;
@@ -477,8 +498,9 @@ double conformal_offset(std::vector<double> e, double alpha) {
   const auto n = static_cast<double>(e.size());
   const auto rank = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 - alpha)));
   if (e.empty() || rank > e.size()) {
-    throw std::invalid_argument(fmt::format("{} calibration runs cannot calibrate a {:g} % interval", e.size(),
-                                            100 * (1 - alpha)));
+    throw awcc::OptionError(fmt::format("{} calibration runs cannot calibrate a {:g} % interval", e.size(),
+                                        100 * (1 - alpha)),
+                            "calibration");
   }
   return e[rank - 1];
 }
@@ -555,16 +577,14 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
 
 namespace {
 
-// The FSCC forest (model.hpp, FsccForest) on its own rows: the same held-out
-// and calibration fractions and split key as the AWCC forests, the velocity
-// forest's settings, target u_true / u_FSCC.
-void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptions& velocity_options,
-                const std::function<std::uint64_t(const TrainingRow&)>& key, TrainResult& result) {
-  auto rows = set.fscc_rows;
-  if (rows.size() < 500) {
-    result.fscc_note = fmt::format("no FSCC forest: {} runs with an FSCC velocity, fewer than 500", rows.size());
-    return;
-  }
+// The runs' split: held out first, then the calibration runs, then the
+// training runs, in the order of a hash of the run (independent of file order).
+struct Split {
+  std::vector<TrainingRow> held_out, calibration, training;
+};
+
+Split split_runs(std::vector<TrainingRow> rows, const TrainOptions& o) {
+  auto key = [&](const TrainingRow& r) { return mix64(o.seed ^ mix64(static_cast<std::uint64_t>(r.run) ^ mix64(r.study))); };
   std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
     const auto ha = key(a), hb = key(b);
     if (ha != hb) return ha < hb;
@@ -572,10 +592,20 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   });
   const auto held = static_cast<std::size_t>(std::llround(o.held_out * static_cast<double>(rows.size())));
   const auto calibrating = static_cast<std::size_t>(std::llround(o.calibration * static_cast<double>(rows.size() - held)));
-  const std::vector<TrainingRow> held_out(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(held));
-  const std::vector<TrainingRow> calibration_rows(rows.begin() + static_cast<std::ptrdiff_t>(held),
-                                                  rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating));
-  const std::vector<TrainingRow> training(rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating), rows.end());
+  const auto at = [&](std::size_t i) { return rows.begin() + static_cast<std::ptrdiff_t>(i); };
+  return {{rows.begin(), at(held)}, {at(held), at(held + calibrating)}, {at(held + calibrating), rows.end()}};
+}
+
+// The FSCC forest (model.hpp, FsccForest) on its own rows: the same held-out
+// and calibration fractions and split key as the AWCC forests, the velocity
+// forest's settings, target u_true / u_FSCC.
+void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptions& velocity_options,
+                TrainResult& result) {
+  if (set.fscc_rows.size() < 500) {
+    result.fscc_note = fmt::format("no FSCC forest: {} runs with an FSCC velocity, fewer than 500", set.fscc_rows.size());
+    return;
+  }
+  const auto [held_out, calibration_rows, training] = split_runs(set.fscc_rows, o);
   const auto names = feature_set_names("fscc");
   FsccForest f;
   f.form = TargetForm::ratio;
@@ -671,109 +701,81 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
 
 }  // namespace
 
-TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
-  o.validate().throw_if_failed();
-  const auto names = feature_set_names(o.feature_set);
-  // Held-out split by a hash of the run index: independent of file order.
-  std::vector<TrainingRow> rows = set.rows;
-  auto key = [&](const TrainingRow& r) { return mix64(o.seed ^ mix64(static_cast<std::uint64_t>(r.run) ^ mix64(r.study))); };
-  std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
-    const auto ha = key(a), hb = key(b);
-    if (ha != hb) return ha < hb;
-    return a.study != b.study ? a.study < b.study : a.run < b.run;
-  });
-  const auto held = static_cast<std::size_t>(std::llround(o.held_out * static_cast<double>(rows.size())));
-  if (held == 0 || held >= rows.size()) {
-    throw std::invalid_argument(fmt::format("{} usable runs cannot be split {:.0f}/{:.0f}; run a larger sweep", rows.size(),
-                                            100 * (1 - o.held_out), 100 * o.held_out));
-  }
-  const std::vector<TrainingRow> held_out(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(held));
-  // The calibration runs come next in the same order; the forests never see them.
-  const auto calibrating = static_cast<std::size_t>(std::llround(o.calibration * static_cast<double>(rows.size() - held)));
-  if (o.calibration > 0.0 && calibrating < 100) {
-    throw std::invalid_argument(fmt::format("{} calibration runs are too few to calibrate the 95 % interval of each "
-                                            "band; run a larger sweep or set calibration to 0",
-                                            calibrating));
-  }
-  const std::vector<TrainingRow> calibration_rows(rows.begin() + static_cast<std::ptrdiff_t>(held),
-                                                  rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating));
-  const std::vector<TrainingRow> training(rows.begin() + static_cast<std::ptrdiff_t>(held + calibrating), rows.end());
+namespace {
 
-  TrainResult result;
-  result.training_rows = static_cast<std::int64_t>(training.size());
-  ForestOptions vopt, topt;
+// The forests' settings from the options, before cross-validation.
+struct Hyperparameters {
+  ForestOptions velocity, turbulence;
+  TargetForm velocity_form = TargetForm::ratio, turbulence_form = TargetForm::difference;
+};
+
+Hyperparameters initial_hyperparameters(const TrainOptions& o) {
+  Hyperparameters h;
+  auto& vopt = h.velocity;
+  auto& topt = h.turbulence;
   vopt.trees = topt.trees = o.trees;
   vopt.threads = topt.threads = o.threads;
   vopt.seed = o.seed;
   topt.seed = o.seed + 1;
   vopt.min_leaf = topt.min_leaf = o.min_leaf;
   vopt.features_per_split = topt.features_per_split = o.features_per_split;
-  TargetForm vform = o.velocity_form, tform = o.turbulence_form;
+  h.velocity_form = o.velocity_form;
+  h.turbulence_form = o.turbulence_form;
+  return h;
+}
 
-  const auto cv_start = std::chrono::steady_clock::now();
+// k-fold cross-validation over the target forms and the grids of min leaf
+// and features per split: each target takes the least pinball loss.
+void cross_validate(const std::vector<TrainingRow>& training, const TrainOptions& o,
+                    const std::vector<std::string>& names, double cv_share,
+                    const std::function<void(double)>& progress, Hyperparameters& h, TrainResult& result) {
   const std::size_t grid = o.min_leaf_grid.size() * o.features_per_split_grid.size() * 2;
-  const double cv_share = o.folds >= 2 ? 0.7 : 0.0;
-  if (o.folds >= 2) {
-    const auto k = static_cast<std::size_t>(o.folds);
-    std::size_t done = 0;
-    for (int target = 0; target < 2; ++target) {
-      const bool velocity = target == 0;
-      const std::array<TargetForm, 2> forms{TargetForm::value,
-                                                  velocity ? TargetForm::ratio : TargetForm::difference};
-      CvEntry best;
-      best.pinball = std::numeric_limits<double>::infinity();
-      for (auto form : forms) {
-        for (int leaf : o.min_leaf_grid) {
-          for (int mtry : o.features_per_split_grid) {
-            double loss = 0.0;
-            for (std::size_t fold = 0; fold < k; ++fold) {
-              std::vector<TrainingRow> fit, test;
-              for (std::size_t i = 0; i < training.size(); ++i) (i % k == fold ? test : fit).push_back(training[i]);
-              ForestOptions fo;
-              fo.trees = o.cv_trees;
-              fo.min_leaf = leaf;
-              fo.features_per_split = mtry;
-              fo.seed = o.seed + 17 * fold + static_cast<std::uint64_t>(target);
-              fo.threads = o.threads;
-              const auto forest = QuantileForest::train(data_of(fit, velocity, form, names), fo);
-              std::vector<double> losses(test.size());
-              parallel_for(test.size(), o.threads, [&](std::size_t i) {
-                losses[i] = target_pinball(predict(forest, form, test[i], velocity, names), test[i], velocity);
-              });
-              for (double l : losses) loss += l;
-            }
-            loss /= static_cast<double>(training.size());
-            result.cv.push_back({velocity ? "velocity" : "turbulence_intensity", form, leaf, mtry, loss});
-            if (loss < best.pinball) best = result.cv.back();
-            if (progress) progress(cv_share * static_cast<double>(++done) / static_cast<double>(grid));
+  const auto k = static_cast<std::size_t>(o.folds);
+  std::size_t done = 0;
+  for (int target = 0; target < 2; ++target) {
+    const bool velocity = target == 0;
+    const std::array<TargetForm, 2> forms{TargetForm::value, velocity ? TargetForm::ratio : TargetForm::difference};
+    CvEntry best;
+    best.pinball = std::numeric_limits<double>::infinity();
+    for (auto form : forms) {
+      for (int leaf : o.min_leaf_grid) {
+        for (int mtry : o.features_per_split_grid) {
+          double loss = 0.0;
+          for (std::size_t fold = 0; fold < k; ++fold) {
+            std::vector<TrainingRow> fit, test;
+            for (std::size_t i = 0; i < training.size(); ++i) (i % k == fold ? test : fit).push_back(training[i]);
+            ForestOptions fo;
+            fo.trees = o.cv_trees;
+            fo.min_leaf = leaf;
+            fo.features_per_split = mtry;
+            fo.seed = o.seed + 17 * fold + static_cast<std::uint64_t>(target);
+            fo.threads = o.threads;
+            const auto forest = QuantileForest::train(data_of(fit, velocity, form, names), fo);
+            std::vector<double> losses(test.size());
+            parallel_for(test.size(), o.threads, [&](std::size_t i) {
+              losses[i] = target_pinball(predict(forest, form, test[i], velocity, names), test[i], velocity);
+            });
+            for (double l : losses) loss += l;
           }
+          loss /= static_cast<double>(training.size());
+          result.cv.push_back({velocity ? "velocity" : "turbulence_intensity", form, leaf, mtry, loss});
+          if (loss < best.pinball) best = result.cv.back();
+          if (progress) progress(cv_share * static_cast<double>(++done) / static_cast<double>(grid));
         }
       }
-      auto& opt = velocity ? vopt : topt;
-      opt.min_leaf = best.min_leaf;
-      opt.features_per_split = best.features_per_split;
-      (velocity ? vform : tform) = best.form;
     }
+    auto& opt = velocity ? h.velocity : h.turbulence;
+    opt.min_leaf = best.min_leaf;
+    opt.features_per_split = best.features_per_split;
+    (velocity ? h.velocity_form : h.turbulence_form) = best.form;
   }
-  result.seconds_cv = seconds_since(cv_start);
-  result.velocity_min_leaf = vopt.min_leaf;
-  result.velocity_features_per_split = vopt.features_per_split;
-  result.turbulence_min_leaf = topt.min_leaf;
-  result.turbulence_features_per_split = topt.features_per_split;
+}
 
-  const auto train_start = std::chrono::steady_clock::now();
-  result.model = fit_model(training, vform, tform, vopt, topt, o.min_windows, names);
-  if (!calibration_rows.empty()) {
-    result.model.calibration =
-        calibrate(result.model, calibration_rows, o.calibration_bands, o.threads, o.calibration_tu_bands);
-  }
-  result.calibration_rows = static_cast<std::int64_t>(calibration_rows.size());
-  if (o.feature_set != "measured") train_fscc(set, o, vopt, key, result);
-  result.seconds_train = seconds_since(train_start);
-  result.held_out = score(result.model, held_out, &result.predictions, o.threads);
-  if (progress) progress(cv_share + 0.1);
-
-  // Learning curve: the same hyperparameters on nested subsets of the training rows.
+// Learning curve: the same hyperparameters on nested subsets of the training rows.
+void learning_curve(const Split& split, const TrainOptions& o, const std::vector<std::string>& names,
+                    const Hyperparameters& h, TrainResult& result) {
+  const auto& training = split.training;
+  const auto& calibration_rows = split.calibration;
   auto gain = [](const std::vector<double>& before, const std::vector<double>& after, double& mean, double& se) {
     const std::size_t n = std::min(before.size(), after.size());
     if (n < 2) return;
@@ -788,14 +790,16 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     const std::size_t n = training.size() * num / den;
     if (n < 10) continue;
     const std::vector<TrainingRow> subset(training.begin(), training.begin() + static_cast<std::ptrdiff_t>(n));
-    auto m = num == den ? result.model : fit_model(subset, vform, tform, vopt, topt, o.min_windows, names);
+    auto m = num == den ? result.model
+                        : fit_model(subset, h.velocity_form, h.turbulence_form, h.velocity, h.turbulence, o.min_windows,
+                                    names);
     if (num != den && !calibration_rows.empty()) {
       m.calibration = calibrate(m, calibration_rows, o.calibration_bands, o.threads, o.calibration_tu_bands);
     }
     // Every point scores the same held-out rows: those inside the full
     // model's ranges (a small subset's own ranges would drop the hard rows).
     m.ranges = result.model.ranges;
-    LearningPoint point{static_cast<std::int64_t>(n), score(m, held_out, nullptr, o.threads)};
+    LearningPoint point{static_cast<std::int64_t>(n), score(m, split.held_out, nullptr, o.threads)};
     if (!result.learning_curve.empty()) {
       const auto& before = result.learning_curve.back().scores;
       gain(before.velocity_losses, point.scores.velocity_losses, point.velocity_gain, point.velocity_gain_se);
@@ -803,13 +807,17 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
     }
     result.learning_curve.push_back(std::move(point));
   }
-  if (progress) progress(1.0);
+}
 
+// The model's provenance: the data, the split, the forests and their held-out scores.
+std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const std::vector<std::string>& names,
+                          const Split& split, const Hyperparameters& hp, const TrainResult& result) {
   const auto& h = result.held_out;
+  const auto& vopt = hp.velocity;
+  const auto& topt = hp.turbulence;
   std::string sources;
   for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
-  result.model.processing = set.processing;
-  result.model.provenance = fmt::format(
+  std::string provenance = fmt::format(
       "pdp train {}: {}; {} features ({}); processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
       "windows); trained on {}, {} set aside to calibrate the intervals, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
       "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
@@ -817,14 +825,15 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
       "{:.1f}/{:.1f} %.",
       awcc::version, sources, o.feature_set, fmt::join(names, ", "), describe(set.processing),
       set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
-      set.excluded_windows, o.min_windows, training.size(), calibration_rows.size(), held_out.size(), o.seed, to_string(vform), vopt.trees,
-      vopt.min_leaf, vopt.features_per_split, to_string(tform), topt.trees, topt.min_leaf,
-      topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected, 100 * h.velocity_coverage80,
-      100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected, 100 * h.tu_coverage80, 100 * h.tu_coverage95);
+      set.excluded_windows, o.min_windows, split.training.size(), split.calibration.size(), split.held_out.size(), o.seed,
+      to_string(hp.velocity_form), vopt.trees, vopt.min_leaf, vopt.features_per_split, to_string(hp.turbulence_form),
+      topt.trees, topt.min_leaf, topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected,
+      100 * h.velocity_coverage80, 100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected,
+      100 * h.tu_coverage80, 100 * h.tu_coverage95);
   if (result.model.fscc) {
     const auto& f = result.fscc_held_out;
     const auto& u = result.fscc_held_out_unserved;
-    result.model.provenance += fmt::format(
+    provenance += fmt::format(
         " FSCC forest (velocity of rows without a usable AWCC result): trained on {} runs{}; held out, the runs AWCC "
         "cannot serve ({} rows): velocity RMSE {:.2f} % raw FSCC, {:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; "
         "all runs with an FSCC velocity ({} rows): RMSE {:.2f} % raw, {:.2f} % corrected, coverage {:.1f}/{:.1f} %.",
@@ -832,7 +841,58 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
         100 * u.rmse_raw, 100 * u.rmse_corrected, 100 * u.coverage80, 100 * u.coverage95, f.rows, 100 * f.rmse_raw,
         100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95);
   }
-  if (!result.fscc_note.empty()) result.model.provenance += " " + result.fscc_note + ".";
+  if (!result.fscc_note.empty()) provenance += " " + result.fscc_note + ".";
+  return provenance;
+}
+
+}  // namespace
+
+TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
+  o.validate().throw_if_failed();
+  const auto names = feature_set_names(o.feature_set);
+  const Split split = split_runs(set.rows, o);
+  const std::size_t runs = set.rows.size();
+  if (split.held_out.empty() || split.held_out.size() >= runs) {
+    throw awcc::OptionError(fmt::format("{} usable runs cannot be split {:.0f}/{:.0f}; run a larger sweep", runs,
+                                        100 * (1 - o.held_out), 100 * o.held_out),
+                            "held-out");
+  }
+  // The calibration runs come next in the same order; the forests never see them.
+  if (o.calibration > 0.0 && split.calibration.size() < 100) {
+    throw awcc::OptionError(fmt::format("{} calibration runs are too few to calibrate the 95 % interval of each "
+                                        "band; run a larger sweep or set calibration to 0",
+                                        split.calibration.size()),
+                            "calibration");
+  }
+
+  TrainResult result;
+  result.training_rows = static_cast<std::int64_t>(split.training.size());
+  Hyperparameters h = initial_hyperparameters(o);
+  const auto cv_start = std::chrono::steady_clock::now();
+  const double cv_share = o.folds >= 2 ? 0.7 : 0.0;
+  if (o.folds >= 2) cross_validate(split.training, o, names, cv_share, progress, h, result);
+  result.seconds_cv = seconds_since(cv_start);
+  result.velocity_min_leaf = h.velocity.min_leaf;
+  result.velocity_features_per_split = h.velocity.features_per_split;
+  result.turbulence_min_leaf = h.turbulence.min_leaf;
+  result.turbulence_features_per_split = h.turbulence.features_per_split;
+
+  const auto train_start = std::chrono::steady_clock::now();
+  result.model = fit_model(split.training, h.velocity_form, h.turbulence_form, h.velocity, h.turbulence, o.min_windows,
+                           names);
+  if (!split.calibration.empty()) {
+    result.model.calibration =
+        calibrate(result.model, split.calibration, o.calibration_bands, o.threads, o.calibration_tu_bands);
+  }
+  result.calibration_rows = static_cast<std::int64_t>(split.calibration.size());
+  if (o.feature_set != "measured") train_fscc(set, o, h.velocity, result);
+  result.seconds_train = seconds_since(train_start);
+  result.held_out = score(result.model, split.held_out, &result.predictions, o.threads);
+  if (progress) progress(cv_share + 0.1);
+  learning_curve(split, o, names, h, result);
+  if (progress) progress(1.0);
+  result.model.processing = set.processing;
+  result.model.provenance = provenance_of(set, o, names, split, h, result);
   return result;
 }
 

@@ -24,7 +24,7 @@ std::vector<awcc::SettingTable> definition_tables(const std::filesystem::path& p
   try {
     return awcc::read_setting_tables(path, groups);
   } catch (const awcc::InputError& e) {
-    throw std::invalid_argument(e.what());
+    throw awcc::OptionError(e.what());
   }
 }
 

@@ -19,7 +19,7 @@ bool is_scene_field(const std::string& name);
 /// A scene field's dimension; dimensionless for any other name (np, anisotropy).
 awcc::Dimension dimension_of(const std::string& name);
 /// The tables of a definition file: a file that cannot be read is a
-/// definition that cannot be run (std::invalid_argument naming the file).
+/// definition that cannot be run (awcc::OptionError naming the file).
 std::vector<awcc::SettingTable> definition_tables(const std::filesystem::path& path,
                                                   const std::vector<std::string>& groups = {});
 /// 64-bit FNV-1a of a text.

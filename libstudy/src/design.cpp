@@ -44,181 +44,192 @@ std::string describe(const DesignCandidate& c) {
                      c.duration, c.needle > 0.0 ? fmt::format(", needle {:g} mm", c.needle * 1e3) : "");
 }
 
-DesignDefinition load_design(const std::filesystem::path& path) {
-  DesignDefinition d;
-  const std::string file = path.string();
-  auto fail = [&](const std::string& where, const std::string& what) -> void {
-    throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
-  };
-  const auto tables = detail::definition_tables(path, {"conditions"});
-  auto quantity = [&](const std::string& where, const std::string& text, awcc::Dimension dim) {
+namespace {
+
+// The checks of a design file, each naming the file, the table and key, and the fix.
+struct DesignFile {
+  std::string file;
+
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+    throw awcc::OptionError(fmt::format("{}: {}: {}", file, where, what));
+  }
+  double quantity(const std::string& where, const std::string& text, awcc::Dimension dim) const {
     try {
       return awcc::parse_quantity(text, dim);
     } catch (const std::exception& e) {
       fail(where, e.what());
     }
-    return 0.0;
-  };
-  auto whole = [&](const std::string& where, const std::string& text, std::int64_t lo, std::int64_t hi) -> long long {
+  }
+  long long whole(const std::string& where, const std::string& text, std::int64_t lo, std::int64_t hi) const {
     try {
       return awcc::parse_whole(text, lo, hi);
     } catch (const std::exception&) {
       fail(where, fmt::format("must be a whole number from {} to {}", lo, hi));
     }
-    return 0LL;
+  }
+
+  void read_design(const awcc::SettingTable& t, DesignDefinition& d) const {
+    for (const auto& s : t.settings) {
+      const std::string where = "[design] " + s.key;
+      if (s.key == "seeds") d.seeds = static_cast<int>(whole(where, s.text, 2, 1000));
+      else if (s.key == "seed") d.seed = static_cast<std::uint64_t>(whole(where, s.text, 0, std::int64_t{1} << 53));
+      else if (s.key == "objective") {
+        if (s.text != "worst-case" && s.text != "mean") fail(where, "write \"worst-case\" or \"mean\"");
+        d.objective = s.text;
+      } else if (s.key == "values") {
+        if (s.text != "corrected" && s.text != "raw") fail(where, "write \"corrected\" or \"raw\"");
+        d.values = s.text;
+      } else if (s.key == "model") {
+        d.model = s.text;
+      } else {
+        fail(where, "unknown key; use seeds, seed, objective, values, model");
+      }
+    }
+  }
+
+  DesignCondition read_condition(const awcc::SettingTable& t) const {
+    DesignCondition c;
+    c.name = t.name.substr(11);
+    if (c.name.empty() || c.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") !=
+                              std::string::npos) {
+      fail("[" + t.name + "]", "a condition's name is letters, digits, - and _");
+    }
+    for (const auto& s : t.settings) {
+      const std::string where = "[" + t.name + "] " + s.key;
+      if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, bubble-diameter, ...) or anisotropy");
+      if (s.key == "seed" || s.key == "dx" || s.key == "dy" || s.key == "dz" || s.key == "tips" || s.key == "fs" ||
+          s.key == "duration") {
+        fail(where, "the probe and the record are candidates: give them in [candidates]");
+      }
+      if (s.items.size() >= 2) {
+        if (!kRangeable.count(s.key)) fail(where, "only velocity, tu, anisotropy, time-scale, void-fraction and bubble-diameter take ranges");
+        const bool log = s.items.size() == 3 && s.items[2] == "log";
+        if (s.items.size() != 2 && !log) fail(where, "write a value, [min, max] or [min, max, \"log\"]");
+        const double lo = quantity(where, s.items[0], dimension_of(s.key));
+        const double hi = quantity(where, s.items[1], dimension_of(s.key));
+        if (!(lo <= hi)) fail(where, "min must not exceed max");
+        if (log && !(lo > 0.0)) fail(where, "a log-uniform range needs min > 0");
+        c.ranges[s.key] = {lo, hi};
+        if (log) c.log_ranges.insert(s.key);
+      } else {
+        if (s.key == "anisotropy") quantity(where, s.text, awcc::Dimension::dimensionless);
+        else {
+          synth::Scene probe;
+          try {
+            synth::set_scene_field(probe, s.key, s.text);
+          } catch (const std::exception& e) {
+            fail(where, e.what());
+          }
+        }
+        c.values[s.key] = s.text;
+      }
+    }
+    // Tu errors are relative: a condition needs Tu well above zero.
+    const double tu_min = c.ranges.count("tu") ? c.ranges["tu"].first
+                          : c.values.count("tu") ? quantity("[" + t.name + "] tu", c.values["tu"], awcc::Dimension::dimensionless)
+                                                 : synth::Scene{}.tu;
+    if (!(tu_min >= 0.02)) fail("[" + t.name + "] tu", "Tu below 0.02: its error is relative (Tu / Tu_true - 1); give Tu >= 0.02");
+    return c;
+  }
+
+  // [candidates]: the lists of settings tried. dx and dy (a grid, which
+  // replaces the default one) or probes (a list of geometries).
+  struct CandidateLists {
+    std::vector<double> dxs{1e-3, 2e-3, 3e-3, 5e-3, 7.5e-3, 10e-3}, dys{0.0, 0.5e-3, 1e-3, 2e-3};
+    bool probes_given = false, grid_given = false;
   };
-  std::vector<double> dxs{1e-3, 2e-3, 3e-3, 5e-3, 7.5e-3, 10e-3}, dys{0.0, 0.5e-3, 1e-3, 2e-3};
-  bool probes_given = false, grid_given = false;
-  for (const auto& t : tables) {
-    if (t.name.empty()) {
-      if (!t.settings.empty()) fail(t.settings.front().key, "must be in a table: [design], [conditions.NAME], [candidates] or [current]");
-      continue;
-    }
-    if (t.name == "design") {
-      for (const auto& s : t.settings) {
-        const std::string where = "[design] " + s.key;
-        if (s.key == "seeds") d.seeds = static_cast<int>(whole(where, s.text, 2, 1000));
-        else if (s.key == "seed") d.seed = static_cast<std::uint64_t>(whole(where, s.text, 0, std::int64_t{1} << 53));
-        else if (s.key == "objective") {
-          if (s.text != "worst-case" && s.text != "mean") fail(where, "write \"worst-case\" or \"mean\"");
-          d.objective = s.text;
-        } else if (s.key == "values") {
-          if (s.text != "corrected" && s.text != "raw") fail(where, "write \"corrected\" or \"raw\"");
-          d.values = s.text;
-        } else if (s.key == "model") {
-          d.model = s.text;
-        } else {
-          fail(where, "unknown key; use seeds, seed, objective, values, model");
+  void read_candidates(const awcc::SettingTable& t, DesignDefinition& d, CandidateLists& lists) const {
+    for (const auto& s : t.settings) {
+      const std::string where = "[candidates] " + s.key;
+      if (s.items.empty()) fail(where, "must be a non-empty list");
+      if (s.key == "dx" || s.key == "dy") {
+        auto& list = s.key == "dx" ? lists.dxs : lists.dys;
+        list.clear();
+        for (const auto& x : s.items) list.push_back(quantity(where, x, awcc::Dimension::length));
+        lists.grid_given = true;
+      } else if (s.key == "probes") {
+        for (const auto& x : s.items) {
+          const auto cells = awcc::split_cells(x);
+          if (cells.size() != 2) fail(where, fmt::format("'{}': write each probe as \"dx,dy\", e.g. \"5mm,1mm\"", x));
+          d.geometries.push_back({quantity(where, cells[0], awcc::Dimension::length),
+                                  quantity(where, cells[1], awcc::Dimension::length)});
         }
-      }
-    } else if (t.name.rfind("conditions.", 0) == 0) {
-      DesignCondition c;
-      c.name = t.name.substr(11);
-      if (c.name.empty() || c.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") !=
-                                std::string::npos) {
-        fail("[" + t.name + "]", "a condition's name is letters, digits, - and _");
-      }
-      for (const auto& s : t.settings) {
-        const std::string where = "[" + t.name + "] " + s.key;
-        if (s.key != "anisotropy" && !is_scene_field(s.key)) fail(where, "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, bubble-diameter, ...) or anisotropy");
-        if (s.key == "seed" || s.key == "dx" || s.key == "dy" || s.key == "dz" || s.key == "tips" || s.key == "fs" ||
-            s.key == "duration") {
-          fail(where, "the probe and the record are candidates: give them in [candidates]");
+        lists.probes_given = true;
+      } else if (s.key == "np") {
+        d.nps.clear();
+        for (const auto& x : s.items) d.nps.push_back(static_cast<int>(whole(where, x, 1, 1000)));
+      } else if (s.key == "fs") {
+        d.fss.clear();
+        for (const auto& x : s.items) d.fss.push_back(quantity(where, x, awcc::Dimension::frequency));
+      } else if (s.key == "duration") {
+        d.durations.clear();
+        for (const auto& x : s.items) d.durations.push_back(quantity(where, x, awcc::Dimension::time));
+      } else if (s.key == "needle") {
+        d.needles.clear();
+        for (const auto& x : s.items) {
+          d.needles.push_back(quantity(where, x, awcc::Dimension::length));
+          if (!(d.needles.back() >= 0.0 && d.needles.back() < 0.01)) fail(where, "a needle diameter is 0 (none) to 10 mm");
         }
-        if (s.items.size() >= 2) {
-          if (!kRangeable.count(s.key)) fail(where, "only velocity, tu, anisotropy, time-scale, void-fraction and bubble-diameter take ranges");
-          const bool log = s.items.size() == 3 && s.items[2] == "log";
-          if (s.items.size() != 2 && !log) fail(where, "write a value, [min, max] or [min, max, \"log\"]");
-          const double lo = quantity(where, s.items[0], dimension_of(s.key));
-          const double hi = quantity(where, s.items[1], dimension_of(s.key));
-          if (!(lo <= hi)) fail(where, "min must not exceed max");
-          if (log && !(lo > 0.0)) fail(where, "a log-uniform range needs min > 0");
-          c.ranges[s.key] = {lo, hi};
-          if (log) c.log_ranges.insert(s.key);
-        } else {
-          if (s.key == "anisotropy") quantity(where, s.text, awcc::Dimension::dimensionless);
-          else {
-            synth::Scene probe;
-            try {
-              synth::set_scene_field(probe, s.key, s.text);
-            } catch (const std::exception& e) {
-              fail(where, e.what());
-            }
-          }
-          c.values[s.key] = s.text;
-        }
+      } else {
+        fail(where, "unknown key; use dx, dy, probes, np, fs, duration, needle");
       }
-      // Tu errors are relative: a condition needs Tu well above zero.
-      const double tu_min = c.ranges.count("tu") ? c.ranges["tu"].first
-                            : c.values.count("tu") ? quantity("[" + t.name + "] tu", c.values["tu"], awcc::Dimension::dimensionless)
-                                                   : synth::Scene{}.tu;
-      if (!(tu_min >= 0.02)) fail("[" + t.name + "] tu", "Tu below 0.02: its error is relative (Tu / Tu_true - 1); give Tu >= 0.02");
-      d.conditions.push_back(std::move(c));
-    } else if (t.name == "candidates") {
-      for (const auto& s : t.settings) {
-        const std::string where = "[candidates] " + s.key;
-        if (s.items.empty()) fail(where, "must be a non-empty list");
-        if (s.key == "dx" || s.key == "dy") {
-          auto& list = s.key == "dx" ? dxs : dys;
-          list.clear();
-          for (const auto& x : s.items) list.push_back(quantity(where, x, awcc::Dimension::length));
-          grid_given = true;
-        } else if (s.key == "probes") {
-          for (const auto& x : s.items) {
-            const auto cells = awcc::split_cells(x);
-            if (cells.size() != 2) fail(where, fmt::format("'{}': write each probe as \"dx,dy\", e.g. \"5mm,1mm\"", x));
-            d.geometries.push_back({quantity(where, cells[0], awcc::Dimension::length),
-                                    quantity(where, cells[1], awcc::Dimension::length)});
-          }
-          probes_given = true;
-        } else if (s.key == "np") {
-          d.nps.clear();
-          for (const auto& x : s.items) d.nps.push_back(static_cast<int>(whole(where, x, 1, 1000)));
-        } else if (s.key == "fs") {
-          d.fss.clear();
-          for (const auto& x : s.items) d.fss.push_back(quantity(where, x, awcc::Dimension::frequency));
-        } else if (s.key == "duration") {
-          d.durations.clear();
-          for (const auto& x : s.items) d.durations.push_back(quantity(where, x, awcc::Dimension::time));
-        } else if (s.key == "needle") {
-          d.needles.clear();
-          for (const auto& x : s.items) {
-            d.needles.push_back(quantity(where, x, awcc::Dimension::length));
-            if (!(d.needles.back() >= 0.0 && d.needles.back() < 0.01)) fail(where, "a needle diameter is 0 (none) to 10 mm");
-          }
-        } else {
-          fail(where, "unknown key; use dx, dy, probes, np, fs, duration, needle");
-        }
-      }
-    } else if (t.name == "current") {
-      DesignCandidate c;
-      std::set<std::string> given;
-      for (const auto& s : t.settings) {
-        const std::string where = "[current] " + s.key;
-        given.insert(s.key);
-        if (s.key == "dx") c.dx = quantity(where, s.text, awcc::Dimension::length);
-        else if (s.key == "dy") c.dy = quantity(where, s.text, awcc::Dimension::length);
-        else if (s.key == "np") c.np = static_cast<int>(whole(where, s.text, 1, 1000));
-        else if (s.key == "fs") c.fs = quantity(where, s.text, awcc::Dimension::frequency);
-        else if (s.key == "duration") c.duration = quantity(where, s.text, awcc::Dimension::time);
-        else if (s.key == "needle") c.needle = quantity(where, s.text, awcc::Dimension::length);
-        else fail(where, "unknown key; use dx, dy, np, fs, duration, needle");
-      }
-      for (const char* k : {"dx", "dy", "np", "fs", "duration"}) {
-        if (!given.count(k)) fail("[current]", fmt::format("give {} (the current probe needs dx, dy, np, fs and duration)", k));
-      }
-      d.current = c;
-    } else {
-      fail("[" + t.name + "]", "unknown table; use [design], [conditions.NAME], [candidates] and [current]");
     }
   }
-  if (d.conditions.empty()) fail("[conditions.NAME]", "give at least one condition, e.g. [conditions.wall] with velocity, tu, void-fraction ...");
-  if (probes_given && grid_given) fail("[candidates]", "give either probes or dx and dy, not both");
-  if (!probes_given) {
-    for (double dx : dxs)
-      for (double dy : dys) d.geometries.push_back({dx, dy});
-  }
-  for (const auto& [dx, dy] : d.geometries) {
-    if (!(dx > 0.0 && dx < 0.1)) fail("[candidates] dx", fmt::format("{} m: a streamwise separation is above 0 and below 100 mm", dx));
-    if (!(dy >= 0.0 && dy < 0.1)) fail("[candidates] dy", fmt::format("{} m: a lateral separation is 0 to 100 mm", dy));
-  }
-  for (double fs : d.fss)
-    if (!(fs >= 1e3 && fs <= 1e8)) fail("[candidates] fs", fmt::format("{} Hz: give 1 kHz to 100 MHz", fs));
-  for (double t : d.durations)
-    if (!(t > 0.0 && t <= 3600.0)) fail("[candidates] duration", fmt::format("{} s: give up to an hour", t));
-  if (d.current) {
-    const auto& c = *d.current;
-    if (std::find(d.geometries.begin(), d.geometries.end(), std::pair{c.dx, c.dy}) == d.geometries.end()) {
-      d.geometries.push_back({c.dx, c.dy});
+
+  DesignCandidate read_current(const awcc::SettingTable& t) const {
+    DesignCandidate c;
+    std::set<std::string> given;
+    for (const auto& s : t.settings) {
+      const std::string where = "[current] " + s.key;
+      given.insert(s.key);
+      if (s.key == "dx") c.dx = quantity(where, s.text, awcc::Dimension::length);
+      else if (s.key == "dy") c.dy = quantity(where, s.text, awcc::Dimension::length);
+      else if (s.key == "np") c.np = static_cast<int>(whole(where, s.text, 1, 1000));
+      else if (s.key == "fs") c.fs = quantity(where, s.text, awcc::Dimension::frequency);
+      else if (s.key == "duration") c.duration = quantity(where, s.text, awcc::Dimension::time);
+      else if (s.key == "needle") c.needle = quantity(where, s.text, awcc::Dimension::length);
+      else fail(where, "unknown key; use dx, dy, np, fs, duration, needle");
     }
-    if (std::find(d.nps.begin(), d.nps.end(), c.np) == d.nps.end()) d.nps.push_back(c.np);
-    if (std::find(d.fss.begin(), d.fss.end(), c.fs) == d.fss.end()) d.fss.push_back(c.fs);
-    if (std::find(d.durations.begin(), d.durations.end(), c.duration) == d.durations.end()) d.durations.push_back(c.duration);
-    if (std::find(d.needles.begin(), d.needles.end(), c.needle) == d.needles.end()) d.needles.push_back(c.needle);
+    for (const char* k : {"dx", "dy", "np", "fs", "duration"}) {
+      if (!given.count(k)) fail("[current]", fmt::format("give {} (the current probe needs dx, dy, np, fs and duration)", k));
+    }
+    return c;
   }
-  if (d.geometries.size() > 63) fail("[candidates]", fmt::format("{} geometries: a simulated probe has at most 63 trailing tips", d.geometries.size()));
-  // The canonical text of what the rows depend on (not the objective, the
-  // values ranked on or the model's name: changing those re-ranks the same rows).
+
+  // The candidates' lists complete and checked: the default grid unless
+  // probes were given, and the current probe's settings among them.
+  void finish_candidates(DesignDefinition& d, const CandidateLists& lists) const {
+    if (d.conditions.empty()) fail("[conditions.NAME]", "give at least one condition, e.g. [conditions.wall] with velocity, tu, void-fraction ...");
+    if (lists.probes_given && lists.grid_given) fail("[candidates]", "give either probes or dx and dy, not both");
+    if (!lists.probes_given) {
+      for (double dx : lists.dxs)
+        for (double dy : lists.dys) d.geometries.push_back({dx, dy});
+    }
+    for (const auto& [dx, dy] : d.geometries) {
+      if (!(dx > 0.0 && dx < 0.1)) fail("[candidates] dx", fmt::format("{} m: a streamwise separation is above 0 and below 100 mm", dx));
+      if (!(dy >= 0.0 && dy < 0.1)) fail("[candidates] dy", fmt::format("{} m: a lateral separation is 0 to 100 mm", dy));
+    }
+    for (double fs : d.fss)
+      if (!(fs >= 1e3 && fs <= 1e8)) fail("[candidates] fs", fmt::format("{} Hz: give 1 kHz to 100 MHz", fs));
+    for (double t : d.durations)
+      if (!(t > 0.0 && t <= 3600.0)) fail("[candidates] duration", fmt::format("{} s: give up to an hour", t));
+    if (d.current) {
+      const auto& c = *d.current;
+      if (std::find(d.geometries.begin(), d.geometries.end(), std::pair{c.dx, c.dy}) == d.geometries.end()) {
+        d.geometries.push_back({c.dx, c.dy});
+      }
+      if (std::find(d.nps.begin(), d.nps.end(), c.np) == d.nps.end()) d.nps.push_back(c.np);
+      if (std::find(d.fss.begin(), d.fss.end(), c.fs) == d.fss.end()) d.fss.push_back(c.fs);
+      if (std::find(d.durations.begin(), d.durations.end(), c.duration) == d.durations.end()) d.durations.push_back(c.duration);
+      if (std::find(d.needles.begin(), d.needles.end(), c.needle) == d.needles.end()) d.needles.push_back(c.needle);
+    }
+    if (d.geometries.size() > 63) fail("[candidates]", fmt::format("{} geometries: a simulated probe has at most 63 trailing tips", d.geometries.size()));
+  }
+};
+
+// The canonical text of what the rows depend on (not the objective, the
+// values ranked on or the model's name: changing those re-ranks the same rows).
+std::string canonical_text(const DesignDefinition& d) {
   std::string c = fmt::format("seeds={};seed={};", d.seeds, d.seed);
   for (const auto& cond : d.conditions) {
     c += "condition=" + cond.name + ";";
@@ -230,7 +241,32 @@ DesignDefinition load_design(const std::filesystem::path& path) {
   for (double fs : d.fss) c += fmt::format("fs={:.17g};", fs);
   for (double t : d.durations) c += fmt::format("duration={:.17g};", t);
   // Not the needles: they scale the rows at ranking, and the rows stay valid.
-  d.canonical = c;
+  return c;
+}
+
+}  // namespace
+
+DesignDefinition load_design(const std::filesystem::path& path) {
+  DesignDefinition d;
+  const DesignFile file{path.string()};
+  DesignFile::CandidateLists lists;
+  for (const auto& t : detail::definition_tables(path, {"conditions"})) {
+    if (t.name.empty()) {
+      if (!t.settings.empty()) file.fail(t.settings.front().key, "must be in a table: [design], [conditions.NAME], [candidates] or [current]");
+    } else if (t.name == "design") {
+      file.read_design(t, d);
+    } else if (t.name.rfind("conditions.", 0) == 0) {
+      d.conditions.push_back(file.read_condition(t));
+    } else if (t.name == "candidates") {
+      file.read_candidates(t, d, lists);
+    } else if (t.name == "current") {
+      d.current = file.read_current(t);
+    } else {
+      file.fail("[" + t.name + "]", "unknown table; use [design], [conditions.NAME], [candidates] and [current]");
+    }
+  }
+  file.finish_candidates(d, lists);
+  d.canonical = canonical_text(d);
   return d;
 }
 
@@ -671,21 +707,61 @@ std::string stats_cells(const ErrorStats& s) {
 
 }  // namespace
 
+namespace {
+
+const RankedColumn kRankedColumns[] = {
+    {"rank", "-", "the candidate's rank, 1 = recommended"},
+    {"objective", "-", "what the candidates are ranked on: the score's worst or mean over the conditions (ranking)"},
+    {"ranking", "text", "worst-case (the largest score over the conditions) or mean: the design's objective"},
+    {"values", "text", "corrected (the model's median where it corrects, AWCC's elsewhere) or raw: the values ranked on"},
+    {"failures", "-", "records without a value, over the conditions"},
+    {"best_share", "-", "share of the bootstrap resamples of the records in which the candidate ranks first"},
+    {"current", "-", "1 for the lab's current probe, else 0"},
+    {"dx", "m", "streamwise tip separation"},
+    {"dy", "m", "lateral tip separation"},
+    {"np", "-", "points per AWCC window"},
+    {"fs", "Hz", "sampling rate"},
+    {"duration", "s", "record duration"},
+    {"needle", "m", "the leading needle's diameter, 0 for point tips"},
+    {"seconds_awcc", "s", "mean AWCC CPU seconds per record (differs from run to run; not ranked on)"},
+    {"condition", "text", "the condition's name; the columns after it are the condition's"},
+    {"records", "-", "records simulated in the condition"},
+    {"condition_failures", "-", "records of the condition without a value"},
+    {"score", "-", "RMS_u + RMS_Tu of the values ranked on, relative"},
+    {"u_bias", "-", "bias of the velocity ranked on, relative"},
+    {"u_spread", "-", "spread of the velocity ranked on, relative"},
+    {"u_rms", "-", "RMS error of the velocity ranked on, relative"},
+    {"tu_bias", "-", "bias of Tu ranked on, relative"},
+    {"tu_spread", "-", "spread of Tu ranked on, relative"},
+    {"tu_rms", "-", "RMS error of Tu ranked on, relative"},
+    {"raw_u_bias", "-", "raw AWCC's velocity bias, relative"},
+    {"raw_u_spread", "-", "raw AWCC's velocity spread, relative"},
+    {"raw_u_rms", "-", "raw AWCC's velocity RMS error, relative"},
+    {"raw_tu_bias", "-", "raw AWCC's Tu bias, relative"},
+    {"raw_tu_spread", "-", "raw AWCC's Tu spread, relative"},
+    {"raw_tu_rms", "-", "raw AWCC's Tu RMS error, relative"},
+    {"corrected_fraction", "-", "share of the records the model corrected"},
+    {"data_yield", "-", "mean accepted / formed AWCC windows"},
+};
+
+}  // namespace
+
+std::span<const RankedColumn> ranked_columns() { return kRankedColumns; }
+
 std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d) {
-  std::string out =
-      "rank,objective,failures,best_share,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,condition_failures,score,"
-      "u_bias,u_spread,u_rms,tu_bias,tu_spread,tu_rms,raw_u_bias,raw_u_spread,raw_u_rms,raw_tu_bias,raw_tu_spread,"
-      "raw_tu_rms,corrected_fraction,data_yield\n";
+  std::string out;
+  for (const auto& c : kRankedColumns) out += (out.empty() ? "" : ",") + std::string(c.name);
+  out += "\n";
   const bool corrected = d.values == "corrected";
   for (const auto& r : ranked) {
     for (const auto& c : r.conditions) {
       const auto& u = corrected ? c.corrected_u : c.raw_u;
       const auto& t = corrected ? c.corrected_tu : c.raw_tu;
-      out += fmt::format("{},{},{},{:.3g},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
-                         num(r.objective), r.failures, r.best_share, r.current ? 1 : 0, num(r.candidate.dx), num(r.candidate.dy),
-                         r.candidate.np, num(r.candidate.fs), num(r.candidate.duration), num(r.candidate.needle),
-                         r.seconds, c.condition,
-                         c.records, c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
+      out += fmt::format("{},{},{},{},{},{:.3g},{},{},{},{},{},{},{},{:.4g},{},{},{},{},{},{},{},{},{:.4g},{:.4g}\n", r.rank,
+                         num(r.objective), d.objective, d.values, r.failures, r.best_share, r.current ? 1 : 0,
+                         num(r.candidate.dx), num(r.candidate.dy), r.candidate.np, num(r.candidate.fs),
+                         num(r.candidate.duration), num(r.candidate.needle), r.seconds, c.condition, c.records,
+                         c.failures, num(c.score), stats_cells(u), stats_cells(t), stats_cells(c.raw_u),
                          stats_cells(c.raw_tu), c.corrected_fraction, c.data_yield);
     }
   }

@@ -3,13 +3,17 @@
 #include "definition.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fmt/format.h>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include "awcc/errors.hpp"
 #include "correction/features.hpp"
+#include "correction/sweep_columns.hpp"
+#include "awcc/option_field.hpp"
 #include "awcc/settings_file.hpp"
 
 #include "awcc/units.hpp"
@@ -21,20 +25,40 @@ namespace {
 
 using detail::dimension_of;
 
-bool is_field(const std::string& name) { return name == "np" || name == "anisotropy" || detail::is_scene_field(name); }
+// The run's own fields beside the scene's (synth::scene_fields).
+const awcc::OptionField<SweepRun> kRunFields[] = {
+    {"np", "-", "points per AWCC window",
+     [](SweepRun& run, std::string_view text) {
+       const double v = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
+       if (v != std::floor(v) || v < 1 || v > 1000) {
+         throw std::invalid_argument(fmt::format("{} must be a whole number in [1, 1000]", text));
+       }
+       run.np = static_cast<int>(v);
+     },
+     [](const SweepRun& run) { return std::to_string(run.np); }},
+    {"anisotropy", "-", "Tu_y/Tu_x = Tu_z/Tu_x, applied when tu-y and tu-z are not set",
+     [](SweepRun& run, std::string_view text) {
+       run.anisotropy = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
+     },
+     [](const SweepRun& run) { return fmt::format("{:g}", run.anisotropy); }},
+};
 
-// Applies one value (text) of a field or of np/anisotropy to a run.
-void apply(SweepRun& run, const std::string& name, const std::string& text) {
-  if (name == "np") {
-    const double v = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
-    if (v != std::floor(v) || v < 1 || v > 1000) throw std::invalid_argument(fmt::format("np = {} must be a whole number in [1, 1000]", text));
-    run.np = static_cast<int>(v);
-  } else if (name == "anisotropy") {
-    run.anisotropy = awcc::parse_quantity(text, awcc::Dimension::dimensionless);
-  } else {
-    synth::set_scene_field(run.scene, name, text);
-  }
+bool is_field(const std::string& name) {
+  return std::any_of(std::begin(kRunFields), std::end(kRunFields), [&](const auto& f) { return f.name == name; }) ||
+         detail::is_scene_field(name);
 }
+
+// Applies one value of a field (the run's or the scene's) through the one
+// application path; a refused value is awcc::setting_error's, naming
+// setting.origin and the field.
+void apply(SweepRun& run, const awcc::OptionSetting& setting) {
+  const std::span<const awcc::OptionSetting> one(&setting, 1);
+  std::vector<bool> used(1, false);
+  awcc::apply_settings(std::span<const awcc::OptionField<SweepRun>>(kRunFields), one, run, used);
+  if (!used[0]) awcc::apply_settings(synth::scene_fields(), one, run.scene, used);
+}
+
+void apply(SweepRun& run, const std::string& name, const std::string& text) { apply(run, {name, text, {}}); }
 
 constexpr const char* kUnknownField = "unknown field; use a scene field's name (velocity, tu, time-scale, void-fraction, "
                                       "bubble-diameter, dx, fs, duration, ...), np or anisotropy";
@@ -45,7 +69,7 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
   SweepDefinition d;
   const std::string file = path.string();
   auto fail = [&](const std::string& where, const std::string& what) -> void {
-    throw std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));
+    throw awcc::OptionError(fmt::format("{}: {}: {}", file, where, what));
   };
   const auto tables = detail::definition_tables(path);
   std::map<std::string, const awcc::SettingTable*> by_name;
@@ -69,7 +93,7 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
       long long v = 0;
       try {
         v = awcc::parse_whole(s.text, s.key == "seed" ? 0 : 1, std::int64_t{1} << 53);
-      } catch (const std::invalid_argument&) {
+      } catch (const std::exception&) {
         fail("[sweep] " + s.key, "must be a whole number >= " + std::string(s.key == "seed" ? "0" : "1"));
       }
       if (s.key == "runs") d.runs = v;
@@ -81,24 +105,26 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
   }
   if (d.mode == "monte-carlo" && d.runs < 1) fail("[sweep] runs", "monte-carlo needs runs >= 1");
   SweepRun probe;
-  auto check_value = [&](const std::string& where, const std::string& name, const std::string& text) {
+  // A refused value names the file and the table (the field is the
+  // setting's); the quantity stays empty: it is fixed in the file.
+  auto check_value = [&](const std::string& in_table, const std::string& name, const std::string& text) {
     SweepRun copy = probe;
     try {
-      apply(copy, name, text);
+      apply(copy, {name, text, file + ": " + in_table});
     } catch (const std::exception& e) {
-      fail(where, e.what());
+      throw awcc::OptionError(e.what());
     }
   };
   for (const auto& s : table("base")) {
     if (!is_field(s.key)) fail("[base] " + s.key, kUnknownField);
-    check_value("[base] " + s.key, s.key, s.text);
+    check_value("[base]", s.key, s.text);
     d.base[s.key] = s.text;
   }
   for (const auto& s : table("grid")) {
     if (!is_field(s.key)) fail("[grid] " + s.key, kUnknownField);
     if (s.items.empty()) fail("[grid] " + s.key, "must be a non-empty list of values");
     for (const auto& text : s.items) {
-      check_value("[grid] " + s.key, s.key, text);
+      check_value("[grid]", s.key, text);
       d.grid[s.key].push_back(text);
     }
   }
@@ -211,16 +237,6 @@ std::uint64_t study_id(const SweepDefinition& d) { return detail::definition_id(
 
 namespace {
 
-const char* const kResultColumns[] = {
-    "np", "anisotropy", "truth_velocity", "truth_turbulence_intensity", "truth_void_fraction", "truth_count_rate",
-    "truth_d32", "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate", "awcc_d32",
-    "awcc_windows_accepted", "awcc_windows_total", "awcc_velocity_error", "awcc_turbulence_intensity_error",
-    "awcc_d32_error", "fscc_velocity", "fscc_turbulence_intensity_chanson", "fscc_r12_max", "fscc_velocity_error",
-    "window_bias", "window_rms", "seconds_synth", "seconds_process", "seconds_fscc", "seconds_awcc", "reason",
-    "probe_dx", "probe_dy", "awcc_filter_a", "awcc_roc", "awcc_weighting", "awcc_signal", "awcc_subsample"};
-// Columns after "reason": written for failed runs too.
-constexpr std::size_t kTrailingColumns = 7;
-
 std::string csv_field_name(std::string_view name) {
   std::string s(name);
   std::replace(s.begin(), s.end(), '-', '_');
@@ -238,17 +254,10 @@ std::string clean(std::string s) {
 }  // namespace
 
 std::string sweep_header() {
-  std::string h = "study,run,seed";
-  for (const auto& f : synth::scene_fields()) {
-    if (f.name == "seed") continue;
-    h += ',';
-    h += csv_field_name(f.name);
-  }
-  for (const char* c : kResultColumns) {
-    h += ',';
-    h += c;
-  }
-  return h;
+  std::vector<std::string> scene;
+  for (const auto& f : synth::scene_fields())
+    if (f.name != "seed") scene.push_back(csv_field_name(f.name));
+  return correction::sweep_csv_header(scene);
 }
 
 bool sets(const SweepDefinition& d, const std::string& name) {
@@ -275,16 +284,25 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
     row += ',';
     row += clean(v);
   }
-  row += fmt::format(",{},{:.10g}", run.np, run.anisotropy);
-  auto trailing = [&](double dx, double dy) {
-    return fmt::format(",{:.10g},{:.10g},{:.10g},{},{},{},{}", dx, dy, processing.filter_a, processing.roc ? "on" : "off",
-                       awcc::to_string(processing.weighting), awcc::to_string(processing.signal),
-                       awcc::to_string(processing.subsample));
+  using correction::SweepColumn;
+  std::array<std::string, correction::sweep_result_column_count> cells;
+  auto cell = [&](SweepColumn c) -> std::string& { return cells[static_cast<std::size_t>(c)]; };
+  cell(SweepColumn::np) = std::to_string(run.np);
+  cell(SweepColumn::anisotropy) = fmt::format("{:.10g}", run.anisotropy);
+  auto finish = [&](double dx, double dy) {
+    cell(SweepColumn::probe_dx) = fmt::format("{:.10g}", dx);
+    cell(SweepColumn::probe_dy) = fmt::format("{:.10g}", dy);
+    cell(SweepColumn::awcc_filter_a) = fmt::format("{:.10g}", processing.filter_a);
+    cell(SweepColumn::awcc_roc) = correction::roc_text(processing.roc);
+    cell(SweepColumn::awcc_weighting) = awcc::to_string(processing.weighting);
+    cell(SweepColumn::awcc_signal) = awcc::to_string(processing.signal);
+    cell(SweepColumn::awcc_subsample) = awcc::to_string(processing.subsample);
+    for (const auto& c : cells) row += "," + c;
+    return row;
   };
   if (!r) {
-    for (std::size_t i = 2; i + 1 + kTrailingColumns < std::size(kResultColumns); ++i) row += ",";
-    row += "," + clean(error);
-    return row + trailing(run.scene.streamwise_separation(), run.scene.lateral_separation());
+    cell(SweepColumn::reason) = clean(error);
+    return finish(run.scene.streamwise_separation(), run.scene.lateral_separation());
   }
   // What the correction reads is the measurement's; the scores are of what
   // pdp process reports.
@@ -295,21 +313,33 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
   std::string reason = error;
   if (awcc && !awcc->ok()) reason += "awcc: " + awcc->message;
   else if (r->measurement.status == correction::CorrectionStatus::probe_corrected) reason += "awcc: " + r->measurement.message;
-  row += "," + num(r->truth_velocity) + "," + num(r->truth_turbulence_intensity) + "," + num(r->truth_void_fraction) +
-         "," + num(r->truth_count_rate) + "," + num(r->truth_d32);
-  row += "," + num(m.velocity) + "," + num(m.turbulence_intensity) + "," + num(m.void_fraction) + "," +
-         num(m.bubble_count_rate) + "," + num(r->awcc_d32.value);
-  row += "," + count(m.windows_accepted) + "," + count(m.windows_total);
-  row += "," + num(r->awcc_velocity.error()) + "," + num(r->awcc_turbulence_intensity.error()) + "," +
-         num(r->awcc_d32.error());
-  row += "," + num(m.fscc_velocity) + "," + num(fscc ? fscc->turbulence_intensity_chanson : std::nullopt) + "," +
-         num(fscc ? std::optional(fscc->r12_max) : std::nullopt) + "," + num(r->fscc_velocity.error());
-  row += "," + num(r->window_bias) + "," + num(r->window_rms);
+  cell(SweepColumn::truth_velocity) = num(r->truth_velocity);
+  cell(SweepColumn::truth_turbulence_intensity) = num(r->truth_turbulence_intensity);
+  cell(SweepColumn::truth_void_fraction) = num(r->truth_void_fraction);
+  cell(SweepColumn::truth_count_rate) = num(r->truth_count_rate);
+  cell(SweepColumn::truth_d32) = num(r->truth_d32);
+  cell(SweepColumn::awcc_velocity) = num(m.velocity);
+  cell(SweepColumn::awcc_turbulence_intensity) = num(m.turbulence_intensity);
+  cell(SweepColumn::awcc_void_fraction) = num(m.void_fraction);
+  cell(SweepColumn::awcc_count_rate) = num(m.bubble_count_rate);
+  cell(SweepColumn::awcc_d32) = num(r->awcc_d32.value);
+  cell(SweepColumn::awcc_windows_accepted) = count(m.windows_accepted);
+  cell(SweepColumn::awcc_windows_total) = count(m.windows_total);
+  cell(SweepColumn::awcc_velocity_error) = num(r->awcc_velocity.error());
+  cell(SweepColumn::awcc_turbulence_intensity_error) = num(r->awcc_turbulence_intensity.error());
+  cell(SweepColumn::awcc_d32_error) = num(r->awcc_d32.error());
+  cell(SweepColumn::fscc_velocity) = num(m.fscc_velocity);
+  cell(SweepColumn::fscc_turbulence_intensity_chanson) = num(fscc ? fscc->turbulence_intensity_chanson : std::nullopt);
+  cell(SweepColumn::fscc_r12_max) = num(fscc ? std::optional(fscc->r12_max) : std::nullopt);
+  cell(SweepColumn::fscc_velocity_error) = num(r->fscc_velocity.error());
+  cell(SweepColumn::window_bias) = num(r->window_bias);
+  cell(SweepColumn::window_rms) = num(r->window_rms);
   // FSCC and AWCC run together, as in pdp process: their own seconds are not
   // measured (seconds_fscc and seconds_awcc stay empty).
-  row += fmt::format(",{:.4f},{:.4f},,", r->seconds_synth, r->seconds_process);
-  row += "," + clean(reason);
-  return row + trailing(m.dx, m.dy);
+  cell(SweepColumn::seconds_synth) = fmt::format("{:.4f}", r->seconds_synth);
+  cell(SweepColumn::seconds_process) = fmt::format("{:.4f}", r->seconds_process);
+  cell(SweepColumn::reason) = clean(reason);
+  return finish(m.dx, m.dy);
 }
 
 std::string run_sweep_row(const SweepRun& run, const RunOptions& options, std::uint64_t study) {

@@ -43,18 +43,19 @@ MISSING_PACKAGE_HELP = ("pdp design --report draws with matplotlib and NumPy and
                         "install Debian's python3-matplotlib, python3-numpy and python3-jinja2 (sudo apt install "
                         "python3-matplotlib python3-numpy python3-jinja2)")
 
-COLUMNS = ["rank", "objective", "failures", "current", "dx", "dy", "np", "fs", "duration", "seconds_awcc",
-           "condition", "records", "condition_failures", "score", "u_bias", "u_spread", "u_rms", "tu_bias",
-           "tu_spread", "tu_rms", "raw_u_bias", "raw_u_spread", "raw_u_rms", "raw_tu_bias", "raw_tu_spread",
-           "raw_tu_rms", "corrected_fraction", "data_yield"]
+# The ranked CSV's header is its declaration (study::ranked_columns in libstudy/include/study/design.hpp):
+# the columns before CONDITION are the candidate's (the same on each of its rows), the rest the condition's.
+CONDITION = "condition"
+# The design's ranking, as pdp design writes it in every row: (column, the values it takes).
+RANKING = ("ranking", ("worst-case", "mean"))
+VALUES = ("values", ("corrected", "raw"))
+TEXT_COLUMNS = {CONDITION, RANKING[0], VALUES[0]}
+# The columns this page reads (any others are carried, not shown).
+USED = ["rank", "objective", RANKING[0], VALUES[0], "failures", "current", "dx", "dy", "np", "fs", "duration",
+        "seconds_awcc", CONDITION, "records", "condition_failures", "score", "u_bias", "u_spread", "u_rms", "tu_bias",
+        "tu_spread", "tu_rms", "raw_u_bias", "raw_tu_bias", "corrected_fraction", "data_yield"]
 # Optional columns and their value when absent (files of pdp design before needles).
 OPTIONAL = {"needle": 0.0}
-# Per candidate (the same on each of its rows) and per condition; the rest may be empty or inf.
-CANDIDATE_FIELDS = ["rank", "objective", "failures", "current", "dx", "dy", "np", "fs", "duration", "needle",
-                    "seconds_awcc"]
-CONDITION_VALUES = ["score", "u_bias", "u_spread", "u_rms", "tu_bias", "tu_spread", "tu_rms", "raw_u_bias",
-                    "raw_u_spread", "raw_u_rms", "raw_tu_bias", "raw_tu_spread", "raw_tu_rms", "corrected_fraction",
-                    "data_yield"]
 # Whole numbers: (smallest allowed, largest allowed or None).
 WHOLE = {"rank": (1, None), "failures": (0, None), "current": (0, 1), "np": (1, None), "records": (0, None),
          "condition_failures": (0, None)}
@@ -111,6 +112,7 @@ class Candidate:
         self.np = int(fields["np"])
         self.fs, self.duration, self.needle = fields["fs"], fields["duration"], fields["needle"]
         self.seconds = fields["seconds_awcc"]
+        self.ranking, self.values = fields[RANKING[0]], fields[VALUES[0]]
         self.conditions = {}  # name -> {column: value}
 
     @property
@@ -145,11 +147,13 @@ def read_ranked(path):
         raise InputProblem(f"{path}: not text (UTF-8): give the ranked CSV pdp design -o wrote") from None
     lines = list(csv.reader(text.splitlines()))
     header = [h.strip() for h in lines[0]] if lines else []
-    missing = [c for c in COLUMNS if c not in header]
+    missing = [c for c in USED if c not in header]
     if missing:
         raise InputProblem(f"{path}: column{'s' if len(missing) > 1 else ''} {', '.join(missing)} missing: not a "
-                           "ranked CSV of pdp design; give the file pdp design -o wrote")
-    candidates, conditions = {}, []
+                           "ranked CSV of this pdp design; give the file pdp design -o wrote (pdp design ranks "
+                           "again from its runs file without simulating)")
+    candidate_columns = set(header[:header.index(CONDITION)]) | set(OPTIONAL)
+    candidates, conditions, ranking = {}, [], None
     for line, cells in enumerate(lines[1:], start=2):
         if not cells:
             continue
@@ -158,8 +162,8 @@ def read_ranked(path):
                                "edited; write it again with pdp design")
         row = dict(zip(header, cells))
         fields, values = dict(OPTIONAL), {}
-        for c in COLUMNS + [c for c in OPTIONAL if c in header]:
-            if c == "condition":
+        for c in header:
+            if c in TEXT_COLUMNS:
                 continue
             try:
                 v = value(row[c])
@@ -175,8 +179,20 @@ def read_ranked(path):
                                        f"{f' to {hi}' if hi is not None else ' up'}")
                 if (c in ("fs", "duration") and v <= 0) or (c in ("dx", "needle") and v < 0):
                     raise InputProblem(f"{path}: line {line}, column {c}: {row[c]} is out of range")
-            (fields if c in CANDIDATE_FIELDS else values)[c] = v
-        name = row["condition"].strip()
+            (fields if c in candidate_columns else values)[c] = v
+        for column, allowed in (RANKING, VALUES):
+            text = row[column].strip()
+            if text not in allowed:
+                raise InputProblem(f"{path}: line {line}, column {column}: '{text}' is not one of "
+                                   f"{', '.join(allowed)}; write the file again with pdp design")
+            fields[column] = text
+        if ranking is None:
+            ranking = (fields[RANKING[0]], fields[VALUES[0]])
+        elif ranking != (fields[RANKING[0]], fields[VALUES[0]]):
+            raise InputProblem(f"{path}: line {line}: ranked by {fields[RANKING[0]]} of the {fields[VALUES[0]]} values, "
+                               f"the rows before by {ranking[0]} of the {ranking[1]} values: a design ranks one "
+                               "way; write the file again with pdp design")
+        name = row[CONDITION].strip()
         if not name:
             raise InputProblem(f"{path}: line {line}: the condition is empty")
         if name not in conditions:
@@ -261,33 +277,6 @@ def ratio(other, best):
     if best.objective is None or best.objective <= 0:
         return "not defined (the recommended candidate's objective is not positive)"
     return f"{other.objective / best.objective:.1f}x the recommended error"
-
-
-def ranking_kind(candidates, design):
-    """'worst-case' or 'mean': the design file's, or what the numbers show."""
-    given = design.get("settings", {}).get("objective") if design else None
-    if given in ("worst-case", "mean"):
-        return given
-    for c in candidates:
-        scores = [c.score(n) for n in c.conditions]
-        if c.objective is None or not scores or any(s is None for s in scores) or len(scores) < 2:
-            continue
-        if math.isclose(c.objective, max(scores), rel_tol=1e-6, abs_tol=1e-12):
-            return "worst-case"
-        if math.isclose(c.objective, sum(scores) / len(scores), rel_tol=1e-6, abs_tol=1e-12):
-            return "mean"
-    return "worst-case"
-
-
-def ranked_on_corrected(candidates):
-    """True when the values ranked on are the corrected ones (they differ from raw AWCC somewhere)."""
-    for c in candidates:
-        for v in c.conditions.values():
-            for q in ("u_bias", "u_spread", "tu_bias", "tu_spread"):
-                a, b = v.get(q), v.get("raw_" + q)
-                if a is not None and b is not None and not math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-12):
-                    return True
-    return False
 
 
 class Layout:
@@ -557,8 +546,8 @@ def build(csv_path, design_path=None, command_line=None, pdp_version=None, argv=
     best, worst = candidates[0], candidates[-1]
     currents = [c for c in candidates if c.current]
     current = currents[0] if currents else None
-    kind = ranking_kind(candidates, design)
-    corrected = ranked_on_corrected(candidates)
+    kind = best.ranking  # every row has the design's: read_ranked checked it
+    corrected = best.values == "corrected"
 
     # Maps: every candidate at the recommended Np, fs, duration and needle, by geometry.
     at_best = {c.geometry: c for c in candidates if c.setting == best.setting}

@@ -19,7 +19,7 @@ import pytest
 from conftest import SOURCE
 
 SCRIPT = SOURCE / "python" / "pdp" / "design_report.py"
-HEADER = ("rank,objective,failures,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,"
+HEADER = ("rank,objective,ranking,values,failures,current,dx,dy,np,fs,duration,needle,seconds_awcc,condition,records,"
           "condition_failures,score,u_bias,u_spread,u_rms,tu_bias,tu_spread,tu_rms,raw_u_bias,raw_u_spread,"
           "raw_u_rms,raw_tu_bias,raw_tu_spread,raw_tu_rms,corrected_fraction,data_yield")
 QUANTITIES = ["u_rms", "tu_rms", "raw_u_bias", "raw_tu_bias"]
@@ -58,7 +58,8 @@ def candidate(rank, dx_mm, dy_mm, np_=10, current=False, failed=False, objective
             "objective": objective, "needle": needle_mm / 1e3}
 
 
-def write_ranked(path, candidates, conditions=("base", "wall"), needle_column=True):
+def write_ranked(path, candidates, conditions=("base", "wall"), needle_column=True, ranking="worst-case",
+                 values_ranked="corrected"):
     """A ranked CSV as pdp design writes it (without the needle column: as it did before needles)."""
     lines = [HEADER if needle_column else HEADER.replace(",needle,", ",")]
     for c in candidates:
@@ -77,7 +78,8 @@ def write_ranked(path, candidates, conditions=("base", "wall"), needle_column=Tr
                 values.insert(0, score)
             if c["failed"]:
                 values.insert(0, score)
-            lines.append(",".join(map(str, [c["rank"], objective, 3 * len(conditions) if c["failed"] else 0,
+            lines.append(",".join(map(str, [c["rank"], objective, ranking, values_ranked,
+                                            3 * len(conditions) if c["failed"] else 0,
                                             int(c["current"]), c["dx"], c["dy"], c["np"], 100000, 20]
                                            + ([c["needle"]] if needle_column else [])
                                            + [0.012, name, 3, failures] + values)))
@@ -192,6 +194,18 @@ def test_a_grid_with_the_current_probe_and_a_failed_candidate(report, tmp_path):
     assert ranked.exists()
 
 
+@pytest.mark.parametrize("ranking, values_ranked", [("mean", "raw"), ("worst-case", "corrected")])
+def test_the_ranking_is_the_files_not_a_guess(report, tmp_path, ranking, values_ranked):
+    # The objectives are the worst scores and the values differ from raw AWCC's: numbers that would have been
+    # read as a worst-case ranking of corrected values; the page says what the file declares.
+    ranked = write_ranked(tmp_path / "ranked.csv", GRID, ranking=ranking, values_ranked=values_ranked)
+    assert report.main([str(ranked), "-o", str(tmp_path / "design.html")]) == 0
+    text = (tmp_path / "design.html").read_text()
+    assert ("mean over the conditions" in text) == (ranking == "mean")
+    assert ("worst condition" in text) == (ranking == "worst-case")
+    assert ("raw AWCC values" in text) == (values_ranked == "raw")
+
+
 def test_a_probe_list_that_is_not_a_grid_is_a_scatter(report, tmp_path):
     probes = [candidate(1, 7.15, 0), candidate(2, 2, 0), candidate(3, 5, 1, current=True),
               candidate(4, 3, 0.5, failed=True)]
@@ -257,6 +271,12 @@ def test_without_tomllib_the_design_file_is_named(report, tmp_path, monkeypatch)
     (lambda t: t.replace("\n2,", "\n1,", 1), "rank 1 is given to two candidates"),
     (lambda t: t.replace(",base,3,", ",base,2.5,", 1), "not a whole number"),
     (lambda t: t + "1,0.1,0\n", "cells"),
+    (lambda t: t.replace(",worst-case,", ",worst,", 1), "line 2, column ranking: 'worst' is not one of worst-case, mean"),
+    (lambda t: t.replace(",corrected,", ",median,", 1), "line 2, column values: 'median' is not one of corrected, raw"),
+    (lambda t: t.replace(",worst-case,", ",mean,", 1), "line 3: ranked by worst-case of the corrected values, the rows "
+                                                         "before by mean"),
+    (lambda t: t.replace("objective,ranking,", "objective,", 1).replace(",worst-case,", ","),
+     "column ranking missing"),
 ])
 def test_a_bad_csv_is_bad_input_and_writes_nothing(report, tmp_path, capsys, change, message):
     ranked = write_ranked(tmp_path / "ranked.csv", GRID)

@@ -42,7 +42,7 @@ duration = "5s"
 TOML
 
 # The ranking without the measured CPU seconds (which differ from run to run).
-ranking() { cut -d, -f1-11,13- "$1"; }
+ranking() { cut -d, -f1-13,15- "$1"; }
 
 "$pdp" --log-level warn design --config "$dir/flow.toml" -o "$dir/one.csv" --threads 1 >"$dir/one.txt" ||
   fail "design, one thread"

@@ -123,6 +123,55 @@ TEST(Training, LoadRefusesDuplicatesAndBadNumbersNamingTheLine) {
   }
 }
 
+// An enum cell that names no value is refused with the file, the row and the
+// value (it used to read as the default processing).
+TEST(Training, AnUnknownProcessingValueIsRefusedNamingTheRowAndTheValue) {
+  const std::string header = kHeader + ",awcc_filter_a,awcc_roc,awcc_weighting,awcc_signal,awcc_subsample";
+  const std::string known[] = {"on", "duration", "binary", "none"};
+  const std::string columns[] = {"awcc_roc", "awcc_weighting", "awcc_signal", "awcc_subsample"};
+  auto processed = [&](std::int64_t run, std::size_t unknown) {
+    auto r = row(run, good(10, 9.5));
+    r.pop_back();
+    r += ",0.4";
+    for (std::size_t i = 0; i < 4; ++i) r += "," + (i == unknown ? std::string("Parabolic") : known[i]);
+    return r + "\n";
+  };
+  // The known values read back as the defaults they name.
+  const auto set = correction::load_training_set({write("training_known.csv", header + "\n" + processed(0, 4))}, 100);
+  EXPECT_TRUE(set.processing == correction::Processing{});
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto file = fmt::format("training_unknown_{}.csv", i);
+    try {
+      (void)correction::load_training_set({write(file, header + "\n" + processed(0, 4) + processed(1, i))}, 100);
+      FAIL() << columns[i];
+    } catch (const awcc::InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(fmt::format("{}:3: column {} = 'Parabolic' is not one of", file, columns[i])), std::string::npos)
+          << what;
+    }
+  }
+}
+
+// Each column training needs, left out, is refused by its name.
+TEST(Training, AMissingColumnIsRefusedByItsName) {
+  const auto names = awcc::split_cells(kHeader);
+  for (const auto& missing : {"study", "run", "dx", "dy", "np", "truth_velocity", "truth_turbulence_intensity",
+                              "awcc_velocity", "awcc_turbulence_intensity", "awcc_void_fraction", "awcc_count_rate",
+                              "awcc_windows_accepted", "reason"}) {
+    std::string header;
+    for (const auto& n : names)
+      if (n != missing) header += (header.empty() ? "" : ",") + n;
+    try {
+      (void)correction::load_training_set({write("training_missing.csv", header + "\n")}, 100);
+      FAIL() << missing;
+    } catch (const awcc::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fmt::format("training_missing.csv: no column '{}'", missing)),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // Every training target is the ratio 1.1, so every quantile is 1.1 u: the
 // scores follow by hand. Row A: truth 1.1 u (corrected error 0, covered; raw
 // 1/1.1 - 1); row B: truth u (corrected 0.1, not covered; raw 0).

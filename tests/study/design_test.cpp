@@ -2,10 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
 
+#include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/probe_correction.hpp"
 #include "synth/synthesiser.hpp"
@@ -234,6 +238,28 @@ TEST(DesignScores, RankingIsByFailuresThenTheWorstConditionThenTheShorterRecord)
   const auto csv = study::ranked_csv(ranked, d);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6 * 2);
   EXPECT_EQ(csv.substr(csv.find('\n') + 1, 2), "1,");
+  // The header is the declaration; every row has a cell per declared column,
+  // and the ranking the report would otherwise have to guess.
+  std::vector<std::string> names;
+  for (const auto& column : study::ranked_columns()) names.emplace_back(column.name);
+  std::istringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(awcc::split_cells(line), names);
+  const auto at = [&](std::string_view name) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  while (std::getline(lines, line)) {
+    const auto cells = awcc::split_cells(line);
+    ASSERT_EQ(cells.size(), names.size()) << line;
+    EXPECT_EQ(cells[at("ranking")], d.objective);
+    EXPECT_EQ(cells[at("values")], d.values);
+  }
+  auto worst = d;
+  worst.objective = "worst-case";
+  worst.values = "corrected";
+  const auto worst_csv = study::ranked_csv(study::rank_candidates(worst, rows), worst);
+  EXPECT_NE(worst_csv.find(",worst-case,corrected,"), std::string::npos);
 }
 
 TEST(DesignScores, TheNeedlesSlowingIsTheInverseOfTheProbeCorrection) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <fmt/format.h>
@@ -9,6 +10,8 @@
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "correction/sweep_columns.hpp"
+#include "correction/training.hpp"
 #include "study/sweep.hpp"
 #include "study/tasks.hpp"
 #include "test_paths.hpp"
@@ -27,6 +30,18 @@ std::string cell(const std::string& row, const std::string& column) {
   return cells.at(static_cast<std::size_t>(at));
 }
 
+// A short run with enough bubbles for AWCC windows.
+study::SweepRun short_run() {
+  study::SweepRun run;
+  run.np = 6;
+  run.scene.fs = 50e3;
+  run.scene.duration = 2.0;
+  run.scene.dx = 3e-3;
+  run.scene.dy = 0.5e-3;
+  run.scene.seed = 21;
+  return run;
+}
+
 TEST(SweepRows, AFailedRunIsAFullRowWithItsReason) {
   study::SweepRun run;
   run.index = 4;
@@ -39,16 +54,9 @@ TEST(SweepRows, AFailedRunIsAFullRowWithItsReason) {
 }
 
 TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
-  study::SweepRun run;
-  run.index = 0;
-  run.np = 6;
-  run.scene.fs = 50e3;
-  run.scene.duration = 2.0;
-  run.scene.dx = 3e-3;
-  run.scene.dy = 0.5e-3;
-  run.scene.seed = 21;
+  const auto run = short_run();
   study::RunOptions options;
-  options.awcc.np = 6;
+  options.awcc.np = run.np;
   const auto r = study::run_scene(run.scene, options);
   const auto& m = r.measurement.measurement;
   const auto row = study::sweep_row(run, &r, "", 1, options.awcc);
@@ -69,6 +77,58 @@ TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
   // Both methods run together: no time of their own.
   EXPECT_EQ(cell(row, "seconds_fscc"), "");
   EXPECT_EQ(cell(row, "seconds_awcc"), "");
+}
+
+// The writer's header is the declaration (key columns, the scene's fields,
+// the result columns in order); what the writer puts in a row, training reads
+// back: the correction's features and the processing, every value of them.
+TEST(SweepRows, WhatTheWriterWritesTrainingReadsBack) {
+  const auto header = cells_of(study::sweep_header());
+  std::vector<std::string> declared;
+  for (const auto& c : correction::sweep_key_columns) declared.emplace_back(c.name);
+  const auto scene = header.size() - correction::sweep_key_columns.size() - correction::sweep_result_column_count;
+  declared.insert(declared.end(), header.begin() + 3, header.begin() + 3 + static_cast<std::ptrdiff_t>(scene));
+  for (const auto& c : correction::sweep_result_columns) declared.emplace_back(c.name);
+  EXPECT_EQ(header, declared);
+  EXPECT_EQ(std::set<std::string>(header.begin(), header.end()).size(), header.size()) << "a column twice";
+
+  const auto run = short_run();
+  study::RunOptions options;
+  options.awcc.np = run.np;
+  // Every processing column away from its default, so that a default read is caught.
+  options.awcc.filter_a = 0.3;
+  options.awcc.roc = false;
+  options.awcc.weighting = awcc::Weighting::none;
+  options.awcc.subsample = awcc::Subsample::parabolic;
+  const auto r = study::run_scene(run.scene, options);
+  const auto row = study::sweep_row(run, &r, "", 7, options.awcc);
+  ASSERT_EQ(cells_of(row).size(), header.size()) << row;
+  study::SweepRun failed = run;
+  failed.index = 1;
+  ASSERT_EQ(cells_of(study::sweep_row(failed, nullptr, "boom", 7, options.awcc)).size(), header.size());
+  EXPECT_EQ(cell(row, "awcc_signal"), "binary");
+  EXPECT_EQ(cell(row, "awcc_weighting"), "none");
+
+  const auto file = pdp_test::temp_dir() / "sweep_round_trip.csv";
+  std::ofstream(file) << study::sweep_header() << "\n" << row << "\n" << study::sweep_row(failed, nullptr, "boom", 7, options.awcc) << "\n";
+  const auto set = correction::load_training_set({file}, 1);
+  EXPECT_EQ(set.total, 2);
+  EXPECT_EQ(set.excluded_error, 1);
+  ASSERT_EQ(set.rows.size(), 1u);
+  EXPECT_FALSE(set.processing_assumed);
+  EXPECT_TRUE(set.processing == correction::processing_of(options.awcc)) << correction::describe(set.processing);
+  const auto& read = set.rows[0];
+  EXPECT_EQ(read.study, 7u);
+  EXPECT_EQ(read.run, 0);
+  // The cells carry 10 significant digits: the features agree to that.
+  const auto expected = correction::make_features(r.measurement.measurement).features;
+  for (const auto& name : correction::feature_set_names("extended")) {
+    const auto a = read.features.value(name), b = expected.value(name);
+    ASSERT_TRUE(a && b) << name;
+    EXPECT_NEAR(*a, *b, 1e-9 * std::max(1.0, std::fabs(*b))) << name;
+  }
+  EXPECT_NEAR(read.true_velocity, r.truth_velocity, 1e-9 * r.truth_velocity);
+  EXPECT_NEAR(read.true_turbulence_intensity, r.truth_turbulence_intensity, 1e-9);
 }
 
 TEST(Tasks, EveryTaskIsAppendedOnceWhateverTheThreads) {

@@ -66,7 +66,9 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "awcc/awcc.hpp"
@@ -127,7 +129,7 @@ struct DesignDefinition {
   [[nodiscard]] std::int64_t rows_per_task() const;
 };
 
-/// Reads and checks a design file; throws std::invalid_argument naming the
+/// Reads and checks a design file; throws awcc::OptionError naming the
 /// file, the table and key, and the fix.
 DesignDefinition load_design(const std::filesystem::path& path);
 
@@ -226,6 +228,20 @@ constexpr int kBootstrapResamples = 200;
 /// (kBootstrapResamples times, seeded by the design's seed: the same rows
 /// give the same shares).
 std::vector<RankedCandidate> rank_candidates(const DesignDefinition& d, const std::vector<DesignRow>& rows);
+
+/// A column of the ranked CSV.
+struct RankedColumn {
+  std::string_view name;
+  std::string_view unit;  ///< "-" for numbers without one, "text" for words
+  std::string_view meaning;
+};
+
+/// The ranked CSV's columns in the order written: its header. The columns
+/// before `condition` are the candidate's (the same on each of its rows), the
+/// rest the condition's. The report (python/pdp/design_report.py) reads the
+/// header as this declaration: it takes the split at `condition` and the
+/// ranking (`ranking`, `values`) from the file, never guesses them.
+std::span<const RankedColumn> ranked_columns();
 
 /// The ranked CSV: one row per candidate and condition, best candidate first.
 std::string ranked_csv(const std::vector<RankedCandidate>& ranked, const DesignDefinition& d);

@@ -50,14 +50,15 @@ struct SweepDefinition {
   std::set<std::string> log_ranges;
 };
 
-/// Reads and checks a sweep file; throws std::invalid_argument (a definition
+/// Reads and checks a sweep file; throws awcc::OptionError (a definition
 /// that cannot be run) naming the file, the table and key, and the fix.
 SweepDefinition load_sweep(const std::filesystem::path& path);
 
 /// True when the definition sets `name` (in [base], [grid] or [ranges]).
 [[nodiscard]] bool sets(const SweepDefinition& d, const std::string& name);
 
-/// The CSV header and one row: the scene, np and anisotropy, the truth, the
+/// The CSV header and one row, in the columns correction/sweep_columns.hpp
+/// declares (training reads them by those names): the scene, np and anisotropy, the truth, the
 /// estimates, the probe geometry processed (probe_dx, probe_dy), run times,
 /// the reason a run failed, and the AWCC processing (awcc_filter_a ...).
 /// What the correction reads (awcc_velocity, awcc_turbulence_intensity,
