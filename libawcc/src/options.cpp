@@ -12,6 +12,7 @@
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/read_back.hpp"
 #include "awcc/units.hpp"
 
 namespace awcc {
@@ -39,9 +40,29 @@ std::string name_of(E value, const std::array<std::pair<const char*, E>, N>& cho
   return "?";
 }
 
+// An enum that is also a written result is spelled by its to_string, over the
+// values read_back.hpp lists: the option, the files and their read-back share
+// one text per value.
+template <class E, std::size_t N>
+E choice(std::string_view text, const E (&values)[N]) {
+  std::string names;
+  for (const E v : values) {
+    if (text == to_string(v)) return v;
+    names += (names.empty() ? "" : " | ") + std::string(to_string(v));
+  }
+  throw std::invalid_argument(fmt::format("'{}' is not one of {}", text, names));
+}
+
+template <class E>
+std::string name_of(E value) {
+  return std::string(to_string(value));
+}
+
+// A switch is written "on"/"off" (switch_text); an option also takes
+// true/yes/1 and false/no/0 as aliases of them.
 bool on_off(std::string_view text) {
-  if (text == "on" || text == "true" || text == "yes" || text == "1") return true;
-  if (text == "off" || text == "false" || text == "no" || text == "0") return false;
+  if (text == switch_text(true) || text == "true" || text == "yes" || text == "1") return true;
+  if (text == switch_text(false) || text == "false" || text == "no" || text == "0") return false;
   throw std::invalid_argument(fmt::format("'{}' is not on or off", text));
 }
 
@@ -85,19 +106,6 @@ constexpr std::array<std::pair<const char*, SampleType>, 4> kTypes{{{"int16", Sa
                                                                     {"float64", SampleType::float64}}};
 constexpr std::array<std::pair<const char*, ByteOrder>, 2> kOrders{{{"little", ByteOrder::little},
                                                                     {"big", ByteOrder::big}}};
-constexpr std::array<std::pair<const char*, ThresholdRule>, 5> kRules{{{"histogram", ThresholdRule::histogram},
-                                                                      {"felder", ThresholdRule::felder},
-                                                                      {"kramer", ThresholdRule::kramer},
-                                                                      {"fixed", ThresholdRule::fixed},
-                                                                      {"hysteresis", ThresholdRule::hysteresis}}};
-constexpr std::array<std::pair<const char*, ProbeType>, 2> kProbes{{{"conductivity", ProbeType::conductivity},
-                                                                    {"optical", ProbeType::optical}}};
-constexpr std::array<std::pair<const char*, Weighting>, 2> kWeightings{{{"duration", Weighting::duration},
-                                                                        {"none", Weighting::none}}};
-constexpr std::array<std::pair<const char*, CorrelationSignal>, 2> kSignals{
-    {{"binary", CorrelationSignal::binary}, {"raw", CorrelationSignal::raw}}};
-constexpr std::array<std::pair<const char*, Subsample>, 2> kSubsamples{{{"none", Subsample::none},
-                                                                        {"parabolic", Subsample::parabolic}}};
 constexpr std::array<std::pair<const char*, CorrelationPath>, 3> kPaths{{{"auto", CorrelationPath::automatic},
                                                                         {"intervals", CorrelationPath::intervals},
                                                                         {"fft", CorrelationPath::fft}}};
@@ -112,10 +120,10 @@ const OptionField<R> kReader[] = {
      [](const R& o) { return o.fs > 0.0 ? format_quantity(o.fs, Dimension::frequency) : std::string("from the file"); }},
     {"override-fs", "", "let the stated sampling rate replace a different one recorded in the file",
      [](R& o, std::string_view t) { o.override_fs = on_off(t); },
-     [](const R& o) { return std::string(o.override_fs ? "on" : "off"); }, true},
+     [](const R& o) { return std::string(switch_text(o.override_fs)); }, true},
     {"allow-truncated", "", "process what a WAV, W64 or RF64 file holds when its data is shorter than its header says",
      [](R& o, std::string_view t) { o.allow_truncated = on_off(t); },
-     [](const R& o) { return std::string(o.allow_truncated ? "on" : "off"); }, true},
+     [](const R& o) { return std::string(switch_text(o.allow_truncated)); }, true},
     {"raw-type", "", "raw files: sample type int16 | int32 | float32 | float64",
      [](R& o, std::string_view t) { o.raw.sample_type = choice(t, kTypes); },
      [](const R& o) { return name_of(o.raw.sample_type, kTypes); }},
@@ -170,8 +178,8 @@ const OptionField<B> kBinarisation[] = {
     {"threshold-rule", "",
      "histogram | felder (Felder's program) | kramer (Kramer's toolbox, thres.m) | fixed (a voltage) | hysteresis (two "
      "thresholds)",
-     [](B& o, std::string_view t) { o.rule = choice(t, kRules); },
-     [](const B& o) { return name_of(o.rule, kRules); }},
+     [](B& o, std::string_view t) { o.rule = choice(t, values::threshold_rule); },
+     [](const B& o) { return name_of(o.rule); }},
     {"threshold", "",
      "histogram/felder: fraction from air to water mode; fixed: a voltage (e.g. 2.5V); hysteresis: two fractions "
      "'low,high'",
@@ -204,8 +212,8 @@ const OptionField<B> kBinarisation[] = {
                                          : std::string("the leading tip's");
      }},
     {"probe", "", "conductivity (air is the low level) | optical (air is the high level)",
-     [](B& o, std::string_view t) { o.probe = choice(t, kProbes); },
-     [](const B& o) { return name_of(o.probe, kProbes); }},
+     [](B& o, std::string_view t) { o.probe = choice(t, values::probe); },
+     [](const B& o) { return name_of(o.probe); }},
     {"bin-width", "V", "voltage histogram bin width; 0 = 100 bins over the observed range",
      [](B& o, std::string_view t) { o.bin_width = quantity(t, Dimension::voltage); },
      [](const B& o) { return format_quantity(o.bin_width, Dimension::voltage); }},
@@ -221,12 +229,12 @@ const OptionField<F> kFscc[] = {
      [](const F& o) { return format_quantity(o.max_lag, Dimension::time); }},
     {"felder-lags", "", "Felder's program: auto lags 0..999, cross lags -199..800 samples, first peak within 1e-5",
      [](F& o, std::string_view t) { o.felder_lags = on_off(t); },
-     [](const F& o) { return std::string(o.felder_lags ? "on" : "off"); }, true},
+     [](const F& o) { return std::string(switch_text(o.felder_lags)); }, true},
     {"felder-scales", "",
      "Felder's program's time-scale rules: float32 lag times, first minimum within 1e-5, Txx and Txy one lag past "
      "the zero or to the minimum",
      [](F& o, std::string_view t) { o.felder_scales = on_off(t); },
-     [](const F& o) { return std::string(o.felder_scales ? "on" : "off"); }, true},
+     [](const F& o) { return std::string(switch_text(o.felder_scales)); }, true},
 };
 
 std::vector<double> quantity_list(std::string_view text, Dimension d, const char* example) {
@@ -246,12 +254,12 @@ using S = StructureOptions;
 const OptionField<S> kStructure[] = {
     {"structure", "", "chord and voltage PDFs, clusters and inter-particle arrivals: on | off",
      [](S& o, std::string_view t) { o.enabled = on_off(t); },
-     [](const S& o) { return std::string(o.enabled ? "on" : "off"); }},
+     [](const S& o) { return std::string(switch_text(o.enabled)); }},
     {"felder-defects", "",
      "Felder's program's chord, cluster and arrival conventions and defects (to reproduce his printed numbers; "
      "docs/output.md lists them)",
      [](S& o, std::string_view t) { o.felder_defects = on_off(t); },
-     [](const S& o) { return std::string(o.felder_defects ? "on" : "off"); }, true},
+     [](const S& o) { return std::string(switch_text(o.felder_defects)); }, true},
     {"voltage-pdf-bin", "V", "bin width of the voltage PDF of each tip",
      [](S& o, std::string_view t) { o.voltage_bin = quantity(t, Dimension::voltage); },
      [](const S& o) { return format_quantity(o.voltage_bin, Dimension::voltage); }},
@@ -314,13 +322,13 @@ const OptionField<A> kAwcc[] = {
      },
      [](const A& o) { return fmt::format("{:g}", o.filter_a); }},
     {"roc", "", "AWCC robust outlier cutoff: on | off",
-     [](A& o, std::string_view t) { o.roc = on_off(t); }, [](const A& o) { return std::string(o.roc ? "on" : "off"); }},
+     [](A& o, std::string_view t) { o.roc = on_off(t); }, [](const A& o) { return std::string(switch_text(o.roc)); }},
     {"weighting", "", "AWCC moments: duration (window-duration weights, Buchhave 1979) | none",
-     [](A& o, std::string_view t) { o.weighting = choice(t, kWeightings); },
-     [](const A& o) { return name_of(o.weighting, kWeightings); }},
+     [](A& o, std::string_view t) { o.weighting = choice(t, values::weighting); },
+     [](const A& o) { return name_of(o.weighting); }},
     {"correlate", "", "FSCC and AWCC correlate the binarised signals or the raw voltages (Felder's and Chanson's practice): binary | raw",
-     [](A& o, std::string_view t) { o.signal = choice(t, kSignals); },
-     [](const A& o) { return name_of(o.signal, kSignals); }},
+     [](A& o, std::string_view t) { o.signal = choice(t, values::signal); },
+     [](const A& o) { return name_of(o.signal); }},
     {"velocity-range", "m/s", "AWCC lags searched from a velocity range 'min,max' (e.g. 0.5m/s,20m/s); default all lags",
      [](A& o, std::string_view t) {
        const auto [lo, hi] = pair_of(t, "0.5m/s,20m/s");
@@ -333,8 +341,8 @@ const OptionField<A> kAwcc[] = {
                              : std::string("all lags");
      }},
     {"subsample", "", "peak refinement of FSCC and AWCC: none | parabolic",
-     [](A& o, std::string_view t) { o.subsample = choice(t, kSubsamples); },
-     [](const A& o) { return name_of(o.subsample, kSubsamples); }},
+     [](A& o, std::string_view t) { o.subsample = choice(t, values::subsample); },
+     [](const A& o) { return name_of(o.subsample); }},
     {"windows-reported", "-", "AWCC quality: fewest accepted windows whose velocity and Tu are reported (insufficient below)",
      [](A& o, std::string_view t) { o.windows_reported = static_cast<int>(whole(t, 2, 1000000)); },
      [](const A& o) { return std::to_string(o.windows_reported); }},
@@ -347,7 +355,7 @@ const OptionField<A> kAwcc[] = {
     {"probe-correction", "",
      "bubble-probe interaction correction of every AWCC window (Hohermuth et al. 2021, Kramer's toolbox v1.3)",
      [](A& o, std::string_view t) { o.probe_correction.enabled = on_off(t); },
-     [](const A& o) { return std::string(o.probe_correction.enabled ? "on" : "off"); }, true},
+     [](const A& o) { return std::string(switch_text(o.probe_correction.enabled)); }, true},
     {"needle-diameter", "m", "probe correction: outer electrode (needle) diameter",
      [](A& o, std::string_view t) { o.probe_correction.needle_diameter = quantity(t, Dimension::length); },
      [](const A& o) { return format_quantity(o.probe_correction.needle_diameter, Dimension::length); }},
@@ -407,13 +415,13 @@ const OptionField<P> kProcess[] = {
      [](const P& o) { return std::to_string(o.histogram_bins); }},
     {"velocity-spectrum", "", "spectrum and integral time scale of AWCC's velocity series: on | off",
      [](P& o, std::string_view t) { o.velocity_spectrum = on_off(t); },
-     [](const P& o) { return std::string(o.velocity_spectrum ? "on" : "off"); }},
+     [](const P& o) { return std::string(switch_text(o.velocity_spectrum)); }},
     {"spectrum-segment", "-", "Welch segment length of the velocity spectrum, in resampled points",
      [](P& o, std::string_view t) { o.spectrum.segment_length = static_cast<int>(whole(t, 8, 1 << 24)); },
      [](const P& o) { return std::to_string(o.spectrum.segment_length); }},
     {"allow-unusual", "", "accept dx outside 0.1-100 mm, fs outside 1 kHz-100 MHz, velocities outside 0.01-200 m/s",
      [](P& o, std::string_view t) { o.allow_unusual = on_off(t); },
-     [](const P& o) { return std::string(o.allow_unusual ? "on" : "off"); }, true},
+     [](const P& o) { return std::string(switch_text(o.allow_unusual)); }, true},
 };
 
 }  // namespace

@@ -63,16 +63,11 @@ constexpr AwccStatus kAwccStatuses[] = {AwccStatus::ok,           AwccStatus::to
                                         AwccStatus::delay_below_one_sample, AwccStatus::too_few_windows,
                                         AwccStatus::tips_swapped, AwccStatus::no_tip_separation};
 constexpr AwccQuality kAwccQualities[] = {AwccQuality::ok, AwccQuality::low, AwccQuality::insufficient};
-constexpr Weighting kWeightings[] = {Weighting::duration, Weighting::none};
-constexpr CorrelationSignal kSignals[] = {CorrelationSignal::binary, CorrelationSignal::raw};
-constexpr Subsample kSubsamples[] = {Subsample::none, Subsample::parabolic};
 constexpr WindowFate kWindowFates[] = {WindowFate::accepted, WindowFate::correlation, WindowFate::lag,
                                        WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
                                        WindowFate::correction};
 constexpr VelocitySource kVelocitySources[] = {VelocitySource::none, VelocitySource::awcc, VelocitySource::fscc};
 
-// A switch as profile_csv_row writes it.
-std::string_view switch_text(bool on) { return on ? "on" : "off"; }
 constexpr bool kSwitches[] = {true, false};
 
 template <class E>
@@ -113,11 +108,11 @@ AwccStatus parse_awcc_status(std::string_view text, const WrittenAt& at) {
 AwccQuality parse_awcc_quality(std::string_view text, const WrittenAt& at) {
   return parse_written(text, kAwccQualities, at);
 }
-Weighting parse_weighting(std::string_view text, const WrittenAt& at) { return parse_written(text, kWeightings, at); }
+Weighting parse_weighting(std::string_view text, const WrittenAt& at) { return parse_written(text, values::weighting, at); }
 CorrelationSignal parse_correlation_signal(std::string_view text, const WrittenAt& at) {
-  return parse_written(text, kSignals, at);
+  return parse_written(text, values::signal, at);
 }
-Subsample parse_subsample(std::string_view text, const WrittenAt& at) { return parse_written(text, kSubsamples, at); }
+Subsample parse_subsample(std::string_view text, const WrittenAt& at) { return parse_written(text, values::subsample, at); }
 WindowFate parse_window_fate(std::string_view text, const WrittenAt& at) {
   return parse_written(text, kWindowFates, at);
 }
@@ -131,9 +126,9 @@ std::vector<std::string_view> written_values(std::string_view column) {
   if (column == c::fscc_status) return texts(kFsccStatuses);
   if (column == c::awcc_status) return texts(kAwccStatuses);
   if (column == c::awcc_quality) return texts(kAwccQualities);
-  if (column == c::awcc_weighting) return texts(kWeightings);
-  if (column == c::awcc_signal) return texts(kSignals);
-  if (column == c::awcc_subsample) return texts(kSubsamples);
+  if (column == c::awcc_weighting) return texts(values::weighting);
+  if (column == c::awcc_signal) return texts(values::signal);
+  if (column == c::awcc_subsample) return texts(values::subsample);
   if (column == c::chord_velocity_source) return texts(kVelocitySources);
   if (column == c::awcc_roc || column == c::awcc_probe_corrected) return texts(kSwitches);
   return {};

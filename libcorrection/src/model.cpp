@@ -23,6 +23,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/read_back.hpp"
 
 namespace correction {
 
@@ -233,9 +234,13 @@ std::string how_to_give(const std::string& feature) {
   if (feature == "fs" || feature == "duration") {
     return fmt::format("a column '{}', or pdp correct --{} for a whole file", feature, feature);
   }
-  if (feature == "windows_accepted") return "a column 'awcc_windows_accepted': AWCC's accepted windows of the row";
+  namespace column = awcc::profile_column;
+  if (feature == "windows_accepted") {
+    return fmt::format("a column '{}': AWCC's accepted windows of the row", column::awcc_windows_accepted);
+  }
   if (feature == "data_yield") {
-    return "columns 'awcc_windows_accepted' and 'awcc_windows_total': AWCC's accepted and formed windows of the row";
+    return fmt::format("columns '{}' and '{}': AWCC's accepted and formed windows of the row",
+                       column::awcc_windows_accepted, column::awcc_windows_total);
   }
   return fmt::format("a column '{}'", feature);
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "awcc/csv.hpp"
+#include "awcc/read_back.hpp"
 #include "awcc/settings_file.hpp"
 #include "test_paths.hpp"
 
@@ -269,3 +270,91 @@ TEST(Validation, EachOptionsStructNamesTheOptionBeyondItsLimit) {
 }
 
 }  // namespace
+
+namespace {
+
+// An option's formatted value, found by its declared name.
+template <class T>
+std::string formatted(std::span<const awcc::OptionField<T>> fields, std::string_view name, const T& o) {
+  for (const auto& f : fields) {
+    if (f.name == name) return f.format(o);
+  }
+  ADD_FAILURE() << name << " is not declared";
+  return {};
+}
+
+// Every value of an enum that is both an option and a written result: the
+// option takes the text the files carry, gives it back when formatted, and
+// the read-back parser turns that text into the same value; a text outside
+// the list is refused naming exactly the values written.
+template <class E, std::size_t N, class Get, class Parse>
+void expect_one_text_per_value(std::string_view option, const E (&values)[N], std::string_view column, Get get,
+                               Parse parse) {
+  std::string listed;
+  for (const E v : values) {
+    const std::string text(awcc::to_string(v));
+    const std::vector<OptionSetting> call{{std::string(option), text, ""}};
+    const auto o = awcc::process_options(call);
+    EXPECT_EQ(get(o), v) << option << " = " << text;
+    const auto written = formatted(awcc::awcc_option_fields(), option, o.awcc_options);
+    EXPECT_EQ(written, text) << option;
+    EXPECT_EQ(parse(written, awcc::WrittenAt{"f.json", "/0", option}), v) << option;
+    listed += (listed.empty() ? "" : " | ") + text;
+  }
+  if (!column.empty()) {
+    std::string from_column;
+    for (const auto t : awcc::written_values(column)) from_column += (from_column.empty() ? "" : " | ") + std::string(t);
+    EXPECT_EQ(from_column, listed) << column;
+  }
+  const std::vector<OptionSetting> bad{{std::string(option), "sideways", ""}};
+  EXPECT_EQ(std::string(error_of(bad).what()), std::string(option) + ": 'sideways' is not one of " + listed);
+}
+
+}  // namespace
+
+TEST(ProcessOptions, AnEnumOptionIsSpelledAsTheFilesWriteItAndReadItBack) {
+  namespace column = awcc::profile_column;
+  expect_one_text_per_value("weighting", awcc::values::weighting, column::awcc_weighting,
+                            [](const ProcessOptions& o) { return o.awcc_options.weighting; }, awcc::parse_weighting);
+  expect_one_text_per_value("correlate", awcc::values::signal, column::awcc_signal,
+                            [](const ProcessOptions& o) { return o.awcc_options.signal; },
+                            awcc::parse_correlation_signal);
+  expect_one_text_per_value("subsample", awcc::values::subsample, column::awcc_subsample,
+                            [](const ProcessOptions& o) { return o.awcc_options.subsample; }, awcc::parse_subsample);
+}
+
+TEST(ProcessOptions, AThresholdRuleAndAProbeAreSpelledAsTheJsonWritesThem) {
+  for (const auto rule : awcc::values::threshold_rule) {
+    if (rule == awcc::ThresholdRule::hysteresis) continue;  // its threshold is a pair, checked elsewhere
+    const std::vector<OptionSetting> call{{"threshold-rule", std::string(awcc::to_string(rule)), ""},
+                                          {"threshold", rule == awcc::ThresholdRule::fixed ? "2.5V" : "0.5", ""}};
+    const auto o = awcc::process_options(call);
+    EXPECT_EQ(o.binarisation.rule, rule);
+    EXPECT_EQ(formatted(awcc::binarisation_option_fields(), "threshold-rule", o.binarisation),
+              awcc::to_string(rule));
+  }
+  for (const auto probe : awcc::values::probe) {
+    const std::vector<OptionSetting> call{{"probe", std::string(awcc::to_string(probe)), ""}};
+    const auto o = awcc::process_options(call);
+    EXPECT_EQ(o.binarisation.probe, probe);
+    EXPECT_EQ(formatted(awcc::binarisation_option_fields(), "probe", o.binarisation), awcc::to_string(probe));
+  }
+}
+
+TEST(ProcessOptions, ASwitchIsWrittenOnOrOffAndTakesItsAliases) {
+  for (const bool on : {true, false}) {
+    const std::string written(awcc::switch_text(on));
+    const auto aliases = on ? std::vector<std::string>{written, "true", "yes", "1"}
+                            : std::vector<std::string>{written, "false", "no", "0"};
+    for (const auto& text : aliases) {
+      const std::vector<OptionSetting> call{{"roc", text, ""}};
+      const auto o = awcc::process_options(call);
+      EXPECT_EQ(o.awcc_options.roc, on) << text;
+      // Formatted as the profile CSV writes it, whatever alias was given.
+      EXPECT_EQ(formatted(awcc::awcc_option_fields(), "roc", o.awcc_options), written) << text;
+      EXPECT_EQ(awcc::parse_switch(written, awcc::WrittenAt{"f.csv", "line 2", "awcc_roc"}), on);
+    }
+  }
+  const std::vector<OptionSetting> bad{{"roc", "maybe", ""}};
+  EXPECT_EQ(std::string(error_of(bad).what()), "roc: 'maybe' is not on or off");
+}

@@ -11,11 +11,29 @@
 #include <vector>
 
 #include "awcc/awcc.hpp"
+#include "awcc/binarisation.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/process.hpp"
 
 namespace awcc {
+
+/// The values of the enums that are both options and written results, in the
+/// order pdp lists them. Each value's text is its to_string: the option
+/// parser and formatter (options.cpp), the writer and the parsers below all
+/// spell a value by it, so a renamed value is read as it is written.
+namespace values {
+inline constexpr Weighting weighting[] = {Weighting::duration, Weighting::none};
+inline constexpr CorrelationSignal signal[] = {CorrelationSignal::binary, CorrelationSignal::raw};
+inline constexpr Subsample subsample[] = {Subsample::none, Subsample::parabolic};
+inline constexpr ThresholdRule threshold_rule[] = {ThresholdRule::histogram, ThresholdRule::felder,
+                                                   ThresholdRule::kramer, ThresholdRule::fixed,
+                                                   ThresholdRule::hysteresis};
+inline constexpr ProbeType probe[] = {ProbeType::conductivity, ProbeType::optical};
+}  // namespace values
+
+/// A switch as pdp writes it (a profile CSV's "on"/"off", an option's value).
+constexpr std::string_view switch_text(bool on) { return on ? "on" : "off"; }
 
 /// Where a text was read: the file, the row (a JSON pointer such as
 /// "/profile/3/awcc", or "line 7" of a CSV) and the key or column.
