@@ -229,10 +229,10 @@ Correction not_corrected(CorrectionStatus status, std::string message) {
 namespace {
 
 // Where a row's missing record feature comes from: the columns pdp process
-// writes (read from any CSV), or pdp correct's options for a whole file.
+// writes (read from any CSV), or the setting stated for a whole file (pdp correct --fs, --duration).
 std::string how_to_give(const std::string& feature) {
   if (feature == "fs" || feature == "duration") {
-    return fmt::format("a column '{}', or pdp correct --{} for a whole file", feature, feature);
+    return fmt::format("a column '{}', or the {} stated for the whole file", feature, feature);
   }
   namespace column = awcc::profile_column;
   if (feature == "windows_accepted") {
