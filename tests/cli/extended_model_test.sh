@@ -73,7 +73,7 @@ PY
 [[ $(column "$dir/nofs-corrected.csv" correction_status) != corrected ]] ||
   fail "no fs: corrected all the same"
 grep -q "fs" <<<"$(column "$dir/nofs-corrected.csv" correction_reason)" || fail "no fs: the reason does not name fs"
-grep -q -- "--fs" <<<"$(column "$dir/nofs-corrected.csv" correction_reason)" || fail "no fs: the reason does not say how to give it"
+grep -q -- "the fs stated for the whole file" <<<"$(column "$dir/nofs-corrected.csv" correction_reason)" || fail "no fs: the reason does not say how to give it"
 # Stated for the whole file, the record's fs gives back the same correction.
 "$pdp" --log-level error correct "$dir/nofs.csv" -m "$dir/x.qrf" --fs 60kHz -o "$dir/fs-given.csv" || fail "correct --fs"
 [[ $(column "$dir/fs-given.csv" corrected_velocity_q0.9) == $(column "$dir/r.csv" corrected_velocity_q0.9) ]] ||
