@@ -226,7 +226,7 @@ class CsvRecording final : public Recording {
     }
     time_column_ = options.csv.time_column;
     if (time_column_ >= columns_) {
-      reader_fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_), "time_column");
+      reader_fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_), "time-column");
     }
     if (time_column_ == -2) {
       time_column_ = -1;
@@ -269,7 +269,7 @@ class CsvRecording final : public Recording {
                                 "correct the file, or force the rate",
                                 format_quantity(1.0 / *lvm_delta, Dimension::frequency), timed_where,
                                 format_quantity(timed->fs, Dimension::frequency)),
-                    "override_fs");
+                    "override-fs");
       }
       info_.fs = stated_rate(path, options, 1.0 / *lvm_delta, "its Delta_X");
     } else if (timed) {
@@ -360,7 +360,7 @@ class CsvRecording final : public Recording {
       try {
         return parse_quantity("1" + name.substr(a + 1, b - a - 1), Dimension::time);
       } catch (const std::invalid_argument&) {
-        reader_fail(info_.path, fmt::format("the time column '{}' has a unit that is not a time", name), "time_column");
+        reader_fail(info_.path, fmt::format("the time column '{}' has a unit that is not a time", name), "time-column");
       }
     }
     return 1.0;
@@ -406,7 +406,7 @@ class CsvRecording final : public Recording {
     base.name = fmt::format("the time column '{}'", name);
     base.where = [this](std::uint64_t index) { return fmt::format("line {}", line_of_row(index)); };
     base.fix = "name the right time column, or state the sampling rate and force it";
-    base.quantity = "time_column";
+    base.quantity = "time-column";
     base.scan = [&](const TimeBase::Sink& sink) {
       std::ifstream in(info_.path, std::ios::binary);
       in.seekg(data_start_);
