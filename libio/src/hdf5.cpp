@@ -56,6 +56,7 @@ namespace awcc::detail {
 namespace {
 
 namespace fs = std::filesystem;
+using pdpsim::hdf5_says;
 
 // A probe has a handful of tips; a wider dataset is a table stored the other
 // way round (or damage), and a frame of it would not fit a block.
@@ -109,26 +110,6 @@ class Handle {
  private:
   hid_t id_ = H5I_INVALID_HID;
 };
-
-// HDF5's innermost complaint about the last failed call (the stack is
-// cleared), as " (HDF5: ...)", or empty.
-std::string hdf5_says() {
-  std::string what;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* e, void* data) -> herr_t {
-        if (n == 0 && e && e->desc) *static_cast<std::string*>(data) = e->desc;
-        return 0;
-      },
-      &what);
-  H5Eclear2(H5E_DEFAULT);
-  // A damaged file's bytes may be quoted (a garbled name): keep the message printable.
-  for (auto& c : what) {
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-  }
-  if (what.size() > 200) what = what.substr(0, 200) + "...";
-  return what.empty() ? std::string() : fmt::format(" (HDF5: {})", what);
-}
 
 enum class Kind { i8, u8, i16, u16, i32, u32, f32, f64 };
 

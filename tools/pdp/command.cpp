@@ -128,6 +128,11 @@ std::string flags_for(std::string_view quantity) {
   return out;
 }
 
+std::string one_line(std::string text) {
+  for (auto at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) text.replace(at, 1, "; ");
+  return text;
+}
+
 int report_error(const std::exception& error) {
   if (const auto* e = dynamic_cast<const awcc::OptionError*>(&error)) {
     spdlog::error("{}", with_flag(e->what(), e->quantity()));
