@@ -12,7 +12,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     synth::Scene s;
     synth::load_scene_toml(path, s);
-    if (s.validate().empty() && s.sample_count() < 200000 && s.duration / s.effective_realisation_step() < 200000 &&
+    if (s.validate().ok() && s.sample_count() < 200000 && s.duration / s.effective_realisation_step() < 200000 &&
         s.duration * s.void_fraction * s.velocity / s.bubble_diameter < 20000) {
       const auto out = synth::synthesise(s);
       for (const auto& sig : out.signals) {

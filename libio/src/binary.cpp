@@ -200,7 +200,7 @@ std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& o
   if (data % frame != 0) {
     reader_fail(path, fmt::format("raw layout: {} data bytes are not a whole number of {}-byte frames ({} channels of {}); "
                            "check the raw layout (channels, sample type, header bytes)",
-                           data, frame, layout.channels, to_string(layout.sample_type)), "raw_layout");
+                           data, frame, layout.channels, to_string(layout.sample_type)), "raw-channels,raw-type,raw-header");
   }
   if (data == 0) reader_fail(path, "the raw file holds no samples");
   RecordingInfo info;

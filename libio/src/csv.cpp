@@ -108,186 +108,28 @@ class CsvRecording final : public Recording {
   CsvRecording(const fs::path& path, const ReaderOptions& options) : in_(path, std::ios::binary) {
     if (!in_) reader_fail(path, "cannot open for reading");
     info_.path = path;
-    std::string line;
     std::int64_t number = 0;
-    // LabVIEW .lvm: header blocks up to the last ***End_of_Header*** before the data.
-    std::optional<double> lvm_delta;
-    char lvm_separator = 0, lvm_decimal = 0;
-    bool lvm = false;
-    int markers = 0;
-    std::streampos body = 0;
-    std::int64_t body_line = 0;
-    {
-      std::streampos at = in_.tellg();
-      if (bounded_getline(in_, line, path, 1) && trim(line).starts_with("LabVIEW Measurement")) lvm = true;
-      in_.clear();
-      in_.seekg(at);
-      if (lvm) {
-        while (bounded_getline(in_, line, path, ++number)) {
-          const auto cells = split(line, '\t');
-          const auto key = cells.empty() ? std::string_view{} : trim(cells[0]);
-          const auto value = cells.size() > 1 ? trim(cells[1]) : std::string_view{};
-          if (key == "Separator") lvm_separator = value == "Comma" ? ',' : (value == "Tab" ? '\t' : 0);
-          if (key == "Decimal_Separator" && !value.empty()) lvm_decimal = value[0];
-          if (key == "Delta_X") {
-            double d;
-            std::string v(value);
-            std::replace(v.begin(), v.end(), ',', '.');
-            if (parse_number(v, d) && d > 0.0) lvm_delta = d;
-          }
-          if (trim(line).starts_with("***End_of_Header***")) {
-            body = in_.tellg();
-            body_line = number;
-            // The file header, then the first segment's: its data follow.
-            // Later segments (their headers inside the data) are refused
-            // by read() as rows that are not numbers.
-            if (++markers == 2) break;
-          }
-        }
-        if (body_line == 0) reader_fail(path, "a LabVIEW measurement file without ***End_of_Header***: not a recording", "not_a_recording");
-        in_.clear();
-        in_.seekg(body);
-        number = body_line;
-      }
-    }
-    // The first rows: separator, decimal mark, header, columns.
-    std::vector<std::string> rows;
-    std::vector<std::int64_t> row_lines;
-    std::vector<std::streampos> row_starts;
-    while (rows.size() < 50) {
-      const std::streampos at = in_.tellg();
-      if (!bounded_getline(in_, line, path, ++number)) break;
-      if (trim(line).empty()) continue;
-      rows.push_back(line);
-      row_lines.push_back(number);
-      row_starts.push_back(at);
-    }
-    if (rows.empty()) reader_fail(path, "the file holds no rows", "not_a_recording");
-    auto in_every = [&](char c) {
-      return std::all_of(rows.begin(), rows.end(), [c](const std::string& r) { return r.find(c) != std::string::npos; });
-    };
-    delimiter_ = options.csv.delimiter ? options.csv.delimiter : lvm_separator;
-    if (!delimiter_) {
-      if (in_every('\t')) delimiter_ = '\t';
-      else if (in_every(';')) delimiter_ = ';';
-      else if (in_every(',')) delimiter_ = ',';
-      else delimiter_ = ' ';
-    }
-    decimal_ = lvm_decimal ? lvm_decimal : '.';
-    if (!lvm_decimal && delimiter_ != ',') {
-      // A decimal comma: digits on both sides of a comma in a cell, and no decimal point.
-      bool comma = false, point = false;
-      for (std::size_t r = rows.size() > 1 ? 1 : 0; r < rows.size(); ++r) {
-        for (auto cell : split(rows[r], delimiter_)) {
-          cell = trim(cell);
-          for (std::size_t k = 1; k + 1 < cell.size(); ++k) {
-            const bool digits = std::isdigit(static_cast<unsigned char>(cell[k - 1])) &&
-                                std::isdigit(static_cast<unsigned char>(cell[k + 1]));
-            if (cell[k] == ',' && digits) comma = true;
-            if (cell[k] == '.' && digits) point = true;
-          }
-        }
-      }
-      if (comma && !point) decimal_ = ',';
-    }
-    const auto first = split(rows[0], delimiter_);
-    bool all_numbers = true;
-    double v;
-    for (auto c : first) all_numbers = all_numbers && (trim(c).empty() || number_of(c, v));
-    const bool header = options.csv.header.value_or(!all_numbers);
-    columns_ = static_cast<int>(first.size());
-    const std::size_t first_data = header ? 1 : 0;
-    if (first_data >= rows.size()) reader_fail(path, "the file holds a header row and no data: not a recording", "not_a_recording");
-    {
-      const auto cells = split(rows[first_data], delimiter_);
-      std::size_t numeric = 0;
-      for (auto c : cells) numeric += number_of(c, v) ? 1 : 0;
-      if (numeric == 0) {
-        reader_fail(path, fmt::format("line {} holds no number: not a column file of samples", row_lines[first_data]),
-             "not_a_recording");
-      }
-    }
-    std::vector<std::string> names(static_cast<std::size_t>(columns_));
-    for (int c = 0; c < columns_; ++c) {
-      names[static_cast<std::size_t>(c)] =
-          header ? std::string(trim(first[static_cast<std::size_t>(c)])) : fmt::format("column {}", c);
-    }
-    // Columns that hold no samples: LabVIEW's Comment, or one left empty in every row (a trailing separator).
-    std::vector<bool> skip(static_cast<std::size_t>(columns_), false);
-    for (int c = 0; c < columns_; ++c) {
-      std::string lower = names[static_cast<std::size_t>(c)];
-      std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-      bool empty = true;
-      for (std::size_t r = first_data; r < rows.size(); ++r) {
-        const auto cells = split(rows[r], delimiter_);
-        if (static_cast<int>(cells.size()) > c && !trim(cells[static_cast<std::size_t>(c)]).empty()) empty = false;
-      }
-      skip[static_cast<std::size_t>(c)] = lower == "comment" || empty;
-    }
-    time_column_ = options.csv.time_column;
-    if (time_column_ >= columns_) {
-      reader_fail(path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_), "time_column");
-    }
-    if (time_column_ == -2) {
-      time_column_ = -1;
-      for (int c = 0; header && c < columns_ && time_column_ < 0; ++c) {
-        if (!skip[static_cast<std::size_t>(c)] && is_time_name(names[static_cast<std::size_t>(c)])) time_column_ = c;
-      }
-      const int usable = static_cast<int>(std::count(skip.begin(), skip.end(), false));
-      for (int c = 0; usable >= 3 && c < columns_ && time_column_ < 0; ++c) {
-        if (!skip[static_cast<std::size_t>(c)] && evenly_increasing(rows, first_data, c)) time_column_ = c;
-      }
-    }
-    for (int c = 0; c < columns_; ++c) {
-      if (c == time_column_ || skip[static_cast<std::size_t>(c)]) continue;
-      // LabVIEW's one X column per channel: the other time columns are not data.
-      if (time_column_ >= 0 && header && is_time_name(names[static_cast<std::size_t>(c)])) continue;
-      data_columns_.push_back(c);
-      info_.channel_names.push_back(names[static_cast<std::size_t>(c)]);
-    }
-    info_.channels = static_cast<int>(data_columns_.size());
-    read_cells_ = std::max(time_column_, data_columns_.empty() ? -1 : data_columns_.back()) + 1;
-    if (info_.channels <= 0) reader_fail(path, "the file has no data column besides its time column", "not_a_recording");
-    data_start_ = row_starts[first_data];
-    first_line_ = row_lines[first_data] - 1;
+    const auto lvm = read_lvm_header(number);
+    const auto sample = first_rows(number);
+    choose_separators(sample, options, lvm);
+    const auto table = choose_columns(sample, options);
+    choose_time_column(sample, table, options);
+    data_start_ = sample.starts[table.first_data];
+    first_line_ = sample.lines[table.first_data] - 1;
     in_.clear();
     in_.seekg(data_start_);
     line_ = first_line_;
-    // Forced, the stated rate sets the time column aside (time_base.hpp).
-    const bool forced = options.override_fs && options.fs > 0.0;
-    std::optional<TimeBaseRate> timed;
-    std::string timed_where;
-    if (time_column_ >= 0 && !forced) {
-      const std::string& name = names[static_cast<std::size_t>(time_column_)];
-      timed_where = fmt::format("its time column '{}'", name);
-      timed = time_column_rate(name, time_unit(header ? name : std::string()));
-    }
-    if (lvm_delta) {
-      if (timed && !agrees(*timed, 1.0 / *lvm_delta)) {
-        reader_fail(path,
-                    fmt::format("its Delta_X gives a sampling rate of {} but {} steps at {}: one of them is wrong; "
-                                "correct the file, or force the rate",
-                                format_quantity(1.0 / *lvm_delta, Dimension::frequency), timed_where,
-                                format_quantity(timed->fs, Dimension::frequency)),
-                    "override_fs");
-      }
-      info_.fs = stated_rate(path, options, 1.0 / *lvm_delta, "its Delta_X");
-    } else if (timed) {
-      info_.fs = stated_rate(path, options, timed->fs, timed_where, timed->tolerance);
-    } else if (options.fs > 0.0) {
-      info_.fs = options.fs;
-    } else {
-      reader_fail(path, "the file has no time column; state the sampling rate, or name the time column", "fs");
-    }
+    info_.fs = sampling_rate(table, options, lvm.delta);
     info_.volts_known = true;
     info_.quantum = 0.0;
     std::string tips;
     for (const auto& n : info_.channel_names) tips += (tips.empty() ? "'" : ", '") + n + "'";
     info_.description = fmt::format(
-        "{} ({} columns, {} separated, decimal {}{}{}; channels {})", lvm ? "LabVIEW text" : "CSV", columns_,
+        "{} ({} columns, {} separated, decimal {}{}{}; channels {})", lvm.lvm ? "LabVIEW text" : "CSV", columns_,
         delimiter_ == '\t' ? "tab" : (delimiter_ == ' ' ? "blank" : fmt::format("'{}'", delimiter_)),
-        decimal_ == ',' ? "comma" : "point", header ? ", header row" : "",
-        time_column_ >= 0 ? fmt::format(", time in '{}'", names[static_cast<std::size_t>(time_column_)]) : "", tips);
+        decimal_ == ',' ? "comma" : "point", table.header ? ", header row" : "",
+        time_column_ >= 0 ? fmt::format(", time in '{}'", table.names[static_cast<std::size_t>(time_column_)]) : "",
+        tips);
     rewind();
   }
 
@@ -331,6 +173,218 @@ class CsvRecording final : public Recording {
   }
 
  private:
+  // What a LabVIEW .lvm header states; lvm false for other files.
+  struct LvmHeader {
+    bool lvm = false;
+    std::optional<double> delta;  // Delta_X, the sample interval
+    char separator = 0, decimal = 0;
+  };
+
+  // LabVIEW .lvm: header blocks up to the last ***End_of_Header*** before the
+  // data, leaving the stream at the data and `number` at the last header line.
+  LvmHeader read_lvm_header(std::int64_t& number) {
+    const fs::path& path = info_.path;
+    LvmHeader h;
+    std::string line;
+    int markers = 0;
+    std::streampos body = 0;
+    std::int64_t body_line = 0;
+    std::streampos at = in_.tellg();
+    if (bounded_getline(in_, line, path, 1) && trim(line).starts_with("LabVIEW Measurement")) h.lvm = true;
+    in_.clear();
+    in_.seekg(at);
+    if (!h.lvm) return h;
+    while (bounded_getline(in_, line, path, ++number)) {
+      const auto cells = split(line, '\t');
+      const auto key = cells.empty() ? std::string_view{} : trim(cells[0]);
+      const auto value = cells.size() > 1 ? trim(cells[1]) : std::string_view{};
+      if (key == "Separator") h.separator = value == "Comma" ? ',' : (value == "Tab" ? '\t' : 0);
+      if (key == "Decimal_Separator" && !value.empty()) h.decimal = value[0];
+      if (key == "Delta_X") {
+        double d;
+        std::string v(value);
+        std::replace(v.begin(), v.end(), ',', '.');
+        if (parse_number(v, d) && d > 0.0) h.delta = d;
+      }
+      if (trim(line).starts_with("***End_of_Header***")) {
+        body = in_.tellg();
+        body_line = number;
+        // The file header, then the first segment's: its data follow.
+        // Later segments (their headers inside the data) are refused
+        // by read() as rows that are not numbers.
+        if (++markers == 2) break;
+      }
+    }
+    if (body_line == 0) reader_fail(path, "a LabVIEW measurement file without ***End_of_Header***: not a recording", "not_a_recording");
+    in_.clear();
+    in_.seekg(body);
+    number = body_line;
+    return h;
+  }
+
+  // The first non-blank rows, their line numbers and where they start: what
+  // separator, decimal mark, header and columns are judged from.
+  struct Sample {
+    std::vector<std::string> rows;
+    std::vector<std::int64_t> lines;
+    std::vector<std::streampos> starts;
+  };
+
+  Sample first_rows(std::int64_t number) {
+    Sample sample;
+    std::string line;
+    while (sample.rows.size() < 50) {
+      const std::streampos at = in_.tellg();
+      if (!bounded_getline(in_, line, info_.path, ++number)) break;
+      if (trim(line).empty()) continue;
+      sample.rows.push_back(line);
+      sample.lines.push_back(number);
+      sample.starts.push_back(at);
+    }
+    if (sample.rows.empty()) reader_fail(info_.path, "the file holds no rows", "not_a_recording");
+    return sample;
+  }
+
+  void choose_separators(const Sample& sample, const ReaderOptions& options, const LvmHeader& lvm) {
+    const auto& rows = sample.rows;
+    auto in_every = [&](char c) {
+      return std::all_of(rows.begin(), rows.end(), [c](const std::string& r) { return r.find(c) != std::string::npos; });
+    };
+    delimiter_ = options.csv.delimiter ? options.csv.delimiter : lvm.separator;
+    if (!delimiter_) {
+      if (in_every('\t')) delimiter_ = '\t';
+      else if (in_every(';')) delimiter_ = ';';
+      else if (in_every(',')) delimiter_ = ',';
+      else delimiter_ = ' ';
+    }
+    decimal_ = lvm.decimal ? lvm.decimal : '.';
+    if (!lvm.decimal && delimiter_ != ',') {
+      // A decimal comma: digits on both sides of a comma in a cell, and no decimal point.
+      bool comma = false, point = false;
+      for (std::size_t r = rows.size() > 1 ? 1 : 0; r < rows.size(); ++r) {
+        for (auto cell : split(rows[r], delimiter_)) {
+          cell = trim(cell);
+          for (std::size_t k = 1; k + 1 < cell.size(); ++k) {
+            const bool digits = std::isdigit(static_cast<unsigned char>(cell[k - 1])) &&
+                                std::isdigit(static_cast<unsigned char>(cell[k + 1]));
+            if (cell[k] == ',' && digits) comma = true;
+            if (cell[k] == '.' && digits) point = true;
+          }
+        }
+      }
+      if (comma && !point) decimal_ = ',';
+    }
+  }
+
+  // The table's shape: a header row or none, the column names and the
+  // columns that hold no samples.
+  struct Table {
+    bool header = false;
+    std::size_t first_data = 0;
+    std::vector<std::string> names;
+    std::vector<bool> skip;
+  };
+
+  Table choose_columns(const Sample& sample, const ReaderOptions& options) {
+    const fs::path& path = info_.path;
+    const auto& rows = sample.rows;
+    Table t;
+    const auto first = split(rows[0], delimiter_);
+    bool all_numbers = true;
+    double v;
+    for (auto c : first) all_numbers = all_numbers && (trim(c).empty() || number_of(c, v));
+    t.header = options.csv.header.value_or(!all_numbers);
+    columns_ = static_cast<int>(first.size());
+    t.first_data = t.header ? 1 : 0;
+    if (t.first_data >= rows.size()) reader_fail(path, "the file holds a header row and no data: not a recording", "not_a_recording");
+    {
+      const auto cells = split(rows[t.first_data], delimiter_);
+      std::size_t numeric = 0;
+      for (auto c : cells) numeric += number_of(c, v) ? 1 : 0;
+      if (numeric == 0) {
+        reader_fail(path, fmt::format("line {} holds no number: not a column file of samples", sample.lines[t.first_data]),
+             "not_a_recording");
+      }
+    }
+    t.names.resize(static_cast<std::size_t>(columns_));
+    for (int c = 0; c < columns_; ++c) {
+      t.names[static_cast<std::size_t>(c)] =
+          t.header ? std::string(trim(first[static_cast<std::size_t>(c)])) : fmt::format("column {}", c);
+    }
+    // Columns that hold no samples: LabVIEW's Comment, or one left empty in every row (a trailing separator).
+    t.skip.assign(static_cast<std::size_t>(columns_), false);
+    for (int c = 0; c < columns_; ++c) {
+      std::string lower = t.names[static_cast<std::size_t>(c)];
+      std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+      bool empty = true;
+      for (std::size_t r = t.first_data; r < rows.size(); ++r) {
+        const auto cells = split(rows[r], delimiter_);
+        if (static_cast<int>(cells.size()) > c && !trim(cells[static_cast<std::size_t>(c)]).empty()) empty = false;
+      }
+      t.skip[static_cast<std::size_t>(c)] = lower == "comment" || empty;
+    }
+    return t;
+  }
+
+  // The time column (stated, by name or by its values) and the data columns.
+  void choose_time_column(const Sample& sample, const Table& t, const ReaderOptions& options) {
+    const auto& names = t.names;
+    const auto& skip = t.skip;
+    time_column_ = options.csv.time_column;
+    if (time_column_ >= columns_) {
+      reader_fail(info_.path, fmt::format("time column {} does not exist: the file has {} columns", time_column_, columns_), "time-column");
+    }
+    if (time_column_ == -2) {
+      time_column_ = -1;
+      for (int c = 0; t.header && c < columns_ && time_column_ < 0; ++c) {
+        if (!skip[static_cast<std::size_t>(c)] && is_time_name(names[static_cast<std::size_t>(c)])) time_column_ = c;
+      }
+      const int usable = static_cast<int>(std::count(skip.begin(), skip.end(), false));
+      for (int c = 0; usable >= 3 && c < columns_ && time_column_ < 0; ++c) {
+        if (!skip[static_cast<std::size_t>(c)] && evenly_increasing(sample.rows, t.first_data, c)) time_column_ = c;
+      }
+    }
+    for (int c = 0; c < columns_; ++c) {
+      if (c == time_column_ || skip[static_cast<std::size_t>(c)]) continue;
+      // LabVIEW's one X column per channel: the other time columns are not data.
+      if (time_column_ >= 0 && t.header && is_time_name(names[static_cast<std::size_t>(c)])) continue;
+      data_columns_.push_back(c);
+      info_.channel_names.push_back(names[static_cast<std::size_t>(c)]);
+    }
+    info_.channels = static_cast<int>(data_columns_.size());
+    read_cells_ = std::max(time_column_, data_columns_.empty() ? -1 : data_columns_.back()) + 1;
+    if (info_.channels <= 0) reader_fail(info_.path, "the file has no data column besides its time column", "not_a_recording");
+  }
+
+  // The sampling rate from Delta_X, the time column or the stated rate
+  // (the data must already be located: the time column is read from there).
+  double sampling_rate(const Table& t, const ReaderOptions& options, std::optional<double> lvm_delta) const {
+    const fs::path& path = info_.path;
+    // Forced, the stated rate sets the time column aside (time_base.hpp).
+    const bool forced = options.override_fs && options.fs > 0.0;
+    std::optional<TimeBaseRate> timed;
+    std::string timed_where;
+    if (time_column_ >= 0 && !forced) {
+      const std::string& name = t.names[static_cast<std::size_t>(time_column_)];
+      timed_where = fmt::format("its time column '{}'", name);
+      timed = time_column_rate(name, time_unit(t.header ? name : std::string()));
+    }
+    if (lvm_delta) {
+      if (timed && !agrees(*timed, 1.0 / *lvm_delta)) {
+        reader_fail(path,
+                    fmt::format("its Delta_X gives a sampling rate of {} but {} steps at {}: one of them is wrong; "
+                                "correct the file, or force the rate",
+                                format_quantity(1.0 / *lvm_delta, Dimension::frequency), timed_where,
+                                format_quantity(timed->fs, Dimension::frequency)),
+                    "override-fs");
+      }
+      return stated_rate(path, options, 1.0 / *lvm_delta, "its Delta_X");
+    }
+    if (timed) return stated_rate(path, options, timed->fs, timed_where, timed->tolerance);
+    if (options.fs > 0.0) return options.fs;
+    reader_fail(path, "the file has no time column; state the sampling rate, or name the time column", "fs");
+  }
+
   // A row of the table: every column read is there. The columns after them
   // hold no samples (LabVIEW's Comment, a trailing separator): LabVIEW writes
   // rows with and without the empty Comment cell, so they may be left out, or
@@ -360,7 +414,7 @@ class CsvRecording final : public Recording {
       try {
         return parse_quantity("1" + name.substr(a + 1, b - a - 1), Dimension::time);
       } catch (const std::invalid_argument&) {
-        reader_fail(info_.path, fmt::format("the time column '{}' has a unit that is not a time", name), "time_column");
+        reader_fail(info_.path, fmt::format("the time column '{}' has a unit that is not a time", name), "time-column");
       }
     }
     return 1.0;
@@ -406,7 +460,7 @@ class CsvRecording final : public Recording {
     base.name = fmt::format("the time column '{}'", name);
     base.where = [this](std::uint64_t index) { return fmt::format("line {}", line_of_row(index)); };
     base.fix = "name the right time column, or state the sampling rate and force it";
-    base.quantity = "time_column";
+    base.quantity = "time-column";
     base.scan = [&](const TimeBase::Sink& sink) {
       std::ifstream in(info_.path, std::ios::binary);
       in.seekg(data_start_);

@@ -56,6 +56,7 @@ namespace awcc::detail {
 namespace {
 
 namespace fs = std::filesystem;
+using pdpsim::hdf5_says;
 
 // A probe has a handful of tips; a wider dataset is a table stored the other
 // way round (or damage), and a frame of it would not fit a block.
@@ -109,26 +110,6 @@ class Handle {
  private:
   hid_t id_ = H5I_INVALID_HID;
 };
-
-// HDF5's innermost complaint about the last failed call (the stack is
-// cleared), as " (HDF5: ...)", or empty.
-std::string hdf5_says() {
-  std::string what;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* e, void* data) -> herr_t {
-        if (n == 0 && e && e->desc) *static_cast<std::string*>(data) = e->desc;
-        return 0;
-      },
-      &what);
-  H5Eclear2(H5E_DEFAULT);
-  // A damaged file's bytes may be quoted (a garbled name): keep the message printable.
-  for (auto& c : what) {
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-  }
-  if (what.size() > 200) what = what.substr(0, 200) + "...";
-  return what.empty() ? std::string() : fmt::format(" (HDF5: {})", what);
-}
 
 enum class Kind { i8, u8, i16, u16, i32, u32, f32, f64 };
 
@@ -425,7 +406,7 @@ class Hdf5Recording final : public Recording {
       fail(fmt::format("dataset '{}' holds a single value or none, not samples; name the dataset that holds the "
                        "samples",
                        s.name),
-           "datasets");
+           "dataset");
     }
     s.dims = dimensions(s.space.get(), s.name);
     std::optional<Kind> kind;
@@ -434,7 +415,7 @@ class Hdf5Recording final : public Recording {
                        "samples are read; store the samples as one of them (numpy: .astype('int16') or 'float64'), "
                        "or name another dataset",
                        s.name, unread),
-           "datasets");
+           "dataset");
     }
     s.kind = *kind;
     if (s.dims.size() == 1) {
@@ -445,7 +426,7 @@ class Hdf5Recording final : public Recording {
         fail(fmt::format("dataset '{}' is {}: more columns than rows, but too many rows (more than {}) to be "
                          "channels; store it samples x channels, or name the dataset(s) holding the channels",
                          s.name, shape_text(s.dims), kMaxStackedChannels),
-             "datasets");
+             "dataset");
       }
       s.transposed = layout->transposed;
       shape(s, layout->frames, layout->channels);
@@ -453,7 +434,7 @@ class Hdf5Recording final : public Recording {
       fail(fmt::format("dataset '{}' has {} dimensions ({}): samples x channels (2-D) or one channel (1-D) is "
                        "expected; name a 1-D or 2-D dataset",
                        s.name, s.dims.size(), shape_text(s.dims)),
-           "datasets");
+           "dataset");
     }
     return s;
   }
@@ -462,13 +443,13 @@ class Hdf5Recording final : public Recording {
     if (channels == 0) {
       fail(fmt::format("dataset '{}' ({}) holds no channel; name the dataset that holds the samples", s.name,
                        shape_text(s.dims)),
-           "datasets");
+           "dataset");
     }
     if (channels > kMaxChannels) {
       fail(fmt::format("dataset '{}' ({}) would hold {} channels, more than {}: a recording is samples x channels; "
                        "name the dataset(s) holding the channels",
                        s.name, shape_text(s.dims), channels, kMaxChannels),
-           "datasets");
+           "dataset");
     }
     if (frames > static_cast<hsize_t>(std::numeric_limits<std::int64_t>::max())) {
       fail(fmt::format("dataset '{}' claims {} samples, more than any file holds: the file is damaged", s.name,
@@ -495,7 +476,7 @@ class Hdf5Recording final : public Recording {
           fail(fmt::format("'{}' is a group: name one group alone (its 1-D datasets are the channels) or several "
                            "datasets",
                            absolute(name)),
-               "datasets");
+               "dataset");
         }
         sources_.push_back(source(name, std::move(object)));
       }
@@ -513,7 +494,7 @@ class Hdf5Recording final : public Recording {
                          matrices.empty() ? "no pdp-sim 'signal' dataset and no numeric 2-D dataset"
                                           : "no pdp-sim 'signal' dataset and several numeric 2-D datasets",
                          listing(found)),
-             "datasets");
+             "dataset");
       }
       sources_.push_back(source(matrices.front()->name, open_named(matrices.front()->name)));
     }
@@ -532,12 +513,12 @@ class Hdf5Recording final : public Recording {
     if (!object.valid()) {
       H5Eclear2(H5E_DEFAULT);
       fail(fmt::format("no dataset or group '{}'; its numeric datasets: {}", absolute(name), listing(list_datasets())),
-           "datasets");
+           "dataset");
     }
     const H5I_type_t type = H5Iget_type(object.get());
     if (type != H5I_DATASET && type != H5I_GROUP) {
       fail(fmt::format("'{}' is a stored datatype, not a dataset; name a dataset or a group", absolute(name)),
-           "datasets");
+           "dataset");
     }
     return object;
   }
@@ -582,13 +563,13 @@ class Hdf5Recording final : public Recording {
       fail(fmt::format("group '{}' holds 1-D datasets ({}) and 2-D datasets ({}): name the dataset(s) holding the "
                        "channels",
                        group_name, quoted(vectors), quoted(matrices)),
-           "datasets");
+           "dataset");
     }
     if (vectors.empty() && matrices.size() != 1) {
       fail(fmt::format("group '{}' holds {}: name the dataset(s) holding the channels",
                        group_name, matrices.empty() ? "no numeric 1-D or 2-D dataset"
                                                     : "several 2-D datasets (" + quoted(matrices) + ")"),
-           "datasets");
+           "dataset");
     }
     for (const auto& name : vectors.empty() ? matrices : vectors) sources_.push_back(source(name, open_named(name)));
   }
@@ -602,13 +583,13 @@ class Hdf5Recording final : public Recording {
         fail(fmt::format("datasets '{}' and '{}' hold {} and {} samples: the channels of one recording have equal "
                          "lengths; name datasets recorded together",
                          first.name, s.name, first.frames, s.frames),
-             "datasets");
+             "dataset");
       }
       if (s.kind != first.kind) {
         fail(fmt::format("datasets '{}' and '{}' hold {} and {}: the channels of one recording are stored alike; "
                          "convert one, or name datasets recorded together",
                          first.name, s.name, info_of(first.kind).name, info_of(s.kind).name),
-             "datasets");
+             "dataset");
       }
       channels += s.channels;
       const std::size_t across = s.dims.size() == 2 ? (s.transposed ? 0 : 1) : 1;
@@ -616,7 +597,7 @@ class Hdf5Recording final : public Recording {
     }
     if (channels > static_cast<std::int64_t>(kMaxChannels)) {
       fail(fmt::format("the datasets named hold {} channels, more than {}: name fewer", channels, kMaxChannels),
-           "datasets");
+           "dataset");
     }
     kind_ = first.kind;
     info_.channels = static_cast<int>(channels);
@@ -788,7 +769,7 @@ class Hdf5Recording final : public Recording {
         fail(fmt::format("attribute 'volts_per_count' of '{}' is {}: a scale must be a positive number; correct it, "
                          "or state the volts per count",
                          src.name, *v),
-             "volts_per_count");
+             "volts-per-count");
       }
       stated.push_back(v);
     }
@@ -797,13 +778,13 @@ class Hdf5Recording final : public Recording {
       if (stated[i].has_value() != vpc.has_value()) {
         fail(fmt::format("'{}' has a volts_per_count attribute and '{}' has none: state the volts per count",
                          vpc ? sources_.front().name : sources_[i].name, vpc ? sources_[i].name : sources_.front().name),
-             "volts_per_count");
+             "volts-per-count");
       }
       if (vpc && std::fabs(*stated[i] - *vpc) > 1e-9 * *vpc) {
         fail(fmt::format("datasets '{}' and '{}' have volts_per_count {} and {}: one recording has one scale; state "
                          "the volts per count",
                          sources_.front().name, sources_[i].name, *vpc, *stated[i]),
-             "volts_per_count");
+             "volts-per-count");
       }
     }
     if (vpc) {
@@ -925,7 +906,7 @@ class Hdf5Recording final : public Recording {
                        "or force the rate",
                        attribute->where, format_quantity(attribute->fs, Dimension::frequency), timed->where,
                        format_quantity(timed->fs, Dimension::frequency)),
-           "override_fs");
+           "override-fs");
     }
     if (attribute) return stated_rate(info_.path, options, attribute->fs, attribute->where);
     if (timed) return stated_rate(info_.path, options, timed->fs, timed->where, timed->tolerance);
@@ -966,14 +947,14 @@ class Hdf5Recording final : public Recording {
         if (!(std::isfinite(*v) && *v > 0.0)) {
           fail(fmt::format("attribute '{}' of {} is {}: a {} must be positive; correct it, or force the rate", name,
                            shown, *v, hertz ? "sampling rate" : "sampling interval"),
-               "override_fs");
+               "override-fs");
         }
         const Rate r{hertz ? *v : 1.0 / *v, fmt::format("attribute '{}' of {}", name, shown)};
         if (found && std::fabs(found->fs - r.fs) > 1e-6 * found->fs) {
           fail(fmt::format("{} and {} give sampling rates of {} and {}: correct the wrong one, or force the rate",
                            found->where, r.where, format_quantity(found->fs, Dimension::frequency),
                            format_quantity(r.fs, Dimension::frequency)),
-               "override_fs");
+               "override-fs");
         }
         if (!found) found = r;
       }
@@ -1014,7 +995,7 @@ class Hdf5Recording final : public Recording {
     }
     if (!numeric_class(type.get())) {
       fail(fmt::format("dataset '{}' is not numeric: a time base holds seconds; rename it, or force the rate", name),
-           "override_fs");
+           "override-fs");
     }
     const auto dims = dimensions(space.get(), name);
     const bool vector = dims.size() == 1 || (dims.size() == 2 && (dims[0] == 1 || dims[1] == 1));
@@ -1022,7 +1003,7 @@ class Hdf5Recording final : public Recording {
       fail(fmt::format("dataset '{}' has shape {}: a time base is one value per sample; correct it, or force the "
                        "rate",
                        name, shape_text(dims)),
-           "override_fs");
+           "override-fs");
     }
     hsize_t n = 1;
     for (auto d : dims) n *= d;
@@ -1030,7 +1011,7 @@ class Hdf5Recording final : public Recording {
       fail(fmt::format("dataset '{}' holds {} values but '{}' holds {} samples: a time base has one value per "
                        "sample; correct the file, or force the rate",
                        name, n, sources_.front().name, info_.frames),
-           "override_fs");
+           "override-fs");
     }
     if (n < 2) return std::nullopt;
     // A time base cut short is refused, not read as zeros.
@@ -1044,7 +1025,7 @@ class Hdf5Recording final : public Recording {
     base.where = [](std::uint64_t index) { return fmt::format("value {}", index); };
     base.float_bits = kind == Kind::f32 ? 24 : (floating ? 53 : 0);
     base.fix = "correct it, or force the rate";
-    base.quantity = "override_fs";
+    base.quantity = "override-fs";
     base.scan = [&](const TimeBase::Sink& sink) {
       Handle file_space(H5Dget_space(dataset));
       std::vector<double> values;

@@ -855,7 +855,7 @@ class MatRecording final : public Recording {
         }
       }
     }
-    if (vars_.empty()) reader_fail(path, "the MAT-file holds no variables", "variables");
+    if (vars_.empty()) reader_fail(path, "the MAT-file holds no variables", "variable");
   }
 
   const Variable* find(const std::string& name) const {
@@ -871,7 +871,7 @@ class MatRecording final : public Recording {
       if (v.matrix2d()) return;
       reader_fail(path, fmt::format("variable '{}' is {}-dimensional ({}): save the channels as a matrix samples x "
                                     "channels, or as one vector each",
-                                    v.name, v.dims.size(), size_text(v.dims)), "variables");
+                                    v.name, v.dims.size(), size_text(v.dims)), "variable");
     }
     std::string what = class_name(v.cls, v.logical, v.complex);
     if (v.cls == MAT_C_SPARSE) what += " (convert it with full())";
@@ -879,7 +879,7 @@ class MatRecording final : public Recording {
     else if (v.cls == MAT_C_STRUCT || v.cls == MAT_C_CELL) what += " (save the field or cell holding the signal as its own variable)";
     reader_fail(path, fmt::format("variable '{}' is a {} {}, not a real numeric array: only double, single, int8 to "
                                   "uint64 and logical arrays hold signals",
-                                  v.name, size_text(v.dims), what), "variables");
+                                  v.name, size_text(v.dims), what), "variable");
   }
 
   void use_matrix(const fs::path& path, const Variable& v) {
@@ -889,7 +889,7 @@ class MatRecording final : public Recording {
     if (!shape) {
       reader_fail(path, fmt::format("variable '{}' is {} x {}: more columns than rows, but too many rows (more than {}) "
                                     "to be channels; save it samples x channels",
-                                    v.name, rows, cols, kMaxStackedChannels), "variables");
+                                    v.name, rows, cols, kMaxStackedChannels), "variable");
     }
     layout_ = shape->transposed ? Layout::transposed : Layout::matrix;
     info_.frames = static_cast<std::int64_t>(shape->frames);
@@ -901,7 +901,7 @@ class MatRecording final : public Recording {
     if (info_.channels > 1024) {
       reader_fail(path, fmt::format("variable '{}' ({}) would be {} channels: not a probe recording; name the "
                                     "variable(s) holding the channels",
-                                    v.name, size_text(v.dims), info_.channels), "variables");
+                                    v.name, size_text(v.dims), info_.channels), "variable");
     }
   }
 
@@ -916,7 +916,7 @@ class MatRecording final : public Recording {
                                       "from; the file's numeric variables: {}. Name the variable holding the channels "
                                       "(a matrix samples x channels, or one vector per channel)",
                                       found.empty() ? "no" : "more than one", listing(vars_, true)),
-                    "variables");
+                    "variable");
       }
       check_signal_class(path, *found.front());
       use_matrix(path, *found.front());
@@ -926,15 +926,15 @@ class MatRecording final : public Recording {
     for (const auto& name : options.variables) {
       const Variable* v = find(name);
       if (!v) {
-        reader_fail(path, fmt::format("no variable '{}'; the file holds: {}", name, listing(vars_, false)), "variables");
+        reader_fail(path, fmt::format("no variable '{}'; the file holds: {}", name, listing(vars_, false)), "variable");
       }
       if (std::find(named.begin(), named.end(), v) != named.end()) {
-        reader_fail(path, fmt::format("variable '{}' is named twice", name), "variables");
+        reader_fail(path, fmt::format("variable '{}' is named twice", name), "variable");
       }
       check_signal_class(path, *v);
       if (v->elements() < 2) {
         reader_fail(path, fmt::format("variable '{}' ({}) holds {} value{}, not a signal", name, size_text(v->dims),
-                                      v->elements(), v->elements() == 1 ? "" : "s"), "variables");
+                                      v->elements(), v->elements() == 1 ? "" : "s"), "variable");
       }
       named.push_back(v);
     }
@@ -946,18 +946,18 @@ class MatRecording final : public Recording {
     for (const auto* v : named) {
       if (!v->vector()) {
         reader_fail(path, fmt::format("variable '{}' is a {} matrix: name one matrix alone, or one vector per channel",
-                                      v->name, size_text(v->dims)), "variables");
+                                      v->name, size_text(v->dims)), "variable");
       }
       if (v->elements() != first.elements()) {
         reader_fail(path, fmt::format("variables '{}' and '{}' hold {} and {} values: the channels must be recorded "
                                       "together, sample for sample",
-                                      first.name, v->name, first.elements(), v->elements()), "variables");
+                                      first.name, v->name, first.elements(), v->elements()), "variable");
       }
       if (v->cls != first.cls || v->logical != first.logical) {
         reader_fail(path, fmt::format("variables '{}' ({}) and '{}' ({}) are of different classes: save the channels "
                                       "in one class",
                                       first.name, class_name(first.cls, first.logical, false), v->name,
-                                      class_name(v->cls, v->logical, false)), "variables");
+                                      class_name(v->cls, v->logical, false)), "variable");
       }
       info_.channel_names.push_back(v->name);
     }
@@ -1064,7 +1064,7 @@ class MatRecording final : public Recording {
         reader_fail(path, fmt::format("variables '{}' ({}) and '{}' ({}) give different sampling rates; state the "
                                       "right one and force it",
                                       rate->first, format_quantity(rate->second, Dimension::frequency), name,
-                                      format_quantity(hz, Dimension::frequency)), "override_fs");
+                                      format_quantity(hz, Dimension::frequency)), "override-fs");
       }
     };
     for (auto name : kRateNames) consider(name, false);
@@ -1114,7 +1114,7 @@ class MatRecording final : public Recording {
     base.float_bits = kind == Kind::f32 ? 24 : (floating ? 53 : 0);
     base.fix = options.fs > 0.0 ? "force the stated rate if the samples are evenly spaced"
                                 : "state the sampling rate if the samples are evenly spaced";
-    base.quantity = options.fs > 0.0 ? "override_fs" : "fs";
+    base.quantity = options.fs > 0.0 ? "override-fs" : "fs";
     base.scan = [&](const TimeBase::Sink& sink) {
       std::vector<double> block;
       for (std::uint64_t at = 0; at < n; at += block.size()) {

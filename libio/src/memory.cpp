@@ -23,11 +23,11 @@ class MemoryRecording final : public Recording {
                   std::string name)
       : samples_(std::move(samples)) {
     const fs::path path(name);
-    if (channels < 1) reader_fail(path, "no channel: give at least one array", "channels");
+    if (channels < 1) reader_fail(path, "no channel: give at least one array");
     const auto c = static_cast<std::size_t>(channels);
     if (samples_.size() % c != 0) {
       reader_fail(path, fmt::format("{} samples are not whole frames of {} channels; give arrays of one length",
-                             samples_.size(), channels), "channels");
+                             samples_.size(), channels));
     }
     if (samples_.empty()) reader_fail(path, "no sample: the arrays are empty");
     if (!(fs > 0.0) || !std::isfinite(fs)) reader_fail(path, fmt::format("sampling rate {} Hz: give a positive rate", fs), "fs");
@@ -94,7 +94,7 @@ std::unique_ptr<Recording> memory_recording(std::vector<float> interleaved, int 
 std::unique_ptr<Recording> memory_recording(std::vector<std::int16_t> interleaved, int channels, double fs,
                                             double quantum, bool volts_known, std::string name) {
   if (!(quantum > 0.0) || !std::isfinite(quantum)) {
-    reader_fail(name, fmt::format("{} V per count: give a positive scale", quantum), "volts_per_count");
+    reader_fail(name, fmt::format("{} V per count: give a positive scale", quantum), "volts-per-count");
   }
   return std::make_unique<MemoryRecording<std::int16_t>>(std::move(interleaved), channels, fs, quantum, volts_known,
                                                          std::move(name));

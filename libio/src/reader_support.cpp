@@ -31,7 +31,7 @@ double stated_rate(const std::filesystem::path& path, const ReaderOptions& optio
                           "stated one",
                           where, format_quantity(recorded, Dimension::frequency),
                           format_quantity(options.fs, Dimension::frequency)),
-              "override_fs");
+              "override-fs");
 }
 
 void check_finite(const std::filesystem::path& path, std::span<const float> values, std::int64_t first_frame, int channels) {

@@ -150,7 +150,7 @@ class SndfileRecording final : public Recording {
         "the header promises {:.3f} s of data but the file holds {:.3f} s: it is truncated (a recording still being "
         "written, or a copy cut short)",
         static_cast<double>(chunk->declared) / frame_bytes / rate, static_cast<double>(present) / frame_bytes / rate);
-    if (!options.allow_truncated) reader_fail(path, what + "; recover the whole file, or process what is there", "truncated");
+    if (!options.allow_truncated) reader_fail(path, what + "; recover the whole file, or process what is there", "allow-truncated");
     info_.warnings.push_back(what + "; only what is there was processed");
   }
 

@@ -328,7 +328,7 @@ class TdmsRecording final : public Recording {
       reader_fail(path, fmt::format("{}: the file is truncated (a recording still being written, or a copy cut short); "
                                     "recover the whole file, or process what is there",
                                     what),
-                  "allow_truncated");
+                  "allow-truncated");
     }
     info_.warnings.push_back(fmt::format("{}: only its whole chunks are read", what));
   }
@@ -347,7 +347,7 @@ class TdmsRecording final : public Recording {
         for (auto i : numeric) {
           const auto& c = channels_[i];
           if (want == c.name || want == c.group + "/" + c.name) {
-            if (found) reader_fail(path, fmt::format("channel name '{}' is in more than one group; write group/channel", want), "tdms_channels");
+            if (found) reader_fail(path, fmt::format("channel name '{}' is in more than one group; write group/channel", want), "tdms-channels");
             found = i;
           }
         }
@@ -355,12 +355,12 @@ class TdmsRecording final : public Recording {
           std::string names;
           for (auto i : numeric) names += (names.empty() ? "" : ", ") + channels_[i].group + "/" + channels_[i].name;
           reader_fail(path, fmt::format("no numeric channel '{}'; the file has: {}", want, names.empty() ? "none" : names),
-                      "tdms_channels");
+                      "tdms-channels");
         }
         selected_.push_back(*found);
       }
     }
-    if (selected_.empty()) reader_fail(path, "the TDMS file holds no int16, int32, float32 or float64 channel", "tdms_channels");
+    if (selected_.empty()) reader_fail(path, "the TDMS file holds no int16, int32, float32 or float64 channel", "tdms-channels");
     const auto& first = channels_[selected_.front()];
     for (auto i : selected_) {
       const auto& c = channels_[i];
@@ -368,14 +368,14 @@ class TdmsRecording final : public Recording {
         reader_fail(path,
                     fmt::format("channels '{}/{}' and '{}/{}' hold {} and {} samples: choose channels recorded together",
                                 first.group, first.name, c.group, c.name, first.total, c.total),
-                    "tdms_channels");
+                    "tdms-channels");
       }
       const auto inc = c.numbers.find("wf_increment");
       const auto inc0 = first.numbers.find("wf_increment");
       if ((inc == c.numbers.end()) != (inc0 == first.numbers.end()) ||
           (inc != c.numbers.end() && std::fabs(inc->second - inc0->second) > 1e-9 * inc0->second)) {
         reader_fail(path, fmt::format("channels '{}/{}' and '{}/{}' have different sampling intervals", first.group,
-                                      first.name, c.group, c.name), "tdms_channels");
+                                      first.name, c.group, c.name), "tdms-channels");
       }
     }
     // Linear scaling: NI_Scale[n]_..., applied in order from scale 1.

@@ -24,6 +24,8 @@ namespace synth::detail {
 
 namespace {
 
+using awcc::pdpsim::hdf5_says;
+
 constexpr hsize_t kChunkFrames = 1 << 16;
 constexpr unsigned kDeflateLevel = 4;
 
@@ -49,20 +51,6 @@ class Handle {
  private:
   hid_t id_;
 };
-
-// HDF5's innermost complaint about the last failed call, as " (HDF5: ...)".
-std::string hdf5_says() {
-  std::string what;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* e, void* data) -> herr_t {
-        if (n == 0 && e && e->desc) *static_cast<std::string*>(data) = e->desc;
-        return 0;
-      },
-      &what);
-  H5Eclear2(H5E_DEFAULT);
-  return what.empty() ? std::string() : fmt::format(" (HDF5: {})", what);
-}
 
 }  // namespace
 

@@ -83,10 +83,12 @@ std::string q(double v, Dimension d) { return format_quantity(v, d); }
 
 }  // namespace
 
-std::vector<std::string> Scene::validate() const {
-  std::vector<std::string> errors;
-  auto bad = [&](std::string_view field, std::string value, std::string_view allowed) {
-    errors.push_back(fmt::format("{} = {} is out of range: {}", field, value, allowed));
+awcc::Validation Scene::validate() const {
+  // Every problem with the field(s) that fix it.
+  std::vector<std::pair<std::string, std::string>> errors;
+  auto bad = [&](std::string_view field, std::string value, std::string_view allowed, std::string_view quantity = {}) {
+    errors.emplace_back(std::string(quantity.empty() ? field : quantity),
+                        fmt::format("{} = {} is out of range: {}", field, value, allowed));
   };
   if (!(finite(velocity) && velocity > 0.0))
     bad("velocity", q(velocity, Dimension::velocity), "it must be > 0 m/s (studied range 1-50 m/s)");
@@ -112,7 +114,7 @@ std::vector<std::string> Scene::validate() const {
     r << 1.0, rho_xy, rho_xz, rho_xy, 1.0, rho_yz, rho_xz, rho_yz, 1.0;
     const double min_eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r).eigenvalues().minCoeff();
     if (!(min_eig > 1e-12)) {
-      errors.push_back(fmt::format(
+      errors.emplace_back("rho-xy,rho-xz,rho-yz", fmt::format(
           "rho-xy = {}, rho-xz = {}, rho-yz = {}: the velocity correlation matrix is not positive "
           "definite (smallest eigenvalue {:.3g}); choose coefficients with 1 + 2 rxy rxz ryz - rxy^2 - "
           "rxz^2 - ryz^2 > 0",
@@ -132,6 +134,7 @@ std::vector<std::string> Scene::validate() const {
 
   const auto p = probe_tips();
   const std::string_view tip_field = tips.empty() ? "dx/dy/dz" : "tips";
+  const std::string_view tip_quantity = tips.empty() ? "dx,dy,dz" : "tips";
   if (p.empty() || p.size() > 64) {
     bad("tips", fmt::format("{} tips", p.size()), "a probe has 1 to 64 tips");
   }
@@ -139,11 +142,11 @@ std::vector<std::string> Scene::validate() const {
     if (!(finite(p[i].x) && finite(p[i].y) && finite(p[i].z) && std::fabs(p[i].x) < 1.0 &&
           std::fabs(p[i].y) < 1.0 && std::fabs(p[i].z) < 1.0)) {
       bad(tip_field, fmt::format("tip {} at ({}, {}, {}) m", i, p[i].x, p[i].y, p[i].z),
-          "tip coordinates must be finite and within 1 m of the origin");
+          "tip coordinates must be finite and within 1 m of the origin", tip_quantity);
     }
     for (std::size_t j = i + 1; j < p.size(); ++j) {
       if (std::hypot(p[i].x - p[j].x, p[i].y - p[j].y, p[i].z - p[j].z) < 1e-9) {
-        errors.push_back(fmt::format(
+        errors.emplace_back(std::string(tip_quantity), fmt::format(
             "{}: tips {} and {} are at the same point ({}, {}, {}) m; separate them (for a two-tip "
             "probe, set a nonzero dx)",
             tip_field, i, j, p[i].x, p[i].y, p[i].z));
@@ -185,7 +188,7 @@ std::vector<std::string> Scene::validate() const {
       for (int i = 0; i < 3; ++i) {
         const double h = dt / time_scale_of(i);
         if (h > 2.0) {
-          errors.push_back(fmt::format(
+          errors.emplace_back("velocity-update,realisation-step", fmt::format(
               "velocity-update = euler is unstable here: realisation-step / time-scale{} = {:.3g} > 2; use "
               "velocity-update = exact (exact for every step) or a realisation-step below {}",
               i == 0 ? "" : (i == 1 ? "-y" : "-z"), h, q(2.0 * time_scale_of(i), Dimension::time)));
@@ -194,7 +197,22 @@ std::vector<std::string> Scene::validate() const {
       }
     }
   }
-  return errors;
+  if (errors.empty()) return {};
+  if (errors.size() == 1) return awcc::Validation::invalid(errors.front().first, errors.front().second);
+  std::string all;
+  for (const auto& e : errors) all += (all.empty() ? "" : "\n") + e.second;
+  return awcc::Validation::invalid({}, all);
+}
+
+awcc::OptionError invalid_scene(const awcc::Validation& validation) {
+  std::string text = "invalid scene:";
+  std::string_view rest = validation.message;
+  while (!rest.empty()) {
+    const auto end = std::min(rest.find('\n'), rest.size());
+    text += "\n  " + std::string(rest.substr(0, end));
+    rest.remove_prefix(std::min(end + 1, rest.size()));
+  }
+  return awcc::OptionError(text, validation.quantity);
 }
 
 // ---------------------------------------------------------------------------

@@ -773,12 +773,7 @@ void for_each_sample_min_form(const Scene& scene, const ReferenceData& ref, PerS
 }  // namespace
 
 Synthesis synthesise(const Scene& scene, const SynthesisOptions& options) {
-  const auto errors = scene.validate();
-  if (!errors.empty()) {
-    std::string message = "invalid scene:";
-    for (const auto& e : errors) message += "\n  " + e;
-    throw std::invalid_argument(message);
-  }
+  if (const auto validation = scene.validate(); !validation.ok()) throw invalid_scene(validation);
   Synthesiser synthesiser(scene, options);
   return synthesiser.run();
 }

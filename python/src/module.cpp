@@ -351,11 +351,7 @@ py::dict synthesise(const Settings& settings, const std::string& signal) {
   for (std::size_t i = 0; i < given.size(); ++i) {
     if (!used[i]) throw awcc::OptionError(fmt::format("unknown scene field '{}'", given[i].name), given[i].name);
   }
-  if (const auto errors = scene.validate(); !errors.empty()) {
-    std::string all;
-    for (const auto& e : errors) all += "\n  " + e;
-    throw awcc::OptionError("invalid scene:" + all, "scene");
-  }
+  if (const auto validation = scene.validate(); !validation.ok()) throw synth::invalid_scene(validation);
   if (signal != "binary" && signal != "voltage") {
     throw awcc::OptionError(fmt::format("signal = {}: give binary or voltage", signal), "signal");
   }

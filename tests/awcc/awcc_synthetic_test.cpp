@@ -86,7 +86,7 @@ TEST_P(AwccExtreme, FinishesWithFiniteResultsOrAReason) {
   synth::Scene s;
   s.duration = 2.0;
   GetParam().apply(s);
-  ASSERT_TRUE(s.validate().empty());
+  ASSERT_TRUE(s.validate().ok()) << s.validate().message;
   const auto syn = synth::synthesise(s);
   const auto r = awcc::awcc(syn.signals[0], syn.signals[1], s.dx, {});
   for (double v : {r.velocity, r.velocity_rms, r.turbulence_intensity, r.velocity_ci95.lower, r.velocity_ci95.upper,

@@ -21,6 +21,7 @@
 #include "awcc/process.hpp"
 #include "awcc/recording.hpp"
 #include "test_paths.hpp"
+#include "declared_quantity.hpp"
 
 namespace {
 
@@ -165,6 +166,7 @@ std::string refusal(F open, std::string* quantity = nullptr) {
     open();
   } catch (const awcc::InputError& e) {
     message = e.what();
+    EXPECT_TRUE(declared_reader_quantity(e.quantity())) << e.quantity();
     if (quantity) *quantity = e.quantity();
   }
   std::fflush(stderr);
@@ -316,7 +318,7 @@ TEST(Hdf5Reader, OneDatasetPerChannelWithDtAndATimeBaseThatAgrees) {
   std::string quantity;
   const auto message = refusal([&] { (void)awcc::open_recording(q, one); }, &quantity);
   EXPECT_TRUE(has(message, "'dt'") && has(message, "/probe/time")) << message;
-  EXPECT_EQ(quantity, "override_fs");
+  EXPECT_EQ(quantity, "override-fs");
 }
 
 TEST(Hdf5Reader, Int16WithVoltsPerCountOffersItsCounts) {
@@ -433,7 +435,7 @@ TEST(Hdf5Reader, ChannelsBySamplesIsReadTransposedAndSaysSo) {
   std::string quantity;
   const auto message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
   EXPECT_TRUE(has(message, "'/wide' is 17 x 100: more columns than rows, but too many rows (more than 16)")) << message;
-  EXPECT_EQ(quantity, "datasets");
+  EXPECT_EQ(quantity, "dataset");
 }
 
 TEST(Hdf5Reader, AbsentOrAmbiguousDatasetsAreRefusedWithTheList) {
@@ -454,7 +456,7 @@ TEST(Hdf5Reader, AbsentOrAmbiguousDatasetsAreRefusedWithTheList) {
   EXPECT_TRUE(has(message, p.string())) << message;
   EXPECT_TRUE(has(message, "several") && has(message, "'/a/first' (float32, 20 x 2)") && has(message, "/b/second"))
       << message;
-  EXPECT_EQ(quantity, "datasets");
+  EXPECT_EQ(quantity, "dataset");
   awcc::ReaderOptions o;
   o.datasets = {"/nothere"};
   message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
@@ -465,7 +467,7 @@ TEST(Hdf5Reader, AbsentOrAmbiguousDatasetsAreRefusedWithTheList) {
   o.datasets = {"/c/vector", "/d/short"};
   message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
   EXPECT_TRUE(has(message, "'/c/vector'") && has(message, "'/d/short'") && has(message, "40 and 30")) << message;
-  EXPECT_EQ(quantity, "datasets");
+  EXPECT_EQ(quantity, "dataset");
 
   const auto q = scratch("vectors_only.h5");
   {
@@ -495,7 +497,7 @@ TEST(Hdf5Reader, ATimeBaseThatIsNotUniformOrIncreasingIsRefused) {
   EXPECT_TRUE(has(message, "'/time'") && has(message, "not evenly spaced") &&
               has(message, "the longest step, 0.00101 s, is to value 500"))
       << message;
-  EXPECT_EQ(quantity, "override_fs");
+  EXPECT_EQ(quantity, "override-fs");
 
   std::vector<double> back(n);
   for (std::size_t i = 0; i < n; ++i) back[i] = static_cast<double>(i) * 1e-5;
@@ -522,7 +524,7 @@ TEST(Hdf5Reader, AStatedRateMustAgreeWithTheFile) {
   std::string quantity;
   const auto message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
   EXPECT_TRUE(has(message, "'/time'") && has(message, "50kHz")) << message;
-  EXPECT_EQ(quantity, "override_fs");
+  EXPECT_EQ(quantity, "override-fs");
   o.fs = 50e3;
   EXPECT_EQ(awcc::open_recording(p, o)->info().fs, 50e3);
   o.fs = 40e3;
@@ -644,7 +646,7 @@ TEST(Hdf5Reader, HostileFilesAreRefusedWithAMessageAndNothingPrinted) {
     o.fs = 1e3;
     const auto message = refusal([&] { (void)awcc::open_recording(odd, o); }, &quantity);
     EXPECT_TRUE(has(message, "'/" + name + "'") && has(message, why)) << message;
-    EXPECT_EQ(quantity, "datasets") << name;
+    EXPECT_EQ(quantity, "dataset") << name;
   }
 }
 

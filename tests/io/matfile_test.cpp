@@ -27,6 +27,7 @@
 #include "awcc/process.hpp"
 #include "awcc/recording.hpp"
 #include "test_paths.hpp"
+#include "declared_quantity.hpp"
 
 namespace {
 
@@ -87,6 +88,7 @@ std::string refusal(const fs::path& p, const awcc::ReaderOptions& o = {}, std::s
     auto r = awcc::open_recording(p, o);
     (void)read_all(*r, 4096);
   } catch (const awcc::InputError& e) {
+    EXPECT_TRUE(declared_reader_quantity(e.quantity())) << e.quantity();
     if (quantity) *quantity = e.quantity();
     return e.what();
   }
@@ -296,7 +298,7 @@ TEST(MatFile, VectorsNamedWithATimeVector) {
     stated.fs = 20000.0;
     std::string quantity;
     EXPECT_NE(refusal(p, stated, &quantity).find("time variable 't'"), std::string::npos);
-    EXPECT_EQ(quantity, "override_fs");
+    EXPECT_EQ(quantity, "override-fs");
     stated.override_fs = true;
     EXPECT_DOUBLE_EQ(awcc::open_recording(p, stated)->info().fs, 20000.0);
   }
@@ -343,7 +345,7 @@ TEST(MatFile, RateVariablesIntervalsAndTheStatedRate) {
   stated.fs = 20000.0;
   std::string quantity;
   EXPECT_NE(refusal(p, stated, &quantity).find("'dt'"), std::string::npos);
-  EXPECT_EQ(quantity, "override_fs");
+  EXPECT_EQ(quantity, "override-fs");
   // Two rate variables must agree.
   write_mat(p, MAT_FT_MAT5, MAT_COMPRESSION_NONE,
             {{"x", MAT_C_DOUBLE, MAT_T_DOUBLE, {n, 2}, x.data()},
@@ -492,7 +494,7 @@ TEST(MatFile, AmbiguousOrEmptyFilesAreRefusedListingTheVariables) {
   EXPECT_NE(msg.find("more than one"), std::string::npos) << msg;
   EXPECT_NE(msg.find("a (300x2 double)"), std::string::npos) << msg;
   EXPECT_NE(msg.find("b (20x2 double)"), std::string::npos) << msg;
-  EXPECT_EQ(quantity, "variables");
+  EXPECT_EQ(quantity, "variable");
   awcc::ReaderOptions o;
   o.variables = {"b"};
   EXPECT_EQ(awcc::open_recording(p, [&] { auto q = o; q.fs = 1e4; return q; }())->info().frames, 20);
@@ -552,7 +554,7 @@ TEST(MatFile, NonNumericVariablesAreRefusedNamingTheirClass) {
       const auto msg = refusal(p, o, &quantity);
       EXPECT_NE(msg.find(std::string("variable '") + name + "' is a"), std::string::npos) << msg;
       EXPECT_NE(msg.find(what), std::string::npos) << msg;
-      EXPECT_EQ(quantity, "variables");
+      EXPECT_EQ(quantity, "variable");
     }
     // Without names, nothing numeric to take: the listing says so.
     const auto msg = refusal(p);

@@ -14,6 +14,7 @@
 #include "awcc/errors.hpp"
 #include "awcc/recording.hpp"
 #include "test_paths.hpp"
+#include "declared_quantity.hpp"
 
 namespace {
 
@@ -84,7 +85,7 @@ TimeBase base_of(const std::vector<double>& values, double resolution = 0.0) {
   b.where = [](std::uint64_t i) { return fmt::format("value {}", i); };
   b.float_bits = 53;
   b.fix = "correct it";
-  b.quantity = "override_fs";
+  b.quantity = "override-fs";
   b.scan = [values, resolution](const TimeBase::Sink& sink) {
     for (std::size_t at = 0; at < values.size(); at += 5) {
       sink(at, std::span<const double>(values).subspan(at, std::min<std::size_t>(5, values.size() - at)));
@@ -98,6 +99,7 @@ std::string refusal(const TimeBase& b, std::string* quantity = nullptr) {
   try {
     (void)awcc::detail::time_base_rate(b);
   } catch (const awcc::InputError& e) {
+    EXPECT_TRUE(declared_reader_quantity(e.quantity())) << e.quantity();
     if (quantity) *quantity = e.quantity();
     return e.what();
   }
@@ -126,7 +128,7 @@ TEST(TimeBaseRule, TheRateIsTheMeanStepsAndEveryStepIsHeldToTheTolerance) {
             std::string::npos) << message;
   EXPECT_NE(message.find("0.101 % off its mean step"), std::string::npos) << message;
   EXPECT_NE(message.find("; correct it"), std::string::npos) << message;
-  EXPECT_EQ(quantity, "override_fs");
+  EXPECT_EQ(quantity, "override-fs");
 }
 
 // A jittered clock (each stamp moved by up to 0.3 % of a step, uniformly):
@@ -211,7 +213,7 @@ TEST(TimeBaseRule, ACsvTimeColumnIsHeldToTheRuleWithItsLineNamed) {
     EXPECT_NE(message.find("the time column 'time' is not evenly spaced"), std::string::npos) << message;
     // Row i at line i + 2; the row after the lost one (i = 322) is line 323.
     EXPECT_NE(message.find("its step to line 323 is 0.0001 s"), std::string::npos) << message;
-    EXPECT_EQ(e.quantity(), "time_column");
+    EXPECT_EQ(e.quantity(), "time-column");
     EXPECT_EQ(message.find("--"), std::string::npos) << message;
   }
   // Forced, the stated rate sets the time column aside.

@@ -227,7 +227,7 @@ TEST(TdmsReader, ATruncatedLastSegmentIsNamedAndReadOnlyWhenAllowed) {
     FAIL() << "a truncated file was accepted";
   } catch (const awcc::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
-    EXPECT_EQ(e.quantity(), "allow_truncated");
+    EXPECT_EQ(e.quantity(), "allow-truncated");
   }
   o.allow_truncated = true;
   auto r = awcc::open_recording(p, o);

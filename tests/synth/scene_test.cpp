@@ -14,23 +14,34 @@ namespace {
 
 using synth::Scene;
 
-std::string joined(const std::vector<std::string>& v) {
-  std::string out;
-  for (const auto& s : v) out += s + "\n";
+// The problems a validation reports, one per line.
+std::vector<std::string> problems(const awcc::Validation& v) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at < v.message.size();) {
+    const auto end = std::min(v.message.find('\n', at), v.message.size());
+    out.push_back(v.message.substr(at, end - at));
+    at = end + 1;
+  }
   return out;
 }
 
-// Expects exactly one message, naming `field` and containing `fragment`.
-void expect_invalid(const Scene& s, const std::string& field, const std::string& fragment) {
-  const auto errors = s.validate();
-  ASSERT_EQ(errors.size(), 1u) << joined(errors);
+// Expects exactly one problem, naming `field` (its quantity too when given) and containing `fragment`.
+void expect_invalid(const Scene& s, const std::string& field, const std::string& fragment,
+                    const std::string& quantity = {}) {
+  const auto v = s.validate();
+  ASSERT_EQ(v.status, awcc::ValidationStatus::invalid);
+  const auto errors = problems(v);
+  ASSERT_EQ(errors.size(), 1u) << v.message;
   EXPECT_NE(errors[0].find(field), std::string::npos) << errors[0];
   EXPECT_NE(errors[0].find(fragment), std::string::npos) << errors[0];
+  if (!quantity.empty()) {
+    EXPECT_EQ(v.quantity, quantity);
+  }
 }
 
 TEST(Scene, DefaultsAreTheBaseCaseAndValid) {
   const Scene s;
-  EXPECT_TRUE(s.validate().empty()) << joined(s.validate());
+  EXPECT_TRUE(s.validate().ok()) << s.validate().message;
   EXPECT_EQ(s.velocity, 10.0);
   EXPECT_EQ(s.tu, 0.25);
   EXPECT_EQ(s.tu_y, 0.125);
@@ -76,11 +87,16 @@ TEST(Scene, ValidationNamesTheFieldAndTheRange) {
   expect_invalid(s, "duration", "shorter than one sample");
   s = Scene{};
   s.velocity = 0.0;
-  expect_invalid(s, "velocity", "> 0 m/s");
+  expect_invalid(s, "velocity", "> 0 m/s", "velocity");
   s = Scene{};
   s.time_scale = -1.0;
-  // time-scale-y and -z default to time-scale, so all three are reported.
-  EXPECT_EQ(s.validate().size(), 3u);
+  // time-scale-y and -z default to time-scale, so all three are reported,
+  // and no single field is the fix.
+  EXPECT_EQ(problems(s.validate()).size(), 3u) << s.validate().message;
+  EXPECT_EQ(s.validate().quantity, "");
+  const auto error = synth::invalid_scene(s.validate());
+  EXPECT_EQ(std::string(error.what()).rfind("invalid scene:\n  time-scale = ", 0), 0u) << error.what();
+  EXPECT_NE(std::string(error.what()).find("\n  time-scale-z = "), std::string::npos) << error.what();
   s = Scene{};
   s.tu = 1.5;
   expect_invalid(s, "tu", "[0, 1]");
@@ -90,10 +106,10 @@ TEST(Scene, ValidationNamesTheFieldAndTheRange) {
   s = Scene{};
   s.dx = 0.0;
   s.dy = 0.0;
-  expect_invalid(s, "tips 0 and 1", "same point");
+  expect_invalid(s, "tips 0 and 1", "same point", "dx,dy,dz");
   s = Scene{};
   s.tips = {{0, 0, 0}, {1e-3, 0, 0}, {1e-3, 0, 0}, {0, 1e-3, 0}};
-  expect_invalid(s, "tips 1 and 2", "same point");
+  expect_invalid(s, "tips 1 and 2", "same point", "tips");
   s = Scene{};
   s.aspect_ratio = 0.0;
   expect_invalid(s, "aspect-ratio", "[0.1, 10]");
@@ -106,9 +122,7 @@ TEST(Scene, CorrelationMatrixMustBePositiveDefinite) {
   s.rho_xy = 0.9;
   s.rho_xz = 0.9;
   s.rho_yz = -0.9;
-  const auto errors = s.validate();
-  ASSERT_EQ(errors.size(), 1u) << joined(errors);
-  EXPECT_NE(errors[0].find("not positive definite"), std::string::npos) << errors[0];
+  expect_invalid(s, "rho-xy", "not positive definite", "rho-xy,rho-xz,rho-yz");
 }
 
 TEST(Scene, EulerIsRefusedWhereItIsUnstable) {
@@ -116,11 +130,9 @@ TEST(Scene, EulerIsRefusedWhereItIsUnstable) {
   s.velocity_update = synth::VelocityUpdate::euler;
   s.realisation_step = 0.25;  // dt/T = 2.5
   s.duration = 10.0;
-  const auto errors = s.validate();
-  ASSERT_EQ(errors.size(), 1u) << joined(errors);
-  EXPECT_NE(errors[0].find("euler is unstable"), std::string::npos) << errors[0];
+  expect_invalid(s, "velocity-update", "euler is unstable", "velocity-update,realisation-step");
   s.velocity_update = synth::VelocityUpdate::exact;
-  EXPECT_TRUE(s.validate().empty()) << joined(s.validate());
+  EXPECT_TRUE(s.validate().ok()) << s.validate().message;
 }
 
 TEST(SceneFields, NamesAreUniqueAndEveryFieldRoundTripsItsDefault) {
@@ -229,7 +241,7 @@ TEST(SceneToml, ShippedSamplesLoadAndValidate) {
                            "short-time-scale.toml", "four-tip.toml"}) {
     Scene s;
     ASSERT_NO_THROW(synth::load_scene_toml(pdp_test::source_dir() / "samples" / name, s)) << name;
-    EXPECT_TRUE(s.validate().empty()) << name << ": " << joined(s.validate());
+    EXPECT_TRUE(s.validate().ok()) << name << ": " << s.validate().message;
   }
 }
 

@@ -203,7 +203,7 @@ TEST_P(ExtremeScene, RunsAndGivesSaneTruth) {
   s.duration = 10.0;
   s.fs = 100e3;
   GetParam().apply(s);
-  ASSERT_TRUE(s.validate().empty());
+  ASSERT_TRUE(s.validate().ok()) << s.validate().message;
   const auto out = run(s);
   const auto& t = out.truth;
   EXPECT_EQ(t.reentries_missed, 0);

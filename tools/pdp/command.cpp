@@ -112,26 +112,6 @@ void finish_parsing(Command& c) {
 
 namespace {
 
-// The readers (being moved to awcc::io) still name some quantities by their
-// former spellings; until they give declared names, this says which options
-// those are. Delete it when no reader throws one of these.
-std::string_view declared_names(std::string_view quantity) {
-  static const std::map<std::string_view, std::string_view, std::less<>> former{
-      {"datasets", "dataset"},
-      {"variables", "variable"},
-      {"tdms_channels", "tdms-channels"},
-      {"time_column", "time-column"},
-      {"override_fs", "override-fs"},
-      {"truncated", "allow-truncated"},
-      {"volts_per_count", "volts-per-count"},
-      {"allow_unusual", "allow-unusual"},
-      {"raw_layout", "raw-channels,raw-type,raw-header"},
-      {"channels", "leading-channel,trailing-channel"},
-  };
-  const auto it = former.find(quantity);
-  return it == former.end() ? quantity : it->second;
-}
-
 std::string with_flag(const std::string& message, std::string_view quantity) {
   const auto flags = flags_for(quantity);
   return flags.empty() ? message : fmt::format("{} ({})", message, flags);
@@ -141,11 +121,16 @@ std::string with_flag(const std::string& message, std::string_view quantity) {
 
 std::string flags_for(std::string_view quantity) {
   std::string out;
-  for (const auto& name : awcc::split_cells(declared_names(quantity))) {
+  for (const auto& name : awcc::split_cells(quantity)) {
     if (name.empty() || !running() || !running()->get_option_no_throw(flag_of(name))) continue;
     out += (out.empty() ? "" : "/") + flag_of(name);
   }
   return out;
+}
+
+std::string one_line(std::string text) {
+  for (auto at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) text.replace(at, 1, "; ");
+  return text;
 }
 
 int report_error(const std::exception& error) {

@@ -58,4 +58,7 @@ const std::string& command_line();
 /// flags of the running command; empty when it has none.
 std::string flags_for(std::string_view quantity);
 
+/// A message of several lines (a scene's problems) on one log line, "; " between them.
+std::string one_line(std::string text);
+
 }  // namespace pdp

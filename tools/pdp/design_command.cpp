@@ -91,9 +91,9 @@ int run_design(const DesignOptions& o) {
   // cannot make is the design's fault, named before minutes are spent.
   for (std::int64_t t = 0; t < d.tasks(); ++t) {
     const auto task = d.task(t);
-    if (const auto errors = task.scene.validate(); !errors.empty()) {
+    if (const auto validation = task.scene.validate(); !validation.ok()) {
       spdlog::error("{}: condition {} record {}: {}", o.config, d.conditions[task.condition].name, task.record,
-                    errors.front());
+                    one_line(validation.message));
       return exit_bad_usage;
     }
   }

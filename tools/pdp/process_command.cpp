@@ -171,183 +171,225 @@ std::string correction_report(const correction::Correction& c) {
       t.quantiles[1], t.quantiles[5], t.quantiles[0], t.quantiles[6], t.measured);
 }
 
-}  // namespace
+// Two outputs into one file would leave only the last; inputs are never
+// modified, so an output that is one of them is refused.
+void check_output_names(const ProcessCommandOptions& o) {
+  const std::vector<std::pair<const char*, const std::string*>> named = {
+      {"--json", &o.json},       {"--csv", &o.csv},
+      {"--windows", &o.windows}, {"--correlation-functions", &o.correlation_functions},
+      {"--spectrum", &o.spectrum}, {"--report", &o.report}};
+  for (std::size_t a = 0; a < named.size(); ++a) {
+    for (std::size_t b = a + 1; b < named.size(); ++b) {
+      const auto& x = *named[a].second;
+      const auto& y = *named[b].second;
+      if (x.empty() || y.empty()) continue;
+      std::error_code ec;
+      if (x == y || (std::filesystem::exists(x) && std::filesystem::equivalent(x, y, ec))) {
+        throw std::invalid_argument(fmt::format("{} and {} both name {}: give each output its own file",
+                                                named[a].first, named[b].first, x));
+      }
+    }
+  }
+  for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum, o.report}) {
+    if (output.empty() || !std::filesystem::exists(output)) continue;
+    for (const auto& input : o.files) {
+      if (std::filesystem::equivalent(output, input)) {
+        throw std::invalid_argument(fmt::format("{} is an input recording; choose another output file", output));
+      }
+    }
+  }
+}
 
-int run_process(ProcessCommandOptions& o) {
+// Everything decided before the first recording is read.
+struct Plan {
   awcc::ProcessOptions options;
   std::vector<std::optional<double>> positions;
   std::optional<correction::CorrectionModel> model;
-  try {
-    options = build_options(o);
-    positions = positions_for(o);
-    if (!o.correct.empty() && !options.awcc) {
-      throw std::invalid_argument("--correct corrects AWCC's estimates; use --method awcc or both");
-    }
-    if (!o.correct.empty() && options.awcc_options.probe_correction.enabled) {
-      throw std::invalid_argument("--correct and --probe-correction both correct AWCC's velocity: the model was trained "
-                                  "on synthetic records without bubble-probe interaction; use one of them");
-    }
-    // Two outputs into one file would leave only the last.
-    {
-      const std::vector<std::pair<const char*, const std::string*>> named = {
-          {"--json", &o.json},       {"--csv", &o.csv},
-          {"--windows", &o.windows}, {"--correlation-functions", &o.correlation_functions},
-          {"--spectrum", &o.spectrum}, {"--report", &o.report}};
-      for (std::size_t a = 0; a < named.size(); ++a) {
-        for (std::size_t b = a + 1; b < named.size(); ++b) {
-          const auto& x = *named[a].second;
-          const auto& y = *named[b].second;
-          if (x.empty() || y.empty()) continue;
-          std::error_code ec;
-          if (x == y || (std::filesystem::exists(x) && std::filesystem::equivalent(x, y, ec))) {
-            throw std::invalid_argument(fmt::format("{} and {} both name {}: give each output its own file",
-                                                    named[a].first, named[b].first, x));
-          }
-        }
-      }
-    }
-    // Inputs are never modified: refuse an output that is one of them.
-    for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum, o.report}) {
-      if (output.empty() || !std::filesystem::exists(output)) continue;
-      for (const auto& input : o.files) {
-        if (std::filesystem::equivalent(output, input)) {
-          throw std::invalid_argument(fmt::format("{} is an input recording; choose another output file", output));
-        }
-      }
-    }
-    // The model is read before any processing: a damaged one, or one trained
-    // on other processing, fails fast.
-    if (!o.correct.empty()) {
-      model = correction::CorrectionModel::load(o.correct);
-      if (const auto why = model->mismatch(correction::processing_of(options.awcc_options)); !why.empty()) {
-        throw std::invalid_argument(fmt::format("--correct {}: the model was trained on results processed otherwise "
-                                                "({}); process with the model's settings or train a model for these",
-                                                o.correct, why));
-      }
-    }
-  } catch (const std::exception& e) {
-    return report_error(e);
+};
+
+Plan plan_of(const ProcessCommandOptions& o) {
+  Plan plan;
+  plan.options = build_options(o);
+  plan.positions = positions_for(o);
+  if (!o.correct.empty() && !plan.options.awcc) {
+    throw std::invalid_argument("--correct corrects AWCC's estimates; use --method awcc or both");
   }
+  if (!o.correct.empty() && plan.options.awcc_options.probe_correction.enabled) {
+    throw std::invalid_argument("--correct and --probe-correction both correct AWCC's velocity: the model was trained "
+                                "on synthetic records without bubble-probe interaction; use one of them");
+  }
+  check_output_names(o);
+  // The model is read before any processing: a damaged one, or one trained
+  // on other processing, fails fast.
+  if (!o.correct.empty()) {
+    plan.model = correction::CorrectionModel::load(o.correct);
+    if (const auto why = plan.model->mismatch(correction::processing_of(plan.options.awcc_options)); !why.empty()) {
+      throw std::invalid_argument(fmt::format("--correct {}: the model was trained on results processed otherwise "
+                                              "({}); process with the model's settings or train a model for these",
+                                              o.correct, why));
+    }
+  }
+  return plan;
+}
+
+// The recordings processed, with the positions and names of those kept.
+struct Processed {
   std::vector<awcc::ProcessResult> results;
-  std::vector<std::optional<double>> kept_positions;
+  std::vector<std::optional<double>> positions;
   std::vector<std::string> inputs, skipped;
-  try {
-    Progress progress("processing");
-    awcc::ProcessWorkspace workspace;  // FFT plans shared by the records
-    for (std::size_t i = 0; i < o.files.size(); ++i) {
-      // A synthetic recording's sidecar states its volts per count.
-      awcc::ProcessOptions file_options = options;
-      if (!(file_options.reader.volts_per_count > 0.0)) {
-        if (const auto vpc = synth::sidecar_volts_per_count(o.files[i])) file_options.reader.volts_per_count = *vpc;
-      }
-      try {
-        results.push_back(awcc::process_recording(o.files[i], file_options, workspace));
-      } catch (const awcc::InputError& e) {
-        // Among several inputs (a glob), a file that is not a recording is
-        // skipped and said; a damaged recording still stops the profile.
-        if (o.files.size() == 1 || e.quantity() != "not_a_recording") throw;
-        spdlog::warn("skipped: {}", e.what());
-        skipped.push_back(e.what());
-        continue;
-      }
-      add_flag_hints(results.back());
-      if (!o.manifest.empty() && !positions[i]) {
-        const auto name = std::filesystem::path(o.files[i]).filename().string();
-        throw std::invalid_argument(
-            fmt::format("{}: no position for {}; add a row '{},<position>'", o.manifest, name, name));
-      }
-      kept_positions.push_back(positions[i]);
-      inputs.push_back(o.files[i]);
-      for (const auto& w : results.back().info.warnings) spdlog::warn("{}: {}", o.files[i], w);
-      if (results.back().fscc) {
-        for (const auto& w : results.back().fscc->warnings) spdlog::warn("{}: {}", o.files[i], w);
-      }
-      if (results.back().spectrum && !results.back().spectrum->warning.empty()) {
-        spdlog::warn("{}: {}", o.files[i], results.back().spectrum->warning);
-      }
-      spdlog::debug("{}: {:.3f} s", o.files[i], results.back().seconds);
-      progress(static_cast<double>(i + 1) / static_cast<double>(o.files.size()));
-    }
-    if (results.empty()) {
-      throw awcc::InputError(fmt::format("none of the {} inputs is a recording", o.files.size()));
-    }
-  } catch (const std::exception& e) {
-    return report_error(e);
+};
+
+void warn_about(const std::string& file, const awcc::ProcessResult& r) {
+  for (const auto& w : r.info.warnings) spdlog::warn("{}: {}", file, w);
+  if (r.fscc) {
+    for (const auto& w : r.fscc->warnings) spdlog::warn("{}: {}", file, w);
   }
-  positions = kept_positions;
+  if (r.spectrum && !r.spectrum->warning.empty()) spdlog::warn("{}: {}", file, r.spectrum->warning);
+}
+
+Processed process_files(const ProcessCommandOptions& o, const Plan& plan) {
+  Processed out;
+  Progress progress("processing");
+  awcc::ProcessWorkspace workspace;  // FFT plans shared by the records
+  for (std::size_t i = 0; i < o.files.size(); ++i) {
+    // A synthetic recording's sidecar states its volts per count.
+    awcc::ProcessOptions file_options = plan.options;
+    if (!(file_options.reader.volts_per_count > 0.0)) {
+      if (const auto vpc = synth::sidecar_volts_per_count(o.files[i])) file_options.reader.volts_per_count = *vpc;
+    }
+    try {
+      out.results.push_back(awcc::process_recording(o.files[i], file_options, workspace));
+    } catch (const awcc::InputError& e) {
+      // Among several inputs (a glob), a file that is not a recording is
+      // skipped and said; a damaged recording still stops the profile.
+      if (o.files.size() == 1 || e.quantity() != "not_a_recording") throw;
+      spdlog::warn("skipped: {}", e.what());
+      out.skipped.push_back(e.what());
+      continue;
+    }
+    add_flag_hints(out.results.back());
+    if (!o.manifest.empty() && !plan.positions[i]) {
+      const auto name = std::filesystem::path(o.files[i]).filename().string();
+      throw std::invalid_argument(
+          fmt::format("{}: no position for {}; add a row '{},<position>'", o.manifest, name, name));
+    }
+    out.positions.push_back(plan.positions[i]);
+    out.inputs.push_back(o.files[i]);
+    warn_about(o.files[i], out.results.back());
+    spdlog::debug("{}: {:.3f} s", o.files[i], out.results.back().seconds);
+    progress(static_cast<double>(i + 1) / static_cast<double>(o.files.size()));
+  }
+  if (out.results.empty()) {
+    throw awcc::InputError(fmt::format("none of the {} inputs is a recording", o.files.size()));
+  }
+  return out;
+}
+
+std::vector<correction::Correction> corrections_of(const Plan& plan, const Processed& p) {
   std::vector<correction::Correction> corrections;
-  if (model) {
-    for (const auto& r : results) {
-      const auto m = correction::measurement_of(r);
-      corrections.push_back(model->correct(m));
-      if (!corrections.back().corrected()) {
-        spdlog::warn("{}: not corrected: {}", r.info.path.string(), corrections.back().message);
-      }
+  if (!plan.model) return corrections;
+  for (const auto& r : p.results) {
+    corrections.push_back(plan.model->correct(correction::measurement_of(r)));
+    if (!corrections.back().corrected()) {
+      spdlog::warn("{}: not corrected: {}", r.info.path.string(), corrections.back().message);
     }
   }
+  return corrections;
+}
+
+// Every output rendered (path, text), before any is written, and what goes
+// to stdout and to the report when no JSON is written.
+struct Rendered {
+  std::vector<std::pair<std::string, std::string>> outputs;
+  std::string stdout_text, json_for_report;
+};
+
+Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processed& p,
+                const std::vector<correction::Correction>& corrections) {
+  const auto& results = p.results;
+  const auto& positions = p.positions;
+  const bool corrected = plan.model.has_value();
   auto correction_json = [&](std::size_t i) {
     auto c = correction::to_json(corrections[i]);
     c["model"] = std::filesystem::path(o.correct).filename().string();
     return c;
   };
-  try {
-    // Every output is rendered and its folder checked before any is written:
-    // a run fails whole or writes all.
-    std::vector<std::pair<std::string, std::string>> outputs;
-    std::string stdout_text, json_for_report;
-    if (!o.json.empty() || !o.report.empty()) {
-      nlohmann::json j;
-      if (results.size() == 1 && o.files.size() == 1) {
-        j = awcc::to_json(results[0]);
-        if (model) j["correction"] = correction_json(0);
-      } else {
-        j["profile"] = nlohmann::json::array();
-        for (std::size_t i = 0; i < results.size(); ++i) {
-          auto row = awcc::to_json(results[i]);
-          row["position"] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
-          if (model) row["correction"] = correction_json(i);
-          j["profile"].push_back(row);
-        }
-        if (!skipped.empty()) j["skipped"] = skipped;
-      }
-      // Hashing the inputs costs a read of each: only for the JSON, which records it.
-      j["provenance"] = awcc::provenance_json(options, inputs, command_line());
-      if (!o.json.empty()) outputs.emplace_back(o.json, awcc::json_text(j));
-      else json_for_report = awcc::json_text(j);
-    }
-    if (!o.windows.empty() && results[0].awcc) outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
-    std::vector<const awcc::ProcessResult*> all;
-    for (const auto& r : results) all.push_back(&r);
-    if (!o.correlation_functions.empty()) {
-      outputs.emplace_back(o.correlation_functions, awcc::correlation_functions_csv(all));
-    }
-    if (!o.spectrum.empty()) outputs.emplace_back(o.spectrum, awcc::velocity_spectrum_csv(all));
-    // The structure tables sit next to the profile CSV: profile.csv, profile_chord_pdf.csv, ...
-    if (!o.csv.empty() && options.structure.enabled) {
-      const std::filesystem::path base(o.csv);
-      for (const auto& [suffix, text] : awcc::structure_csv_tables(all, positions)) {
-        outputs.emplace_back((base.parent_path() / (base.stem().string() + suffix)).string(), text);
-      }
-    }
-    if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {
-      stdout_text = results[0].report();
-      if (model) stdout_text += correction_report(corrections[0]);
+  Rendered out;
+  if (!o.json.empty() || !o.report.empty()) {
+    nlohmann::json j;
+    if (results.size() == 1 && o.files.size() == 1) {
+      j = awcc::to_json(results[0]);
+      if (corrected) j["correction"] = correction_json(0);
     } else {
-      std::string table = awcc::profile_csv_header();
-      table += model ? "," + correction::correction_csv_header() + "\n" : "\n";
+      j["profile"] = nlohmann::json::array();
       for (std::size_t i = 0; i < results.size(); ++i) {
-        table += awcc::profile_csv_row(results[i], positions[i]);
-        table += model ? "," + correction::correction_csv_cells(corrections[i]) + "\n" : "\n";
+        auto row = awcc::to_json(results[i]);
+        row["position"] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
+        if (corrected) row["correction"] = correction_json(i);
+        j["profile"].push_back(row);
       }
-      if (o.csv.empty()) stdout_text = table;
-      else outputs.emplace_back(o.csv, table);
+      if (!p.skipped.empty()) j["skipped"] = p.skipped;
     }
-    for (const auto& [path, text] : outputs) awcc::check_output_folder(path);
+    // Hashing the inputs costs a read of each: only for the JSON, which records it.
+    j["provenance"] = awcc::provenance_json(plan.options, p.inputs, command_line());
+    if (!o.json.empty()) out.outputs.emplace_back(o.json, awcc::json_text(j));
+    else out.json_for_report = awcc::json_text(j);
+  }
+  if (!o.windows.empty() && results[0].awcc) out.outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
+  std::vector<const awcc::ProcessResult*> all;
+  for (const auto& r : results) all.push_back(&r);
+  if (!o.correlation_functions.empty()) {
+    out.outputs.emplace_back(o.correlation_functions, awcc::correlation_functions_csv(all));
+  }
+  if (!o.spectrum.empty()) out.outputs.emplace_back(o.spectrum, awcc::velocity_spectrum_csv(all));
+  // The structure tables sit next to the profile CSV: profile.csv, profile_chord_pdf.csv, ...
+  if (!o.csv.empty() && plan.options.structure.enabled) {
+    const std::filesystem::path base(o.csv);
+    for (const auto& [suffix, text] : awcc::structure_csv_tables(all, positions)) {
+      out.outputs.emplace_back((base.parent_path() / (base.stem().string() + suffix)).string(), text);
+    }
+  }
+  if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {
+    out.stdout_text = results[0].report();
+    if (corrected) out.stdout_text += correction_report(corrections[0]);
+  } else {
+    std::string table = awcc::profile_csv_header();
+    table += corrected ? "," + correction::correction_csv_header() + "\n" : "\n";
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      table += awcc::profile_csv_row(results[i], positions[i]);
+      table += corrected ? "," + correction::correction_csv_cells(corrections[i]) + "\n" : "\n";
+    }
+    if (o.csv.empty()) out.stdout_text = table;
+    else out.outputs.emplace_back(o.csv, table);
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_process(ProcessCommandOptions& o) {
+  Plan plan;
+  try {
+    plan = plan_of(o);
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  Processed processed;
+  try {
+    processed = process_files(o, plan);
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  const auto corrections = corrections_of(plan, processed);
+  try {
+    // A run fails whole or writes all: every folder is checked before any output is written.
+    const auto rendered = render(o, plan, processed, corrections);
+    for (const auto& [path, text] : rendered.outputs) awcc::check_output_folder(path);
     if (!o.report.empty()) awcc::check_output_folder(o.report);
-    for (const auto& [path, text] : outputs) awcc::write_text_atomically(path, text);
-    fmt::print("{}", stdout_text);
+    for (const auto& [path, text] : rendered.outputs) awcc::write_text_atomically(path, text);
+    fmt::print("{}", rendered.stdout_text);
     std::fflush(stdout);
-    if (!o.report.empty()) return report_of(o, json_for_report);
+    if (!o.report.empty()) return report_of(o, rendered.json_for_report);
   } catch (const std::exception& e) {
     return report_error(e);
   }

@@ -30,11 +30,7 @@ synth::Scene build_scene(const SceneCli& cli) {
   }
   std::vector<bool> used(settings.size(), false);
   awcc::apply_settings(fields, std::span<const awcc::OptionSetting>(settings), scene, used);
-  if (const auto errors = scene.validate(); !errors.empty()) {
-    std::string all;
-    for (const auto& e : errors) all += "\n  " + e;
-    throw std::invalid_argument("invalid scene:" + all);
-  }
+  if (const auto validation = scene.validate(); !validation.ok()) throw synth::invalid_scene(validation);
   return scene;
 }
 

@@ -51,8 +51,8 @@ int run_sweep(const SweepOptions& o) {
     return code == exit_bad_input ? exit_bad_usage : code;
   }
   for (const auto& run : runs) {
-    if (const auto errors = run.scene.validate(); !errors.empty()) {
-      spdlog::error("{}: run {} has an invalid scene: {}", o.study, run.index, errors.front());
+    if (const auto validation = run.scene.validate(); !validation.ok()) {
+      spdlog::error("{}: run {} has an invalid scene: {}", o.study, run.index, one_line(validation.message));
       return exit_bad_usage;
     }
   }

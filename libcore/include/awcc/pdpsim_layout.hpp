@@ -1,6 +1,6 @@
 #pragma once
 // pdp-sim's HDF5 signal layout (mattbuergler/pdp-simulator, binary_signal.h5),
-// in one place because libawcc reads it and libsynth writes it:
+// in one place because awcc::io reads it and libsynth writes it:
 //  - root dataset `signal`, samples x sensors, 0 (water) / 1 (air) as uint8
 //    ('u1'; pdp-sim's own tools read it back as int8);
 //  - root dataset `time`, float64 seconds, one value per sample, from 0;
@@ -12,6 +12,7 @@
 // attribute on `signal`.
 
 #include <mutex>
+#include <string>
 
 namespace awcc::pdpsim {
 
@@ -28,5 +29,12 @@ inline std::mutex& hdf5_mutex() {
   static std::mutex m;
   return m;
 }
+
+/// libhdf5's innermost complaint about the last failed call, as
+/// " (HDF5: ...)" (printable, at most 200 characters: a damaged file's bytes
+/// may be quoted), or empty; clears libhdf5's error stack. For the readers'
+/// and the writer's messages alike; call it holding hdf5_mutex(). Defined
+/// beside the layout (libhdf5 stays a private dependency of awcc::core).
+std::string hdf5_says();
 
 }  // namespace awcc::pdpsim

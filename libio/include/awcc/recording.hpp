@@ -115,7 +115,7 @@ class Recording {
   [[nodiscard]] const RecordingInfo& info() const { return info_; }
   /// Reads up to max_frames frames into `out` (at least max_frames x channels
   /// floats, interleaved volts). Returns the frames read; 0 at the end.
-  /// Throws std::runtime_error on damaged data (naming file and position).
+  /// Throws awcc::InputError on damaged data (naming file and position).
   virtual std::int64_t read(std::span<float> out, std::int64_t max_frames) = 0;
   /// Back to the first frame.
   virtual void rewind() = 0;
@@ -134,7 +134,9 @@ class Recording {
 };
 
 /// Opens a recording (detecting the format by content and extension unless
-/// told). Throws std::runtime_error naming the file, the problem and the fix.
+/// told). Throws awcc::InputError naming the file, the problem and the fix;
+/// its quantity() is the declared name of the reader option that fixes it
+/// ("dataset", "override-fs"), or empty when the file itself must change.
 std::unique_ptr<Recording> open_recording(const std::filesystem::path& path, const ReaderOptions& options = {});
 
 /// A recording held in memory (the Python module's arrays): frames x channels

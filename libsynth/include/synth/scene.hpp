@@ -12,7 +12,9 @@
 #include <string_view>
 #include <vector>
 
+#include "awcc/errors.hpp"
 #include "awcc/units.hpp"
+#include "awcc/validation.hpp"
 
 namespace synth {
 
@@ -92,9 +94,12 @@ struct Scene {
   /// Record length in samples, round(duration * fs).
   [[nodiscard]] std::int64_t sample_count() const;
 
-  /// Empty when the scene is valid; otherwise one message per problem, each
-  /// naming the field, its value and the allowed range.
-  [[nodiscard]] std::vector<std::string> validate() const;
+  /// ok, or every problem found, one per line, each naming the field, its
+  /// value and the allowed range (a scene is often wrong in several fields at
+  /// once, and one run should name them all). quantity: the field(s) of the
+  /// problem when there is one ("rho-xy,rho-xz,rho-yz"); empty when there
+  /// are several, as no single option fixes them.
+  [[nodiscard]] awcc::Validation validate() const;
 };
 
 /// A scene field as the user writes it.
@@ -114,6 +119,10 @@ std::span<const SceneField> scene_fields();
 
 /// Sets one field by name; throws std::invalid_argument (unknown field or bad value).
 void set_scene_field(Scene& scene, std::string_view name, std::string_view text);
+
+/// The error a front end or the synthesiser raises for a scene that failed
+/// validate(): "invalid scene:" and each problem on its own indented line.
+[[nodiscard]] awcc::OptionError invalid_scene(const awcc::Validation& validation);
 
 /// Reads a scene TOML file over `scene` (fields absent from the file keep their
 /// values). Keys are the field names; values are numbers in SI units or strings

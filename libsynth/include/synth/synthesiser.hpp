@@ -78,8 +78,8 @@ struct Synthesis {
   std::optional<ReferenceData> reference;    ///< with keep_reference_data
 };
 
-/// Synthesises a valid scene (throws std::invalid_argument listing
-/// Scene::validate() messages otherwise).
+/// Synthesises a valid scene (throws invalid_scene(scene.validate())
+/// otherwise).
 Synthesis synthesise(const Scene& scene, const SynthesisOptions& options = {});
 
 /// Reference piercing by testing every sample of every tip against every
