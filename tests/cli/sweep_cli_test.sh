@@ -7,8 +7,7 @@ set -u
 pdp=$1
 dir=$2/sweep_cli
 rm -rf "$dir" && mkdir -p "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+source "$(dirname "$0")/lib.sh"
 
 cat >"$dir/grid.toml" <<'TOML'
 [sweep]
@@ -25,18 +24,9 @@ bubble-diameter = ["2mm", "4mm"]
 dy = ["0mm", "1mm"]
 TOML
 
-# Rows without the run-time columns, sorted by run: what must not depend on
-# threads, order or interruptions.
-canonical() {
-  python3 - "$1" <<'PY'
-import csv, sys
-rows = list(csv.reader(open(sys.argv[1])))
-header, body = rows[0], rows[1:]
-keep = [i for i, h in enumerate(header) if not h.startswith("seconds_")]
-for r in sorted(body, key=lambda r: int(r[1])):
-    print(",".join(r[i] for i in keep))
-PY
-}
+# canonical FILE: the rows that must not depend on threads, order or
+# interruptions (lib.sh's sweep_rows).
+canonical() { sweep_rows "$1"; }
 
 "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/two.csv" --threads 2 || fail "sweep, 2 threads"
 "$pdp" --log-level warn sweep "$dir/grid.toml" -o "$dir/one.csv" --threads 1 || fail "sweep, 1 thread"
