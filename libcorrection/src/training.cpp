@@ -605,7 +605,12 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
     result.fscc_note = fmt::format("no FSCC forest: {} runs with an FSCC velocity, fewer than 500", set.fscc_rows.size());
     return;
   }
-  const auto [held_out, calibration_rows, training] = split_runs(set.fscc_rows, o);
+  // Named references, not a structured binding: the lambdas below use them
+  // (clang 14, which builds the fuzz targets, cannot capture a binding).
+  const Split split = split_runs(set.fscc_rows, o);
+  const auto& held_out = split.held_out;
+  const auto& calibration_rows = split.calibration;
+  const auto& training = split.training;
   const auto names = feature_set_names("fscc");
   FsccForest f;
   f.form = TargetForm::ratio;

@@ -44,7 +44,10 @@ std::vector<BenchRow> bench_one(const std::string& name, std::uint64_t seed, con
   if (std::find(plan.durations.begin(), plan.durations.end(), plan.base_duration) == plan.durations.end())
     records.emplace_back(plan.base_duration, 500e3);
   for (double f : plan.rates) records.emplace_back(plan.base_duration, f);
-  for (const auto& [duration, fs] : records) {
+  for (const auto& duration_and_rate : records) {
+    // Named copies, not a structured binding: the lambda below uses them
+    // (clang 14, which builds the fuzz targets, cannot capture a binding).
+    const double duration = duration_and_rate.first, fs = duration_and_rate.second;
     synth::Scene s = bench_scene(name);
     s.duration = duration;
     s.fs = fs;
