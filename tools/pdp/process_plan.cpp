@@ -1,0 +1,141 @@
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "awcc/csv.hpp"
+#include "awcc/options.hpp"
+#include "awcc/units.hpp"
+#include "process_steps.hpp"
+
+namespace pdp {
+
+namespace {
+
+awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
+  auto settings = o.library.settings();
+  if (!o.preset.empty()) settings.push_back({"preset", o.preset, origin_of("preset")});
+  const auto p = awcc::process_options(settings);
+  if (!o.windows.empty() && o.files.size() != 1) {
+    throw std::invalid_argument("--windows writes the window table of one recording; give one file");
+  }
+  if (!o.windows.empty() && !p.awcc) throw std::invalid_argument("--windows needs --method awcc or both");
+  if (!o.spectrum.empty() && (!p.awcc || !p.velocity_spectrum)) {
+    throw std::invalid_argument("--spectrum writes AWCC's velocity spectrum: use --method awcc or both, and "
+                                "--velocity-spectrum on");
+  }
+  if (!o.correlation_functions.empty() && !p.fscc) {
+    throw std::invalid_argument("--correlation-functions writes FSCC's functions: use --method fscc or both");
+  }
+  return p;
+}
+
+// Positions per file: from --positions, or a manifest CSV "file,position".
+std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o) {
+  std::vector<std::optional<double>> out(o.files.size());
+  auto length = [](const std::string& text, const std::string& where) {
+    try {
+      return awcc::parse_quantity(text, awcc::Dimension::length);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
+    }
+  };
+  if (!o.positions.empty()) {
+    const auto items = awcc::split_cells(o.positions);
+    if (items.size() != o.files.size()) {
+      throw std::invalid_argument(fmt::format("--positions gives {} positions for {} files; give one per file",
+                                              items.size(), o.files.size()));
+    }
+    for (std::size_t i = 0; i < items.size(); ++i) out[i] = length(items[i], "--positions");
+  } else if (!o.manifest.empty()) {
+    std::ifstream in(o.manifest);
+    std::map<std::string, double> by_name;
+    std::string line;
+    int number = 0;
+    while (std::getline(in, line)) {
+      ++number;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      const auto cells = awcc::split_cells(line);
+      if (cells.size() < 2) continue;
+      try {
+        by_name[std::filesystem::path(cells[0]).filename().string()] =
+            awcc::parse_quantity(cells[1], awcc::Dimension::length);
+      } catch (const std::invalid_argument& e) {
+        if (number == 1) continue;  // header row
+        throw std::invalid_argument(fmt::format("{}:{}: {}", o.manifest, number, e.what()));
+      }
+    }
+    std::map<std::string, std::string> seen;
+    for (std::size_t i = 0; i < o.files.size(); ++i) {
+      const auto name = std::filesystem::path(o.files[i]).filename().string();
+      if (const auto [at, fresh] = seen.emplace(name, o.files[i]); !fresh) {
+        throw std::invalid_argument(fmt::format("{} and {} share the name {}, which the manifest matches by: rename "
+                                                "one or give --positions",
+                                                at->second, o.files[i], name));
+      }
+      // A file without a row is refused once it proves to be a recording
+      // (a README caught by the same glob is skipped, not positioned).
+      if (const auto it = by_name.find(name); it != by_name.end()) out[i] = it->second;
+    }
+  }
+  return out;
+}
+
+// Two outputs into one file would leave only the last; inputs are never
+// modified, so an output that is one of them is refused.
+void check_output_names(const ProcessCommandOptions& o) {
+  const std::vector<std::pair<const char*, const std::string*>> named = {
+      {"--json", &o.json},       {"--csv", &o.csv},
+      {"--windows", &o.windows}, {"--correlation-functions", &o.correlation_functions},
+      {"--spectrum", &o.spectrum}, {"--report", &o.report}};
+  for (std::size_t a = 0; a < named.size(); ++a) {
+    for (std::size_t b = a + 1; b < named.size(); ++b) {
+      const auto& x = *named[a].second;
+      const auto& y = *named[b].second;
+      if (x.empty() || y.empty()) continue;
+      std::error_code ec;
+      if (x == y || (std::filesystem::exists(x) && std::filesystem::equivalent(x, y, ec))) {
+        throw std::invalid_argument(fmt::format("{} and {} both name {}: give each output its own file",
+                                                named[a].first, named[b].first, x));
+      }
+    }
+  }
+  for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum, o.report}) {
+    if (output.empty() || !std::filesystem::exists(output)) continue;
+    for (const auto& input : o.files) {
+      if (std::filesystem::equivalent(output, input)) {
+        throw std::invalid_argument(fmt::format("{} is an input recording; choose another output file", output));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Plan plan_of(const ProcessCommandOptions& o) {
+  Plan plan;
+  plan.options = build_options(o);
+  plan.positions = positions_for(o);
+  if (!o.correct.empty() && !plan.options.awcc) {
+    throw std::invalid_argument("--correct corrects AWCC's estimates; use --method awcc or both");
+  }
+  if (!o.correct.empty() && plan.options.awcc_options.probe_correction.enabled) {
+    throw std::invalid_argument("--correct and --probe-correction both correct AWCC's velocity: the model was trained "
+                                "on synthetic records without bubble-probe interaction; use one of them");
+  }
+  check_output_names(o);
+  // The model is read before any processing: a damaged one, or one trained
+  // on other processing, fails fast.
+  if (!o.correct.empty()) {
+    plan.model = correction::CorrectionModel::load(o.correct);
+    if (const auto why = plan.model->mismatch(correction::processing_of(plan.options.awcc_options)); !why.empty()) {
+      throw std::invalid_argument(fmt::format("--correct {}: the model was trained on results processed otherwise "
+                                              "({}); process with the model's settings or train a model for these",
+                                              o.correct, why));
+    }
+  }
+  return plan;
+}
+
+}  // namespace pdp

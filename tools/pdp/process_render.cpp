@@ -1,0 +1,114 @@
+#include <fmt/format.h>
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include "awcc/atomic_output.hpp"
+#include "awcc/errors.hpp"
+#include "awcc/json_text.hpp"
+#include "awcc/serialise.hpp"
+#include "command.hpp"
+#include "process_steps.hpp"
+#include "report_command.hpp"
+
+namespace pdp {
+
+namespace {
+
+std::string correction_report(const correction::Correction& c) {
+  if (!c.corrected()) return fmt::format("  correction: not corrected: {}\n", c.message);
+  const auto& u = *c.velocity;
+  const auto& t = *c.turbulence_intensity;
+  return fmt::format(
+      "  correction (quantile regression forest):\n"
+      "    velocity             {:.4f} m/s median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n"
+      "    turbulence intensity {:.4f} median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
+      u.median(), u.quantiles[1], u.quantiles[5], u.quantiles[0], u.quantiles[6], u.measured, t.median(),
+      t.quantiles[1], t.quantiles[5], t.quantiles[0], t.quantiles[6], t.measured);
+}
+
+}  // namespace
+
+// The report is drawn from the JSON: the --json file, or the same text in a
+// hidden scratch file beside the report, removed afterwards.
+int report_of(const ProcessCommandOptions& o, const std::string& json_text) {
+  if (!o.json.empty()) return write_report({o.json, "-o", o.report});
+  const auto folder = std::filesystem::absolute(o.report).parent_path();
+  std::string scratch = (folder / ".pdp-report-XXXXXX.json").string();
+  const int fd = mkstemps(scratch.data(), 5);
+  if (fd < 0) throw awcc::OutputError(fmt::format("{}: cannot create a scratch file for the report's JSON: {}",
+                                                  folder.string(), std::strerror(errno)));
+  ::close(fd);
+  struct Remove {
+    std::string path;
+    ~Remove() { std::error_code ec; std::filesystem::remove(path, ec); }
+  } remove{scratch};
+  awcc::write_text_atomically(scratch, json_text);
+  return write_report({scratch, "-o", o.report, "--input-name", "the results of pdp process (no --json written)"});
+}
+
+Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processed& p,
+                const std::vector<correction::Correction>& corrections) {
+  const auto& results = p.results;
+  const auto& positions = p.positions;
+  const bool corrected = plan.model.has_value();
+  auto correction_json = [&](std::size_t i) {
+    auto c = correction::to_json(corrections[i]);
+    c["model"] = std::filesystem::path(o.correct).filename().string();
+    return c;
+  };
+  Rendered out;
+  if (!o.json.empty() || !o.report.empty()) {
+    nlohmann::json j;
+    if (results.size() == 1 && o.files.size() == 1) {
+      j = awcc::to_json(results[0]);
+      if (corrected) j["correction"] = correction_json(0);
+    } else {
+      j["profile"] = nlohmann::json::array();
+      for (std::size_t i = 0; i < results.size(); ++i) {
+        auto row = awcc::to_json(results[i]);
+        row["position"] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
+        if (corrected) row["correction"] = correction_json(i);
+        j["profile"].push_back(row);
+      }
+      if (!p.skipped.empty()) j["skipped"] = p.skipped;
+    }
+    // Hashing the inputs costs a read of each: only for the JSON, which records it.
+    j["provenance"] = awcc::provenance_json(plan.options, p.inputs, command_line());
+    if (!o.json.empty()) out.outputs.emplace_back(o.json, awcc::json_text(j));
+    else out.json_for_report = awcc::json_text(j);
+  }
+  if (!o.windows.empty() && results[0].awcc) out.outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
+  std::vector<const awcc::ProcessResult*> all;
+  for (const auto& r : results) all.push_back(&r);
+  if (!o.correlation_functions.empty()) {
+    out.outputs.emplace_back(o.correlation_functions, awcc::correlation_functions_csv(all));
+  }
+  if (!o.spectrum.empty()) out.outputs.emplace_back(o.spectrum, awcc::velocity_spectrum_csv(all));
+  // The structure tables sit next to the profile CSV: profile.csv, profile_chord_pdf.csv, ...
+  if (!o.csv.empty() && plan.options.structure.enabled) {
+    const std::filesystem::path base(o.csv);
+    for (const auto& [suffix, text] : awcc::structure_csv_tables(all, positions)) {
+      out.outputs.emplace_back((base.parent_path() / (base.stem().string() + suffix)).string(), text);
+    }
+  }
+  if (results.size() == 1 && o.files.size() == 1 && o.csv.empty()) {
+    out.stdout_text = results[0].report();
+    if (corrected) out.stdout_text += correction_report(corrections[0]);
+  } else {
+    std::string table = awcc::profile_csv_header();
+    table += corrected ? "," + correction::correction_csv_header() + "\n" : "\n";
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      table += awcc::profile_csv_row(results[i], positions[i]);
+      table += corrected ? "," + correction::correction_csv_cells(corrections[i]) + "\n" : "\n";
+    }
+    if (o.csv.empty()) out.stdout_text = table;
+    else out.outputs.emplace_back(o.csv, table);
+  }
+  return out;
+}
+
+}  // namespace pdp
