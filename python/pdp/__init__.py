@@ -8,6 +8,8 @@ Numpy in, numpy and dicts out, no file needed:
     a = pdp.awcc(lead, trail, fs=20e3, dx=7.15e-3, np=10)
     s = pdp.synth(duration=10, fs=100e3)                # signals and their truth
     c = pdp.correct(r, model="awcc.qrf")                # bias-corrected quantiles
+    p = pdp.process(files, fs=20e3, dx="7.15mm", positions=ys)  # a Profile
+    p.to_dataframe(), p.profile[1].windows              # the profile CSV's table; a position's windows
 
 Options are the command line's, by the same declarations (``pdp process
 --help``): write ``filter_a=0.5`` for ``--filter-a 0.5``. A number is in SI
@@ -29,12 +31,14 @@ from ._errors import InputError, OptionError, OutputError, PdpError
 __version__ = _pdp.version
 __all__ = ["read", "binarise", "phase_statistics", "fscc", "awcc", "process", "synth", "correct", "options",
            "profile_columns",
-           "Result", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
+           "Result", "Profile", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
 
 
 class Result(dict):
     """A result: the JSON object of docs/output.md, with attribute access
-    (``r.awcc.velocity`` is ``r["awcc"]["velocity"]``)."""
+    (``r.awcc.velocity`` is ``r["awcc"]["velocity"]``). A key that is also a
+    dict method (``values`` of a profile column) is read with brackets:
+    ``c["values"]``; ``c.values`` is the method."""
 
     def __getattr__(self, name):
         try:
@@ -50,8 +54,51 @@ class Result(dict):
         return _json.dumps(self, **kwargs)
 
 
+# What pdp.process keeps of a recording beside its JSON, as attributes of its
+# Result: the window table, R11 and R12, the velocity spectrum.
+_DETAIL = ("windows", "correlation", "spectrum")
+
+
+class Profile(Result):
+    """A profile: ``{"profile": [...], "provenance": ...}`` as ``pdp process
+    --json`` writes it, one Result per position in ``profile``. Processed by
+    pdp.process, each position keeps its detail: ``profile[i].windows`` (the
+    AWCC window table), ``.correlation`` and ``.spectrum``."""
+
+    def __getattr__(self, name):
+        if name in _DETAIL and name not in self:
+            raise AttributeError(f"a profile has no '{name}' of its own: each position has its own, "
+                                 f"profile[i].{name}")
+        return super().__getattr__(name)
+
+    def to_dataframe(self):
+        """The profile as a pandas DataFrame: one row per position, the
+        profile CSV's columns (pdp.profile_columns(self): names, order, SI
+        units in ``attrs["units"]``, meanings in ``attrs["meanings"]``) with
+        the JSON's values (None/NaN where the CSV cell is empty; true/false
+        where it writes on/off; ``file`` as given; ``warnings`` a list).
+        Needs pandas (Debian's python3-pandas)."""
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("Profile.to_dataframe needs pandas: install Debian's python3-pandas "
+                              "(scripts/setup installs it)") from None
+        from .report import cell_value  # the report's table reads its cells the same way
+
+        columns = profile_columns(self)
+        provenance = self.get("provenance") or {}
+        rows = self["profile"]
+        frame = pandas.DataFrame({c["name"]: [cell_value(row, c, provenance) for row in rows] for c in columns},
+                                 columns=[c["name"] for c in columns])
+        frame.attrs["units"] = {c["name"]: c["unit"] for c in columns}
+        frame.attrs["meanings"] = {c["name"]: c["meaning"] for c in columns}
+        return frame
+
+
 def _wrap(value):
     if isinstance(value, dict):
+        if isinstance(value.get("profile"), list):
+            return Profile((k, _wrap(v)) for k, v in value.items())
         return Result((k, _wrap(v)) for k, v in value.items())
     if isinstance(value, list):
         return [_wrap(v) for v in value]
@@ -101,14 +148,25 @@ def options(group=None):
     return [Result(o) for o in _OPTIONS if group is None or o["group"] == group]
 
 
-def profile_columns():
-    """The profile CSV's columns, then the correction's: ``name``, ``unit``
-    ("" for text, "-" when dimensionless), ``pointer`` (RFC 6901: where the
-    same value is in a recording's result; "" for the version, which is in the
-    provenance), ``meaning`` and ``values`` (the texts an enum or on/off
-    column may hold; empty for numbers and free text), as the libraries
-    declare them."""
-    return [Result(c) for c in _pdp.profile_columns()]
+def profile_columns(result=None):
+    """The profile CSV's columns as the libraries declare them: ``name``,
+    ``unit`` ("" for text, "-" when dimensionless), ``pointer`` (RFC 6901:
+    where the same value is in a recording's result; "" for the version,
+    which is in the provenance), ``meaning`` and ``values`` (the texts an
+    enum or on/off column may hold; empty for numbers and free text; read it
+    as ``c["values"]``). Without ``result``: every column, the correction's
+    last. With a result of pdp.process or pdp.correct (a profile, one
+    recording, or their JSON as a dict): the columns its CSV has, the
+    correction's only when it holds a correction."""
+    if result is None:
+        corrected = True
+    elif isinstance(result, dict):
+        rows = result["profile"] if isinstance(result.get("profile"), list) else [result]
+        corrected = any(isinstance(r, dict) and r.get("correction") is not None for r in rows)
+    else:
+        raise TypeError(f"profile_columns(result): result is of type {type(result).__name__}; give what pdp.process or "
+                        "pdp.correct returned (or a process JSON loaded as a dict), or nothing for every column")
+    return [Result(c) for c in _pdp.profile_columns(corrected)]
 
 
 _UNITS = {o["name"]: o["unit"] for o in _OPTIONS if o["group"] != "scene"}
@@ -274,7 +332,9 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     AWCC window table, ``result.correlation`` R11 and R12 (``lag`` in s,
     ``r11``, ``r12``; NaN outside a function's lags) and ``result.spectrum``
     Welch's PSD of AWCC's velocity series (``frequency`` Hz, ``density``
-    (m/s)^2/Hz, ``resolvable_frequency``), or None."""
+    (m/s)^2/Hz, ``resolvable_frequency``), or None. A profile is a Profile:
+    each position ``result.profile[i]`` has them, and ``result.to_dataframe()``
+    is the profile CSV's table."""
     settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
     if isinstance(source, (str, _os.PathLike)):
@@ -285,11 +345,12 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
         paths = [_os.fspath(p) for p in source]
         if positions is not None and len(positions) != len(paths):
             raise OptionError(f"{len(positions)} positions for {len(paths)} files; give one per file")
-        rows, windows, detail = [], None, None
+        rows, details = [], []
         for i, path in enumerate(paths):
-            row, _, _ = _pdp.process_file(path, settings, preset or "")
+            row, windows, detail = _pdp.process_file(path, settings, preset or "")
             row["position"] = None if positions is None else float(positions[i])
             rows.append(row)
+            details.append(_detail(windows, detail))
         inputs, out = paths, {"profile": rows}
     else:
         out, windows, detail = _arrays(source, trail, fs, volts_per_count, options, preset)
@@ -301,10 +362,18 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
             _warnings.warn(w, stacklevel=2)
     out["provenance"] = _pdp.provenance(inputs, settings, preset or "", call)
     result = _wrap(out)
-    result.windows = _table(windows)
-    result.correlation = None if detail is None else detail["correlation"]
-    result.spectrum = None if detail is None else detail["spectrum"]
+    if isinstance(source, (list, tuple)):
+        for row, row_detail in zip(result.profile, details):
+            row.__dict__.update(row_detail)
+    else:
+        result.__dict__.update(_detail(windows, detail))
     return result
+
+
+def _detail(windows, detail):
+    """A recording's detail (_DETAIL) from the compiled core's answer."""
+    return {"windows": _table(windows), "correlation": None if detail is None else detail["correlation"],
+            "spectrum": None if detail is None else detail["spectrum"]}
 
 
 def synth(scene=None, *, signal="binary", **fields):
@@ -352,13 +421,20 @@ def correct(results, model, *, dx=None, dy=None, np=None):
     ``pdp.process`` returns (one recording or a profile) or a process JSON
     loaded as a dict. Returns the results with a ``correction`` object per
     recording (median, 80 % and 95 % quantiles of u and Tu, or why not
-    corrected), as ``pdp correct`` writes them. ``dx``, ``dy`` (m) and ``np``
+    corrected), as ``pdp correct`` writes them, each recording's windows,
+    correlation and spectrum kept. ``dx``, ``dy`` (m) and ``np``
     fill values the results lack."""
     out, warnings = _pdp.correct(_json.dumps(results), _os.fspath(model), dx, dy, np)
     for w in warnings:
         import warnings as _warnings
         _warnings.warn(w, stacklevel=2)
-    return _wrap(out)
+    corrected = _wrap(out)
+    # What pdp.process kept beside the JSON stays with its recording.
+    before = results.get("profile", [results]) if isinstance(results, dict) else []
+    after = corrected.profile if isinstance(corrected, Profile) else [corrected]
+    for old, new in zip(before, after):
+        new.__dict__.update({k: v for k, v in getattr(old, "__dict__", {}).items() if k in _DETAIL})
+    return corrected
 
 
 # --- help from the declarations ------------------------------------------------

@@ -450,8 +450,9 @@ PYBIND11_MODULE(_pdp, m) {
       translate("OutputError", e.what(), {});
     }
   });
-  m.def("profile_columns", [] {
-    // The profile CSV's columns and then the correction's, as the libraries declare them.
+  m.def("profile_columns", [](bool correction) {
+    // The profile CSV's columns and then, when the CSV holds a correction, the
+    // correction's, as the libraries declare them.
     py::list out;
     auto add = [&](std::span<const awcc::ProfileColumn> columns) {
       for (const auto& c : columns) {
@@ -463,9 +464,9 @@ PYBIND11_MODULE(_pdp, m) {
       }
     };
     add(awcc::profile_csv_columns());
-    add(correction::correction_csv_columns());
+    if (correction) add(correction::correction_csv_columns());
     return out;
-  });
+  }, py::arg("correction"));
   m.def("options", &options);
   m.def("read", &read_recording, py::arg("path"), py::arg("settings"));
   m.def("binarise", &binarise, py::arg("channels"), py::arg("fs"), py::arg("volts_per_count"), py::arg("settings"));
