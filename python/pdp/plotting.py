@@ -20,9 +20,15 @@ import re
 import tempfile
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
+from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa: E402
+from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.font_manager import FontProperties  # noqa: E402
+from matplotlib.path import Path  # noqa: E402
+from matplotlib.transforms import Bbox  # noqa: E402
 
 # Okabe & Ito (2008): distinguishable with every common colour-vision deficiency.
 BLACK, ORANGE, SKY, GREEN, YELLOW, BLUE, VERMILION, PURPLE, GREY = (
@@ -69,6 +75,7 @@ def figure(width=4.6, height=3.4, rows=1, cols=1, margins=None):
     inches) fix the layout: much faster than tight_layout or a tight bounding
     box, which lay every tick label out again (most of a report's time)."""
     fig = Figure(figsize=(width, height))
+    FigureCanvasAgg(fig)  # a renderer to measure legends with (legend())
     axes = fig.subplots(rows, cols, squeeze=False)
     if margins:
         left, bottom, right, top = margins
@@ -167,8 +174,175 @@ def _finish(ax, ylabel, xlabel, title, legend_size=None):
     ax.set_ylabel(ylabel)
     ax.set_xlabel(xlabel)
     ax.set_title(title)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="best", fontsize=legend_size)
+    legend(ax, fontsize=legend_size)
+
+
+# --- legends where the data is not ------------------------------------------------
+# matplotlib's loc="best" takes the place that covers the fewest line
+# vertices, markers ignored, and covers data when every place does; error
+# bars, text beside points and arrows it does not see. Here a legend goes to
+# the first place inside its axes that covers nothing drawn, measured in
+# display pixels, else beneath the axes' tick labels and label, the figure
+# grown to hold it.
+
+# Each place inside the axes and the anchor (Bbox.anchored) matplotlib puts a legend there by.
+_INSIDE = (("upper right", "NE"), ("upper left", "NW"), ("lower right", "SE"), ("lower left", "SW"),
+           ("upper center", "N"), ("lower center", "S"), ("center right", "E"), ("center left", "W"),
+           ("center", "C"))
+_CLEARANCE = 3.0  # points kept free around a legend
+
+
+def _renderer(fig):
+    """A renderer to measure text with: the canvas's, or Agg's (the one the
+    SVG's layout is measured with too) for a canvas that has none."""
+    get = getattr(fig.canvas, "get_renderer", None)
+    return get() if get else RendererAgg(int(fig.bbox.width), int(fig.bbox.height), fig.dpi)
+
+
+def _no_line(style):
+    return style in (None, "None", "none", "", " ")
+
+
+def _drawn(ax, renderer):
+    """What the axes draw, in display pixels: (polylines as (n, 2) arrays,
+    boxes clipped to the axes as an (n, 4) array x0 y0 x1 y1, boxes of text
+    and arrows, which are not clipped)."""
+    ax.get_xlim(), ax.get_ylim()  # autoscaling done: the transforms are final
+    points = renderer.points_to_pixels(1.0)
+    lines, boxes, texts = [], [], []
+
+    def box(b):
+        return [b.x0, b.y0, b.x1, b.y1]
+
+    for line in ax.lines:
+        if not line.get_visible():
+            continue
+        xy = line.get_transform().transform(np.asarray(line.get_xydata(), dtype=float))
+        if not _no_line(line.get_linestyle()) and len(xy) > 1:
+            lines.append(xy)
+        if not _no_line(line.get_marker()):
+            r = points * (0.5 * line.get_markersize() + line.get_markeredgewidth())
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            boxes.extend(np.column_stack([xy - r, xy + r]))
+    for c in ax.collections:
+        if not c.get_visible():
+            continue
+        if isinstance(c, LineCollection):  # error bars
+            transform = c.get_transform()
+            lines.extend(transform.transform(np.asarray(v, dtype=float)) for v in c.get_segments() if len(v))
+        else:
+            boxes.append(box(c.get_window_extent(renderer)))
+    for patch in ax.patches:
+        if not patch.get_visible():
+            continue
+        if patch.get_fill():  # bars
+            boxes.append(box(patch.get_window_extent(renderer)))
+        else:  # steps
+            path = patch.get_transform().transform_path(patch.get_path())
+            lines.extend(path.to_polygons(closed_only=False))
+    for text in ax.texts:
+        if not text.get_visible():
+            continue
+        if text.get_text():
+            texts.append(box(text.get_window_extent(renderer)))
+        arrow = getattr(text, "arrow_patch", None)
+        if arrow is not None:
+            text.update_positions(renderer)
+            texts.append(box(arrow.get_window_extent(renderer)))
+    return lines, np.array(boxes, dtype=float).reshape(-1, 4), np.array(texts, dtype=float).reshape(-1, 4)
+
+
+def _overlap(boxes, b):
+    return bool(np.any((boxes[:, 0] < b.x1) & (boxes[:, 2] > b.x0) & (boxes[:, 1] < b.y1) & (boxes[:, 3] > b.y0)))
+
+
+def _covers(b, drawn, clip):
+    """Whether box b covers anything drawn (data is clipped to the axes' box)."""
+    lines, boxes, texts = drawn
+    if _overlap(texts, b):
+        return True
+    inner = Bbox.intersection(b, clip)
+    if inner is None:
+        return False
+    if _overlap(boxes, inner):
+        return True
+    for xy in lines:
+        finite = np.isfinite(xy).all(axis=1)
+        for run in np.split(xy, np.flatnonzero(np.diff(finite.astype(int))) + 1):  # a NaN breaks a line
+            run = run[np.isfinite(run).all(axis=1)]
+            if len(run) and Path(run).intersects_bbox(inner, filled=False):
+                return True
+    return False
+
+
+def legend(ax, fontsize=None):
+    """The axes' legend where it covers no data: the first place inside the
+    axes whose box, with 3 points around it, covers no point, line, error
+    bar, bar, step, reference line or label the axes draw; where there is
+    none, beneath the axes' tick labels and label (in as many columns as fit
+    the axes' width, at most 3), the figure grown to hold it. Call it when
+    the axes are complete (limits set). Returns the legend, or None without
+    labelled artists."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    fig = ax.figure
+    renderer = _renderer(fig)
+    drawn = _drawn(ax, renderer)
+    pad = renderer.points_to_pixels(_CLEARANCE)
+    # Made once and measured: each place's box is the legend's size anchored
+    # in the axes inset by its border pad, as matplotlib places it.
+    placed = ax.legend(handles, labels, loc=_INSIDE[0][0], fontsize=fontsize)
+    size = placed.get_window_extent(renderer)
+    inset = ax.bbox.padded(-placed.borderaxespad * renderer.points_to_pixels(placed.prop.get_size_in_points()))
+    for loc, anchor in _INSIDE:
+        if not _covers(size.anchored(anchor, container=inset).padded(pad), drawn, ax.bbox):
+            return placed if loc == _INSIDE[0][0] else ax.legend(handles, labels, loc=loc, fontsize=fontsize)
+    below = ax.xaxis.get_tightbbox(renderer)
+    bottom = min(ax.bbox.y0, below.y0 if below is not None else ax.bbox.y0) - pad
+    anchor = (0.5, (bottom - ax.bbox.y0) / ax.bbox.height)
+    for ncol in range(min(3, len(handles)), 0, -1):
+        placed = ax.legend(handles, labels, loc="upper center", bbox_to_anchor=anchor, bbox_transform=ax.transAxes,
+                           ncol=ncol, fontsize=fontsize)
+        extent = placed.get_window_extent(renderer)
+        if extent.width <= ax.bbox.width:
+            break
+    need = _floor_beneath(ax, extent, renderer) + pad - extent.y0
+    if need > 0:
+        _grow_beneath(fig, ax.bbox.y0, need)
+    return placed
+
+
+def _floor_beneath(ax, extent, renderer):
+    """The highest display y that a legend beneath ax must stay above: the
+    tops of the axes below it (with room for a title, which a panel drawn
+    later may still get) and the figure's own texts (a footer) under it,
+    else the figure's bottom edge."""
+    title = renderer.get_text_width_height_descent("Ag", FontProperties(size=matplotlib.rcParams["axes.titlesize"]),
+                                                   ismath=False)[1]
+    title += renderer.points_to_pixels(matplotlib.rcParams["axes.titlepad"])
+    floor = 0.0
+    for other in ax.figure.axes:
+        b = other.bbox
+        if other is not ax and b.y1 <= ax.bbox.y0 and b.x0 < extent.x1 and b.x1 > extent.x0:
+            floor = max(floor, b.y1 + title)
+    for text in ax.figure.texts:
+        b = text.get_window_extent(renderer)
+        if b.y1 <= ax.bbox.y0 and b.x0 < extent.x1 and b.x1 > extent.x0:
+            floor = max(floor, b.y1)
+    return floor
+
+
+def _grow_beneath(fig, y, pixels):
+    """Opens a band `pixels` high at display height y: the figure grows and
+    every axes at or above y moves up, each keeping its size in inches."""
+    width, height = fig.get_size_inches()
+    grow = pixels / fig.dpi
+    positions = [(a, a.get_position()) for a in fig.axes]
+    fig.set_size_inches(width, height + grow)
+    for a, p in positions:
+        lift = grow if p.y0 * height * fig.dpi >= y - 0.5 else 0.0
+        a.set_position([p.x0, (p.y0 * height + lift) / (height + grow), p.width, p.height * height / (height + grow)])
 
 
 def _not_ok(ax, what, result):
