@@ -190,6 +190,16 @@ _INSIDE = (("upper right", "NE"), ("upper left", "NW"), ("lower right", "SE"), (
            ("upper center", "N"), ("lower center", "S"), ("center right", "E"), ("center left", "W"),
            ("center", "C"))
 _CLEARANCE = 3.0  # points kept free around a legend
+# Text measured at one resolution is up to ~6 % taller or wider at another
+# (hinting: 63 pt at 72 dpi, 68 at 100, 72 at 120 for one 6-line legend);
+# the free place around a legend grows with it by this fraction of its size.
+_GROWTH = 0.08
+
+
+def _around(box, pad):
+    """box with pad pixels and _GROWTH of its size added on every side."""
+    w, h = pad + _GROWTH * box.width, pad + _GROWTH * box.height
+    return Bbox.from_extents(box.x0 - w, box.y0 - h, box.x1 + w, box.y1 + h)
 
 
 def _renderer(fig):
@@ -296,7 +306,7 @@ def legend(ax, fontsize=None):
     size = placed.get_window_extent(renderer)
     inset = ax.bbox.padded(-placed.borderaxespad * renderer.points_to_pixels(placed.prop.get_size_in_points()))
     for loc, anchor in _INSIDE:
-        if not _covers(size.anchored(anchor, container=inset).padded(pad), drawn, ax.bbox):
+        if not _covers(_around(size.anchored(anchor, container=inset), pad), drawn, ax.bbox):
             return placed if loc == _INSIDE[0][0] else ax.legend(handles, labels, loc=loc, fontsize=fontsize)
     below = ax.xaxis.get_tightbbox(renderer)
     bottom = min(ax.bbox.y0, below.y0 if below is not None else ax.bbox.y0) - pad
@@ -307,7 +317,7 @@ def legend(ax, fontsize=None):
         extent = placed.get_window_extent(renderer)
         if extent.width <= ax.bbox.width:
             break
-    need = _floor_beneath(ax, extent, renderer) + pad - extent.y0
+    need = _floor_beneath(ax, extent, renderer) - _around(extent, pad).y0
     if need > 0:
         _grow_beneath(fig, ax.bbox.y0, need)
     return placed
