@@ -10,7 +10,8 @@ return matplotlib Figures; ``svg`` turns one into inline SVG text.
 Conventions, for print and for colour-blind readers: the Okabe-Ito palette,
 each series also told apart by marker or line style; positions in mm on the
 vertical axis (a profile is read bottom to top); times in ms; velocities in
-m/s; never metres in scientific notation.
+m/s; never metres in scientific notation; a legend covers no data (legend():
+a free place inside the axes, else beneath them).
 """
 
 import io
