@@ -26,6 +26,15 @@ def cli():
     return run
 
 
+def made(*args, cwd=None):
+    """Runs pdp with args (quiet) and asserts it succeeded; skips without PDP_CLI."""
+    path = os.environ.get("PDP_CLI")
+    if not path or not os.path.exists(path):
+        pytest.skip("PDP_CLI is not set to the pdp command line (ctest sets it)")
+    done = subprocess.run([path, "--log-level", "error", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+    assert done.returncode == 0, done.stderr
+
+
 @pytest.fixture(scope="session")
 def real_files():
     if not DATA.is_dir():

@@ -12,17 +12,14 @@ and grid, titles, legends) on a transparent canvas, so that a pixel with
 any opacity is one the data drew."""
 
 import json
-import os
-import subprocess
 
 import matplotlib
 import numpy as np
 import pdp
-import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from pdp import plotting, report
 
-from conftest import MODEL
+from conftest import MODEL, made
 
 DPI = 72  # a legend's box and the data scale alike; 72 keeps ten 3 x 3 figures quick
 
@@ -121,14 +118,6 @@ def details(path):
         assert detail is not None, why
         return detail
     return rows, detail_of
-
-
-def made(*args, cwd=None):
-    path = os.environ.get("PDP_CLI")
-    if not path or not os.path.exists(path):
-        pytest.skip("PDP_CLI is not set to the pdp command line (ctest sets it)")
-    done = subprocess.run([path, "--log-level", "error", *map(str, args)], capture_output=True, text=True, cwd=cwd)
-    assert done.returncode == 0, done.stderr
 
 
 def test_no_legend_of_the_real_report_covers_data(real_files, tmp_path):

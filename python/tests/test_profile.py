@@ -8,24 +8,15 @@ installs it, and a machine without it fails here rather than skipping."""
 import csv
 import math
 import os
-import subprocess
 
 import numpy as np
 import pandas
 import pdp
 import pytest
 
-from conftest import DATA, MODEL, SOURCE
+from conftest import DATA, MODEL, SOURCE, made
 
 POSITIONS = [0.002, 0.008, 0.014, 0.020, 0.026, 0.032, 0.038, 0.044, 0.050, 0.054]  # m
-
-
-def cli(*args, cwd=None):
-    path = os.environ.get("PDP_CLI")
-    if not path or not os.path.exists(path):
-        pytest.skip("PDP_CLI is not set to the pdp command line (ctest sets it)")
-    done = subprocess.run([path, "--log-level", "error", *map(str, args)], capture_output=True, text=True, cwd=cwd)
-    assert done.returncode == 0, done.stderr
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +26,7 @@ def corrected(real_files):
 
 def cli_csv(real_files, folder, *more):
     positions = ",".join(f"{1e3 * y:g}mm" for y in POSITIONS[:len(real_files)])
-    cli("process", *real_files, "--fs", "20kHz", "--dx", "7.15mm", "--positions", positions, *more,
+    made("process", *real_files, "--fs", "20kHz", "--dx", "7.15mm", "--positions", positions, *more,
         "--csv", folder / "profile.csv")
     with open(folder / "profile.csv", newline="") as f:
         return list(csv.reader(f))
