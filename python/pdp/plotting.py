@@ -400,7 +400,7 @@ def _awcc_and_corrected(ax, y, rows, quantity, measured_label):
     for forest, colour, mark, what in (("awcc", VERMILION, "^", "corrected"),
                                        ("fscc", PURPLE, "s", "corrected from FSCC (no usable AWCC)")):
         def corrected(r, forest=forest):
-            if (get(r, "correction", "forest") or "awcc") != forest:
+            if (get(r, "correction", "forest") or "awcc") != forest or _untrusted(r):
                 return None
             return get(r, "correction", quantity, "median")
         for low, high, marker, width, label in (("0.025", "0.975", None, 1.0, f"{what}, 95 % band"),
@@ -416,12 +416,38 @@ def _quantiles(r, q, a, b):
     return (qs.get(a), qs.get(b)) if qs else None
 
 
+def _untrusted(r):
+    """A correction whose quantiles are kept but not presented as corrected."""
+    return get(r, "correction", "status") == "untrusted"
+
+
+def _untrusted_medians(ax, y, rows, quantity, unit):
+    """Untrusted corrections' medians, drawn apart (hollow, grey, no band)
+    once the axes' limits are set, which they leave as they are: one beyond
+    them is drawn at the edge, pointing out, with its value."""
+    points = [(y[i], number(get(r, "correction", quantity, "median"))) for i, r in enumerate(rows) if _untrusted(r)]
+    points = [(yi, v) for yi, v in points if v is not None]
+    if not points:
+        return
+    lo, hi = ax.get_xlim()
+    style = dict(ls="none", mfc="none", mec=GREY, mew=1.5, ms=8)
+    for yi, v in points:
+        x, marker, side = (hi, ">", -1) if v > hi else (lo, "<", 1) if v < lo else (v, "o", 0)
+        ax.plot([x], [yi], marker=marker, clip_on=False, scalex=False, scaley=False, **style)
+        if side:
+            ax.annotate(f"{v:.3g} {unit}".rstrip(), (x, yi), textcoords="offset points", xytext=(8 * side, 0),
+                        ha="left" if side > 0 else "right", va="center", fontsize=7, color=GREY)
+    ax.plot([], [], marker="o", label="untrusted correction's median (not a corrected value)", **style)
+    ax.set_xlim(lo, hi)
+
+
 def profile_velocity(rows, ax=None):
     fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "fscc", "velocity"), color=BLACK, marker="D", ls=":", mfc="none",
             label="FSCC")
     _awcc_and_corrected(ax, y, rows, "velocity", "AWCC, 95 % interval")
+    _untrusted_medians(ax, y, rows, "velocity", "m/s")
     _finish(ax, ylabel, "mean interfacial velocity (m/s)", "Velocity")
     return fig
 
@@ -431,6 +457,7 @@ def profile_turbulence(rows, ax=None):
     y, ylabel = positions_mm(rows)
     _awcc_and_corrected(ax, y, rows, "turbulence_intensity", "AWCC, 95 % interval")
     ax.set_xlim(left=0)
+    _untrusted_medians(ax, y, rows, "turbulence_intensity", "")
     _finish(ax, ylabel, "turbulence intensity Tu (-)", "Turbulence intensity (AWCC)")
     return fig
 

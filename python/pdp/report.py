@@ -97,9 +97,10 @@ def check_written_values(path, data, rows, columns):
         where = f"/profile/{i}" if "profile" in data else ""
         for c in columns:
             value = pointer_value(row, c["pointer"]) if c.get("values") else None
-            if isinstance(value, str) and value not in c["values"]:
-                raise InputProblem(f"{path}: {where}{c['pointer']} = '{value}' is not a value pdp writes "
-                                   f"({', '.join(c['values'])}); give the file pdp process --json wrote")
+            for v in value if isinstance(value, list) else [value]:  # a list column: each of its codes
+                if isinstance(v, str) and v not in c["values"]:
+                    raise InputProblem(f"{path}: {where}{c['pointer']} = '{v}' is not a value pdp writes "
+                                       f"({', '.join(c['values'])}); give the file pdp process --json wrote")
 
 
 def cell_value(row, column, provenance):
@@ -340,6 +341,12 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
         spectrum_warning = (row.get("velocity_spectrum") or {}).get("warning")
         if spectrum_warning:
             notes.append(("velocity_spectrum.warning", spectrum_warning, None))
+        correction = row.get("correction") or {}
+        if correction.get("status") == "untrusted":
+            notes.append(("correction.status", "untrusted: its quantiles are kept in the table but are not a "
+                          "corrected value (the figures draw its median apart, hollow)", None))
+        for text in correction.get("notes") or []:
+            notes.append(("correction.notes", text, None))
         positions.append({"index": i, "label": labels[i], "file": row.get("file"), "svg": position_svgs[i],
                           "quality": (row.get("awcc") or {}).get("quality"), "notes": notes,
                           "detail_note": detail_notes[i]})

@@ -1,0 +1,86 @@
+"""The report reads keys issue 29 adds to the JSON (hand-edited here until the
+libraries write them): a correction with status `untrusted` (quantiles kept,
+not presented as corrected) is drawn apart, hollow, without setting the
+axis' limits; a list column's codes are checked one by one."""
+
+import copy
+import json
+
+import pytest
+from pdp import plotting, report
+
+from conftest import MODEL, made
+from test_legends import check_legends
+
+UNTRUSTED = "untrusted correction's median (not a corrected value)"
+
+
+@pytest.fixture(scope="module")
+def rows(real_files, tmp_path_factory):
+    d = tmp_path_factory.mktemp("untrusted")
+    positions = ",".join(f"{p}mm" for p in (2, 8, 14, 20, 26, 32, 38, 44, 50, 54))
+    made("process", *real_files, "--fs", "20kHz", "--dx", "7.15mm", "--positions", positions, "--correct", MODEL,
+         "--json", d / "profile.json")
+    return json.loads((d / "profile.json").read_text())["profile"]
+
+
+def edited(rows, index, status="untrusted"):
+    out = copy.deepcopy(rows)
+    if status is None:
+        out[index]["correction"] = None
+    else:
+        out[index]["correction"]["status"] = status
+    return out
+
+
+def drawn_xs(ax):
+    """Every x the axes draw as a point or line, error bars' ends included."""
+    xs = [x for line in ax.lines for x in line.get_xdata()]
+    for c in ax.collections:
+        xs += [x for segment in c.get_segments() for x, _ in segment]
+    return xs
+
+
+@pytest.mark.parametrize("figure, quantity, index", [
+    (plotting.profile_velocity, "velocity", 0),  # the 2 mm row: corrected by the FSCC forest to 6.62 m/s
+    (plotting.profile_velocity, "velocity", 5),  # a median inside the axis
+    (plotting.profile_turbulence, "turbulence_intensity", 5),
+])
+def test_an_untrusted_correction_is_drawn_apart_and_sets_no_limit(rows, figure, quantity, index):
+    median = rows[index]["correction"][quantity]["median"]
+    fig = figure(edited(rows, index))
+    ax = fig.axes[0]
+    # The axis is the one drawn without that row's correction at all: an exact identity.
+    assert ax.get_xlim() == figure(edited(rows, index, None)).axes[0].get_xlim()
+    # Not among the corrected values, its bands not drawn: only the hollow mark stands for it.
+    hollow = [line for line in ax.lines if line.get_mfc() == "none" and line.get_marker() in "o<>"
+              and len(line.get_xdata()) == 1 and line.get_ydata()[0] == pytest.approx(1e3 * rows[index]["position"])]
+    assert len(hollow) == 1
+    lo, hi = ax.get_xlim()
+    if lo <= median <= hi:
+        assert hollow[0].get_xdata()[0] == median and hollow[0].get_marker() == "o"
+    else:  # at the edge, pointing out, with its value
+        assert hollow[0].get_marker() == ">" and hollow[0].get_xdata()[0] == hi
+        assert [t.get_text() for t in ax.texts] == [f"{median:.3g} m/s"]
+    others = [x for x in drawn_xs(ax) if x == median]
+    assert len(others) == (1 if lo <= median <= hi else 0)
+    q = rows[index]["correction"][quantity]["quantiles"]
+    assert not {q["0.025"], q["0.975"], q["0.1"], q["0.9"]} & set(drawn_xs(ax))
+    assert UNTRUSTED in [t.get_text() for t in ax.get_legend().get_texts()]
+    check_legends(fig, f"untrusted {quantity} {index}")
+
+
+def test_the_2mm_correction_no_longer_stretches_the_velocity_axis(rows):
+    """The issue's case: 6.62 m/s, band to 13.1 m/s, neighbours 1.6-3.4 m/s.
+    Corrected, it stretches the axis past 13 m/s; untrusted, the axis ends
+    below 4 m/s (FSCC's 3.40 m/s and AWCC's intervals are the widest left)."""
+    assert plotting.profile_velocity(rows).axes[0].get_xlim()[1] > 13
+    assert plotting.profile_velocity(edited(rows, 0)).axes[0].get_xlim()[1] < 4
+
+
+def test_a_list_columns_codes_are_checked_one_by_one(tmp_path):
+    columns = [{"name": "flags", "pointer": "/flags", "values": ["methods_disagree", "signal_not_two_level"]}]
+    data = {"profile": [{"flags": ["methods_disagree"]}, {"flags": ["methods_disagree", "bogus"]}]}
+    report.check_written_values("in.json", data, data["profile"][:1], columns)  # known codes pass
+    with pytest.raises(report.InputProblem, match=r"in.json: /profile/1/flags = 'bogus' is not a value pdp writes"):
+        report.check_written_values("in.json", data, data["profile"], columns)
