@@ -23,6 +23,7 @@
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/flags.hpp"
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
 #include "awcc/process.hpp"
@@ -464,6 +465,14 @@ PYBIND11_MODULE(_pdp, m) {
     };
     add(awcc::profile_csv_columns());
     add(correction::correction_csv_columns());
+    return out;
+  });
+  m.def("flags", [] {
+    // The codes a result's "flags" may hold, with their meanings (awcc/flags.hpp).
+    py::list out;
+    for (const auto& f : awcc::flag_names) {
+      out.append(py::dict(py::arg("code") = std::string(f.code), py::arg("meaning") = std::string(f.meaning)));
+    }
     return out;
   });
   m.def("options", &options);
