@@ -475,6 +475,8 @@ PYBIND11_MODULE(_pdp, m) {
     }
     return out;
   });
+  // What FSCC's and AWCC's intervals cover, as the summary says it (one sentence, for the report).
+  m.attr("sampling_intervals_only") = std::string(awcc::sampling_intervals_only);
   m.def("options", &options);
   m.def("read", &read_recording, py::arg("path"), py::arg("settings"));
   m.def("binarise", &binarise, py::arg("channels"), py::arg("fs"), py::arg("volts_per_count"), py::arg("settings"));

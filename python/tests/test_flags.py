@@ -16,6 +16,7 @@ def test_flag_codes_are_the_librarys_with_meanings():
     assert all(f["meaning"] for f in flags)
     column = next(c for c in pdp.profile_columns() if c["name"] == "flags")
     assert sorted(column["values"]) == sorted(codes)
+    assert "sampling intervals" in _pdp.sampling_intervals_only and "bias" in _pdp.sampling_intervals_only
 
 
 def test_the_8mm_row_carries_its_flag_and_warning(real_files):

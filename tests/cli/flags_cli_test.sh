@@ -17,7 +17,6 @@ src=$3
 data=$src/../shared/data/felder-stepped-spillway
 rm -rf "$dir" && mkdir -p "$dir"
 source "$(dirname "$0")/lib.sh"
-py() { /usr/bin/python3 "$@"; }
 
 # Case 7: four channels, the tips on 0 and 1.
 "$pdp" --log-level error synth -q --config "$src/samples/four-tip.toml" --duration 4s -o "$dir/four.flac" || fail "synth four-tip"
@@ -26,7 +25,7 @@ py() { /usr/bin/python3 "$@"; }
 four="channels 2 and 3 of 4 are not processed (a 4-tip probe?): this version processes one tip pair, channels 0 and 1"
 grep -qF "$four" "$dir/four.err" || fail "stderr lacks the ignored channels: $(cat "$dir/four.err")"
 grep -qF "warning: $four" "$dir/four.txt" || fail "the summary lacks the ignored channels"
-py - "$dir/four.json" "$four" <<'PY' || fail "the JSON lacks the ignored channels"
+/usr/bin/python3 - "$dir/four.json" "$four" <<'PY' || fail "the JSON lacks the ignored channels"
 import json, sys
 j = json.load(open(sys.argv[1]))
 assert j["flags"] == ["channels_ignored"] and j["warnings"][0].startswith(sys.argv[2]), (j["flags"], j["warnings"])
@@ -43,7 +42,7 @@ if [[ -d $data ]]; then
     fail "process the profile to stdout"
 
   # Case 3: only the 8 mm row is flagged, in the JSON, the CSV file and the table on stdout.
-  py - "$dir/profile.json" "$dir/profile.csv" "$dir/stdout.csv" <<'PY' || fail "case 3: the 8 mm row's flag"
+  /usr/bin/python3 - "$dir/profile.json" "$dir/profile.csv" "$dir/stdout.csv" <<'PY' || fail "case 3: the 8 mm row's flag"
 import csv, json, sys
 rows = json.load(open(sys.argv[1]))["profile"]
 flagged = [r["position"] for r in rows if "methods_disagree" in r["flags"]]
@@ -66,7 +65,7 @@ PY
     fail "the summary does not say what the intervals cover"
 
   # Case 5: the E4 text of stderr, exactly, in the JSON and the CSV of the five files it fires for.
-  py - "$dir/profile.json" "$dir/profile.csv" "$dir/profile.err" <<'PY' || fail "case 5: the E4 warning in every output"
+  /usr/bin/python3 - "$dir/profile.json" "$dir/profile.csv" "$dir/profile.err" <<'PY' || fail "case 5: the E4 warning in every output"
 import csv, json, re, sys
 rows = json.load(open(sys.argv[1])).get("profile")
 table = {row["file"]: row for row in csv.DictReader(open(sys.argv[2]))}
