@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <iterator>
 #include <stdexcept>
 
 namespace awcc {
@@ -219,7 +220,16 @@ std::pair<std::int64_t, std::int64_t> segment_window(std::int64_t s0, std::int64
   return {t0, t0 + length - (kmax - kmin + 1)};
 }
 
-// Felder's segmented Pearson coefficients of binary signals, averaged over the segments.
+// The lag of r's maximum (its first occurrence) over lags first.., when positive.
+std::optional<std::int64_t> positive_peak_lag(std::span<const double> r, std::int64_t first) {
+  if (r.empty()) return std::nullopt;
+  const auto it = std::max_element(r.begin(), r.end());
+  if (!(*it > 0.0)) return std::nullopt;
+  return first + static_cast<std::int64_t>(it - r.begin());
+}
+
+// Felder's segmented Pearson coefficients of binary signals, averaged over
+// the segments; each segment's R12 peak is kept for the velocity's interval.
 void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const FsccLags& lags, FftPlanCache& plans,
                CorrelationFunctions& f) {
   const std::int64_t n = x.sample_count;
@@ -228,31 +238,38 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
   f.r12.assign(static_cast<std::size_t>(lags.r12_last - lags.r12_first + 1), 0.0);
   int used11 = 0, used12 = 0;
   const AirPrefix px(x), py(y);
+  // Pearson's coefficient per lag over the segment's window, empty when a signal is constant there.
   auto pearson = [&](const AirIntervals& a, const AirPrefix& pa, const AirPrefix& pb, const AirIntervals& b,
-                     std::int64_t s0, std::int64_t kmin, std::int64_t kmax, std::vector<double>& acc) {
+                     std::int64_t s0, std::int64_t kmin, std::int64_t kmax) {
+    std::vector<double> r;
     const auto [t0, t1] = segment_window(s0, length, kmin, kmax);
     const std::int64_t w = t1 - t0;
-    if (w < 2) return false;
+    if (w < 2) return r;
     const double wd = static_cast<double>(w);
     const double ma = static_cast<double>(pa.in(t0, t1)) / wd;
     const double va = ma * (1 - ma);
-    if (!(va > 0.0)) return false;
+    if (!(va > 0.0)) return r;
     const auto sums = lagged_products(a, b, t0, t1, kmin, kmax, plans);
-    std::vector<double> r(sums.size());
+    r.resize(sums.size());
     for (std::size_t j = 0; j < sums.size(); ++j) {
       const std::int64_t k = kmin + static_cast<std::int64_t>(j);
       const double mb = static_cast<double>(pb.in(t0 + k, t1 + k)) / wd;
       const double vb = mb * (1 - mb);
-      if (!(vb > 0.0)) return false;
+      if (!(vb > 0.0)) return std::vector<double>();
       r[j] = (sums[j] / wd - ma * mb) / std::sqrt(va * vb);
     }
+    return r;
+  };
+  auto add = [](const std::vector<double>& r, std::vector<double>& acc) {
     for (std::size_t j = 0; j < r.size(); ++j) acc[j] += r[j];
-    return true;
+    return !r.empty();
   };
   for (int s = 0; s < segments; ++s) {
     const std::int64_t s0 = static_cast<std::int64_t>(s) * length;
-    used11 += pearson(x, px, px, x, s0, 0, lags.r11_last, f.r11);
-    used12 += pearson(x, px, py, y, s0, lags.r12_first, lags.r12_last, f.r12);
+    used11 += add(pearson(x, px, px, x, s0, 0, lags.r11_last), f.r11);
+    const auto r12 = pearson(x, px, py, y, s0, lags.r12_first, lags.r12_last);
+    used12 += add(r12, f.r12);
+    if (const auto peak = positive_peak_lag(r12, lags.r12_first)) f.segment_peak_lags.push_back(*peak);
   }
   if (used11 == 0 || used12 == 0) {
     f.status = FsccStatus::no_common_segment;
@@ -311,11 +328,16 @@ struct RawCorrelation::Segment {
   LaggedPearson r11, r12;
 };
 
+bool RawCorrelation::fits(std::int64_t samples, double fs, const FsccOptions& options) {
+  const FsccLags lags = fscc_lags(samples, fs, options);
+  return samples / std::max(1, options.segments) - (lags.r12_last - lags.r12_first + 1) >= 2;
+}
+
 RawCorrelation::RawCorrelation(std::int64_t samples, double fs, const FsccOptions& options, FftPlanCache& plans)
     : samples_(samples), fs_(fs), lags_(fscc_lags(samples, fs, options)), segments_(options.segments), plans_(plans) {
   options.validate().throw_if_failed();
   length_ = samples / segments_;
-  if (length_ - (lags_.r12_last - lags_.r12_first + 1) < 2) {
+  if (!fits(samples, fs, options)) {
     throw std::invalid_argument(fmt::format("{} samples in {} segments leave no correlation window", samples, segments_));
   }
   sum11_.assign(static_cast<std::size_t>(lags_.r11_last + 1), 0.0);
@@ -363,6 +385,7 @@ void RawCorrelation::feed(std::int64_t first, std::span<const double> leading, s
       for (std::size_t j = 0; j < r11.size(); ++j) sum11_[j] += r11[j];
       for (std::size_t j = 0; j < r12.size(); ++j) sum12_[j] += r12[j];
       ++used_;
+      if (const auto peak = positive_peak_lag(r12, lags_.r12_first)) segment_peaks_.push_back(*peak);
     }
     current_ = nullptr;
   }
@@ -388,6 +411,7 @@ CorrelationFunctions RawCorrelation::finish() {
   }
   f.r11 = sum11_;
   f.r12 = sum12_;
+  f.segment_peak_lags = segment_peaks_;
   for (auto& v : f.r11) v /= used_;
   for (auto& v : f.r12) v /= used_;
   return f;
@@ -591,8 +615,42 @@ FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOpti
   return out;
 }
 
+FsccOptions interval_options(const FsccOptions& options) {
+  FsccOptions out = options;
+  out.segments = fscc_interval_segments;
+  return out;
+}
+
+std::optional<Interval95> fscc_velocity_interval(std::span<const std::int64_t> segment_peak_lags, double lag,
+                                                 double fs, double dx) {
+  const auto n = segment_peak_lags.size();
+  if (n < static_cast<std::size_t>(fscc_interval_segments_min) || !(fs > 0.0) || !(lag > 0.0)) return std::nullopt;
+  // Student's t(0.975, n - 1) for the n = 5..10 segments that can hold a peak.
+  static constexpr double t975[] = {2.776, 2.571, 2.447, 2.365, 2.306, 2.262};
+  static_assert(std::size(t975) == fscc_interval_segments - fscc_interval_segments_min + 1);
+  const double t = t975[std::min(n, static_cast<std::size_t>(fscc_interval_segments)) - fscc_interval_segments_min];
+  double mean = 0.0;
+  for (const auto k : segment_peak_lags) mean += static_cast<double>(k);
+  mean /= static_cast<double>(n);
+  double ss = 0.0;
+  for (const auto k : segment_peak_lags) ss += (static_cast<double>(k) - mean) * (static_cast<double>(k) - mean);
+  const double standard_error = std::sqrt(ss / static_cast<double>(n - 1) / static_cast<double>(n));
+  constexpr double rounding = 0.475;  // 95 % half-width of a uniform error within +/- 1/2 sample
+  const double half = std::hypot(t * standard_error, rounding) / fs;
+  if (!(lag > half)) return std::nullopt;
+  return Interval95{dx / (lag + half), dx / (lag - half)};
+}
+
+void add_velocity_interval(FsccResult& result, const CorrelationFunctions& spread, double dx) {
+  if (!result.ok() || spread.status != FsccStatus::ok) return;
+  result.velocity_ci95 = fscc_velocity_interval(spread.segment_peak_lags, result.lag, spread.fs, dx);
+  result.interval_segments = static_cast<int>(spread.segment_peak_lags.size());
+}
+
 FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options) {
-  return fscc_from_functions(correlation_functions(leading, trailing, options), dx, options);
+  auto out = fscc_from_functions(correlation_functions(leading, trailing, options), dx, options);
+  if (out.ok()) add_velocity_interval(out, correlation_functions(leading, trailing, interval_options(options)), dx);
+  return out;
 }
 
 }  // namespace awcc

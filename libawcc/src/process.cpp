@@ -8,6 +8,7 @@
 #include <thread>
 #include <type_traits>
 
+#include "awcc/assess.hpp"
 #include "awcc/detail/awcc_driver.hpp"
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/detail/read_ahead.hpp"
@@ -456,6 +457,7 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     add_structure(out, r, options);
     add_spectrum(out, options);
+    out.warnings = assess(out);
   }
   return out;
 }
@@ -570,6 +572,10 @@ FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const Pro
   const auto lead = static_cast<std::size_t>(options.leading_channel);
   const auto trail = static_cast<std::size_t>(options.trailing_channel);
   RawCorrelation correlation(b.info.frames, b.info.fs, options.fscc_options, plans);
+  // The same correlation over the interval's segments, fed alongside (the velocity's sampling interval).
+  const FsccOptions spread_options = interval_options(options.fscc_options);
+  std::optional<RawCorrelation> spread;
+  if (RawCorrelation::fits(b.info.frames, b.info.fs, spread_options)) spread.emplace(b.info.frames, b.info.fs, spread_options, plans);
   // 16-bit counts are read as they are stored (volts = count x quantum, exact in double).
   const bool counts = recording.has_int16() && recording.info().quantum > 0.0;
   const double quantum = recording.info().quantum;
@@ -596,6 +602,7 @@ FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const Pro
       }
     }
     correlation.feed(position, xs, ys);
+    if (spread) spread->feed(position, xs, ys);
     position += n;
   }
   if (position != b.info.frames) {
@@ -603,7 +610,9 @@ FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const Pro
                                  "being read",
                                  path.string(), position, b.info.frames));
   }
-  return fscc_from_functions(correlation.finish(), options.dx, options.fscc_options);
+  auto out = fscc_from_functions(correlation.finish(), options.dx, options.fscc_options);
+  if (spread) add_velocity_interval(out, spread->finish(), options.dx);
+  return out;
 }
 
 ProcessResult process_recording(const std::filesystem::path& path, const ProcessOptions& options) {
@@ -641,6 +650,7 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& opti
     out.tips = tip_results(binarised, options, out.velocity());
     add_structure(out, binarised, options);
     add_spectrum(out, options);
+    out.warnings = assess(out);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

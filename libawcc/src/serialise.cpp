@@ -67,6 +67,11 @@ constexpr WindowFate kWindowFates[] = {WindowFate::accepted, WindowFate::correla
                                        WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
                                        WindowFate::correction};
 constexpr VelocitySource kVelocitySources[] = {VelocitySource::none, VelocitySource::awcc, VelocitySource::fscc};
+constexpr auto kFlags = [] {
+  std::array<Flag, flag_names.size()> out{};
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = flag_names[i].flag;
+  return out;
+}();
 
 constexpr bool kSwitches[] = {true, false};
 
@@ -76,15 +81,15 @@ std::string_view text_of(E v) {
 }
 std::string_view text_of(bool on) { return switch_text(on); }
 
-template <class E, std::size_t N>
-std::vector<std::string_view> texts(const E (&values)[N]) {
+template <class Values>
+std::vector<std::string_view> texts(const Values& values) {
   std::vector<std::string_view> out;
-  for (const E v : values) out.push_back(text_of(v));
+  for (const auto v : values) out.push_back(text_of(v));
   return out;
 }
 
-template <class E, std::size_t N>
-E parse_written(std::string_view text, const E (&values)[N], const WrittenAt& at) {
+template <class Values, class E = std::remove_cvref_t<decltype(*std::begin(std::declval<const Values&>()))>>
+E parse_written(std::string_view text, const Values& values, const WrittenAt& at) {
   for (const E v : values) {
     if (text_of(v) == text) return v;
   }
@@ -120,6 +125,17 @@ VelocitySource parse_velocity_source(std::string_view text, const WrittenAt& at)
   return parse_written(text, kVelocitySources, at);
 }
 bool parse_switch(std::string_view text, const WrittenAt& at) { return parse_written(text, kSwitches, at); }
+Flag parse_flag(std::string_view text, const WrittenAt& at) { return parse_written(text, kFlags, at); }
+
+std::vector<Flag> parse_flags_cell(std::string_view cell, const WrittenAt& at) {
+  std::vector<Flag> out;
+  for (std::size_t from = 0; from < cell.size();) {
+    const auto end = std::min(cell.find("; ", from), cell.size());
+    out.push_back(parse_flag(cell.substr(from, end - from), at));
+    from = end + 2;
+  }
+  return out;
+}
 
 std::vector<std::string_view> written_values(std::string_view column) {
   namespace c = profile_column;
@@ -131,6 +147,7 @@ std::vector<std::string_view> written_values(std::string_view column) {
   if (column == c::awcc_subsample) return texts(values::subsample);
   if (column == c::chord_velocity_source) return texts(kVelocitySources);
   if (column == c::awcc_roc || column == c::awcc_probe_corrected) return texts(kSwitches);
+  if (column == c::flags) return texts(kFlags);
   return {};
 }
 
@@ -332,6 +349,29 @@ json to_json(const Threshold& t) {
   return out;
 }
 
+namespace {
+
+std::vector<std::string> warning_texts(const ProcessResult& r) {
+  std::vector<std::string> out;
+  for (const auto& w : r.warnings) out.push_back(w.text);
+  return out;
+}
+
+std::vector<std::string> flag_codes(const ProcessResult& r) {
+  std::vector<std::string> out;
+  for (const auto& w : r.warnings) out.emplace_back(to_string(w.flag));
+  return out;
+}
+
+// A list as the profile CSV writes it in one cell.
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : "; ") + s;
+  return out;
+}
+
+}  // namespace
+
 json to_json(const ProcessResult& r) {
   json tips = json::array();
   for (const auto& t : r.tips) {
@@ -367,7 +407,8 @@ json to_json(const ProcessResult& r) {
       {process_key::dx, r.dx},
       {process_key::dy, r.dy},
       {process_key::tips, tips},
-      {"warnings", r.info.warnings},
+      {process_key::warnings, warning_texts(r)},
+      {process_key::flags, flag_codes(r)},
       {"chord_velocity_source", to_string(r.velocity_source())},
       {"chord_velocity", optional(r.velocity())},
   };
@@ -377,6 +418,8 @@ json to_json(const ProcessResult& r) {
         {process_key::status, to_string(f.status)},
         {process_key::reason, f.ok() ? json(nullptr) : json(f.message)},
         {process_key::velocity, f.ok() ? json(f.velocity) : json(nullptr)},
+        {"velocity_ci95", f.ok() && f.velocity_ci95 ? ci(*f.velocity_ci95) : json(nullptr)},
+        {"interval_segments", f.interval_segments},
         {"lag", f.lag},
         {"lag_samples", f.lag_samples},
         {process_key::r12_max, f.r12_max},
@@ -499,6 +542,8 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"void_fraction_ci95_upper", "-", "/tips/0/void_fraction_ci95/1", "void fraction, 95 % interval, upper"},
       {"bubble_count_rate_ci95_lower", "1/s", "/tips/0/bubble_count_rate_ci95/0", "bubble count rate, 95 % interval, lower"},
       {"bubble_count_rate_ci95_upper", "1/s", "/tips/0/bubble_count_rate_ci95/1", "bubble count rate, 95 % interval, upper"},
+      {"fscc_velocity_ci95_lower", "m/s", "/fscc/velocity_ci95/0", "FSCC velocity, 95 % sampling interval, lower"},
+      {"fscc_velocity_ci95_upper", "m/s", "/fscc/velocity_ci95/1", "FSCC velocity, 95 % sampling interval, upper"},
       {"awcc_velocity_ci95_lower", "m/s", "/awcc/velocity_ci95/0", "AWCC velocity, 95 % interval, lower"},
       {"awcc_velocity_ci95_upper", "m/s", "/awcc/velocity_ci95/1", "AWCC velocity, 95 % interval, upper"},
       {"awcc_velocity_rms_ci95_lower", "m/s", "/awcc/velocity_rms_ci95/0", "u_rms, 95 % interval, lower"},
@@ -507,7 +552,8 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"awcc_turbulence_intensity_ci95_upper", "-", "/awcc/turbulence_intensity_ci95/1", "AWCC Tu, 95 % interval, upper"},
       {profile_column::chord_velocity_source, "", "/chord_velocity_source", "the velocity of the chord lengths and d32"},
       {"pdp_version", "", "", "pdp version (the provenance's)"},
-      {"warnings", "", "/warnings", "what the reader accepted but you must know; FSCC's plausibility warnings"},
+      {profile_column::warnings, "", "/warnings", "every warning of the row, with advice (the reader's, FSCC's, the time scale's, the methods' consistency)"},
+      {profile_column::flags, "", "/flags", "the warnings' flag codes, in the same order"},
       {profile_column::awcc_probe_corrected, "", "/awcc/probe_corrected", "bubble-probe interaction correction applied"},
       {"awcc_velocity_measured", "m/s", "/awcc/velocity_measured", "AWCC velocity before the probe correction"},
       {"awcc_velocity_rms_measured", "m/s", "/awcc/velocity_rms_measured", "u_rms before the probe correction"},
@@ -561,19 +607,16 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   auto interval = [&](bool known, const Interval95& i) {
     return known ? fmt::format("{},{}", number(i.lower), number(i.upper)) : std::string(",");
   };
-  out += fmt::format(",{},{},{},{},{},{},{},{},{},{},{}", number(r.info.fs), number(duration),
+  const bool fscc_interval = fscc_ok && f->velocity_ci95;
+  out += fmt::format(",{},{},{},{},{},{},{},{},{},{},{},{}", number(r.info.fs), number(duration),
                      a ? to_string(a->quality) : "", csv_cell(a ? a->quality_reason : std::string()),
                      interval(true, lead.void_fraction_ci95), interval(true, lead.bubble_count_rate_ci95),
+                     interval(fscc_interval, fscc_interval ? *f->velocity_ci95 : Interval95{}),
                      interval(awcc_ok, a ? a->velocity_ci95 : Interval95{}),
                      interval(awcc_ok, a ? a->velocity_rms_ci95 : Interval95{}),
                      interval(awcc_ok, a ? a->turbulence_intensity_ci95 : Interval95{}), to_string(r.velocity_source()),
                      version);
-  std::string warnings;
-  for (const auto& w : r.info.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
-  if (f) {
-    for (const auto& w : f->warnings) warnings += (warnings.empty() ? "" : "; ") + w;
-  }
-  out += "," + csv_cell(warnings);
+  out += "," + csv_cell(joined(warning_texts(r))) + "," + csv_cell(joined(flag_codes(r)));
   const bool corrected = awcc_ok && a->probe_corrected;
   out += fmt::format(",{},{},{},{}", a ? switch_text(a->probe_corrected) : "",
                      csv_number(corrected ? std::optional(a->velocity_measured) : std::nullopt),
@@ -716,7 +759,6 @@ std::string ProcessResult::report() const {
   auto line = [&out](const std::string& s) { out += s + "\n"; };
   line(fmt::format("{}: {}, {} channels, {:.6g} Hz, {} samples ({:.3f} s)", info.path.string(), info.description,
                    info.channels, info.fs, info.frames, info.fs > 0 ? static_cast<double>(info.frames) / info.fs : 0.0));
-  for (const auto& w : info.warnings) line("  warning: " + w);
   const char* names[2] = {"leading", "trailing"};
   for (std::size_t i = 0; i < tips.size(); ++i) {
     const auto& t = tips[i];
@@ -744,8 +786,17 @@ std::string ProcessResult::report() const {
   if (fscc) {
     const auto& f = *fscc;
     if (f.ok()) {
-      line(fmt::format("  FSCC: velocity {:.4f} m/s (dx {:.3f} mm / lag {:.4f} ms), R12max {:.4f}", f.velocity, dx * 1e3,
-                       f.lag * 1e3, f.r12_max));
+      std::string interval;
+      if (f.velocity_ci95) {
+        interval = fmt::format("95 % sampling interval {:.4f} - {:.4f}", f.velocity_ci95->lower, f.velocity_ci95->upper);
+      } else if (f.interval_segments < fscc_interval_segments_min) {
+        interval = fmt::format("no sampling interval: {} of {} segments hold a peak", f.interval_segments,
+                               fscc_interval_segments);
+      } else {
+        interval = "no sampling interval: the segments' peak lags scatter to lag 0";
+      }
+      line(fmt::format("  FSCC: velocity {:.4f} m/s ({}), dx {:.3f} mm / lag {:.4f} ms, R12max {:.4f}", f.velocity,
+                       interval, dx * 1e3, f.lag * 1e3, f.r12_max));
     } else {
       line(fmt::format("  FSCC: velocity undefined: {}", f.message));
     }
@@ -757,13 +808,12 @@ std::string ProcessResult::report() const {
                      f.turbulence_intensity_chanson ? fmt::format("{:.4f}", *f.turbulence_intensity_chanson)
                                                     : std::string("n/a")));
     if (!f.note.empty()) line("        note: " + f.note);
-    for (const auto& w : f.warnings) line("        warning: " + w);
   }
   if (awcc) {
     const auto& a = *awcc;
     if (a.ok()) {
-      line(fmt::format("  AWCC: velocity {:.4f} m/s (95 % CI {:.4f} - {:.4f}), u_rms {:.4f} m/s, Tu {:.4f} (95 % CI "
-                       "{:.4f} - {:.4f})",
+      line(fmt::format("  AWCC: velocity {:.4f} m/s (95 % sampling interval {:.4f} - {:.4f}), u_rms {:.4f} m/s, Tu "
+                       "{:.4f} ({:.4f} - {:.4f})",
                        a.velocity, a.velocity_ci95.lower, a.velocity_ci95.upper, a.velocity_rms,
                        a.turbulence_intensity, a.turbulence_intensity_ci95.lower, a.turbulence_intensity_ci95.upper));
     } else {
@@ -784,6 +834,7 @@ std::string ProcessResult::report() const {
                      a.count(WindowFate::too_short) ? fmt::format(", {} too short", a.count(WindowFate::too_short))
                                                     : std::string()));
   }
+  if ((fscc && fscc->ok() && fscc->velocity_ci95) || (awcc && awcc->ok())) line("  " + std::string(sampling_intervals_only));
   if (structure) {
     const auto& st = *structure;
     line(fmt::format("  structure of the leading tip ({} conventions): {} bubbles, {} regime", st.felder_defects ? "Felder's" : "default",
@@ -822,12 +873,12 @@ std::string ProcessResult::report() const {
                      spectrum->mean_window_duration * 1e3,
                      spectrum->time_scale_ratio ? fmt::format("{:.2f}", *spectrum->time_scale_ratio) : std::string("n/a"),
                      spectrum->resolvable_frequency));
-    if (!spectrum->warning.empty()) line("        warning: " + spectrum->warning);
   }
   if (const auto s = velocity_source(); s != VelocitySource::awcc && (awcc || fscc)) {
     line(s == VelocitySource::fscc ? "  chord lengths and d32 use FSCC's velocity (AWCC's is not of quality ok)"
                                    : "  chord lengths and d32: no velocity");
   }
+  for (const auto& w : warnings) line(fmt::format("  warning: {} [{}]", w.text, to_string(w.flag)));
   return out;
 }
 

@@ -140,6 +140,40 @@ std::optional<double> integral_to_first_zero(std::span<const double> r, double d
   return std::nullopt;
 }
 
+namespace detail {
+
+std::string windows_too_long(const AwccResult& awcc, double ratio) {
+  std::string out = fmt::format("the velocity's integral time scale is {:.2f} mean window durations (below {:g}): the "
+                                "windows are too long to follow its fluctuations, and AWCC's turbulence intensity is "
+                                "underestimated (Kramer et al.'s error E4).",
+                                ratio, time_scale_ratio_min);
+  if (ratio <= time_scale_ratio_unresolved) {
+    out += " Adjacent windows' velocities are uncorrelated: the time scale is not resolved and may be shorter still.";
+  }
+  // T_W is proportional to Np (METHOD 6): windows of Np' particles give the ratio ratio Np / Np'.
+  const int np = awcc.np;
+  const double np_enough = np * ratio / time_scale_ratio_min;
+  const int np_advised = static_cast<int>(std::floor(np_enough));
+  if (np_advised >= np_least) {
+    out += fmt::format(" Windows of np = {} particles or fewer (now {}) would be short enough, though shorter windows "
+                       "correlate worse and fewer may pass the filter.",
+                       np_advised, np);
+  } else {
+    out += fmt::format(" Windows short enough would need np = {:.1f} or fewer (now {}), under the {} particles per window "
+                       "the method is used with: at this void fraction and bubble size AWCC's windows cannot follow "
+                       "the flow.",
+                       np_enough, np, np_least);
+  }
+  const auto windows_ok = awcc.options.windows_ok;
+  if (awcc.windows_accepted < windows_ok) {
+    out += fmt::format(" The time scale itself rests on {} accepted windows (quality ok needs {}) and is uncertain too.",
+                       awcc.windows_accepted, windows_ok);
+  }
+  return out;
+}
+
+}  // namespace detail
+
 VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, const SpectrumOptions& options) {
   VelocitySpectrum out;
   if (!awcc.ok()) {
@@ -177,12 +211,7 @@ VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, cons
   out.integral_time_scale = integral_to_first_zero(slotted_autocorrelation(times, values, slot, slots), slot);
   if (out.integral_time_scale) {
     out.time_scale_ratio = *out.integral_time_scale / out.mean_window_duration;
-    if (*out.time_scale_ratio < 2.0) {
-      out.warning = fmt::format("the velocity's integral time scale is {:.2f} mean window durations (below 2): the "
-                                "windows are too long to follow its fluctuations, and AWCC's turbulence intensity is "
-                                "underestimated (Kramer et al.'s error E4); use fewer particles per window",
-                                *out.time_scale_ratio);
-    }
+    if (*out.time_scale_ratio < time_scale_ratio_min) out.warning = detail::windows_too_long(awcc, *out.time_scale_ratio);
   } else {
     out.warning = "the velocity's autocorrelation does not reach zero within half the record: no integral time scale";
   }

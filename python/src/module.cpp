@@ -23,6 +23,7 @@
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/flags.hpp"
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
 #include "awcc/process.hpp"
@@ -467,6 +468,16 @@ PYBIND11_MODULE(_pdp, m) {
     if (correction) add(correction::correction_csv_columns());
     return out;
   }, py::arg("correction"));
+  m.def("flags", [] {
+    // The codes a result's "flags" may hold, with their meanings (awcc/flags.hpp).
+    py::list out;
+    for (const auto& f : awcc::flag_names) {
+      out.append(py::dict(py::arg("code") = std::string(f.code), py::arg("meaning") = std::string(f.meaning)));
+    }
+    return out;
+  });
+  // What FSCC's and AWCC's intervals cover, as the summary says it (one sentence, for the report).
+  m.attr("sampling_intervals_only") = std::string(awcc::sampling_intervals_only);
   m.def("options", &options);
   m.def("read", &read_recording, py::arg("path"), py::arg("settings"));
   m.def("binarise", &binarise, py::arg("channels"), py::arg("fs"), py::arg("volts_per_count"), py::arg("settings"));

@@ -44,10 +44,6 @@ void check_row(const awcc::ProcessResult& r, const std::optional<double>& positi
   j["position"] = position ? json(*position) : json(nullptr);
   // The CSV names the file only; the JSON holds the path the user gave.
   j["file"] = fs::path(j["file"].get<std::string>()).filename().string();
-  // FSCC's plausibility warnings join the reader's in the CSV's one cell.
-  if (j["fscc"].is_object()) {
-    for (const auto& w : j["fscc"]["warnings"]) j["warnings"].push_back(w);
-  }
   const auto cells = awcc::split_cells(awcc::profile_csv_row(r, position));
   const auto columns = awcc::profile_csv_columns();
   ASSERT_EQ(cells.size(), columns.size()) << what;

@@ -2,7 +2,7 @@
 // enum value's text parses back to the value, a text pdp does not write is
 // refused naming the file, the row, the field and the value, and every
 // column of the profile CSV of real recordings reads back to the value of the
-// result it was written from.
+// result it was written from (the flags column to the row's flags, in order).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -49,6 +49,7 @@ TEST(ReadBack, EveryEnumValueParsesBackFromItsText) {
   every_value_parses_back<awcc::Subsample>(2, awcc::parse_subsample);
   every_value_parses_back<awcc::WindowFate>(static_cast<int>(awcc::window_fate_count), awcc::parse_window_fate);
   every_value_parses_back<awcc::VelocitySource>(3, awcc::parse_velocity_source);
+  every_value_parses_back<awcc::Flag>(static_cast<int>(awcc::flag_names.size()), awcc::parse_flag);
   EXPECT_TRUE(awcc::parse_switch("on", kAt));
   EXPECT_FALSE(awcc::parse_switch("off", kAt));
 }
@@ -82,6 +83,7 @@ TEST(ReadBack, TextPdpDoesNotWriteIsRefusedNamingFileRowAndValue) {
   refused(awcc::parse_velocity_source, "both");
   refused(awcc::parse_switch, "true");
   refused(awcc::parse_switch, "1");
+  refused(awcc::parse_flag, "E4");  // the warning's name in the paper, not a code pdp writes
 }
 
 // The text of the row's cell of a column, by the declaration's name.
@@ -126,6 +128,12 @@ void check_read_back(const awcc::ProcessResult& r, const std::string& what) {
   for (const auto& c : awcc::profile_csv_columns()) {
     const std::string& text = cell.at(std::string(c.name));
     SCOPED_TRACE(what + ": column " + std::string(c.name) + " = '" + text + "'");
+    if (c.name == awcc::profile_column::flags) {
+      std::vector<awcc::Flag> flags;
+      for (const auto& w : r.warnings) flags.push_back(w.flag);
+      EXPECT_EQ(awcc::parse_flags_cell(text, at), flags);
+      continue;
+    }
     if (const auto e = enum_columns.find(c.name); e != enum_columns.end()) {
       if (!text.empty()) {  // empty: the method was not run
         e->second(text);

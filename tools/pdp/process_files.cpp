@@ -11,12 +11,9 @@ namespace pdp {
 
 namespace {
 
+// The row's one list (awcc/assess.hpp), as the JSON and CSV write it.
 void warn_about(const std::string& file, const awcc::ProcessResult& r) {
-  for (const auto& w : r.info.warnings) spdlog::warn("{}: {}", file, w);
-  if (r.fscc) {
-    for (const auto& w : r.fscc->warnings) spdlog::warn("{}: {}", file, w);
-  }
-  if (r.spectrum && !r.spectrum->warning.empty()) spdlog::warn("{}: {}", file, r.spectrum->warning);
+  for (const auto& w : r.warnings) spdlog::warn("{}: {} [{}]", file, w.text, awcc::to_string(w.flag));
 }
 
 }  // namespace

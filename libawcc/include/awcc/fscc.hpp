@@ -30,6 +30,28 @@
 // lags within 1e-5, and integrals that run one lag past the zero or minimum
 // (felder-program.md 3).
 //
+// Sampling interval of the velocity (95 %). FSCC gives one peak lag per
+// record; its scatter is measured as batch means measure a mean's. The same
+// correlation (signal, lag range, rules) over S = fscc_interval_segments
+// non-overlapping segments gives S' peak lags k_s, in samples (the segments
+// where both tips vary and R12 has a positive maximum). The record's R12 is
+// about the mean of its segments' R12_s; near their peaks R12_s(k) ~
+// R_s - a (k - k_s)^2 / 2 with about the same curvature a, so the record's
+// peak lies at about the mean of the k_s and scatters as that mean: standard
+// error s_k / sqrt(S'), s_k the k_s' sample standard deviation, 95 %
+// half-width t(0.975, S' - 1) s_k / sqrt(S') (Student: S' is small). The
+// record's integer peak adds its rounding, uniform within +/- 1/2 sample, of
+// 95 % half-width 0.475 samples. The two combine in quadrature:
+//   h = sqrt((t s_k / sqrt(S'))^2 + 0.475^2) samples, H = h / fs,
+// and u = dx / tau maps the lag interval [tau - H, tau + H] onto
+//   [dx / (tau + H), dx / (tau - H)]   (asymmetric; none when tau <= H).
+// Segments of a 45 s record (4.5 s) are far longer than a flow's time
+// scales (ms), so their peaks are independent. A segment of few bubbles
+// peaks far from the others and widens the interval: it is conservative
+// where FSCC rests on few bubbles. With fewer than fscc_interval_segments_min
+// segments holding a peak there is no interval. Like AWCC's, it covers the
+// scatter of a finite record only, not the method's bias.
+//
 // The lagged products of binary signals are computed from the pairs of air
 // intervals within the lag range, or from FFTs of blocks (overlap-save) when
 // bubbles are so dense that the pairs cost more; memory depends on the lag
@@ -45,6 +67,7 @@
 
 #include "awcc/air_intervals.hpp"
 #include "awcc/fft.hpp"
+#include "awcc/phase_statistics.hpp"
 #include "awcc/validation.hpp"
 
 namespace awcc {
@@ -96,6 +119,10 @@ struct FsccResult {
   std::optional<double> turbulence_intensity_chanson;
   /// Scales that are empty, with the reason ("t_r12_zero": "R12 stays above 0 ...").
   std::vector<std::pair<std::string, std::string>> scale_notes;
+  /// 95 % sampling interval of the velocity, m/s (above); empty unless ok and
+  /// enough segments hold a peak.
+  std::optional<Interval95> velocity_ci95;
+  int interval_segments = 0;         ///< segments of the interval's correlation that hold a peak
   std::string note;                  ///< the scale notes in one sentence
   std::vector<std::string> warnings; ///< a velocity that is defined but implausible, with the likely cause
   std::int64_t r11_first_lag = 0, r12_first_lag = 0;  ///< lag (samples) of r11[0], r12[0]
@@ -116,6 +143,9 @@ struct CorrelationFunctions {
   std::int64_t r11_first_lag = 0, r12_first_lag = 0;
   std::vector<double> r11, r12;
   int segments_used = 0;
+  /// R12's peak lag in each segment used, samples (segmented functions;
+  /// segments whose R12 has no positive maximum give none).
+  std::vector<std::int64_t> segment_peak_lags;
   FsccStatus status = FsccStatus::ok;  ///< ok, constant_*, no_common_segment
   std::string message;
 };
@@ -139,6 +169,9 @@ class RawCorrelation {
   void feed(std::int64_t first, std::span<const double> leading, std::span<const double> trailing);
   /// After every frame was fed.
   CorrelationFunctions finish();
+  /// Whether a record of `samples` leaves each of the options' segments a
+  /// correlation window (the constructor throws std::invalid_argument if not).
+  static bool fits(std::int64_t samples, double fs, const FsccOptions& options);
 
  private:
   struct Segment;
@@ -155,12 +188,33 @@ class RawCorrelation {
   std::vector<double> sum11_, sum12_;
   int used_ = 0;
   bool constant_leading_ = true, constant_trailing_ = true;
+  std::vector<std::int64_t> segment_peaks_;
 };
+
+/// Segments of the velocity's sampling interval (above), and the fewest
+/// holding a peak that give one.
+inline constexpr int fscc_interval_segments = 10;
+inline constexpr int fscc_interval_segments_min = 5;
+
+/// The options of the interval's correlation: the record's own, over
+/// fscc_interval_segments segments.
+FsccOptions interval_options(const FsccOptions& options);
+
+/// The 95 % sampling interval of u = dx / lag (lag in s, dx in m) from the
+/// segments' peak lags (samples) at fs (above); empty with fewer than
+/// fscc_interval_segments_min lags or when the lag interval reaches 0.
+std::optional<Interval95> fscc_velocity_interval(std::span<const std::int64_t> segment_peak_lags, double lag,
+                                                 double fs, double dx);
+
+/// Sets result.velocity_ci95 and interval_segments from `spread`, the
+/// functions of the same signals under interval_options (when result is ok).
+void add_velocity_interval(FsccResult& result, const CorrelationFunctions& spread, double dx);
 
 /// Peak, velocity (dx in m) and time scales from the correlation functions.
 FsccResult fscc_from_functions(CorrelationFunctions functions, double dx, const FsccOptions& options);
 
-/// FSCC of two binary signals of equal length and rate; dx in m.
+/// FSCC of two binary signals of equal length and rate; dx in m; with the
+/// velocity's sampling interval.
 FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options = {});
 
 }  // namespace awcc

@@ -12,6 +12,7 @@
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
 #include "awcc/fft.hpp"
+#include "awcc/flags.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/recording.hpp"
@@ -91,6 +92,9 @@ struct ProcessResult {
   std::optional<AwccResult> awcc;
   std::optional<StructureResult> structure;
   std::optional<VelocitySpectrum> spectrum;  ///< of AWCC's series, when AWCC ran
+  /// Every warning of the recording with its flag, in one list (awcc/assess.hpp
+  /// assembles it; every output writes it).
+  std::vector<Warning> warnings;
   double seconds = 0.0;               ///< wall time of the processing
 
   /// The velocity of chord lengths and d32 (velocity_source()).

@@ -12,6 +12,7 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
+#include "awcc/flags.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/process.hpp"
@@ -52,12 +53,18 @@ CorrelationSignal parse_correlation_signal(std::string_view text, const WrittenA
 Subsample parse_subsample(std::string_view text, const WrittenAt& at);
 WindowFate parse_window_fate(std::string_view text, const WrittenAt& at);
 VelocitySource parse_velocity_source(std::string_view text, const WrittenAt& at);
+/// One flag code of a row's "flags" (a JSON list's entry, or one of a CSV
+/// cell's codes joined by "; ").
+Flag parse_flag(std::string_view text, const WrittenAt& at);
+/// A profile CSV's flags cell: its codes in order (none for an empty cell).
+std::vector<Flag> parse_flags_cell(std::string_view cell, const WrittenAt& at);
 /// A switch of the profile CSV ("on"/"off", as profile_csv_row writes a JSON
 /// true/false).
 bool parse_switch(std::string_view text, const WrittenAt& at);
 
 /// The texts a profile CSV column may hold, by its name: an enum's values
-/// (by its to_string) or a switch's on/off; empty for a number or free text.
+/// (by its to_string), a switch's on/off, or the flag codes whose list the
+/// flags column joins; empty for a number or free text.
 /// The Python module hands them to the report (pdp.profile_columns()).
 std::vector<std::string_view> written_values(std::string_view column);
 
@@ -73,6 +80,9 @@ inline constexpr std::string_view samples = "samples";
 inline constexpr std::string_view duration = "duration";
 inline constexpr std::string_view dx = "dx";
 inline constexpr std::string_view dy = "dy";
+/// The row's warnings (texts) and their flags (codes), one each, in order (awcc/flags.hpp).
+inline constexpr std::string_view warnings = "warnings";
+inline constexpr std::string_view flags = "flags";
 // In a tip's, FSCC's or AWCC's object:
 inline constexpr std::string_view status = "status";
 inline constexpr std::string_view reason = "reason";
@@ -124,6 +134,8 @@ inline constexpr std::string_view duration = "duration";
 inline constexpr std::string_view awcc_quality = "awcc_quality";
 inline constexpr std::string_view chord_velocity_source = "chord_velocity_source";
 inline constexpr std::string_view awcc_probe_corrected = "awcc_probe_corrected";
+inline constexpr std::string_view warnings = "warnings";  ///< the texts, joined by "; "
+inline constexpr std::string_view flags = "flags";        ///< the codes, joined by "; "
 }  // namespace profile_column
 
 }  // namespace awcc

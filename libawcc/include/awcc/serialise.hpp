@@ -14,6 +14,11 @@
 
 namespace awcc {
 
+/// What FSCC's and AWCC's intervals cover, as the summary (ProcessResult::report) says beside them.
+inline constexpr std::string_view sampling_intervals_only =
+    "FSCC's and AWCC's intervals are 95 % sampling intervals: they cover the scatter of a finite record, not the "
+    "method's bias, which the bias correction (pdp correct) estimates.";
+
 nlohmann::json to_json(const ProcessResult& result);
 nlohmann::json to_json(const AwccOptions& options);
 nlohmann::json to_json(const StructureResult& result);

@@ -28,7 +28,16 @@
 // variance, integrated to the first zero; the held series' scale is reported
 // beside it.
 // T_u / T_W < 2 means the windows are too long to follow the turbulence:
-// AWCC's Tu is then underestimated (the paper's error E4); said in a warning.
+// AWCC's Tu is then underestimated (the paper's error E4); said in a warning
+// whose advice fits the row. Windows last T_W = Np d_b / (1.5 u c) (METHOD 6),
+// proportional to Np, so windows of Np' <= Np (T_u / T_W) / 2 particles would
+// reach the ratio 2 if T_u stays; below np_least particles (METHOD 4: Np
+// 3-30) the windows cannot be shortened enough. Adjacent windows are about T_W
+// apart: when their velocities are uncorrelated the slotted autocorrelation
+// (slots T_W / 2) falls to 0 by lag T_W and T_u / T_W <= 1/2, and at most 1/4
+// when it is 0 by the first slot: the scale is then not resolved and the true
+// one may be shorter still, so Np' is an upper bound. With fewer accepted
+// windows than quality ok needs, T_u itself is uncertain, and the warning says so.
 
 #include <cstdint>
 #include <optional>
@@ -100,6 +109,20 @@ struct VelocitySpectrum {
   std::optional<double> time_scale_ratio;     ///< T_u / T_W
   std::string warning;                ///< T_u / T_W < 2, or T_u not reached
 };
+
+/// The least T_u / T_W at which AWCC's windows follow the velocity (error E4 below).
+inline constexpr double time_scale_ratio_min = 2.0;
+/// T_u / T_W at or below which adjacent windows' velocities are uncorrelated (above).
+inline constexpr double time_scale_ratio_unresolved = 0.5;
+/// The fewest particles per window the method is used with (METHOD 4: Np 3-30).
+inline constexpr int np_least = 3;
+
+namespace detail {
+/// The E4 warning of an AWCC result whose T_u / T_W is `ratio` (< time_scale_ratio_min),
+/// with the advice that fits it: the np that would do, or that none would,
+/// and whether the accepted windows are few.
+std::string windows_too_long(const AwccResult& awcc, double ratio);
+}  // namespace detail
 
 /// The spectrum and time scale of AWCC's accepted windows over a record of
 /// `duration` s.

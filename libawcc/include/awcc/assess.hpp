@@ -1,0 +1,47 @@
+#pragma once
+// A processed recording's one list of warnings (awcc/flags.hpp), assembled in
+// one place after processing: the reader's notes, the channels not processed,
+// FSCC's plausibility warnings, the velocity series' time-scale warning and
+// the consistency of FSCC and AWCC. process_recording and process_binarised
+// fill ProcessResult::warnings with it; every output writes that list.
+//
+// FSCC and AWCC disagree (methods_disagree) when their velocities differ by
+// more than their 95 % sampling intervals allow together. With d = u_AWCC -
+// u_FSCC and h_F, h_A the half-widths of the two intervals on the sides that
+// face each other (FSCC's is asymmetric, awcc/fscc.hpp), the difference of
+// two independent estimates has the 95 % half-width sqrt(h_F^2 + h_A^2); the
+// flag is raised when |d| exceeds it. Both methods read the same record, so
+// their sampling errors are positively correlated and the difference scatters
+// less than that: the rule is conservative (a flagged difference is no
+// scatter). It compares whenever both give a velocity: AWCC of quality low
+// is compared (its interval is wide when its windows are few), AWCC of
+// quality insufficient gives no velocity and is not. FSCC without an interval
+// (too few segments hold a peak) is not compared.
+
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "awcc/flags.hpp"
+#include "awcc/process.hpp"
+
+namespace awcc {
+
+/// FSCC's and AWCC's velocities side by side (m/s).
+struct MethodsComparison {
+  double fscc = 0.0, awcc = 0.0;
+  Interval95 fscc_ci95, awcc_ci95;
+  double difference = 0.0;  ///< awcc - fscc
+  double allowed = 0.0;     ///< the 95 % half-width of the difference (above)
+  double relative = 0.0;    ///< |difference| / fscc
+  [[nodiscard]] bool disagree() const { return std::abs(difference) > allowed; }
+};
+
+/// Both velocities and their intervals; empty unless both methods gave a
+/// velocity and FSCC an interval.
+std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const AwccResult& awcc);
+
+/// Every warning of a processed recording, in the order of the list above.
+std::vector<Warning> assess(const ProcessResult& result);
+
+}  // namespace awcc

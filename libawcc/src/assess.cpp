@@ -1,0 +1,111 @@
+#include "awcc/assess.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <string>
+
+namespace awcc {
+
+std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const AwccResult& awcc) {
+  if (!fscc.ok() || !fscc.velocity_ci95 || !awcc.ok()) return std::nullopt;
+  MethodsComparison c;
+  c.fscc = fscc.velocity;
+  c.awcc = awcc.velocity;
+  c.fscc_ci95 = *fscc.velocity_ci95;
+  c.awcc_ci95 = awcc.velocity_ci95;
+  c.difference = c.awcc - c.fscc;
+  // The sides of the intervals that face each other.
+  const bool awcc_below = c.difference < 0.0;
+  const double h_fscc = awcc_below ? c.fscc - c.fscc_ci95.lower : c.fscc_ci95.upper - c.fscc;
+  const double h_awcc = awcc_below ? c.awcc_ci95.upper - c.awcc : c.awcc - c.awcc_ci95.lower;
+  c.allowed = std::hypot(h_fscc, h_awcc);
+  c.relative = std::abs(c.difference) / c.fscc;
+  return c;
+}
+
+namespace {
+
+// "channel 2", "channels 2 and 3", "channels 2, 3 and 4", with the names a column file gives.
+std::string channel_list(const std::vector<int>& channels, const std::vector<std::string>& names) {
+  constexpr std::size_t shown = 8;
+  std::string out = channels.size() == 1 ? "channel " : "channels ";
+  for (std::size_t i = 0; i < channels.size() && i < shown; ++i) {
+    const auto c = static_cast<std::size_t>(channels[i]);
+    if (i > 0) out += i + 1 == channels.size() ? " and " : ", ";
+    out += std::to_string(channels[i]);
+    if (c < names.size() && !names[c].empty()) out += fmt::format(" ('{}')", names[c]);
+  }
+  if (channels.size() > shown) out += fmt::format(" and {} more", channels.size() - shown);
+  return out;
+}
+
+std::optional<Warning> channels_ignored(const ProcessResult& r) {
+  std::vector<int> ignored;
+  for (int c = 0; c < r.info.channels; ++c) {
+    if (std::none_of(r.tips.begin(), r.tips.end(), [c](const TipResult& t) { return t.channel == c; })) {
+      ignored.push_back(c);
+    }
+  }
+  if (ignored.empty() || r.tips.size() < 2) return std::nullopt;
+  return Warning{Flag::channels_ignored,
+                 fmt::format("{} of {} {} not processed (a {}-tip probe?): this version processes one tip pair, "
+                             "channels {} and {} (leading-channel, trailing-channel)",
+                             channel_list(ignored, r.info.channel_names), r.info.channels,
+                             ignored.size() == 1 ? "is" : "are", r.info.channels, r.tips[0].channel, r.tips[1].channel)};
+}
+
+std::optional<Warning> methods_disagree(const ProcessResult& r) {
+  if (!r.fscc || !r.awcc) return std::nullopt;
+  const auto c = compare_methods(*r.fscc, *r.awcc);
+  if (!c || !c->disagree()) return std::nullopt;
+  const auto& a = *r.awcc;
+  std::string text = fmt::format(
+      "AWCC's velocity {:.3f} m/s (95 % sampling interval {:.3f}-{:.3f}) and FSCC's {:.3f} m/s ({:.3f}-{:.3f}) differ "
+      "by {:.3f} m/s (AWCC {:.0f} % {} FSCC), more than their sampling intervals allow together ({:.3f} m/s): one "
+      "method is biased here, which neither interval covers.",
+      c->awcc, c->awcc_ci95.lower, c->awcc_ci95.upper, c->fscc, c->fscc_ci95.lower, c->fscc_ci95.upper,
+      std::abs(c->difference), 100.0 * c->relative, c->difference < 0.0 ? "below" : "above", c->allowed);
+  if (a.quality != AwccQuality::ok) {
+    // Few windows: where they peak, against FSCC, shows the selection.
+    double lag_min = 0.0, lag_max = 0.0;
+    bool any = false;
+    for (const auto& w : a.windows) {
+      if (w.fate != WindowFate::accepted) continue;
+      lag_min = any ? std::min(lag_min, w.lag) : w.lag;
+      lag_max = any ? std::max(lag_max, w.lag) : w.lag;
+      any = true;
+    }
+    if (any) {
+      text += fmt::format(" AWCC's {} accepted windows peak at lags {:.2f}-{:.2f} ms, FSCC's whole record at {:.2f} ms.",
+                          a.windows_accepted, lag_min * 1e3, lag_max * 1e3, r.fscc->lag * 1e3);
+    }
+    text += fmt::format(" AWCC rests on {} accepted windows of {} (quality {}): so few windows passing its filter can "
+                        "be a biased selection of the bubbles",
+                        a.windows_accepted, a.windows_total, to_string(a.quality));
+    text += r.velocity_source() == VelocitySource::fscc ? ", and chord lengths and d32 use FSCC's velocity." : ".";
+  } else {
+    text += " Both rest on enough data: the bias correction estimates AWCC's bias; look at FSCC's correlation "
+            "functions and AWCC's window table for the cause.";
+  }
+  return Warning{Flag::methods_disagree, std::move(text)};
+}
+
+}  // namespace
+
+std::vector<Warning> assess(const ProcessResult& r) {
+  std::vector<Warning> out;
+  for (const auto& w : r.info.warnings) out.push_back({Flag::reader_note, w});
+  if (auto w = channels_ignored(r)) out.push_back(std::move(*w));
+  if (r.fscc) {
+    for (const auto& w : r.fscc->warnings) out.push_back({Flag::fscc_implausible, w});
+  }
+  if (r.spectrum && !r.spectrum->warning.empty()) {
+    out.push_back({r.spectrum->integral_time_scale ? Flag::integral_scale_short : Flag::integral_scale_undefined,
+                   r.spectrum->warning});
+  }
+  if (auto w = methods_disagree(r)) out.push_back(std::move(*w));
+  return out;
+}
+
+}  // namespace awcc

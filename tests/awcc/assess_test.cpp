@@ -1,0 +1,297 @@
+// A row's one list of warnings (awcc/assess.hpp, awcc/flags.hpp): the flag
+// table, the list assembled from every source in order, the FSCC/AWCC
+// disagreement rule at its limit (on each side, with FSCC's asymmetric
+// interval), FSCC's sampling interval against a reference computed here, the
+// E4 advice that fits the row, and the channels a recording holds beyond the
+// tip pair.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "awcc/assess.hpp"
+#include "awcc/fscc.hpp"
+#include "awcc/process.hpp"
+#include "awcc/read_back.hpp"
+#include "awcc/velocity_series.hpp"
+#include "random_signals.hpp"
+#include "signal_builders.hpp"
+
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(Flags, TableIsInEnumOrderWithDistinctCodesAndTheProfileColumnListsThem) {
+  std::set<std::string_view> codes;
+  for (std::size_t i = 0; i < awcc::flag_names.size(); ++i) {
+    const auto& f = awcc::flag_names[i];
+    EXPECT_EQ(static_cast<std::size_t>(f.flag), i);
+    EXPECT_EQ(awcc::to_string(f.flag), f.code);
+    EXPECT_TRUE(codes.insert(f.code).second) << f.code << " twice";
+    EXPECT_FALSE(f.meaning.empty()) << f.code;
+    // A code is one word of the field: it joins a CSV cell with "; " and splits back.
+    EXPECT_EQ(f.code.find_first_of(" ;,"), std::string_view::npos) << f.code;
+  }
+  const auto listed = awcc::written_values(awcc::profile_column::flags);
+  EXPECT_EQ(std::set<std::string_view>(listed.begin(), listed.end()), codes);
+}
+
+TEST(Flags, CellOfCodesParsesBackAndAnUnknownCodeIsRefused) {
+  const awcc::WrittenAt at{"profile.csv", "line 3", "flags"};
+  EXPECT_TRUE(awcc::parse_flags_cell("", at).empty());
+  const auto flags = awcc::parse_flags_cell("reader_note; methods_disagree; integral_scale_short", at);
+  EXPECT_EQ(flags, (std::vector{awcc::Flag::reader_note, awcc::Flag::methods_disagree,
+                                awcc::Flag::integral_scale_short}));
+  try {
+    awcc::parse_flags_cell("reader_note; E4", at);
+    ADD_FAILURE() << "an unknown code accepted";
+  } catch (const awcc::InputError& e) {
+    EXPECT_TRUE(contains(e.what(), "profile.csv") && contains(e.what(), "line 3") && contains(e.what(), "'E4'"))
+        << e.what();
+  }
+}
+
+// FSCC ok at 2 m/s with the interval [1.9, 2.2] (asymmetric, as dx / lag
+// makes it), and AWCC ok at `velocity` +/- 0.05 m/s.
+awcc::FsccResult fscc_at_2() {
+  awcc::FsccResult f;
+  f.status = awcc::FsccStatus::ok;
+  f.velocity = 2.0;
+  f.lag = 3e-3;
+  f.velocity_ci95 = awcc::Interval95{1.9, 2.2};
+  return f;
+}
+
+awcc::AwccResult awcc_at(double velocity, awcc::AwccQuality quality = awcc::AwccQuality::ok) {
+  awcc::AwccResult a;
+  a.status = awcc::AwccStatus::ok;
+  a.quality = quality;
+  a.velocity = velocity;
+  a.velocity_ci95 = {velocity - 0.05, velocity + 0.05};
+  a.windows_accepted = quality == awcc::AwccQuality::ok ? 400 : 12;
+  a.windows_total = 500;
+  return a;
+}
+
+TEST(MethodsDisagree, AtTheLimitOnEachSideWithTheIntervalsSidesThatFaceEachOther) {
+  // AWCC below FSCC: FSCC's lower half-width 0.1 and AWCC's upper 0.05 combine to hypot(0.1, 0.05).
+  const double below = std::sqrt(0.1 * 0.1 + 0.05 * 0.05);
+  const auto f = fscc_at_2();
+  for (const double eps : {1e-9, -1e-9}) {
+    const auto c = awcc::compare_methods(f, awcc_at(2.0 - below * (1.0 + eps)));
+    ASSERT_TRUE(c);
+    EXPECT_NEAR(c->allowed, below, 1e-12);
+    EXPECT_EQ(c->disagree(), eps > 0) << eps;
+  }
+  // AWCC above: FSCC's upper half-width 0.2 faces it, hypot(0.2, 0.05); a
+  // difference of 0.15 exceeds the lower side's 0.112 but not this.
+  const double above = std::sqrt(0.2 * 0.2 + 0.05 * 0.05);
+  EXPECT_FALSE(awcc::compare_methods(f, awcc_at(2.15))->disagree());
+  for (const double eps : {1e-9, -1e-9}) {
+    const auto c = awcc::compare_methods(f, awcc_at(2.0 + above * (1.0 + eps)));
+    EXPECT_NEAR(c->allowed, above, 1e-12);
+    EXPECT_EQ(c->disagree(), eps > 0) << eps;
+  }
+  // Exactly at the limit (binary-exact numbers, half-widths 0.5 and 0.375
+  // combining to 0.625): not beyond it; a step further is.
+  awcc::FsccResult exact = f;
+  exact.velocity_ci95 = awcc::Interval95{1.5, 2.5};
+  auto a = awcc_at(1.375);
+  a.velocity_ci95 = {1.0, 1.75};
+  const auto at_limit = awcc::compare_methods(exact, a);
+  EXPECT_EQ(at_limit->allowed, 0.625);
+  EXPECT_EQ(at_limit->difference, -0.625);
+  EXPECT_FALSE(at_limit->disagree());
+  EXPECT_EQ(at_limit->relative, 0.3125);
+  a.velocity = std::nextafter(1.375, 0.0);
+  EXPECT_TRUE(awcc::compare_methods(exact, a)->disagree());
+}
+
+TEST(MethodsDisagree, ComparedWhenBothGiveAVelocityAndFsccAnInterval) {
+  const auto f = fscc_at_2();
+  EXPECT_TRUE(awcc::compare_methods(f, awcc_at(1.0, awcc::AwccQuality::low)));  // low quality: compared
+  auto insufficient = awcc_at(1.0);
+  insufficient.status = awcc::AwccStatus::too_few_windows;  // no velocity
+  insufficient.quality = awcc::AwccQuality::insufficient;
+  EXPECT_FALSE(awcc::compare_methods(f, insufficient));
+  auto no_interval = f;
+  no_interval.velocity_ci95.reset();
+  EXPECT_FALSE(awcc::compare_methods(no_interval, awcc_at(1.0)));
+  auto failed = f;
+  failed.status = awcc::FsccStatus::no_positive_peak;
+  EXPECT_FALSE(awcc::compare_methods(failed, awcc_at(1.0)));
+}
+
+awcc::ProcessResult row(const awcc::FsccResult& f, const awcc::AwccResult& a) {
+  awcc::ProcessResult r;
+  r.info.channels = 2;
+  r.tips.resize(2);
+  r.tips[1].channel = 1;
+  r.fscc = f;
+  r.awcc = a;
+  return r;
+}
+
+TEST(MethodsDisagree, TheWarningGivesBothValuesBothIntervalsAndTheRelativeDifference) {
+  auto a = awcc_at(1.6, awcc::AwccQuality::low);
+  a.windows.push_back({.lag = 4.0e-3, .fate = awcc::WindowFate::accepted});
+  a.windows.push_back({.lag = 9.0e-3, .fate = awcc::WindowFate::roc});
+  a.windows.push_back({.lag = 4.5e-3, .fate = awcc::WindowFate::accepted});
+  const auto warnings = awcc::assess(row(fscc_at_2(), a));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].flag, awcc::Flag::methods_disagree);
+  const auto& t = warnings[0].text;
+  for (const char* part : {"1.600 m/s", "1.550-1.650", "2.000 m/s", "1.900-2.200", "differ by 0.400 m/s",
+                           "AWCC 20 % below FSCC", "(0.112 m/s)", "lags 4.00-4.50 ms", "FSCC's whole record at 3.00 ms",
+                           "12 accepted windows of 500 (quality low)", "chord lengths and d32 use FSCC's velocity"}) {
+    EXPECT_TRUE(contains(t, part)) << "'" << part << "' not in: " << t;
+  }
+  // Quality ok: the advice is the correction's, not the windows'.
+  const auto ok = awcc::assess(row(fscc_at_2(), awcc_at(2.4)));
+  ASSERT_EQ(ok.size(), 1u);
+  EXPECT_TRUE(contains(ok[0].text, "AWCC 20 % above FSCC")) << ok[0].text;
+  EXPECT_TRUE(contains(ok[0].text, "bias correction")) << ok[0].text;
+  EXPECT_FALSE(contains(ok[0].text, "quality low")) << ok[0].text;
+  EXPECT_FALSE(contains(ok[0].text, "accepted windows peak at")) << ok[0].text;  // many windows: no lag range
+  // Within the limit: no warning.
+  EXPECT_TRUE(awcc::assess(row(fscc_at_2(), awcc_at(2.1))).empty());
+}
+
+TEST(Assess, CollectsEverySourceInOrderWithItsFlagAndText) {
+  auto r = row(fscc_at_2(), awcc_at(1.0, awcc::AwccQuality::low));
+  r.info.warnings = {"the header promises 10 s; 8 s present", "values read as counts"};
+  r.fscc->warnings = {"FSCC velocity 120 m/s is above 100 m/s"};
+  r.spectrum.emplace();
+  r.spectrum->status = awcc::SpectrumStatus::ok;
+  r.spectrum->integral_time_scale = 1e-3;
+  r.spectrum->warning = "the velocity's integral time scale is 0.25 mean window durations";
+  r.info.channels = 3;
+  const auto w = awcc::assess(r);
+  std::vector<awcc::Flag> flags;
+  for (const auto& x : w) flags.push_back(x.flag);
+  EXPECT_EQ(flags, (std::vector{awcc::Flag::reader_note, awcc::Flag::reader_note, awcc::Flag::channels_ignored,
+                                awcc::Flag::fscc_implausible, awcc::Flag::integral_scale_short,
+                                awcc::Flag::methods_disagree}));
+  EXPECT_EQ(w[0].text, r.info.warnings[0]);
+  EXPECT_EQ(w[1].text, r.info.warnings[1]);
+  EXPECT_EQ(w[3].text, r.fscc->warnings[0]);
+  EXPECT_EQ(w[4].text, r.spectrum->warning);
+  // No time scale: the spectrum's warning is of the undefined kind.
+  r.spectrum->integral_time_scale.reset();
+  EXPECT_EQ(awcc::assess(r)[4].flag, awcc::Flag::integral_scale_undefined);
+}
+
+// The sampling interval from the segments' peak lags, against the formula of
+// awcc/fscc.hpp worked here with a two-pass standard deviation.
+TEST(FsccInterval, SegmentsPeakLagsGiveTheStudentIntervalWithTheRoundingInQuadrature) {
+  const double fs = 20e3, dx = 7.15e-3;
+  const std::vector<std::int64_t> lags{57, 52, 61, 55, 58, 49, 66, 57, 54, 60};
+  const double lag = 57.0 / fs;
+  double mean = 0.0;
+  for (auto k : lags) mean += static_cast<double>(k) / 10.0;
+  double var = 0.0;
+  for (auto k : lags) var += (static_cast<double>(k) - mean) * (static_cast<double>(k) - mean) / 9.0;
+  const double half = std::sqrt(std::pow(2.262 * std::sqrt(var / 10.0), 2) + 0.475 * 0.475) / fs;
+  const auto i = awcc::fscc_velocity_interval(lags, lag, fs, dx);
+  ASSERT_TRUE(i);
+  EXPECT_NEAR(i->lower, dx / (lag + half), 1e-12);
+  EXPECT_NEAR(i->upper, dx / (lag - half), 1e-12);
+  EXPECT_LT(i->lower, dx / lag);
+  EXPECT_GT(i->upper - dx / lag, dx / lag - i->lower);  // u = dx / tau: wider above
+
+  // Five segments: t(0.975, 4) = 2.776.
+  const std::vector<std::int64_t> five{57, 52, 61, 55, 58};
+  double m5 = 0.0, v5 = 0.0;
+  for (auto k : five) m5 += static_cast<double>(k) / 5.0;
+  for (auto k : five) v5 += (static_cast<double>(k) - m5) * (static_cast<double>(k) - m5) / 4.0;
+  const double h5 = std::sqrt(std::pow(2.776 * std::sqrt(v5 / 5.0), 2) + 0.475 * 0.475) / fs;
+  EXPECT_NEAR(awcc::fscc_velocity_interval(five, lag, fs, dx)->lower, dx / (lag + h5), 1e-12);
+
+  // Equal lags: the rounding alone, 0.475 samples.
+  const std::vector<std::int64_t> equal(10, 57);
+  EXPECT_NEAR(awcc::fscc_velocity_interval(equal, lag, fs, dx)->upper, dx / (lag - 0.475 / fs), 1e-12);
+  // Four segments give no interval; neither does a lag interval reaching 0.
+  EXPECT_FALSE(awcc::fscc_velocity_interval(std::vector<std::int64_t>{57, 52, 61, 55}, lag, fs, dx));
+  EXPECT_FALSE(awcc::fscc_velocity_interval(std::vector<std::int64_t>{2, 300, 5, 250, 1, 280}, 3.0 / fs, fs, dx));
+}
+
+TEST(FsccInterval, BinaryFsccCarriesItFromItsSegments) {
+  // A random telegraph signal and its copy 40 samples later: every segment
+  // peaks at 40, so the interval is the rounding's alone.
+  const auto lead = pdp_test::telegraph(200'000, 7, 20e3);
+  const auto trail = pdp_test::shifted(lead, 40);
+  const auto f = awcc::fscc(lead, trail, 5e-3);
+  ASSERT_TRUE(f.ok()) << f.message;
+  ASSERT_TRUE(f.velocity_ci95);
+  EXPECT_EQ(f.interval_segments, awcc::fscc_interval_segments);
+  EXPECT_NEAR(f.velocity_ci95->lower, 5e-3 / ((40 + 0.475) / 20e3), 1e-12);
+  EXPECT_NEAR(f.velocity_ci95->upper, 5e-3 / ((40 - 0.475) / 20e3), 1e-12);
+}
+
+// The E4 warning's advice: the np that would do, or that none would, and
+// whether the accepted windows are few.
+TEST(E4Advice, NamesTheNpThatWouldDoOrSaysNoneWouldAndWhetherTheWindowsAreFew) {
+  awcc::AwccResult a;
+  a.status = awcc::AwccStatus::ok;
+  a.np = 10;
+  a.windows_accepted = 23;  // file 04: ratio 1.27
+  const auto few = awcc::detail::windows_too_long(a, 1.27);
+  EXPECT_TRUE(contains(few, "1.27 mean window durations")) << few;
+  EXPECT_TRUE(contains(few, "np = 6 particles or fewer (now 10)")) << few;  // 10 x 1.27 / 2 = 6.35
+  EXPECT_TRUE(contains(few, "rests on 23 accepted windows (quality ok needs 100)")) << few;
+  EXPECT_FALSE(contains(few, "not resolved")) << few;
+  a.windows_accepted = 355;  // file 10: ratio 0.24
+  const auto unresolved = awcc::detail::windows_too_long(a, 0.24);
+  EXPECT_TRUE(contains(unresolved, "not resolved")) << unresolved;
+  EXPECT_TRUE(contains(unresolved, "np = 1.2 or fewer (now 10), under the 3 particles")) << unresolved;
+  EXPECT_FALSE(contains(unresolved, "rests on")) << unresolved;
+  EXPECT_FALSE(contains(unresolved, "particles or fewer")) << unresolved;
+  // Around the least np, 3: ratio 0.61 allows np = 3.05, so 3; 0.58 allows 2.9, so none.
+  EXPECT_TRUE(contains(awcc::detail::windows_too_long(a, 0.61), "np = 3 particles or fewer"));
+  EXPECT_TRUE(contains(awcc::detail::windows_too_long(a, 0.58), "np = 2.9 or fewer (now 10), under"));
+}
+
+// A recording of four channels, the tips on two of them.
+std::unique_ptr<awcc::Recording> four_channels() {
+  const auto lead = awcc::to_dense(pdp_test::telegraph(40'000, 3, 20e3, 40, 200));
+  std::vector<float> frames;
+  for (std::size_t i = 0; i < lead.size(); ++i) {
+    for (std::size_t c = 0; c < 4; ++c) {
+      const std::size_t j = i >= 10 * c ? i - 10 * c : 0;  // channel c: 10 c samples later
+      frames.push_back(lead[j] ? 0.3f : 4.0f);
+    }
+  }
+  return awcc::memory_recording(std::move(frames), 4, 20e3, "four.dat");
+}
+
+TEST(ChannelsIgnored, AFourChannelRecordingNamesTheChannelsNotProcessed) {
+  awcc::ProcessOptions o;
+  o.dx = 5e-3;
+  o.awcc = false;
+  auto recording = four_channels();
+  const auto r = awcc::process_recording(*recording, o);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.warnings[0].flag, awcc::Flag::channels_ignored);
+  EXPECT_EQ(r.warnings[0].text,
+            "channels 2 and 3 of 4 are not processed (a 4-tip probe?): this version processes one tip pair, channels "
+            "0 and 1 (leading-channel, trailing-channel)");
+  o.trailing_channel = 3;
+  EXPECT_TRUE(contains(awcc::process_recording(*recording, o).warnings.at(0).text,
+                       "channels 1 and 2 of 4 are not processed"));
+  // Two channels: nothing ignored.
+  o.trailing_channel = 1;
+  std::vector<float> two;
+  for (int i = 0; i < 4000; ++i) {
+    two.push_back((i / 50) % 2 ? 0.3f : 4.0f);
+    two.push_back(((i + 5) / 50) % 2 ? 0.3f : 4.0f);
+  }
+  const auto pair = awcc::process_recording(*awcc::memory_recording(std::move(two), 2, 20e3), o);
+  EXPECT_TRUE(std::none_of(pair.warnings.begin(), pair.warnings.end(),
+                           [](const awcc::Warning& w) { return w.flag == awcc::Flag::channels_ignored; }));
+}
+
+}  // namespace
