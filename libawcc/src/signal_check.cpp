@@ -90,10 +90,11 @@ SignalCheck check_signal(const VoltageHistogram& h, ProbeType probe, std::option
   const double n = static_cast<double>(h.total());
   const double q = h.resolution();
   const auto at_limit = [&](double v) { return limits && (v <= limits->low + 0.5 * q || v >= limits->high - 0.5 * q); };
-  const auto levels = h.binary_levels();
-  if (levels && levels->size() == 2) return binary_input(h, *levels);
-  if (levels) {
-    const double v = levels->front();
+  const auto values = h.values();
+  if (const auto levels = h.binary_levels(); levels && values.size() == 2) return binary_input(h, *levels);
+  if (values.size() == 1) {
+    // One value, or several within one step of the data's resolution.
+    const double v = values.front().first;
     out.low_level = out.high_level = v;
     out.flatness = 1.0;
     if (at_limit(v)) {
@@ -102,7 +103,8 @@ SignalCheck check_signal(const VoltageHistogram& h, ProbeType probe, std::option
       out.message = fmt::format("every sample sits at the digitiser's limit ({:+.4g} V): the channel is saturated", v);
     } else {
       out.status = SignalStatus::one_level;
-      out.message = fmt::format("every sample is {:.4g} V: one level, no interface ({})", v, no_interface_cause);
+      out.message = fmt::format("every sample is {:.4g} V (to the data's resolution, {}): one level, no interface ({})",
+                                v, format_quantity(q, Dimension::voltage), no_interface_cause);
     }
     return out;
   }
@@ -120,7 +122,7 @@ SignalCheck check_signal(const VoltageHistogram& h, ProbeType probe, std::option
 
   std::int64_t below = 0, flat_low = 0, flat_high = 0, at_rail = 0;
   double rail_value = 0.0;
-  for (const auto& [v, count] : h.values()) {
+  for (const auto& [v, count] : values) {
     if (v < middle) {
       below += count;
       if (std::fabs(v - lo) <= near) flat_low += count;
