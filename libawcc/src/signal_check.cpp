@@ -163,7 +163,7 @@ SignalCheck check_signal(const VoltageHistogram& h, ProbeType probe, std::option
         near, lo, hi, percent(out.flatness), percent(o.min_flatness));
     return out;
   }
-  const double level = share(flat_low, below) >= share(flat_high, above) ? lo : hi;
+  const double level = below > above ? lo : hi;  // the majority's
   if (separation < o.min_separation_counts * q) {
     out.status = SignalStatus::one_level;
     out.message = fmt::format(

@@ -9,10 +9,12 @@
 //
 // From the voltage histogram binarisation gathered (at the data's resolution
 // q: one count, or 0.1 mV for floating data), in this order:
-//  0. Binary input (at most two distinct values, the higher air) was
-//     binarised by whoever wrote it: no voltage to check, status
-//     binary_input. Only the polarity cue 5 applies. One distinct value is
-//     not binary input but one level (3).
+//  0. Binary input (two distinct values, the higher air) was binarised by
+//     whoever wrote it: no voltage to check, status binary_input; only the
+//     polarity cue 5a applies, to its air value. One value (or two within
+//     one step of the resolution) is not binary input but one level (3). A
+//     dead channel flickering between exactly two counts passes as binary
+//     input: nothing tells it from a 0/1 file.
 //  1. Levels: the histogram threshold rule with 100 bins over the observed
 //     range [min, max] (choose_threshold, bin width 0: scale-free) gives the
 //     low and high modes L_lo < L_hi, their separation D = L_hi - L_lo and
@@ -39,8 +41,9 @@
 //     the real recordings' water level 0.980-0.998 (their air level, dips
 //     that rarely settle, 0.22-0.84), synthetic c 0.005-0.6 at least 0.982;
 //     Gaussian noise 0.02-0.15 (its two modes lie within a fraction of a
-//     standard deviation), uniform noise 0.40, a 50 Hz sine (mains hum on an
-//     open input) 0.47, with noise 0.41. A level spread evenly over a band
+//     standard deviation), uniform noise 0.22-0.40 (at most 0.5: a side
+//     R / 2 wide keeps (D / 4) / (R / 2) within D / 8), a 50 Hz sine (mains
+//     hum on an open input) 0.47, with noise 0.41. A level spread evenly over a band
 //     B keeps (D / 4) / B of its side within D / 8 when centred: a slow drift
 //     of the levels by about 0.3 D passes (real recording 05, 0.8 V over
 //     45 s: 0.65), by 0.4 D or more it fails (1.2 V: 0.49), before the
