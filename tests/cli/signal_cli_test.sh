@@ -7,12 +7,9 @@
 # the failure in the JSON, the CSV and on stderr.
 # Usage: signal_cli_test.sh PDP SCRATCH_DIR SOURCE_DIR
 set -u
-pdp=$1
-dir=$2/signal_cli
-src=$3
-data=$src/../shared/data/felder-stepped-spillway
-rm -rf "$dir" && mkdir -p "$dir"
 source "$(dirname "$0")/lib.sh"
+pdp=$1 dir=$2/signal_cli data=$3/../shared/data/felder-stepped-spillway
+rm -rf "$dir" && mkdir -p "$dir"
 py() { /usr/bin/python3 "$@"; }
 
 # 200,000 frames of two channels of Gaussian noise (sigma 6000 counts, 0.92 V).

