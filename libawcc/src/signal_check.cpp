@@ -144,7 +144,7 @@ SignalCheck check_signal(const VoltageHistogram& h, ProbeType probe, std::option
   const bool air_low = probe == ProbeType::conductivity;
   out.air_share = static_cast<double>(air_low ? below : above) / n;
 
-  // 2-4, the first that fails.
+  // 2-4 (the header), the first that fails.
   if (limits && out.rail_share >= o.max_rail_share) {
     out.status = SignalStatus::saturated;
     out.message = fmt::format(

@@ -12,7 +12,7 @@
 //  0. Binary input (two distinct values, the higher air) was binarised by
 //     whoever wrote it: no voltage to check, status binary_input; only the
 //     polarity cue 5a applies, to its air value. One value (or two within
-//     one step of the resolution) is not binary input but one level (3). A
+//     one step of the resolution) is not binary input but one level (4). A
 //     dead channel flickering between exactly two counts passes as binary
 //     input: nothing tells it from a 0/1 file.
 //  1. Levels: the histogram threshold rule with 100 bins over the observed
@@ -27,14 +27,7 @@
 //     puts 95 % of the samples at the limit, and noise larger than the range
 //     74 %, which the flat-level test alone would take for two levels. Other
 //     sample types do not record their limits: not tested.
-//  3. One level: every sample at one value, or D < min_separation_counts (16)
-//     x q (four bits between the levels: a dead channel's levels are 1-2
-//     counts apart, the real recordings' 11,000-22,000), or fewer than
-//     min_minor_share (0.01 %) of the samples on the far side of m (the real
-//     recordings hold at least 0.36 % there, synthetic c = 0.005 0.46 %).
-//     A tip in clear water or air throughout looks the same: processed with
-//     allow-bad-signal it gives c = 0 or 1.
-//  4. No flat level: a phase-detection signal holds a level flat while the
+//  3. No flat level: a phase-detection signal holds a level flat while the
 //     tip stays in one phase. The flatness of a side is the share of its
 //     samples (those below m for L_lo, from m up for L_hi) within D / 8 of
 //     its level; the flatter side must reach min_flatness (0.6). Measured:
@@ -43,14 +36,23 @@
 //     Gaussian noise 0.02-0.15 (its two modes lie within a fraction of a
 //     standard deviation), uniform noise 0.22-0.40 (at most 0.5: a side
 //     R / 2 wide keeps (D / 4) / (R / 2) within D / 8), a 50 Hz sine (mains
-//     hum on an open input) 0.47, with noise 0.41. A level spread evenly over a band
-//     B keeps (D / 4) / B of its side within D / 8 when centred: a slow drift
-//     of the levels by about 0.3 D passes (real recording 05, 0.8 V over
-//     45 s: 0.65), by 0.4 D or more it fails (1.2 V: 0.49), before the
-//     drift carries a level across m (about 0.5 D, where c goes wrong).
+//     hum on an open input) 0.47, with noise 0.41. A level spread evenly
+//     over a band B keeps (D / 4) / B of its side within D / 8 when centred:
+//     a slow drift of the levels by about 0.3 D passes (real recording 05,
+//     0.8 V over 45 s: 0.65), by 0.4 D or more it fails (1.2 V: 0.49),
+//     before the drift carries a level across m (about 0.5 D, where c goes
+//     wrong).
 //     A trough between two modes is not required: at c = 0.004 (recording
 //     01) the dips rarely reach the air level, the air side has no mode and
 //     no trough (trough / smaller mode 0.63).
+//  4. One level (a flat level that passed 3): every sample at one value, or
+//     D < min_separation_counts (16) x q (four bits between the levels: a
+//     dead channel's levels are 1-2 counts apart, the real recordings'
+//     11,000-22,000), or fewer than min_minor_share (0.01 %) of the samples
+//     on the far side of m (the real recordings hold at least 0.36 % there,
+//     synthetic c = 0.005 0.46 %).
+//     A tip in clear water or air throughout looks the same: processed with
+//     allow-bad-signal it gives c = 0 or 1.
 //  5. Polarity. probe states which level is air (conductivity: the low one,
 //     optical: the high one); c' = the share of samples on that level's side
 //     of m. Two cues:
@@ -90,9 +92,9 @@ struct SignalCheckOptions {
   /// and the recording's warnings (the declared option allow-bad-signal).
   bool allow_bad_signal = false;
   double max_rail_share = 0.01;          ///< 2: share of samples at a 16-bit limit that makes a level clipped, -
-  double min_separation_counts = 16.0;   ///< 3: least separation of the levels, in histogram resolutions
-  double min_minor_share = 1e-4;         ///< 3: least share of samples on the far side of the midpoint, -
-  double min_flatness = 0.6;             ///< 4: least share of the flatter side within D / 8 of its level, -
+  double min_flatness = 0.6;             ///< 3: least share of the flatter side within D / 8 of its level, -
+  double min_separation_counts = 16.0;   ///< 4: least separation of the levels, in histogram resolutions
+  double min_minor_share = 1e-4;         ///< 4: least share of samples on the far side of the midpoint, -
   double zero_level_ratio = 2.0;         ///< 5b: how much farther from 0 V the signal level must lie, -
 
   [[nodiscard]] Validation validate() const;
@@ -107,7 +109,7 @@ enum class SignalStatus {
   one_level,          ///< fails: constant, nearly so, or no excursions
   no_flat_level,      ///< fails: noise, hum, or levels drifting
   saturated,          ///< fails: a level clipped at the digitiser's limit
-  inverted_polarity,  ///< fails: the stated air level is the continuous one and the signal level
+  inverted_polarity,  ///< fails: the stated air level holds more than 70 % and lies farther from 0 V (sign inverted)
 };
 std::string_view to_string(SignalStatus status);
 
