@@ -96,6 +96,10 @@ std::optional<Warning> methods_disagree(const ProcessResult& r) {
 std::vector<Warning> assess(const ProcessResult& r) {
   std::vector<Warning> out;
   for (const auto& w : r.info.warnings) out.push_back({Flag::reader_note, w});
+  for (std::size_t i = 0; i < r.tips.size(); ++i) {
+    auto text = signal_warning(r.tips[i].signal, r.tips[i].channel, i == 0 ? "leading" : "trailing");
+    if (!text.empty()) out.push_back({Flag::signal_check, std::move(text)});
+  }
   if (auto w = channels_ignored(r)) out.push_back(std::move(*w));
   if (r.fscc) {
     for (const auto& w : r.fscc->warnings) out.push_back({Flag::fscc_implausible, w});

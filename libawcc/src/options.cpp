@@ -422,6 +422,11 @@ const OptionField<P> kProcess[] = {
     {"allow-unusual", "", "accept dx outside 0.1-100 mm, fs outside 1 kHz-100 MHz, velocities outside 0.01-200 m/s",
      [](P& o, std::string_view t) { o.allow_unusual = on_off(t); },
      [](const P& o) { return std::string(switch_text(o.allow_unusual)); }, true},
+    {"allow-bad-signal", "",
+     "process a tip whose voltage fails the signal check (noise, a dead or clipped channel, inverted polarity), the "
+     "failure in every output",
+     [](P& o, std::string_view t) { o.signal_check.allow_bad_signal = on_off(t); },
+     [](const P& o) { return std::string(switch_text(o.signal_check.allow_bad_signal)); }, true},
 };
 
 }  // namespace

@@ -27,8 +27,8 @@ Validation ProcessOptions::validate() const {
         fmt::format("the leading and trailing tips are both channel {}; choose two channels", leading_channel));
   }
   if (!(dx >= 0.0 && std::isfinite(dx))) return Validation::invalid("dx", fmt::format("dx = {} m must be >= 0", dx));
-  for (const auto& part : {binarisation.validate(), fscc_options.validate(), awcc_options.validate(),
-                           structure.validate(), spectrum.validate()}) {
+  for (const auto& part : {binarisation.validate(), signal_check.validate(), fscc_options.validate(),
+                           awcc_options.validate(), structure.validate(), spectrum.validate()}) {
     if (!part.ok()) return part;
   }
   if (block_frames < 1) return Validation::invalid("", "block_frames must be >= 1");
@@ -261,6 +261,46 @@ std::optional<std::pair<std::int16_t, std::int16_t>> band_from(const std::int16_
   }
 }
 
+// The signal check of both tips (awcc/signal_check.hpp), before any
+// statistics: a failure stops the recording unless allowed; an allowed
+// failure or a flag becomes a warning of the result (signal_warning, assess).
+void check_tips(BinarisedRecording& out, const ProcessOptions& options, std::optional<DigitiserLimits> limits) {
+  struct Tip {
+    const std::optional<VoltageHistogram>& histogram;
+    SignalCheck& check;
+    int channel;
+    const char* name;
+  };
+  const Tip tips[] = {{out.leading_histogram, out.leading_signal, options.leading_channel, "leading"},
+                      {out.trailing_histogram, out.trailing_signal, options.trailing_channel, "trailing"}};
+  const bool allowed = options.signal_check.allow_bad_signal;
+  std::string refusal, quantity = "allow-bad-signal";
+  const SignalCheck* first = nullptr;
+  for (const Tip& tip : tips) {
+    if (!tip.histogram) continue;
+    tip.check = check_signal(*tip.histogram, options.binarisation.probe, limits, options.signal_check);
+    const std::string where = fmt::format("channel {} ({} tip)", tip.channel, tip.name);
+    if (!tip.check.failed()) continue;  // a flag, if any, is the result's warning (assess)
+    if (allowed) {
+      tip.check.overridden = true;
+      continue;
+    }
+    if (!first) {
+      first = &tip.check;
+      refusal = where + ": " + tip.check.message;
+    } else if (tip.check.status == first->status) {
+      refusal += fmt::format("; {} likewise", where);
+    } else {
+      refusal += "; " + where + ": " + tip.check.message;
+    }
+    if (tip.check.status == SignalStatus::inverted_polarity) quantity = "probe,allow-bad-signal";
+  }
+  if (!first) return;
+  throw InputError(fmt::format("{}: {}; to process it anyway, with the failure in every output, allow a bad signal",
+                               out.info.path.string(), refusal),
+                   quantity);
+}
+
 }  // namespace
 
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options) {
@@ -360,6 +400,8 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
     throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
   }
   out.info.frames = out.leading.sample_count;
+  check_tips(out, options,
+             recording->has_int16() && info.quantum > 0.0 ? std::optional(int16_limits(info.quantum)) : std::nullopt);
   return out;
 }
 
@@ -472,9 +514,10 @@ std::vector<TipResult> tip_results(const BinarisedRecording& r, const ProcessOpt
     return channel >= 0 && static_cast<std::size_t>(channel) < n.size() ? n[static_cast<std::size_t>(channel)]
                                                                        : std::string();
   };
-  return {{options.leading_channel, name(options.leading_channel), r.leading_threshold, phase_statistics(r.leading, po)},
+  return {{options.leading_channel, name(options.leading_channel), r.leading_threshold, phase_statistics(r.leading, po),
+           r.leading_signal},
           {options.trailing_channel, name(options.trailing_channel), r.trailing_threshold,
-           phase_statistics(r.trailing, po)}};
+           phase_statistics(r.trailing, po), r.trailing_signal}};
 }
 
 namespace {

@@ -370,6 +370,20 @@ std::string joined(const std::vector<std::string>& items) {
   return out;
 }
 
+// A tip's signal check (awcc/signal_check.hpp): what it saw and whether a
+// failure was processed anyway.
+json to_json(const SignalCheck& s) {
+  return json{{process_key::status, to_string(s.status)},
+              {"message", s.message.empty() ? json(nullptr) : json(s.message)},
+              {"overridden", s.overridden},
+              {"low_level", s.low_level},
+              {"high_level", s.high_level},
+              {"flatness", s.flatness},
+              {"minor_share", s.minor_share},
+              {"rail_share", s.rail_share},
+              {"air_share", s.air_share}};
+}
+
 }  // namespace
 
 json to_json(const ProcessResult& r) {
@@ -396,6 +410,7 @@ json to_json(const ProcessResult& r) {
         {"sauter_diameter", optional(p.sauter_diameter)},
     };
     tip.update(to_json(t.threshold));
+    tip[process_key::signal] = to_json(t.signal);
     tips.push_back(tip);
   }
   json out{

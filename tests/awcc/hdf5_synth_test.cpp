@@ -55,6 +55,9 @@ nlohmann::json comparable(const awcc::ProcessResult& r, bool thresholds) {
     if (!thresholds) {
       for (auto key = threshold_keys.begin(); key != threshold_keys.end(); ++key) tip.erase(key.key());
       tip.erase("threshold_note");
+      // The levels of binary input are the file's values (0 and 1, or a count's volts).
+      tip["signal"].erase("low_level");
+      tip["signal"].erase("high_level");
     }
   }
   return j;

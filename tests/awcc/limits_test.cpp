@@ -201,7 +201,13 @@ TEST(Limits, ValuesAtTheInt16LimitsAndDenormalFloats) {
   awcc::ProcessOptions o;
   o.reader.fs = 20e3;
   o.dx = 5e-3;
+  // Clipped levels fail the signal check; the trailing tip, two values, is
+  // binary input whose higher value, air by that convention, holds 75 %:
+  // flagged. The arithmetic at the limits is what this tests.
+  o.signal_check.allow_bad_signal = true;
   const auto r = awcc::process_recording(dat, o);
+  EXPECT_EQ(r.tips[0].signal.status, awcc::SignalStatus::saturated);
+  EXPECT_EQ(r.tips[1].signal.status, awcc::SignalStatus::air_continuous);
   EXPECT_NEAR(r.tips[0].phase.void_fraction, 0.25, 1e-3);
   EXPECT_TRUE(std::isfinite(r.tips[0].threshold.threshold));
   // Float32 raw data full of denormals around clean levels.
@@ -223,9 +229,12 @@ TEST(Limits, ValuesAtTheInt16LimitsAndDenormalFloats) {
   p.reader.format = "raw";
   p.reader.raw.sample_type = awcc::SampleType::float32;
   p.dx = 5e-3;
+  p.signal_check.allow_bad_signal = true;  // the trailing tip: denormals around 0 V, one level
   const auto q = awcc::process_recording(raw, p);
+  EXPECT_EQ(q.tips[0].signal.status, awcc::SignalStatus::two_level);
+  EXPECT_EQ(q.tips[1].signal.status, awcc::SignalStatus::one_level);
   EXPECT_NEAR(q.tips[0].phase.void_fraction, 0.2, 1e-3);
-  // The second channel is all denormals: a constant channel, not an error.
+  // The second channel is all denormals: a constant channel, processed as allowed.
   EXPECT_TRUE(std::isfinite(q.tips[1].phase.void_fraction));
   EXPECT_FALSE(q.fscc->ok());
 }

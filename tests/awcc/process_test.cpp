@@ -3,6 +3,7 @@
 // and bad input.
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/serialise.hpp"
+#include "awcc/flags.hpp"
 #include "awcc/process.hpp"
 
 #include <gtest/gtest.h>
@@ -17,6 +18,16 @@
 #include "test_paths.hpp"
 
 namespace {
+
+// The texts of a result's signal-check warnings (its flag signal_check).
+std::vector<std::string> signal_texts(const awcc::ProcessResult& r) {
+  std::vector<std::string> out;
+  for (const auto& w : r.warnings) {
+    if (w.flag == awcc::Flag::signal_check) out.push_back(w.text);
+  }
+  return out;
+}
+
 
 namespace fs = std::filesystem;
 
@@ -424,9 +435,11 @@ TEST(ProcessInput, ChannelProblemsAreNamed) {
   EXPECT_NE(process_error(two, o).find("channel 5"), std::string::npos);
 }
 
-TEST(ProcessInput, AConstantChannelIsNotAnError) {
-  // Leading tip: bubbles; trailing tip: constant water. c = 0, F = 0, and the
-  // velocity is undefined with its reason.
+TEST(ProcessInput, AConstantChannelIsRefusedUnlessAllowed) {
+  // Leading tip: bubbles; trailing tip: constant, a dead probe or a tip in
+  // clear water (the signal check cannot tell): refused, naming the file,
+  // the tip and the override. Allowed: c = 0, F = 0, the velocity undefined
+  // with its reason, and the failure in the tip's result and the warnings.
   std::vector<std::int16_t> data;
   for (int i = 0; i < 20000; ++i) {
     data.push_back(static_cast<std::int16_t>((i / 37) % 5 == 0 ? 2000 + i % 3 : 27000 + i % 2));
@@ -437,7 +450,22 @@ TEST(ProcessInput, AConstantChannelIsNotAnError) {
   awcc::ProcessOptions o;
   o.reader.fs = 20e3;
   o.dx = 5e-3;
+  try {
+    awcc::process_recording(p, o);
+    ADD_FAILURE() << "a constant channel was processed without allow-bad-signal";
+  } catch (const awcc::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(p.string() + ": channel 1 (trailing tip): every sample is 4.12 V", 0), 0u) << what;
+    EXPECT_NE(what.find("one level"), std::string::npos) << what;
+    EXPECT_EQ(e.quantity(), "allow-bad-signal");
+  }
+  o.signal_check.allow_bad_signal = true;
   const auto r = awcc::process_recording(p, o);
+  EXPECT_EQ(r.tips[0].signal.status, awcc::SignalStatus::two_level);
+  EXPECT_EQ(r.tips[1].signal.status, awcc::SignalStatus::one_level);
+  EXPECT_TRUE(r.tips[1].signal.overridden);
+  ASSERT_EQ(signal_texts(r).size(), 1u);
+  EXPECT_EQ(signal_texts(r)[0].rfind("channel 1 (trailing tip): every sample is", 0), 0u) << signal_texts(r)[0];
   EXPECT_NEAR(r.tips[0].phase.void_fraction, 0.2, 0.01);
   EXPECT_EQ(r.tips[1].phase.void_fraction, 0.0);
   EXPECT_EQ(r.tips[1].phase.bubble_count_rate, 0.0);

@@ -76,6 +76,8 @@ class VoltageHistogram {
   /// histograms of integer data gathered elsewhere (same quantum).
   void add_counts(std::span<const std::int64_t> counts, std::int64_t first_index);
   [[nodiscard]] std::int64_t total() const { return total_; }
+  /// The resolution of the histogram (the quantum it was built with), V.
+  [[nodiscard]] double resolution() const { return width_; }
   /// Distinct values seen, when there were at most two (binary input).
   [[nodiscard]] std::optional<std::vector<double>> binary_levels() const;
   /// Counts regrouped into bins [k w, (k+1) w): (k, count) for nonempty bins.

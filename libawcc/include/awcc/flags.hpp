@@ -16,6 +16,7 @@ namespace awcc {
 
 enum class Flag {
   reader_note,               ///< the reader accepted the file but says something about it (a cut file, an assumed scale)
+  signal_check,              ///< a tip's signal check flagged it, or failed and it was processed anyway
   channels_ignored,          ///< the recording has channels beyond the tip pair processed
   fscc_implausible,          ///< FSCC's velocity is defined but beyond air-water flows
   integral_scale_short,      ///< the velocity's integral time scale is under 2 window durations (error E4)
@@ -31,8 +32,10 @@ struct FlagName {
 
 /// Every flag in the enum's order: to_string, parse_flag and the lists of
 /// codes read this one table.
-inline constexpr std::array<FlagName, 6> flag_names{{
+inline constexpr std::array<FlagName, 7> flag_names{{
     {Flag::reader_note, "reader_note", "the reader accepted the file but notes something about it"},
+    {Flag::signal_check, "signal_check",
+     "a tip's voltage is not a clean two-level signal of the stated polarity, or its air level is the continuous one"},
     {Flag::channels_ignored, "channels_ignored", "channels beyond the tip pair were not processed"},
     {Flag::fscc_implausible, "fscc_implausible", "FSCC's velocity lies beyond air-water flows"},
     {Flag::integral_scale_short, "integral_scale_short",

@@ -16,6 +16,7 @@
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/recording.hpp"
+#include "awcc/signal_check.hpp"
 #include "awcc/structure.hpp"
 #include "awcc/velocity_series.hpp"
 
@@ -26,6 +27,9 @@ struct ProcessOptions {
   int leading_channel = 0;            ///< channel index of the leading tip
   int trailing_channel = 1;           ///< channel index of the trailing tip
   BinarisationOptions binarisation;
+  /// Each tip's voltage must be a two-level signal of the stated polarity
+  /// (awcc/signal_check.hpp) before any statistics.
+  SignalCheckOptions signal_check;
   double dx = 0.0;                    ///< streamwise tip separation, m (required for velocities)
   double dy = 0.0;                    ///< lateral tip separation, m (reported)
   bool fscc = true;                   ///< run FSCC
@@ -73,6 +77,7 @@ struct TipResult {
   std::string name;                   ///< the channel's name in a column file's header (else empty)
   Threshold threshold;
   PhaseStatistics phase;
+  SignalCheck signal;                 ///< the signal check of its voltage
 };
 
 /// The two binary signals of a recording (what AWCC and FSCC consume).
@@ -82,6 +87,8 @@ struct BinarisedRecording {
   AirIntervals leading, trailing;
   /// The voltage histograms the thresholds came from (the voltage PDFs).
   std::optional<VoltageHistogram> leading_histogram, trailing_histogram;
+  /// The signal check of each tip's histogram (unchecked without one).
+  SignalCheck leading_signal, trailing_signal;
 };
 
 struct ProcessResult {
@@ -107,7 +114,8 @@ struct ProcessResult {
 };
 
 /// Reads and binarises the two tips' channels. Throws InputError naming the
-/// file and the problem, OptionError for options that cannot work.
+/// file and the problem (a tip failing the signal check, unless
+/// signal_check.allow_bad_signal), OptionError for options that cannot work.
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options);
 /// The same from an open recording (read from its start; options.reader is not used).
 BinarisedRecording binarise_recording(Recording& recording, const ProcessOptions& options);

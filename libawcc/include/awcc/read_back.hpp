@@ -100,6 +100,7 @@ inline constexpr std::string_view options = "options";
 inline constexpr std::string_view filter_a = "filter_a";
 inline constexpr std::string_view roc = "roc";
 inline constexpr std::string_view weighting = "weighting";
+/// Also a tip's object's key of its signal check (awcc/signal_check.hpp).
 inline constexpr std::string_view signal = "signal";
 inline constexpr std::string_view subsample = "subsample";
 /// Retired by issue 28: a JSON written before the "status" keys existed says
