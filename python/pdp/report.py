@@ -316,6 +316,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs, per_position=detail)
 
     text_columns = [c for c in columns if c["name"].endswith("reason") or c["name"] == "warnings"]
+    # A row's flags are codes, each with its text among the warnings: an empty list is no gap.
+    list_columns = text_columns + [c for c in columns if c["name"] == "flags"]
     gaps, table = {}, []
     for c in columns:
         cells = []
@@ -325,7 +327,7 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
             if c in text_columns and value:  # long text: told below the table, linked from here
                 cell["text"], cell["note"] = "see note", True
             if value is None or value == []:
-                if c not in text_columns:  # an empty reason or warning is no gap
+                if c not in list_columns:  # an empty reason, warning or flag list is no gap
                     cell["gap"] = gaps.setdefault(gap_reason(row, c["pointer"], have_positions), len(gaps) + 1)
             cells.append(cell)
         table.append({"name": c["name"], "unit": c["unit"], "meaning": c["meaning"], "pointer": c["pointer"],
@@ -338,8 +340,9 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
             value = cell_value(row, c, provenance)
             for k, v in enumerate(v for v in (value if isinstance(value, list) else [value]) if v):
                 notes.append((c["name"], v, f"note-{i}-{c['name']}" if k == 0 else None))
+        # Files written before the warnings were one list kept E4's warning apart.
         spectrum_warning = (row.get("velocity_spectrum") or {}).get("warning")
-        if spectrum_warning:
+        if spectrum_warning and spectrum_warning not in (row.get("warnings") or []):
             notes.append(("velocity_spectrum.warning", spectrum_warning, None))
         correction = row.get("correction") or {}
         if correction.get("status") == "untrusted":
@@ -360,7 +363,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     return env.get_template("report.html.j2").render(
         title=input_name or os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
         positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
-        provenance=provenance, made=made, panels=plotting.POSITION_PANELS, single="profile" not in data)
+        provenance=provenance, made=made, panels=plotting.POSITION_PANELS, single="profile" not in data,
+        sampling_intervals_only=pdp._pdp.sampling_intervals_only)
 
 
 def _parser():
