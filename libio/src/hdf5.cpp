@@ -763,12 +763,20 @@ class Hdf5Recording final : public Recording {
       return;
     }
     std::vector<std::optional<double>> stated;
+    // The largest count's magnitude: times the scale it must still be a sample (a float).
+    const double full_scale = std::ldexp(1.0, k.is_signed ? k.bits - 1 : k.bits);
     for (const auto& src : sources_) {
       const auto v = number_attribute(src.dataset.get(), pdpsim::volts_per_count_attribute, src.name);
       if (v && !(std::isfinite(*v) && *v > 0.0)) {
         fail(fmt::format("attribute 'volts_per_count' of '{}' is {}: a scale must be a positive number; correct it, "
                          "or state the volts per count",
                          src.name, *v),
+             "volts-per-count");
+      }
+      if (v && *v * full_scale > std::numeric_limits<float>::max()) {
+        fail(fmt::format("attribute 'volts_per_count' of '{}' is {:g}: a {} count of {:g} would be {:g} V, beyond a "
+                         "sample's range (+/- 3.4e38 V); correct it, or state the volts per count",
+                         src.name, *v, k.name, full_scale, *v * full_scale),
              "volts-per-count");
       }
       stated.push_back(v);

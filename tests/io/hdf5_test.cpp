@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <thread>
@@ -359,6 +360,39 @@ TEST(Hdf5Reader, Int16WithVoltsPerCountOffersItsCounts) {
   EXPECT_EQ(u->info().quantum, 1.0 / 32768.0);
   EXPECT_FALSE(u->info().warnings.empty());
   EXPECT_EQ(u->info().fs, 8e3);  // from the root
+}
+
+// Found by fuzz_read_hdf5: a volts_per_count attribute of 1e298 was accepted,
+// so read() handed out infinite volts (count x scale beyond a float) while
+// read_int16() offered the counts with that quantum: the two paths of
+// processing disagreed, and neither refused. A scale for which the largest
+// count is no sample is refused, naming the attribute; the largest that is
+// still a float is read.
+TEST(Hdf5Reader, AVoltsPerCountBeyondTheSampleRangeIsRefused) {
+  const std::size_t n = 64;
+  std::vector<std::int16_t> counts(n * 2);
+  for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = static_cast<std::int16_t>(i % 2 ? -32768 : 32767);
+  const double largest = std::numeric_limits<float>::max() / 32768.0;  // -32768 x this is -FLT_MAX
+  const auto p = scratch("huge_scale.h5");
+  {
+    Writer w(p);
+    const hid_t huge = w.dataset("huge", H5T_STD_I16LE, H5T_NATIVE_INT16, {n, 2}, counts.data());
+    Writer::number(huge, "volts_per_count", 1e298);
+    const hid_t edge = w.dataset("edge", H5T_STD_I16LE, H5T_NATIVE_INT16, {n, 2}, counts.data());
+    Writer::number(edge, "volts_per_count", largest);
+    w.number("/", "fs", 8e3);
+    w.close_datasets();
+  }
+  awcc::ReaderOptions o;
+  o.datasets = {"huge"};
+  std::string quantity;
+  const auto message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
+  EXPECT_TRUE(has(message, "attribute 'volts_per_count' of '/huge' is 1e+298")) << message;
+  EXPECT_TRUE(has(message, "beyond a sample's range")) << message;
+  EXPECT_EQ(quantity, "volts-per-count");
+  o.datasets = {"edge"};
+  auto r = awcc::open_recording(p, o);
+  for (const float v : read_all(*r, 17)) ASSERT_TRUE(std::isfinite(v)) << v;
 }
 
 TEST(Hdf5Reader, ChunkedDeflatedDatasetReadInOddBlocksEqualsTheWhole) {
