@@ -20,7 +20,8 @@
 //    start with the file's path (readers name the file);
 //  - a recording that opens with no channel, no positive rate, or fewer
 //    frames read than RecordingInfo::frames announces without a refusal, or
-//    more;
+//    more; a sample handed out that is not finite (NaN, infinite: readers
+//    refuse them, naming the sample);
 //  - a second pass after rewind() that differs from the first (its first
 //    block), and a 16-bit pass (read_int16) that differs from the float one by
 //    more than rounding: processing takes either.
@@ -81,6 +82,9 @@ std::int64_t read_all(awcc::Recording& r, std::int64_t block, std::vector<float>
   for (std::int64_t n; (n = r.read(buffer, block)) > 0;) {
     if (n > block) finding("read() returned more frames than asked:", std::to_string(n));
     const auto values = static_cast<std::size_t>(n) * static_cast<std::size_t>(r.info().channels);
+    for (std::size_t i = 0; i < values; ++i) {
+      if (!std::isfinite(buffer[i])) finding("read() handed out a sample that is not finite:", std::to_string(buffer[i]));
+    }
     if (total == 0) first.assign(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(values));
     total += n;
   }
@@ -113,10 +117,8 @@ void check(awcc::Recording& r) {
   std::vector<float> again(values);
   const std::int64_t n = r.read(again, block);
   const auto head = static_cast<std::size_t>(n) * static_cast<std::size_t>(info.channels);
-  // Compared as bits: a sample the reader hands out twice is the same sample.
-  if (head != first.size() || !std::equal(first.begin(), first.end(), again.begin(), [](float a, float b) {
-        return a == b || (std::isnan(a) && std::isnan(b));
-      })) {
+  // Every sample is finite (checked above): equal means the same sample.
+  if (head != first.size() || !std::equal(first.begin(), first.end(), again.begin())) {
     finding("the first block differs after rewind()");
   }
   if (!r.has_int16()) return;

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -475,9 +476,14 @@ class TdmsRecording final : public Recording {
           default: { double x; std::memcpy(&x, p, 8); v = x; break; }
         }
         const double volts = slope * v + intercept;
-        if (!std::isfinite(volts)) {
-          reader_fail(info_.path, fmt::format("sample {} of channel '{}/{}' is not finite (NaN or infinite)",
-                                              position_ + static_cast<std::int64_t>(done + k), channel.group, channel.name));
+        // A finite double beyond a float (a count times a huge scale) would be an infinite sample.
+        if (!(std::fabs(volts) <= std::numeric_limits<float>::max())) {
+          reader_fail(info_.path,
+                      fmt::format("sample {} of channel '{}/{}' is {}", position_ + static_cast<std::int64_t>(done + k),
+                                  channel.group, channel.name,
+                                  std::isfinite(volts) ? fmt::format("{:g} V, beyond a sample's range (+/- 3.4e38 V): "
+                                                                     "check the channel's scale", volts)
+                                                       : std::string("not finite (NaN or infinite)")));
         }
         values_[done + k] = static_cast<float>(volts);
       }

@@ -296,6 +296,32 @@ TEST(TdmsReader, AScaleCountBeyondTheScalesDescribedAppliesTheScalesThereAre) {
   }
 }
 
+// A linear scale that takes a count beyond a float (slope 1e300): read()
+// handed out infinite volts without a word (the finite check was on the
+// double). Found by the reader fuzz target's check that every sample read is
+// finite (fuzz_read_tdms); the sample is named, with its value.
+TEST(TdmsReader, AScaleThatTakesASampleBeyondAFloatIsRefusedNamingIt) {
+  const Bytes m = metadata({{"/'probe'/'lead'", 20, 2, 3,
+                             {{"wf_increment", 10, 1e-4, ""},
+                              {"NI_Scaling_Status", 0x20, 0, "unscaled"},
+                              {"NI_Number_Of_Scales", 7, 1, ""},
+                              {"NI_Scale[1]_Scale_Type", 0x20, 0, "Linear"},
+                              {"NI_Scale[1]_Linear_Slope", 10, 1e300, ""}}}});
+  Bytes raw;
+  for (int v : {0, 1000, 2}) raw.put(static_cast<std::int16_t>(v));
+  const auto p = scratch("huge-slope.tdms");
+  write(p, segment(kMeta | kNewList | kRaw, &m, raw));
+  auto r = awcc::open_recording(p, {});
+  try {
+    (void)read_all(*r);
+    ADD_FAILURE() << "a sample of 1e303 V was read";
+  } catch (const awcc::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sample 1 of channel 'probe/lead' is 1e+303 V, beyond a sample's range"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TdmsReader, HostileBytesAreRefusedWithAMessage) {
   Bytes bad;
   bad.b.insert(bad.b.end(), {'T', 'D', 'S', 'm'});
