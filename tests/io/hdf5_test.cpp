@@ -395,6 +395,21 @@ TEST(Hdf5Reader, AVoltsPerCountBeyondTheSampleRangeIsRefused) {
   for (const float v : read_all(*r, 17)) ASSERT_TRUE(std::isfinite(v)) << v;
 }
 
+// Found by fuzz_read_hdf5 (the inputs are committed as found, tests/io/data):
+// pdp-sim files whose `sensor_id` attribute has a damaged integer type (bit
+// fields outside its bytes). libhdf5 1.10.8 converted it to double trusting the
+// fields: a stack smash in H5T__bit_get_d on one, a heap overflow in
+// H5T__bit_copy on the other. A damaged number type is refused before any
+// conversion, naming the attribute.
+TEST(Hdf5Reader, ADamagedNumberTypeIsRefusedBeforeLibhdf5ConvertsIt) {
+  for (const char* name : {"hdf5-damaged-type-stack-smash.h5", "hdf5-damaged-type-overflow.h5"}) {
+    const auto p = pdp_test::source_dir() / "tests/io/data" / name;
+    ASSERT_TRUE(fs::exists(p)) << p;
+    const auto message = refusal([&] { (void)awcc::open_recording(p, {}); });
+    EXPECT_TRUE(has(message, p.string() + ": attribute 'sensor_id' of '/signal' has a damaged number type")) << message;
+  }
+}
+
 TEST(Hdf5Reader, ChunkedDeflatedDatasetReadInOddBlocksEqualsTheWhole) {
   const std::size_t n = 100'003;
   std::vector<std::int16_t> counts(n * 2);
