@@ -410,6 +410,22 @@ TEST(Hdf5Reader, ADamagedNumberTypeIsRefusedBeforeLibhdf5ConvertsIt) {
   }
 }
 
+// Found by fuzz_read_hdf5 (the input as found, tests/io/data): a chunked,
+// deflated dataset of 1500 int16 values whose header gives chunks of
+// 536871168 values (1 GB) stored in 270 bytes. libhdf5 allocated and inflated
+// a whole chunk per read: 21 s and 1 GB to read 3 kB. Chunks the stored bytes
+// cannot hold (deflate expands at most 1032-fold) are refused.
+TEST(Hdf5Reader, ChunksLargerThanTheirStorageCanHoldAreRefused) {
+  const auto p = pdp_test::source_dir() / "tests/io/data/hdf5-lying-chunk-size.h5";
+  awcc::ReaderOptions o;
+  o.fs = 10000.0;
+  o.datasets = {"/run"};
+  const auto message = refusal([&] { (void)awcc::open_recording(p, o); });
+  EXPECT_TRUE(has(message, "dataset '/run/lead' has 14 chunks of 1073742336 bytes stored in 270 bytes, more than its "
+                           "compression allows: the file is damaged"))
+      << message;
+}
+
 TEST(Hdf5Reader, ChunkedDeflatedDatasetReadInOddBlocksEqualsTheWhole) {
   const std::size_t n = 100'003;
   std::vector<std::int16_t> counts(n * 2);
