@@ -149,9 +149,31 @@ hid_t memory_type(Kind k) {
   return H5T_NATIVE_INT16;
 }
 
+// A number type whose bit fields lie outside its bytes (a damaged file):
+// libhdf5 1.10's conversions trust the fields and write past their buffers
+// (found by fuzz_read_hdf5: stack smashing in H5T__bit_get_d, overflows in
+// H5T__bit_copy reading a sensor_id attribute), so such a type is never read.
+bool damaged_number_type(hid_t type) {
+  const H5T_class_t cls = H5Tget_class(type);
+  if (cls != H5T_INTEGER && cls != H5T_FLOAT) return false;
+  const std::size_t bits = 8 * H5Tget_size(type);
+  const int offset = H5Tget_offset(type);
+  const std::size_t precision = H5Tget_precision(type);
+  if (bits == 0 || offset < 0 || precision == 0 || static_cast<std::size_t>(offset) + precision > bits) return true;
+  if (cls == H5T_INTEGER) return false;
+  std::size_t sign = 0, exponent = 0, exponent_bits = 0, mantissa = 0, mantissa_bits = 0;
+  if (H5Tget_fields(type, &sign, &exponent, &exponent_bits, &mantissa, &mantissa_bits) < 0) {
+    H5Eclear2(H5E_DEFAULT);
+    return true;
+  }
+  return sign >= bits || exponent_bits == 0 || exponent + exponent_bits > bits || mantissa + mantissa_bits > bits ||
+         exponent_bits > 64 || mantissa_bits > 64;
+}
+
 // "strings", "int64", ... for a type that is not read; empty with `kind` set when it is.
 std::string classify(hid_t file_type, std::optional<Kind>& kind) {
   kind.reset();
+  if (damaged_number_type(file_type)) return "numbers of a damaged type (its bit fields lie outside its bytes)";
   Handle native(H5Tget_native_type(file_type, H5T_DIR_ASCEND));
   const hid_t t = native.valid() ? native.get() : file_type;
   const H5T_class_t cls = H5Tget_class(t);
@@ -648,6 +670,8 @@ class Hdf5Recording final : public Recording {
       }
       case H5D_CHUNKED: {
         const int filters = H5Pget_nfilters(dcpl.get());
+        // Deflate expands at most 1032-fold; shuffle and checksums not at all.
+        std::uint64_t expansion = 1;
         for (int k = 0; k < filters; ++k) {
           unsigned flags = 0;
           std::size_t n_values = 0;
@@ -660,6 +684,8 @@ class Hdf5Recording final : public Recording {
                              "with gzip (deflate) or without compression (h5repack -f GZIP=4)",
                              name, id, filter));
           }
+          if (id == H5Z_FILTER_DEFLATE) expansion = std::max<std::uint64_t>(expansion, 1032);
+          else if (id != H5Z_FILTER_SHUFFLE && id != H5Z_FILTER_FLETCHER32) expansion = 0;  // no bound known
         }
         const int rank = H5Pget_chunk(dcpl.get(), 0, nullptr);
         std::vector<hsize_t> chunk(dims.size(), 0);
@@ -686,6 +712,17 @@ class Hdf5Recording final : public Recording {
         }
         std::uint64_t chunk_bytes = element;
         for (auto c : chunk) chunk_bytes = times(chunk_bytes, c);
+        // libhdf5 allocates a whole chunk to read any of it: chunks the stored
+        // bytes cannot hold are a lying header, not a recording (found by
+        // fuzz_read_hdf5: 1 GB chunks in a 10 kB file, 21 s and 1 GB per read).
+        const hsize_t held = H5Dget_storage_size(dataset);
+        H5Eclear2(H5E_DEFAULT);
+        constexpr std::uint64_t slack = 1024;  // a chunk's own headers, per chunk
+        if (expansion > 0 && times(chunk_bytes, stored) > times(expansion, held) + times(slack, stored)) {
+          fail(fmt::format("dataset '{}' has {} chunks of {} bytes stored in {} bytes, more than its compression "
+                           "allows: the file is damaged",
+                           name, stored, chunk_bytes, held));
+        }
         const std::uint64_t row = across < dims.size() ? (dims[across] + chunk[across] - 1) / chunk[across] : 1;
         cache = times(chunk_bytes, row + 1);
         break;
@@ -737,6 +774,9 @@ class Hdf5Recording final : public Recording {
       fail(fmt::format("attribute '{}' of '{}' is not a number: store it as one (a float or an integer)", name,
                        where));
     }
+    if (damaged_number_type(type.get())) {
+      fail(fmt::format("attribute '{}' of '{}' has a damaged number type: the file is damaged", name, where));
+    }
     const hssize_t values = H5Sget_simple_extent_npoints(space.get());
     if (values != 1) {
       fail(fmt::format("attribute '{}' of '{}' holds {} values, one was expected: store a single number", name,
@@ -763,12 +803,20 @@ class Hdf5Recording final : public Recording {
       return;
     }
     std::vector<std::optional<double>> stated;
+    // The largest count's magnitude: times the scale it must still be a sample (a float).
+    const double full_scale = std::ldexp(1.0, k.is_signed ? k.bits - 1 : k.bits);
     for (const auto& src : sources_) {
       const auto v = number_attribute(src.dataset.get(), pdpsim::volts_per_count_attribute, src.name);
       if (v && !(std::isfinite(*v) && *v > 0.0)) {
         fail(fmt::format("attribute 'volts_per_count' of '{}' is {}: a scale must be a positive number; correct it, "
                          "or state the volts per count",
                          src.name, *v),
+             "volts-per-count");
+      }
+      if (v && *v * full_scale > std::numeric_limits<float>::max()) {
+        fail(fmt::format("attribute 'volts_per_count' of '{}' is {:g}: a {} count of {:g} would be {:g} V, beyond a "
+                         "sample's range (+/- 3.4e38 V); correct it, or state the volts per count",
+                         src.name, *v, k.name, full_scale, *v * full_scale),
              "volts-per-count");
       }
       stated.push_back(v);
@@ -836,6 +884,9 @@ class Hdf5Recording final : public Recording {
     const auto count = static_cast<std::size_t>(n);
     std::vector<std::string> ids;
     if (numeric_class(type.get())) {
+      if (damaged_number_type(type.get())) {
+        fail(fmt::format("attribute '{}' of '{}' has a damaged number type: the file is damaged", name, s.name));
+      }
       std::vector<double> values(count);
       if (H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, values.data()) < 0) {
         fail(fmt::format("attribute '{}' of '{}' cannot be read{}: the file is damaged", name, s.name, hdf5_says()));
@@ -1017,7 +1068,10 @@ class Hdf5Recording final : public Recording {
     // A time base cut short is refused, not read as zeros.
     check_storage(name, dataset, dims, H5Tget_size(type.get()), 1);
     std::optional<Kind> kind;
-    (void)classify(type.get(), kind);
+    if (const auto unread = classify(type.get(), kind); !kind) {
+      fail(fmt::format("dataset '{}' holds {}: a time base is numbers; correct it, or force the rate", name, unread),
+           "override-fs");
+    }
     const bool floating = kind == Kind::f32 || kind == Kind::f64;
     TimeBase base;
     base.path = info_.path;

@@ -114,6 +114,7 @@ class SndfileRecording final : public Recording {
     // Companded or compressed samples (u-law, A-law, ADPCM, Vorbis, ...) have
     // no volts: read normalised to full scale 1.
     const bool coded = bits == 0 && !floating_;
+    coded_ = coded;
     // Values as counts for integer data, as stored for floating data.
     sf_command(file_.get(), SFC_SET_NORM_FLOAT, nullptr, coded ? SF_TRUE : SF_FALSE);
     const double vpc = options.volts_per_count;
@@ -172,8 +173,17 @@ class SndfileRecording final : public Recording {
     return got;
   }
 
+  // Opened afresh, not sf_seek(0): libsndfile does not always seek back to
+  // where its first pass began (an AU header giving its data offset as 0: the
+  // first pass starts after the header, the seek at byte 0, so the second
+  // pass read the header as samples; found by fuzz_read_sndfile).
   void rewind() override {
-    sf_seek(file_.get(), 0, SEEK_SET);
+    SF_INFO sf{};
+    file_.reset(sf_open(info_.path.c_str(), SFM_READ, &sf));
+    if (!file_ || sf.channels != info_.channels) {
+      reader_fail(info_.path, "cannot be opened again for a second pass: the file changed or went away");
+    }
+    sf_command(file_.get(), SFC_SET_NORM_FLOAT, nullptr, coded_ ? SF_TRUE : SF_FALSE);
     position_ = 0;
   }
 
@@ -195,6 +205,7 @@ class SndfileRecording final : public Recording {
   bool floating_ = false;
   bool floating_double_ = false;
   bool int16_ = false;
+  bool coded_ = false;
   double scale_ = 1.0;
   std::int64_t position_ = 0;
 };

@@ -11,9 +11,11 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <charconv>
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -388,12 +390,27 @@ class TdmsRecording final : public Recording {
       const auto status = c.strings.find("NI_Scaling_Status");
       const auto count = c.numbers.find("NI_Number_Of_Scales");
       if (status != c.strings.end() && status->second == "unscaled" && count != c.numbers.end()) {
-        for (int k = 1; k <= static_cast<int>(count->second) - 0; ++k) {
-          const auto type = c.strings.find(fmt::format("NI_Scale[{}]_Scale_Type", k));
-          if (type == c.strings.end()) continue;
-          if (type->second != "Linear") {
+        // The scales the file describes, up to the count it states, in order:
+        // the count is the file's word, not a loop bound (a count of 2^31
+        // would loop for minutes, one of 1e300 would not fit an int).
+        std::vector<std::pair<int, const std::string*>> present;  // k, its type
+        constexpr std::string_view head = "NI_Scale[", tail = "]_Scale_Type";
+        for (const auto& entry : c.strings) {
+          const std::string_view key = entry.first;
+          if (key.size() <= head.size() + tail.size() || !key.starts_with(head) || !key.ends_with(tail)) continue;
+          const std::string_view number = key.substr(head.size(), key.size() - head.size() - tail.size());
+          int k = 0;
+          const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), k);
+          if (error == std::errc{} && end == number.data() + number.size() && number.front() != '0' && k >= 1 &&
+              k <= count->second) {
+            present.emplace_back(k, &entry.second);
+          }
+        }
+        std::sort(present.begin(), present.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (const auto& [k, type] : present) {
+          if (*type != "Linear") {
             reader_fail(path, fmt::format("channel '{}/{}' has a '{}' scale: only linear scales are supported", c.group,
-                                          c.name, type->second));
+                                          c.name, *type));
           }
           const double m = c.numbers.count(fmt::format("NI_Scale[{}]_Linear_Slope", k))
                                ? c.numbers.at(fmt::format("NI_Scale[{}]_Linear_Slope", k)) : 1.0;
@@ -459,9 +476,14 @@ class TdmsRecording final : public Recording {
           default: { double x; std::memcpy(&x, p, 8); v = x; break; }
         }
         const double volts = slope * v + intercept;
-        if (!std::isfinite(volts)) {
-          reader_fail(info_.path, fmt::format("sample {} of channel '{}/{}' is not finite (NaN or infinite)",
-                                              position_ + static_cast<std::int64_t>(done + k), channel.group, channel.name));
+        // A finite double beyond a float (a count times a huge scale) would be an infinite sample.
+        if (!(std::fabs(volts) <= std::numeric_limits<float>::max())) {
+          reader_fail(info_.path,
+                      fmt::format("sample {} of channel '{}/{}' is {}", position_ + static_cast<std::int64_t>(done + k),
+                                  channel.group, channel.name,
+                                  std::isfinite(volts) ? fmt::format("{:g} V, beyond a sample's range (+/- 3.4e38 V): "
+                                                                     "check the channel's scale", volts)
+                                                       : std::string("not finite (NaN or infinite)")));
         }
         values_[done + k] = static_cast<float>(volts);
       }

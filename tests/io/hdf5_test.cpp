@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <thread>
@@ -359,6 +360,70 @@ TEST(Hdf5Reader, Int16WithVoltsPerCountOffersItsCounts) {
   EXPECT_EQ(u->info().quantum, 1.0 / 32768.0);
   EXPECT_FALSE(u->info().warnings.empty());
   EXPECT_EQ(u->info().fs, 8e3);  // from the root
+}
+
+// Found by fuzz_read_hdf5: a volts_per_count attribute of 1e298 was accepted,
+// so read() handed out infinite volts (count x scale beyond a float) while
+// read_int16() offered the counts with that quantum: the two paths of
+// processing disagreed, and neither refused. A scale for which the largest
+// count is no sample is refused, naming the attribute; the largest that is
+// still a float is read.
+TEST(Hdf5Reader, AVoltsPerCountBeyondTheSampleRangeIsRefused) {
+  const std::size_t n = 64;
+  std::vector<std::int16_t> counts(n * 2);
+  for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = static_cast<std::int16_t>(i % 2 ? -32768 : 32767);
+  const double largest = std::numeric_limits<float>::max() / 32768.0;  // -32768 x this is -FLT_MAX
+  const auto p = scratch("huge_scale.h5");
+  {
+    Writer w(p);
+    const hid_t huge = w.dataset("huge", H5T_STD_I16LE, H5T_NATIVE_INT16, {n, 2}, counts.data());
+    Writer::number(huge, "volts_per_count", 1e298);
+    const hid_t edge = w.dataset("edge", H5T_STD_I16LE, H5T_NATIVE_INT16, {n, 2}, counts.data());
+    Writer::number(edge, "volts_per_count", largest);
+    w.number("/", "fs", 8e3);
+    w.close_datasets();
+  }
+  awcc::ReaderOptions o;
+  o.datasets = {"huge"};
+  std::string quantity;
+  const auto message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
+  EXPECT_TRUE(has(message, "attribute 'volts_per_count' of '/huge' is 1e+298")) << message;
+  EXPECT_TRUE(has(message, "beyond a sample's range")) << message;
+  EXPECT_EQ(quantity, "volts-per-count");
+  o.datasets = {"edge"};
+  auto r = awcc::open_recording(p, o);
+  for (const float v : read_all(*r, 17)) ASSERT_TRUE(std::isfinite(v)) << v;
+}
+
+// Found by fuzz_read_hdf5 (the inputs are committed as found, tests/io/data):
+// pdp-sim files whose `sensor_id` attribute has a damaged integer type (bit
+// fields outside its bytes). libhdf5 1.10.8 converted it to double trusting the
+// fields: a stack smash in H5T__bit_get_d on one, a heap overflow in
+// H5T__bit_copy on the other. A damaged number type is refused before any
+// conversion, naming the attribute.
+TEST(Hdf5Reader, ADamagedNumberTypeIsRefusedBeforeLibhdf5ConvertsIt) {
+  for (const char* name : {"hdf5-damaged-type-stack-smash.h5", "hdf5-damaged-type-overflow.h5"}) {
+    const auto p = pdp_test::source_dir() / "tests/io/data" / name;
+    ASSERT_TRUE(fs::exists(p)) << p;
+    const auto message = refusal([&] { (void)awcc::open_recording(p, {}); });
+    EXPECT_TRUE(has(message, p.string() + ": attribute 'sensor_id' of '/signal' has a damaged number type")) << message;
+  }
+}
+
+// Found by fuzz_read_hdf5 (the input as found, tests/io/data): a chunked,
+// deflated dataset of 1500 int16 values whose header gives chunks of
+// 536871168 values (1 GB) stored in 270 bytes. libhdf5 allocated and inflated
+// a whole chunk per read: 21 s and 1 GB to read 3 kB. Chunks the stored bytes
+// cannot hold (deflate expands at most 1032-fold) are refused.
+TEST(Hdf5Reader, ChunksLargerThanTheirStorageCanHoldAreRefused) {
+  const auto p = pdp_test::source_dir() / "tests/io/data/hdf5-lying-chunk-size.h5";
+  awcc::ReaderOptions o;
+  o.fs = 10000.0;
+  o.datasets = {"/run"};
+  const auto message = refusal([&] { (void)awcc::open_recording(p, o); });
+  EXPECT_TRUE(has(message, "dataset '/run/lead' has 14 chunks of 1073742336 bytes stored in 270 bytes, more than its "
+                           "compression allows: the file is damaged"))
+      << message;
 }
 
 TEST(Hdf5Reader, ChunkedDeflatedDatasetReadInOddBlocksEqualsTheWhole) {

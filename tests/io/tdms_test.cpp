@@ -5,6 +5,7 @@
 // rate, channels chosen by name, a truncated last segment, hostile bytes.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -266,6 +267,59 @@ TEST(TdmsReader, ARecordingIsProcessedEndToEnd) {
   ASSERT_TRUE(r.fscc && r.fscc->ok()) << r.fscc->message;
   EXPECT_EQ(r.fscc->lag_samples, delay);
   EXPECT_EQ(r.tips[0].name, "probe/lead");
+}
+
+// Found by fuzz_read_tdms: NI_Number_Of_Scales is the file's word, and was the
+// loop bound. A count of 2^32 - 1 did not fit the int it was cast to (the
+// scale was silently dropped: counts read as volts); one of 2^31 - 1 looped
+// two billion times (minutes per file). Only the scales the file describes are
+// applied, whatever count it states.
+TEST(TdmsReader, AScaleCountBeyondTheScalesDescribedAppliesTheScalesThereAre) {
+  for (const double count : {4294967295.0, 2147483647.0}) {
+    const Bytes m = metadata({{"/'probe'/'lead'", 20, 2, 3,
+                               {{"wf_increment", 10, 1e-4, ""},
+                                {"NI_Scaling_Status", 0x20, 0, "unscaled"},
+                                {"NI_Number_Of_Scales", 7, count, ""},
+                                {"NI_Scale[1]_Scale_Type", 0x20, 0, "Linear"},
+                                {"NI_Scale[1]_Linear_Slope", 10, 0.5, ""},
+                                {"NI_Scale[1]_Linear_Y_Intercept", 10, 1.0, ""}}}});
+    Bytes raw;
+    for (int v : {10, 20, -30}) raw.put(static_cast<std::int16_t>(v));
+    const auto p = scratch("many-scales.tdms");
+    write(p, segment(kMeta | kNewList | kRaw, &m, raw));
+    const auto start = std::chrono::steady_clock::now();
+    auto r = awcc::open_recording(p, {});
+    // A few milliseconds; two billion scale look-ups took minutes.
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0) << count;
+    EXPECT_TRUE(r->info().volts_known) << count;
+    EXPECT_EQ(read_all(*r), (std::vector<float>{6.0f, 11.0f, -14.0f})) << count;
+  }
+}
+
+// A linear scale that takes a count beyond a float (slope 1e300): read()
+// handed out infinite volts without a word (the finite check was on the
+// double). Found by the reader fuzz target's check that every sample read is
+// finite (fuzz_read_tdms); the sample is named, with its value.
+TEST(TdmsReader, AScaleThatTakesASampleBeyondAFloatIsRefusedNamingIt) {
+  const Bytes m = metadata({{"/'probe'/'lead'", 20, 2, 3,
+                             {{"wf_increment", 10, 1e-4, ""},
+                              {"NI_Scaling_Status", 0x20, 0, "unscaled"},
+                              {"NI_Number_Of_Scales", 7, 1, ""},
+                              {"NI_Scale[1]_Scale_Type", 0x20, 0, "Linear"},
+                              {"NI_Scale[1]_Linear_Slope", 10, 1e300, ""}}}});
+  Bytes raw;
+  for (int v : {0, 1000, 2}) raw.put(static_cast<std::int16_t>(v));
+  const auto p = scratch("huge-slope.tdms");
+  write(p, segment(kMeta | kNewList | kRaw, &m, raw));
+  auto r = awcc::open_recording(p, {});
+  try {
+    (void)read_all(*r);
+    ADD_FAILURE() << "a sample of 1e303 V was read";
+  } catch (const awcc::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sample 1 of channel 'probe/lead' is 1e+303 V, beyond a sample's range"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(TdmsReader, HostileBytesAreRefusedWithAMessage) {
