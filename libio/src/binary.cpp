@@ -184,7 +184,14 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   info.frames = rows;
   info.quantum = layout.volts_per_count;
   info.volts_known = true;
-  return std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  auto recording = std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  check_interleaving(*recording, "the .dat header's channel count (bytes 4-7)", [&](int n) {
+    const auto samples = static_cast<std::int64_t>(rows) * channels;
+    return fmt::format("correct the header to {} channels{}, or read the file as raw (format raw, raw-channels {}, "
+                       "raw-header 8 bytes)",
+                       n, samples % n == 0 ? fmt::format(" and {} rows", samples / n) : std::string(), n);
+  }, "format");
+  return recording;
 }
 
 std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& options) {
@@ -213,7 +220,10 @@ std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& o
   const bool integer = layout.sample_type == SampleType::int16 || layout.sample_type == SampleType::int32;
   info.quantum = integer ? layout.volts_per_count : 0.0;
   info.volts_known = true;
-  return std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  auto recording = std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  check_interleaving(*recording, "the stated raw layout (raw-channels)",
+                     [](int n) { return fmt::format("state raw-channels {}", n); }, "raw-channels");
+  return recording;
 }
 
 }  // namespace detail
