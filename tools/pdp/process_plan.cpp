@@ -3,9 +3,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <vector>
 
 #include "awcc/csv.hpp"
 #include "awcc/options.hpp"
+#include "awcc/sha256.hpp"
 #include "awcc/units.hpp"
 #include "process_steps.hpp"
 
@@ -111,10 +113,58 @@ void check_output_names(const ProcessCommandOptions& o) {
   }
 }
 
+// The first 64 KiB's digest: two recordings differ there (a copy does not),
+// so whole files are compared only when their sizes and heads agree.
+std::string head_digest(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> head(std::size_t{1} << 16);
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  awcc::Sha256 digest;
+  digest.update({reinterpret_cast<const std::uint8_t*>(head.data()), static_cast<std::size_t>(in.gcount())});
+  return digest.hex();
+}
+
+// A profile measures each position once: a file given twice (the same path,
+// two paths to one file, or a copy under another name) would count one
+// recording at two positions, and is refused naming both arguments.
+void check_repeated_inputs(const std::vector<std::string>& files) {
+  namespace fs = std::filesystem;
+  std::map<std::pair<std::uintmax_t, std::string>, std::vector<std::size_t>> seen;  // (size, head digest) -> files
+  std::map<std::size_t, std::string> whole;                           // file -> digest of all its bytes
+  auto whole_digest = [&](std::size_t i) -> const std::string& {
+    auto it = whole.find(i);
+    if (it == whole.end()) it = whole.emplace(i, awcc::sha256_of_file(files[i])).first;
+    return it->second;
+  };
+  for (std::size_t j = 0; j < files.size(); ++j) {
+    std::error_code ec;
+    if (!fs::is_regular_file(files[j], ec)) continue;  // folders and README.md: skipped later, said there
+    for (std::size_t i = 0; i < j; ++i) {
+      if (files[i] == files[j] || fs::equivalent(files[i], files[j], ec)) {
+        throw std::invalid_argument(fmt::format("{} and {} (files {} and {}) are one file: a profile measures each "
+                                                "position once; remove the repeat",
+                                                files[i], files[j], i + 1, j + 1));
+      }
+    }
+    const auto size = fs::file_size(files[j], ec);
+    if (ec) continue;
+    auto& alike = seen[{size, head_digest(files[j])}];
+    for (const std::size_t i : alike) {
+      if (whole_digest(i) != whole_digest(j)) continue;
+      throw std::invalid_argument(fmt::format("{} and {} (files {} and {}) hold the same bytes: one recording copied "
+                                              "under two names, not two measurements; give each position its own "
+                                              "recording",
+                                              files[i], files[j], i + 1, j + 1));
+    }
+    alike.push_back(j);
+  }
+}
+
 }  // namespace
 
 Plan plan_of(const ProcessCommandOptions& o) {
   Plan plan;
+  check_repeated_inputs(o.files);
   plan.options = build_options(o);
   plan.positions = positions_for(o);
   if (!o.correct.empty() && !plan.options.awcc) {
