@@ -152,6 +152,13 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   in.read(header, 8);
   const auto rows = load<std::int32_t>(header, std::endian::native == std::endian::big);
   const auto channels = load<std::int32_t>(header + 4, std::endian::native == std::endian::big);
+  // LabVIEW writes the header of an acquisition stopped before its first
+  // sample: a recording with no samples, not another layout.
+  if (rows == 0 && channels > 0 && channels <= 64 && size == 8) {
+    reader_fail(path, fmt::format("the .dat header says 0 rows of {} channels and no sample follows: the acquisition "
+                                  "recorded nothing; record again",
+                                  channels));
+  }
   if (rows <= 0 || channels <= 0 || channels > 64) {
     reader_fail(path, fmt::format("the .dat header says {} rows and {} channels, which is not a UQ .dat header; if the file "
                            "is headerless, read it as a raw file with its layout",

@@ -53,6 +53,7 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
   } else if (!o.manifest.empty()) {
     std::ifstream in(o.manifest);
     std::map<std::string, double> by_name;
+    std::map<std::string, int> line_of;
     std::string line;
     int number = 0;
     while (std::getline(in, line)) {
@@ -60,13 +61,19 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       if (!line.empty() && line.back() == '\r') line.pop_back();
       const auto cells = awcc::split_cells(line);
       if (cells.size() < 2) continue;
+      double position = 0.0;
       try {
-        by_name[std::filesystem::path(cells[0]).filename().string()] =
-            awcc::parse_quantity(cells[1], awcc::Dimension::length);
+        position = awcc::parse_quantity(cells[1], awcc::Dimension::length);
       } catch (const std::invalid_argument& e) {
         if (number == 1) continue;  // header row
         throw std::invalid_argument(fmt::format("{}:{}: {}", o.manifest, number, e.what()));
       }
+      const auto name = std::filesystem::path(cells[0]).filename().string();
+      if (const auto [at, fresh] = line_of.emplace(name, number); !fresh) {
+        throw std::invalid_argument(fmt::format("{}: lines {} and {} both position {}; keep one", o.manifest, at->second,
+                                                number, name));
+      }
+      by_name[name] = position;
     }
     std::map<std::string, std::string> seen;
     for (std::size_t i = 0; i < o.files.size(); ++i) {
@@ -79,6 +86,17 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       // A file without a row is refused once it proves to be a recording
       // (a README caught by the same glob is skipped, not positioned).
       if (const auto it = by_name.find(name); it != by_name.end()) out[i] = it->second;
+    }
+  }
+  // One position per recording: a position given twice is a typo (or two
+  // recordings of one position, which a profile cannot tell apart).
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      if (!out[i] || !out[j] || *out[i] != *out[j]) continue;
+      throw std::invalid_argument(fmt::format("{} gives {} and {} the same position, {}; a profile has one recording "
+                                              "per position: correct the position, or process the repeat on its own",
+                                              o.positions.empty() ? o.manifest : std::string("--positions"), o.files[i],
+                                              o.files[j], awcc::format_quantity(*out[i], awcc::Dimension::length)));
     }
   }
   return out;
