@@ -43,6 +43,9 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
     }
   };
+  if (!o.positions.empty() && !o.manifest.empty()) {
+    throw std::invalid_argument("--positions and --manifest both give the positions; give one of them");
+  }
   if (!o.positions.empty()) {
     const auto items = awcc::split_cells(o.positions);
     if (items.size() != o.files.size()) {

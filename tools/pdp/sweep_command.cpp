@@ -61,6 +61,7 @@ int run_sweep(const SweepOptions& o) {
   int refused = 0;
   if (mpi.rank() == 0) {
     try {
+      awcc::check_output_folder(o.output);  // a folder named as the output is said as such
       done = study::finished_runs(o.output, id);
       std::error_code ec;
       if (!std::filesystem::exists(o.output, ec) || std::filesystem::file_size(o.output, ec) == 0) {
