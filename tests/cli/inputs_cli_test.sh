@@ -6,12 +6,10 @@
 # docs/reliability.md lists them.
 # Usage: inputs_cli_test.sh PDP SCRATCH_DIR SOURCE_DIR
 set -u
-pdp=$1
-dir=$2/inputs_cli
-src=$3
+source "$(dirname "$0")/lib.sh"
+pdp=$1 dir=$2/inputs_cli src=$3
 data=$src/../shared/data/felder-stepped-spillway
 rm -rf "$dir" && mkdir -p "$dir"
-source "$(dirname "$0")/lib.sh"
 py() { /usr/bin/python3 "$@"; }
 # refused CODE TEXT CMD...: as expect, and the --json the command names is not written.
 refused() {
