@@ -37,22 +37,27 @@ bool looks_like_option(const std::string& a) {
   return std::isalpha(static_cast<unsigned char>(c)) != 0;
 }
 
-// The option an argument names in `app`: --name, --name=value, -x, -xVALUE.
-const CLI::Option* option_of(const CLI::App& app, const std::string& a) {
-  const std::string name = a.substr(0, a.find('='));
-  if (const auto* o = app.get_option_no_throw(name)) return o;
-  if (a[1] != '-' && a.size() > 2) {
-    const auto* o = app.get_option_no_throw(a.substr(0, 2));
-    if (o && o->get_items_expected_max() > 0) return o;
-  }
-  return nullptr;
-}
+// How an argument reads in `app`: whether it names its options (--name,
+// --name=value, -x, -xVALUE, short flags together: -qo FILE), and whether
+// the next argument is a value.
+struct Reading {
+  bool known = false;
+  bool value_follows = false;
+};
 
-// Whether the option's value is the next argument.
-bool value_follows(const CLI::Option* o, const std::string& a) {
-  if (o->get_items_expected_max() == 0) return false;  // a flag
-  if (a.find('=') != std::string::npos) return false;
-  return a[1] == '-' || a.size() == 2;  // not -xVALUE
+bool takes_value(const CLI::Option* o) { return o->get_items_expected_max() > 0; }
+
+Reading read_argument(const CLI::App& app, const std::string& a) {
+  if (a[1] == '-') {
+    const auto* o = app.get_option_no_throw(a.substr(0, a.find('=')));
+    return {o != nullptr, o && takes_value(o) && a.find('=') == std::string::npos};
+  }
+  for (std::size_t k = 1; k < a.size(); ++k) {
+    const auto* o = app.get_option_no_throw(std::string{'-', a[k]});
+    if (!o) return {};
+    if (takes_value(o)) return {true, k + 1 == a.size()};  // the rest of the argument, or the next, is its value
+  }
+  return {true, false};
 }
 
 // The long flags: what a typo is measured against (a one-letter flag is one
@@ -115,13 +120,13 @@ std::vector<std::string> arrange_arguments(const CLI::App& app, const std::vecto
     const std::string& a = arguments[at];
     if (a == "--") break;
     if (looks_like_option(a)) {
-      const auto* o = option_of(app, a);
-      if (!o) {
+      const Reading r = read_argument(app, a);
+      if (!r.known) {
         // An option of the subcommand (or of another) before it: said so, not taken for a typo.
         const std::string name = a.substr(0, a.find('='));
         for (std::size_t k = at + 1; k < arguments.size(); ++k) {
           for (const auto* s : subcommands) {
-            if (s->get_name() == arguments[k] && option_of(*s, a)) {
+            if (s->get_name() == arguments[k] && read_argument(*s, a).known) {
               throw std::invalid_argument(
                   fmt::format("{} is an option of pdp {}: give it after '{}'", name, s->get_name(), s->get_name()));
             }
@@ -129,7 +134,7 @@ std::vector<std::string> arrange_arguments(const CLI::App& app, const std::vecto
         }
         std::vector<std::string> owners;
         for (const auto* s : subcommands) {
-          if (option_of(*s, a)) owners.push_back("pdp " + s->get_name());
+          if (read_argument(*s, a).known) owners.push_back("pdp " + s->get_name());
         }
         if (!owners.empty()) {
           throw std::invalid_argument(fmt::format("{} is an option of {}, not of pdp itself: give it after the command",
@@ -137,7 +142,7 @@ std::vector<std::string> arrange_arguments(const CLI::App& app, const std::vecto
         }
         unknown_option(a, app);
       }
-      if (value_follows(o, a)) ++at;
+      if (r.value_follows) ++at;
       continue;
     }
     for (const auto* s : subcommands) {
@@ -166,15 +171,15 @@ std::vector<std::string> arrange_arguments(const CLI::App& app, const std::vecto
       continue;
     }
     const bool last = i + 1 == arguments.size();
-    if (const auto* o = option_of(*sub, a)) {
+    if (const Reading r = read_argument(*sub, a); r.known) {
       after.push_back(a);
-      if (value_follows(o, a) && !last) after.push_back(arguments[++i]);
+      if (r.value_follows && !last) after.push_back(arguments[++i]);
       continue;
     }
     // pdp's own options work after the subcommand too.
-    if (const auto* o = option_of(app, a)) {
+    if (const Reading r = read_argument(app, a); r.known) {
       before.push_back(a);
-      if (value_follows(o, a) && !last) before.push_back(arguments[++i]);
+      if (r.value_follows && !last) before.push_back(arguments[++i]);
       continue;
     }
     std::error_code ec;
