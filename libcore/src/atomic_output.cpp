@@ -16,8 +16,8 @@ void check_output_folder(const std::filesystem::path& target) {
   // renamed over, or the temporary file named in the error: said here.
   std::error_code ec;
   if (!target.has_filename() || fs::is_directory(target, ec)) {
-    throw OutputError(fmt::format("{}: is a folder, not a file; name the output file (a path in the folder)",
-                                  target.string()));
+    throw OutputError(
+        fmt::format("{}: is a folder, not a file; name the output file (a path in the folder)", target.string()));
   }
   if (!fs::is_directory(parent)) {
     throw OutputError(fmt::format("{}: the folder {} does not exist; create it or choose another output path",
@@ -49,9 +49,10 @@ void write_text_atomically(const std::filesystem::path& target, std::string_view
     out.close();
     // The target named, not the temporary file: that is the path the user gave.
     if (!out) {
-      throw OutputError(fmt::format("{}: could not write the file (no permission to write in its folder, or the disk "
-                                    "is full)",
-                                    target.string()));
+      throw OutputError(
+          fmt::format("{}: could not write the file (no permission to write in its folder, or the disk "
+                      "is full)",
+                      target.string()));
     }
   });
 }

@@ -1,12 +1,12 @@
 #include "awcc/units.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <numbers>
-#include <fmt/format.h>
 #include <stdexcept>
 #include <vector>
 
@@ -155,7 +155,8 @@ double parse_quantity(std::string_view text, Dimension dimension) {
       ++matches;
     }
   }
-  if (matches == 1) return fail(fmt::format("unknown unit '{}' (units are case-sensitive: did you mean {}?)", unit, near));
+  if (matches == 1)
+    return fail(fmt::format("unknown unit '{}' (units are case-sensitive: did you mean {}?)", unit, near));
   return fail(fmt::format("unknown unit '{}'", unit));
 }
 

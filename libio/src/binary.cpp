@@ -192,12 +192,16 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   info.quantum = layout.volts_per_count;
   info.volts_known = true;
   auto recording = std::make_unique<BinaryRecording>(path, std::move(info), layout);
-  check_interleaving(*recording, "the .dat header's channel count (bytes 4-7)", [&](int n) {
-    const auto samples = static_cast<std::int64_t>(rows) * channels;
-    return fmt::format("correct the header to {} channels{}, or read the file as raw (format raw, raw-channels {}, "
-                       "raw-header 8 bytes)",
-                       n, samples % n == 0 ? fmt::format(" and {} rows", samples / n) : std::string(), n);
-  }, "format");
+  check_interleaving(
+      *recording, "the .dat header's channel count (bytes 4-7)",
+      [&](int n) {
+        const auto samples = static_cast<std::int64_t>(rows) * channels;
+        return fmt::format(
+            "correct the header to {} channels{}, or read the file as raw (format raw, raw-channels {}, "
+            "raw-header 8 bytes)",
+            n, samples % n == 0 ? fmt::format(" and {} rows", samples / n) : std::string(), n);
+      },
+      "format");
   return recording;
 }
 
@@ -228,8 +232,9 @@ std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& o
   info.quantum = integer ? layout.volts_per_count : 0.0;
   info.volts_known = true;
   auto recording = std::make_unique<BinaryRecording>(path, std::move(info), layout);
-  check_interleaving(*recording, "the stated raw layout (raw-channels)",
-                     [](int n) { return fmt::format("state raw-channels {}", n); }, "raw-channels");
+  check_interleaving(
+      *recording, "the stated raw layout (raw-channels)", [](int n) { return fmt::format("state raw-channels {}", n); },
+      "raw-channels");
   return recording;
 }
 

@@ -225,20 +225,24 @@ class CsvRecording final : public Recording {
       read_lvm_line(line, h);
       if (trim(line).starts_with("***End_of_Header***")) break;
       if (!bounded_getline(in_, line, info_.path, line_ + 1)) {
-        reader_fail(info_.path, fmt::format("the LabVIEW segment header at line {} has no ***End_of_Header***: the file "
-                                            "is truncated or damaged", start));
+        reader_fail(info_.path,
+                    fmt::format("the LabVIEW segment header at line {} has no ***End_of_Header***: the file "
+                                "is truncated or damaged",
+                                start));
       }
       ++line_;
     }
     const auto& f = first_segment_;
     if (h.channels && f.channels && *h.channels != *f.channels) {
       reader_fail(info_.path, fmt::format("the LabVIEW segment at line {} has {} channels, the first segment {}: save "
-                                          "the segments as separate files", start, *h.channels, *f.channels));
+                                          "the segments as separate files",
+                                          start, *h.channels, *f.channels));
     }
     if (h.delta && f.delta && std::fabs(*h.delta - *f.delta) > 1e-6 * *f.delta) {
-      reader_fail(info_.path, fmt::format("the LabVIEW segment at line {} has Delta_X {:g} s, the first segment {:g} s: "
-                                          "its sampling rate differs; save the segments as separate files",
-                                          start, *h.delta, *f.delta));
+      reader_fail(info_.path,
+                  fmt::format("the LabVIEW segment at line {} has Delta_X {:g} s, the first segment {:g} s: "
+                              "its sampling rate differs; save the segments as separate files",
+                              start, *h.delta, *f.delta));
     }
     // The column names (a row that is not numbers), if the segment repeats them.
     const std::streampos at = in_.tellg();

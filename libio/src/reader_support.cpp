@@ -1,6 +1,6 @@
 // The readers' shared support (reader_support.hpp).
-#include <cmath>
 #include <fmt/format.h>
+#include <cmath>
 #include <fstream>
 #include <stdexcept>
 #include <vector>

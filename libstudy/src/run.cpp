@@ -184,16 +184,16 @@ json run_to_json(const RunResult& r) {
                    {"d32", opt(r.fscc_d32.value)}};
   }
   if (p.awcc) {
-    out["awcc"] = {{"status", awcc::to_string(p.awcc->status)},
-                   {"reason", p.awcc->ok() ? json(nullptr) : json(p.awcc->message)},
-                   {"quality", awcc::to_string(p.awcc->quality)},
-                   {"quality_reason", p.awcc->quality == awcc::AwccQuality::ok ? json(nullptr)
-                                                                                : json(p.awcc->quality_reason)},
-                   {"velocity", opt(r.awcc_velocity.value)},
-                   {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},
-                   {"d32", opt(r.awcc_d32.value)},
-                   {"windows_total", p.awcc->windows_total},
-                   {"windows_accepted", p.awcc->windows_accepted}};
+    out["awcc"] = {
+        {"status", awcc::to_string(p.awcc->status)},
+        {"reason", p.awcc->ok() ? json(nullptr) : json(p.awcc->message)},
+        {"quality", awcc::to_string(p.awcc->quality)},
+        {"quality_reason", p.awcc->quality == awcc::AwccQuality::ok ? json(nullptr) : json(p.awcc->quality_reason)},
+        {"velocity", opt(r.awcc_velocity.value)},
+        {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},
+        {"d32", opt(r.awcc_d32.value)},
+        {"windows_total", p.awcc->windows_total},
+        {"windows_accepted", p.awcc->windows_accepted}};
   }
   out["error"] = {{"void_fraction", opt(r.void_fraction.error())},
                   {"bubble_count_rate", opt(r.count_rate.error())},
@@ -220,7 +220,8 @@ std::string fscc_status_line(const awcc::FsccResult& f) {
 std::string awcc_status_line(const awcc::AwccResult& a) {
   // Insufficient whenever not ok: the quality reason is the status message, said once.
   if (!a.ok()) {
-    return fmt::format("AWCC: status {}, quality insufficient, no velocity: {}\n", awcc::to_string(a.status), a.message);
+    return fmt::format("AWCC: status {}, quality insufficient, no velocity: {}\n", awcc::to_string(a.status),
+                       a.message);
   }
   if (a.quality == awcc::AwccQuality::low) {
     return fmt::format("AWCC: status ok, quality low (its values are flagged): {}\n", a.quality_reason);
@@ -265,9 +266,10 @@ std::string run_report(const RunResult& r) {
                        a.count(awcc::WindowFate::lag), a.count(awcc::WindowFate::roc),
                        a.count(awcc::WindowFate::constant));
     if (r.window_bias) {
-      out += fmt::format("window level (AWCC quality {}): AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms "
-                         "{:.4f} m/s\n",
-                         awcc::to_string(a.quality), *r.window_bias, *r.window_rms);
+      out += fmt::format(
+          "window level (AWCC quality {}): AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms "
+          "{:.4f} m/s\n",
+          awcc::to_string(a.quality), *r.window_bias, *r.window_rms);
     }
     for (const auto& [label, s] : {std::pair{"accepted", &r.accepted_truth}, std::pair{"rejected", &r.rejected_truth}}) {
       out += fmt::format("true window velocity, {}: mean {:.4f}, sd {:.4f}, quartiles {:.4f} {:.4f} {:.4f} m/s ({})\n",

@@ -91,9 +91,15 @@ RepeatSummary summarise_runs(const std::vector<RunResult>& runs) {
     out.awcc_undefined += !r.awcc_velocity.value;
     if (!r.processed.awcc) continue;
     switch (r.processed.awcc->quality) {
-      case awcc::AwccQuality::ok: ++out.awcc_ok; break;
-      case awcc::AwccQuality::low: ++out.awcc_low; break;
-      case awcc::AwccQuality::insufficient: ++out.awcc_insufficient; break;
+      case awcc::AwccQuality::ok:
+        ++out.awcc_ok;
+        break;
+      case awcc::AwccQuality::low:
+        ++out.awcc_low;
+        break;
+      case awcc::AwccQuality::insufficient:
+        ++out.awcc_insufficient;
+        break;
     }
   }
   return out;
@@ -137,9 +143,10 @@ std::string repeats_report(const std::vector<RunResult>& runs, const RepeatSumma
     out += fmt::format("{:<28}{:>8}{:>10.3f}{}{:>14.3f}{} to {:.3f}{}\n", e.name, m.count, m.mean * scale, unit,
                        m.lower * scale, unit, m.upper * scale, unit);
   }
-  out += fmt::format("AWCC quality: {} runs ok, {} low, {} insufficient (no velocity); the AWCC errors are over the ok "
-                     "and low runs\n",
-                     summary.awcc_ok, summary.awcc_low, summary.awcc_insufficient);
+  out += fmt::format(
+      "AWCC quality: {} runs ok, {} low, {} insufficient (no velocity); the AWCC errors are over the ok "
+      "and low runs\n",
+      summary.awcc_ok, summary.awcc_low, summary.awcc_insufficient);
   if (summary.fscc_undefined || summary.awcc_undefined) {
     out += fmt::format("velocity undefined in {} FSCC and {} AWCC runs\n", summary.fscc_undefined,
                        summary.awcc_undefined);

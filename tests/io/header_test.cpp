@@ -207,8 +207,8 @@ std::string labview_file(int channels_line, bool comment_cells, const std::vecto
   }
   t += fmt::format("Channels\t{}\t\t{}", channels_line, eol);
   t += fmt::format("Samples\t{}\t{}\t{}", rows, rows, eol);
-  t += fmt::format("Date\t2024/03/05\t2024/03/05\t{}Time\t10:15:02.4973711967468261719\t10:15:02.4973711967468261719\t{}",
-                   eol, eol);
+  t += fmt::format(
+      "Date\t2024/03/05\t2024/03/05\t{}Time\t10:15:02.4973711967468261719\t10:15:02.4973711967468261719\t{}", eol, eol);
   t += fmt::format("Y_Unit_Label\tVolts\tVolts\t{}X_Dimension\tTime\tTime\t{}", eol, eol);
   t += fmt::format("X0\t0.0000000000000000E+0\t0.0000000000000000E+0\t{}Delta_X\t0.000050\t0.000050\t{}", eol, eol);
   t += fmt::format("***End_of_Header***\t\t\t{}X_Value\tVoltage\tVoltage_0\tComment{}", eol, eol);

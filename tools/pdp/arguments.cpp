@@ -45,7 +45,9 @@ struct Reading {
   bool value_follows = false;
 };
 
-bool takes_value(const CLI::Option* o) { return o->get_items_expected_max() > 0; }
+bool takes_value(const CLI::Option* o) {
+  return o->get_items_expected_max() > 0;
+}
 
 Reading read_argument(const CLI::App& app, const std::string& a) {
   if (a[1] == '-') {

@@ -73,8 +73,8 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       }
       const auto name = std::filesystem::path(cells[0]).filename().string();
       if (const auto [at, fresh] = line_of.emplace(name, number); !fresh) {
-        throw std::invalid_argument(fmt::format("{}: lines {} and {} both position {}; keep one", o.manifest, at->second,
-                                                number, name));
+        throw std::invalid_argument(
+            fmt::format("{}: lines {} and {} both position {}; keep one", o.manifest, at->second, number, name));
       }
       by_name[name] = position;
     }
@@ -96,10 +96,11 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
   for (std::size_t j = 0; j < out.size(); ++j) {
     for (std::size_t i = 0; i < j; ++i) {
       if (!out[i] || !out[j] || *out[i] != *out[j]) continue;
-      throw std::invalid_argument(fmt::format("{} gives {} and {} the same position, {}; a profile has one recording "
-                                              "per position: correct the position, or process the repeat on its own",
-                                              o.positions.empty() ? o.manifest : std::string("--positions"), o.files[i],
-                                              o.files[j], awcc::format_quantity(*out[i], awcc::Dimension::length)));
+      throw std::invalid_argument(
+          fmt::format("{} gives {} and {} the same position, {}; a profile has one recording "
+                      "per position: correct the position, or process the repeat on its own",
+                      o.positions.empty() ? o.manifest : std::string("--positions"), o.files[i], o.files[j],
+                      awcc::format_quantity(*out[i], awcc::Dimension::length)));
     }
   }
   return out;
@@ -151,7 +152,7 @@ std::string head_digest(const std::filesystem::path& path) {
 void check_repeated_inputs(const std::vector<std::string>& files) {
   namespace fs = std::filesystem;
   std::map<std::pair<std::uintmax_t, std::string>, std::vector<std::size_t>> seen;  // (size, head digest) -> files
-  std::map<std::size_t, std::string> whole;                           // file -> digest of all its bytes
+  std::map<std::size_t, std::string> whole;                                         // file -> digest of all its bytes
   auto whole_digest = [&](std::size_t i) -> const std::string& {
     auto it = whole.find(i);
     if (it == whole.end()) it = whole.emplace(i, awcc::sha256_of_file(files[i])).first;
@@ -162,9 +163,10 @@ void check_repeated_inputs(const std::vector<std::string>& files) {
     if (!fs::is_regular_file(files[j], ec)) continue;  // folders and README.md: skipped later, said there
     for (std::size_t i = 0; i < j; ++i) {
       if (files[i] == files[j] || fs::equivalent(files[i], files[j], ec)) {
-        throw std::invalid_argument(fmt::format("{} and {} (files {} and {}) are one file: a profile measures each "
-                                                "position once; remove the repeat",
-                                                files[i], files[j], i + 1, j + 1));
+        throw std::invalid_argument(
+            fmt::format("{} and {} (files {} and {}) are one file: a profile measures each "
+                        "position once; remove the repeat",
+                        files[i], files[j], i + 1, j + 1));
       }
     }
     const auto size = fs::file_size(files[j], ec);
@@ -172,10 +174,11 @@ void check_repeated_inputs(const std::vector<std::string>& files) {
     auto& alike = seen[{size, head_digest(files[j])}];
     for (const std::size_t i : alike) {
       if (whole_digest(i) != whole_digest(j)) continue;
-      throw std::invalid_argument(fmt::format("{} and {} (files {} and {}) hold the same bytes: one recording copied "
-                                              "under two names, not two measurements; give each position its own "
-                                              "recording",
-                                              files[i], files[j], i + 1, j + 1));
+      throw std::invalid_argument(
+          fmt::format("{} and {} (files {} and {}) hold the same bytes: one recording copied "
+                      "under two names, not two measurements; give each position its own "
+                      "recording",
+                      files[i], files[j], i + 1, j + 1));
     }
     alike.push_back(j);
   }
