@@ -12,6 +12,13 @@ namespace awcc {
 void check_output_folder(const std::filesystem::path& target) {
   namespace fs = std::filesystem;
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  // A folder named as the output (or a path ending in a separator) would be
+  // renamed over, or the temporary file named in the error: said here.
+  std::error_code ec;
+  if (!target.has_filename() || fs::is_directory(target, ec)) {
+    throw OutputError(
+        fmt::format("{}: is a folder, not a file; name the output file (a path in the folder)", target.string()));
+  }
   if (!fs::is_directory(parent)) {
     throw OutputError(fmt::format("{}: the folder {} does not exist; create it or choose another output path",
                                   target.string(), parent.string()));
@@ -40,7 +47,13 @@ void write_text_atomically(const std::filesystem::path& target, std::string_view
     std::ofstream out(temporary, std::ios::binary);
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
     out.close();
-    if (!out) throw OutputError(fmt::format("{}: could not write the file", temporary.string()));
+    // The target named, not the temporary file: that is the path the user gave.
+    if (!out) {
+      throw OutputError(
+          fmt::format("{}: could not write the file (no permission to write in its folder, or the disk "
+                      "is full)",
+                      target.string()));
+    }
   });
 }
 

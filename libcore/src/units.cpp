@@ -1,10 +1,12 @@
 #include "awcc/units.hpp"
 
+#include <fmt/format.h>
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <numbers>
-#include <fmt/format.h>
 #include <stdexcept>
 #include <vector>
 
@@ -129,6 +131,32 @@ double parse_quantity(std::string_view text, Dimension dimension) {
   for (const auto& u : units_of(dimension)) {
     if (u.symbol == unit) return value * u.scale;
   }
+  // A European decimal comma (7,15mm) or a list (5mm,6mm) where one value belongs.
+  if (unit.size() > 1 && unit[0] == ',' && std::isdigit(static_cast<unsigned char>(unit[1]))) {
+    std::string point(s);
+    point[static_cast<std::size_t>(ptr - s.data())] = '.';
+    throw std::invalid_argument(fmt::format("'{}' is not {}: its decimal separator is a comma; write {}", text,
+                                            dimension_name(dimension), point));
+  }
+  if (unit.find(',') != std::string_view::npos) {
+    throw std::invalid_argument(
+        fmt::format("'{}' is not {}: it is a list; give one value", text, dimension_name(dimension)));
+  }
+  // Units are case-sensitive (mHz is not MHz): a unit in the wrong case is named with the right one.
+  std::string near;
+  int matches = 0;
+  for (const auto& u : units_of(dimension)) {
+    if (u.symbol.size() != unit.size() || u.symbol.empty()) continue;
+    const bool same = std::equal(unit.begin(), unit.end(), u.symbol.begin(), [](char a, char b) {
+      return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+    });
+    if (same) {
+      near = u.symbol;
+      ++matches;
+    }
+  }
+  if (matches == 1)
+    return fail(fmt::format("unknown unit '{}' (units are case-sensitive: did you mean {}?)", unit, near));
   return fail(fmt::format("unknown unit '{}'", unit));
 }
 

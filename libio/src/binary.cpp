@@ -152,6 +152,13 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   in.read(header, 8);
   const auto rows = load<std::int32_t>(header, std::endian::native == std::endian::big);
   const auto channels = load<std::int32_t>(header + 4, std::endian::native == std::endian::big);
+  // LabVIEW writes the header of an acquisition stopped before its first
+  // sample: a recording with no samples, not another layout.
+  if (rows == 0 && channels > 0 && channels <= 64 && size == 8) {
+    reader_fail(path, fmt::format("the .dat header says 0 rows of {} channels and no sample follows: the acquisition "
+                                  "recorded nothing; record again",
+                                  channels));
+  }
   if (rows <= 0 || channels <= 0 || channels > 64) {
     reader_fail(path, fmt::format("the .dat header says {} rows and {} channels, which is not a UQ .dat header; if the file "
                            "is headerless, read it as a raw file with its layout",
@@ -184,7 +191,18 @@ std::unique_ptr<Recording> open_uq_dat(const fs::path& path, const ReaderOptions
   info.frames = rows;
   info.quantum = layout.volts_per_count;
   info.volts_known = true;
-  return std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  auto recording = std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  check_interleaving(
+      *recording, "the .dat header's channel count (bytes 4-7)",
+      [&](int n) {
+        const auto samples = static_cast<std::int64_t>(rows) * channels;
+        return fmt::format(
+            "correct the header to {} channels{}, or read the file as raw (format raw, raw-channels {}, "
+            "raw-header 8 bytes)",
+            n, samples % n == 0 ? fmt::format(" and {} rows", samples / n) : std::string(), n);
+      },
+      "format");
+  return recording;
 }
 
 std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& options) {
@@ -213,7 +231,11 @@ std::unique_ptr<Recording> open_raw(const fs::path& path, const ReaderOptions& o
   const bool integer = layout.sample_type == SampleType::int16 || layout.sample_type == SampleType::int32;
   info.quantum = integer ? layout.volts_per_count : 0.0;
   info.volts_known = true;
-  return std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  auto recording = std::make_unique<BinaryRecording>(path, std::move(info), layout);
+  check_interleaving(
+      *recording, "the stated raw layout (raw-channels)", [](int n) { return fmt::format("state raw-channels {}", n); },
+      "raw-channels");
+  return recording;
 }
 
 }  // namespace detail

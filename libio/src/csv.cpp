@@ -114,6 +114,14 @@ class CsvRecording final : public Recording {
     choose_separators(sample, options, lvm);
     const auto table = choose_columns(sample, options);
     choose_time_column(sample, table, options);
+    if (lvm.channels && *lvm.channels != info_.channels) {
+      std::string names;
+      for (const auto& n : info_.channel_names) names += (names.empty() ? "'" : ", '") + n + "'";
+      reader_fail(path, fmt::format("its header's Channels line says {} channels, but its rows hold {} data column{} "
+                                    "({}): the header does not describe the data; correct the Channels line or "
+                                    "the columns",
+                                    *lvm.channels, info_.channels, info_.channels == 1 ? "" : "s", names));
+    }
     data_start_ = sample.starts[table.first_data];
     first_line_ = sample.lines[table.first_data] - 1;
     in_.clear();
@@ -139,6 +147,10 @@ class CsvRecording final : public Recording {
     while (n < max_frames && bounded_getline(in_, line, info_.path, line_ + 1)) {
       ++line_;
       if (trim(line).empty()) continue;
+      if (lvm_ && trim(line).starts_with("Channels")) {
+        skip_lvm_segment(line);
+        continue;
+      }
       const auto cells = split(line, delimiter_);
       if (!fits(cells)) {
         reader_fail(info_.path, fmt::format("line {} has {} cells where the first row has {}; fix or remove the line", line_,
@@ -177,8 +189,76 @@ class CsvRecording final : public Recording {
   struct LvmHeader {
     bool lvm = false;
     std::optional<double> delta;  // Delta_X, the sample interval
+    std::optional<int> channels;  // Channels, the segment's data channels
     char separator = 0, decimal = 0;
   };
+
+  // One line of a LabVIEW header: the keys the reader uses. Tab separates
+  // key and value (a file written with Separator Comma: a comma).
+  static void read_lvm_line(std::string_view line, LvmHeader& h) {
+    const auto cells = split(line, line.find('\t') != std::string_view::npos ? '\t' : ',');
+    const auto key = cells.empty() ? std::string_view{} : trim(cells[0]);
+    const auto value = cells.size() > 1 ? trim(cells[1]) : std::string_view{};
+    if (key == "Separator") h.separator = value == "Comma" ? ',' : (value == "Tab" ? '\t' : 0);
+    if (key == "Decimal_Separator" && !value.empty()) h.decimal = value[0];
+    if (key == "Channels") {
+      double n;
+      if (parse_number(value, n) && n >= 0.0 && n < 1e6 && n == std::floor(n)) h.channels = static_cast<int>(n);
+    }
+    if (key == "Delta_X") {
+      double d;
+      std::string v(value);
+      std::replace(v.begin(), v.end(), ',', '.');
+      if (parse_number(v, d) && d > 0.0) h.delta = d;
+    }
+  }
+
+  // A later segment of a LabVIEW file (LabVIEW starts one at every write
+  // unless told to write one header only): its header, from its Channels
+  // line to ***End_of_Header***, and the column names after it are skipped;
+  // its channels and sample interval must be the first segment's.
+  void skip_lvm_segment(const std::string& first) {
+    LvmHeader h;
+    const std::int64_t start = line_;
+    std::string line = first;
+    for (;;) {
+      read_lvm_line(line, h);
+      if (trim(line).starts_with("***End_of_Header***")) break;
+      if (!bounded_getline(in_, line, info_.path, line_ + 1)) {
+        reader_fail(info_.path,
+                    fmt::format("the LabVIEW segment header at line {} has no ***End_of_Header***: the file "
+                                "is truncated or damaged",
+                                start));
+      }
+      ++line_;
+    }
+    const auto& f = first_segment_;
+    if (h.channels && f.channels && *h.channels != *f.channels) {
+      reader_fail(info_.path, fmt::format("the LabVIEW segment at line {} has {} channels, the first segment {}: save "
+                                          "the segments as separate files",
+                                          start, *h.channels, *f.channels));
+    }
+    if (h.delta && f.delta && std::fabs(*h.delta - *f.delta) > 1e-6 * *f.delta) {
+      reader_fail(info_.path,
+                  fmt::format("the LabVIEW segment at line {} has Delta_X {:g} s, the first segment {:g} s: "
+                              "its sampling rate differs; save the segments as separate files",
+                              start, *h.delta, *f.delta));
+    }
+    // The column names (a row that is not numbers), if the segment repeats them.
+    const std::streampos at = in_.tellg();
+    const std::int64_t at_line = line_;
+    while (bounded_getline(in_, line, info_.path, line_ + 1)) {
+      ++line_;
+      if (trim(line).empty()) continue;
+      double v;
+      const auto cells = split(line, delimiter_);
+      if (!cells.empty() && !number_of(cells[0], v)) return;
+      break;
+    }
+    in_.clear();
+    in_.seekg(at);
+    line_ = at_line;
+  }
 
   // LabVIEW .lvm: header blocks up to the last ***End_of_Header*** before the
   // data, leaving the stream at the data and `number` at the last header line.
@@ -195,26 +275,17 @@ class CsvRecording final : public Recording {
     in_.seekg(at);
     if (!h.lvm) return h;
     while (bounded_getline(in_, line, path, ++number)) {
-      const auto cells = split(line, '\t');
-      const auto key = cells.empty() ? std::string_view{} : trim(cells[0]);
-      const auto value = cells.size() > 1 ? trim(cells[1]) : std::string_view{};
-      if (key == "Separator") h.separator = value == "Comma" ? ',' : (value == "Tab" ? '\t' : 0);
-      if (key == "Decimal_Separator" && !value.empty()) h.decimal = value[0];
-      if (key == "Delta_X") {
-        double d;
-        std::string v(value);
-        std::replace(v.begin(), v.end(), ',', '.');
-        if (parse_number(v, d) && d > 0.0) h.delta = d;
-      }
+      read_lvm_line(line, h);
       if (trim(line).starts_with("***End_of_Header***")) {
         body = in_.tellg();
         body_line = number;
         // The file header, then the first segment's: its data follow.
-        // Later segments (their headers inside the data) are refused
-        // by read() as rows that are not numbers.
+        // Later segments' headers, inside the data, read() skips.
         if (++markers == 2) break;
       }
     }
+    lvm_ = h.lvm;
+    first_segment_ = h;
     if (body_line == 0) reader_fail(path, "a LabVIEW measurement file without ***End_of_Header***: not a recording", "not_a_recording");
     in_.clear();
     in_.seekg(body);
@@ -508,6 +579,8 @@ class CsvRecording final : public Recording {
   }
 
   std::ifstream in_;
+  bool lvm_ = false;
+  LvmHeader first_segment_;  // a LabVIEW file's header up to its first data
   char delimiter_ = ',';
   char decimal_ = '.';
   int columns_ = 0;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -36,6 +37,16 @@ T load(const void* p, bool swap) {
   std::memcpy(&v, b, sizeof(T));
   return v;
 }
+
+/// Refuses a recording of interleaved samples (frame after frame of
+/// `channels` values) whose stated channel count does not fit its data: a
+/// header saying 3 channels over data of 2 deinterleaves into channels that
+/// each mix both tips, which no later step can tell from a flow. Reads the
+/// first block and rewinds. `stated` names where the count comes from (a
+/// header field, a stated layout), `fix(n)` the remedy when the data hold n
+/// channels, `quantity` the reader setting that fixes it.
+void check_interleaving(Recording& recording, std::string_view stated, const std::function<std::string(int)>& fix,
+                        std::string quantity = {});
 
 /// The first n bytes of a file (fewer when it is shorter): what magic tests look at.
 std::string leading_bytes(const std::filesystem::path& path, std::size_t n);

@@ -218,7 +218,11 @@ bool audio_magic(const fs::path& path) {
 }
 
 std::unique_ptr<Recording> open_sndfile(const fs::path& path, const ReaderOptions& options) {
-  return std::make_unique<SndfileRecording>(path, options);
+  auto recording = std::make_unique<SndfileRecording>(path, options);
+  check_interleaving(*recording, "the audio header's channel count", [](int n) {
+    return fmt::format("the header is wrong: write the file again with {} channels", n);
+  });
+  return recording;
 }
 
 }  // namespace awcc::detail

@@ -48,7 +48,8 @@ std::string comparison_report(const Comparison& c) {
   };
   const auto& truth_u = c.truth_velocity;
   const auto& truth_tu = c.truth_turbulence_intensity;
-  std::string out = fmt::format("{}\n", c.what);
+  // Each method's status and AWCC's quality level (FSCC has none) before the values they qualify.
+  std::string out = fmt::format("{}\n{}{}", c.what, fscc_status_line(f), awcc_status_line(a));
   out += fmt::format("{:<26}{:>14}{:>14}{}\n", "", "FSCC", "AWCC", truth_u ? fmt::format("{:>14}", "truth") : "");
   out += fmt::format("{:<26}{:>14}{:>14}{}\n", "velocity (m/s)", num(f.ok(), f.velocity, "{:.4f}"),
                      num(a.ok(), a.velocity, "{:.4f}"), truth_u ? fmt::format("{:>14.4f}", *truth_u) : "");
@@ -66,8 +67,6 @@ std::string comparison_report(const Comparison& c) {
                      num(kept > 0, kept > 0 ? mean_r12 / static_cast<double>(kept) : 0.0, "{:.4f}"));
   out += fmt::format("{:<26}{:>14}{:>14}\n", "windows kept", "-", fmt::format("{} of {}", a.windows_accepted, a.windows_total));
   out += fmt::format("{:<26}{:>14.3f}{:>14.3f}\n", "run time (s)", c.fscc_seconds, c.awcc_seconds);
-  if (!f.ok()) out += fmt::format("FSCC: {}\n", f.message);
-  if (!a.ok()) out += fmt::format("AWCC: {}\n", a.message);
   return out;
 }
 

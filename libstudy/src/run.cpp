@@ -184,13 +184,16 @@ json run_to_json(const RunResult& r) {
                    {"d32", opt(r.fscc_d32.value)}};
   }
   if (p.awcc) {
-    out["awcc"] = {{"status", awcc::to_string(p.awcc->status)},
-                   {"reason", p.awcc->ok() ? json(nullptr) : json(p.awcc->message)},
-                   {"velocity", opt(r.awcc_velocity.value)},
-                   {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},
-                   {"d32", opt(r.awcc_d32.value)},
-                   {"windows_total", p.awcc->windows_total},
-                   {"windows_accepted", p.awcc->windows_accepted}};
+    out["awcc"] = {
+        {"status", awcc::to_string(p.awcc->status)},
+        {"reason", p.awcc->ok() ? json(nullptr) : json(p.awcc->message)},
+        {"quality", awcc::to_string(p.awcc->quality)},
+        {"quality_reason", p.awcc->quality == awcc::AwccQuality::ok ? json(nullptr) : json(p.awcc->quality_reason)},
+        {"velocity", opt(r.awcc_velocity.value)},
+        {"turbulence_intensity", opt(r.awcc_turbulence_intensity.value)},
+        {"d32", opt(r.awcc_d32.value)},
+        {"windows_total", p.awcc->windows_total},
+        {"windows_accepted", p.awcc->windows_accepted}};
   }
   out["error"] = {{"void_fraction", opt(r.void_fraction.error())},
                   {"bubble_count_rate", opt(r.count_rate.error())},
@@ -209,6 +212,23 @@ json run_to_json(const RunResult& r) {
   return out;
 }
 
+std::string fscc_status_line(const awcc::FsccResult& f) {
+  return f.ok() ? std::string("FSCC: status ok\n")
+                : fmt::format("FSCC: status {}, no velocity: {}\n", awcc::to_string(f.status), f.message);
+}
+
+std::string awcc_status_line(const awcc::AwccResult& a) {
+  // Insufficient whenever not ok: the quality reason is the status message, said once.
+  if (!a.ok()) {
+    return fmt::format("AWCC: status {}, quality insufficient, no velocity: {}\n", awcc::to_string(a.status),
+                       a.message);
+  }
+  if (a.quality == awcc::AwccQuality::low) {
+    return fmt::format("AWCC: status ok, quality low (its values are flagged): {}\n", a.quality_reason);
+  }
+  return "AWCC: status ok, quality ok\n";
+}
+
 std::string run_report(const RunResult& r) {
   const auto& p = r.processed;
   std::string out;
@@ -220,6 +240,9 @@ std::string run_report(const RunResult& r) {
     return e ? fmt::format("{:+.2f} %", 100.0 * *e) : std::string("n/a");
   };
   auto mm = [](const std::optional<double>& v) { return v ? std::optional(*v * 1e3) : std::nullopt; };
+  // Each method's status and AWCC's quality level (FSCC has none) before the values they qualify.
+  if (p.fscc) out += fscc_status_line(*p.fscc);
+  if (p.awcc) out += awcc_status_line(*p.awcc);
   out += fmt::format("{:<26}{:>12}{:>12}{:>10}{:>12}{:>10}\n", "quantity", "truth", "FSCC", "error", "AWCC", "error");
   out += fmt::format("{:<26}{:>12.4f}{:>12}{:>10}{:>12}{:>10}\n", "mean velocity (m/s)", r.truth_velocity,
                      val(r.fscc_velocity.value, "{:.4f}"), err(r.fscc_velocity), val(r.awcc_velocity.value, "{:.4f}"),
@@ -236,17 +259,17 @@ std::string run_report(const RunResult& r) {
                      r.truth_count_rate, val(r.count_rate.value, "{:.2f}"), err(r.count_rate));
   out += "(FSCC turbulence intensity: Chanson's estimate; d32 from the velocity pdp process chooses: AWCC's of "
          "quality ok, else FSCC's)\n";
-  if (p.fscc && !p.fscc->ok()) out += "FSCC undefined: " + p.fscc->message + "\n";
   if (p.awcc) {
     const auto& a = *p.awcc;
-    if (!a.ok()) out += "AWCC undefined: " + a.message + "\n";
     out += fmt::format("AWCC windows: {} accepted of {} ({} correlation, {} lag, {} outlier cutoff, {} constant)\n",
                        a.windows_accepted, a.windows_total, a.count(awcc::WindowFate::correlation),
                        a.count(awcc::WindowFate::lag), a.count(awcc::WindowFate::roc),
                        a.count(awcc::WindowFate::constant));
     if (r.window_bias) {
-      out += fmt::format("window level: AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms {:.4f} m/s\n",
-                         *r.window_bias, *r.window_rms);
+      out += fmt::format(
+          "window level (AWCC quality {}): AWCC u_i minus window-averaged truth: bias {:+.4f} m/s, rms "
+          "{:.4f} m/s\n",
+          awcc::to_string(a.quality), *r.window_bias, *r.window_rms);
     }
     for (const auto& [label, s] : {std::pair{"accepted", &r.accepted_truth}, std::pair{"rejected", &r.rejected_truth}}) {
       out += fmt::format("true window velocity, {}: mean {:.4f}, sd {:.4f}, quartiles {:.4f} {:.4f} {:.4f} m/s ({})\n",

@@ -7,6 +7,8 @@
 
 namespace study {
 
+using nlohmann::json;
+
 namespace {
 
 // Student t 0.975 quantile for df degrees of freedom.
@@ -71,8 +73,11 @@ RepeatSummary summarise_runs(const std::vector<RunResult>& runs) {
       {"awcc d32", "awcc_d32", false, [](const RunResult& r) { return r.awcc_d32.error(); }},
       {"void fraction", "void_fraction", false, [](const RunResult& r) { return r.void_fraction.error(); }},
       {"bubble count rate", "bubble_count_rate", false, [](const RunResult& r) { return r.count_rate.error(); }},
-      {"window bias (m/s)", "window_bias", true, [](const RunResult& r) { return r.window_bias; }},
-      {"window rms (m/s)", "window_rms", true, [](const RunResult& r) { return r.window_rms; }},
+      // AWCC's windows, over the runs AWCC gives a velocity (quality ok or low), as its other errors.
+      {"window bias (m/s)", "window_bias", true,
+       [](const RunResult& r) { return r.awcc_velocity.value ? r.window_bias : std::nullopt; }},
+      {"window rms (m/s)", "window_rms", true,
+       [](const RunResult& r) { return r.awcc_velocity.value ? r.window_rms : std::nullopt; }},
   };
   RepeatSummary out;
   for (const auto& s : series) {
@@ -84,6 +89,18 @@ RepeatSummary summarise_runs(const std::vector<RunResult>& runs) {
   for (const auto& r : runs) {
     out.fscc_undefined += !r.fscc_velocity.value;
     out.awcc_undefined += !r.awcc_velocity.value;
+    if (!r.processed.awcc) continue;
+    switch (r.processed.awcc->quality) {
+      case awcc::AwccQuality::ok:
+        ++out.awcc_ok;
+        break;
+      case awcc::AwccQuality::low:
+        ++out.awcc_low;
+        break;
+      case awcc::AwccQuality::insufficient:
+        ++out.awcc_insufficient;
+        break;
+    }
   }
   return out;
 }
@@ -93,10 +110,14 @@ nlohmann::json repeats_to_json(const std::vector<RunResult>& runs, const RepeatS
   nlohmann::json errors = nlohmann::json::object();
   for (const auto& e : summary.errors) {
     const auto& m = e.summary;
-    errors[e.key] = {{"runs", m.count}, {"mean", m.mean}, {"ci95", {m.lower, m.upper}}};
+    // No run gave the value: no mean and no interval (not zeros).
+    errors[e.key] = {{"runs", m.count},
+                     {"mean", m.count ? json(m.mean) : json(nullptr)},
+                     {"ci95", m.count ? json{m.lower, m.upper} : json(nullptr)}};
   }
   j["repeat"] = runs.size();
   j["error"] = errors;
+  j["awcc_quality"] = {{"ok", summary.awcc_ok}, {"low", summary.awcc_low}, {"insufficient", summary.awcc_insufficient}};
   j["runs"] = nlohmann::json::array();
   for (const auto& r : runs) j["runs"].push_back(run_to_json(r));
   if (!runs.empty()) {
@@ -115,9 +136,17 @@ std::string repeats_report(const std::vector<RunResult>& runs, const RepeatSumma
     const auto& m = e.summary;
     const double scale = e.absolute ? 1.0 : 100.0;
     const char* unit = e.absolute ? "" : " %";
+    if (m.count == 0) {
+      out += fmt::format("{:<28}{:>8}{:>12}{:>24}\n", e.name, m.count, "n/a", "n/a");
+      continue;
+    }
     out += fmt::format("{:<28}{:>8}{:>10.3f}{}{:>14.3f}{} to {:.3f}{}\n", e.name, m.count, m.mean * scale, unit,
                        m.lower * scale, unit, m.upper * scale, unit);
   }
+  out += fmt::format(
+      "AWCC quality: {} runs ok, {} low, {} insufficient (no velocity); the AWCC errors are over the ok "
+      "and low runs\n",
+      summary.awcc_ok, summary.awcc_low, summary.awcc_insufficient);
   if (summary.fscc_undefined || summary.awcc_undefined) {
     out += fmt::format("velocity undefined in {} FSCC and {} AWCC runs\n", summary.fscc_undefined,
                        summary.awcc_undefined);

@@ -119,7 +119,7 @@ expect 1 "junk.dat" "$pdp" process "$dir/junk.dat" --fs 20kHz --dx 5mm
 expect 3 "does not exist" "$pdp" process "$dir/a.flac" --dx 5mm --json "$dir/no/such/folder/a.json"
 # Outputs are all written or none: a CSV into a missing folder leaves no JSON.
 rm -f "$dir/b.json"
-expect 3 "does not exist" "$pdp" process "$dir/a.flac" "$dir/a.flac" --dx 5mm --json "$dir/b.json" \
+expect 3 "does not exist" "$pdp" process "$dir/a.flac" "$dir/b.flac" --dx 5mm --json "$dir/b.json" \
   --csv "$dir/no/such/folder/b.csv"
 [[ -e $dir/b.json ]] && fail "a JSON was written although the CSV could not be"
 printf '{"tips": [{"void_fraction": "x"}], "awcc": {"defined": true, "velocity": 1, "turbulence_intensity": 0.1, "windows_accepted": "many", "options": {"filter_a": 0.4, "roc": "on"}}}' >"$dir/typed.json"

@@ -82,8 +82,10 @@ import json,sys
 a=json.load(open('$dir/rec.json'))['correction']; b=json.load(open('$dir/again.json'))['correction']
 sys.exit(0 if a==b else 1)" || fail "pdp correct and process --correct disagree"
 
-# A profile CSV carries dx, dy and Np: corrected as it is.
-"$pdp" --log-level error process "$dir/rec.flac" "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc \
+# A profile CSV carries dx, dy and Np: corrected as it is (two recordings of the scene: a profile refuses one twice).
+"$pdp" --log-level warn synth -q --duration 4s --fs 100kHz --velocity 5m/s --tu 0.1 --void-fraction 0.2 --bubble-diameter 2mm \
+  --dx 4.5mm --dy 0.5mm --seed 10 -o "$dir/rec2.flac" || fail "synth"
+"$pdp" --log-level error process "$dir/rec.flac" "$dir/rec2.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc \
   --csv "$dir/profile.csv" || fail "profile"
 "$pdp" correct "$dir/profile.csv" -m "$dir/a.qrf" -o "$dir/corrected.csv" || fail "correct CSV"
 head -1 "$dir/corrected.csv" | grep -q ",correction_in_range,correction_reason,correction_forest,corrected_velocity,corrected_velocity_q0.025," ||

@@ -123,7 +123,8 @@ py -c "import json; json.load(open('$dir/latin1.json'))" || fail "the JSON of a 
 
 # 9. A folder, a README.md, a path with spaces and a file name with a comma among the inputs.
 mkdir -p "$dir/a folder"
-cp "$dir/rec.wav" "$dir/a folder/with space, and comma.wav"
+"$pdp" --log-level warn synth -q --duration 2s --fs 100kHz --velocity 4m/s --dy 0mm --signal voltage --seed 2 \
+  -o "$dir/a folder/with space, and comma.wav" || fail "synth"
 printf '# Notes\nThis is not a recording.\n' >"$dir/README.md"
 err=$("$pdp" process "$dir/rec.wav" "$dir/a folder/with space, and comma.wav" "$dir/README.md" "$dir/a folder" \
   --dx 5mm --csv "$dir/glob.csv" --json "$dir/glob.json" 2>&1) || fail "a profile with non-recordings: $err"

@@ -129,7 +129,7 @@ import struct, sys, math
 d = sys.argv[1]
 open(f"{d}/truncated.dat", "wb").write(struct.pack("<ii", 900000, 2) + b"\0" * 4000)
 open(f"{d}/lying.dat", "wb").write(struct.pack("<ii", 10, 2) + b"\0" * 4000)
-open(f"{d}/single.dat", "wb").write(struct.pack("<ii", 1000, 1) + struct.pack("<1000h", *([100, 20000] * 500)))
+open(f"{d}/single.dat", "wb").write(struct.pack("<ii", 1000, 1) + struct.pack("<1000h", *([100] * 500 + [20000] * 500)))
 open(f"{d}/nan.raw", "wb").write(struct.pack("<6f", 1.0, 2.0, float("nan"), 4.0, 5.0, 6.0))
 open(f"{d}/inf.raw", "wb").write(struct.pack("<4f", 1.0, float("inf"), 3.0, 4.0))
 open(f"{d}/textcell.csv", "w").write("lead,trail\n1.0,4.0\n1.1,x4.0\n")

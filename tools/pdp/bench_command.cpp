@@ -18,7 +18,8 @@ void setup_bench(CLI::App& app, Command& command, BenchOptions& o) {
   auto* cmd = app.add_subcommand("bench", "Error against cost of every method and setting on fixed scenes, over seeds");
   command.app = cmd;
   add_config_option(command);
-  command.required.push_back(cmd->add_option("-o,--output", o.output, "CSV: one row per scene, seed and setting"));
+  command.required.push_back(
+      path_option(cmd->add_option("-o,--output", o.output, "CSV: one row per scene, seed and setting")));
   cmd->add_option("--seeds", o.seeds, "seeds per scene; RMS error, bias and spread are over these")
       ->check(CLI::Range(1, 1000))->capture_default_str();
   cmd->add_option("--first-seed", o.first_seed, "the first seed")->capture_default_str();
@@ -27,7 +28,8 @@ void setup_bench(CLI::App& app, Command& command, BenchOptions& o) {
       ->capture_default_str();
   cmd->add_option("--duration", o.duration, "record length of the Np, fs and raw-voltage settings (0.1s to 1h)")
       ->capture_default_str();
-  cmd->add_option("--correct", o.correct, "correction model (.qrf): adds the corrected AWCC of every interval-path setting");
+  path_option(cmd->add_option("--correct", o.correct,
+                              "correction model (.qrf): adds the corrected AWCC of every interval-path setting"));
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores); the numbers do not depend on it")
       ->check(CLI::Range(0, 4096))->capture_default_str();
   cmd->add_flag("--quick", o.quick, "short records, two seeds and few settings (for tests)");

@@ -5,7 +5,9 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 
+#include "arguments.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/settings_file.hpp"
@@ -17,6 +19,11 @@ namespace {
 std::map<std::string, std::string, std::less<>>& origins() {
   static std::map<std::string, std::string, std::less<>> map;
   return map;
+}
+// The options whose values are paths (path_option).
+std::set<const CLI::Option*>& path_options() {
+  static std::set<const CLI::Option*> set;
+  return set;
 }
 // The command being run (one process, one command): errors name only its flags.
 const CLI::App*& running() {
@@ -62,6 +69,20 @@ void add_config_option(Command& c) {
                         c.app->get_name() + "] table; the command line overrides it");
 }
 
+CLI::Option* path_option(CLI::Option* option) {
+  path_options().insert(option);
+  return option;
+}
+
+namespace {
+// A settings file's path value, relative to the file's folder (absolute ones as they are).
+std::string from_settings_folder(const std::string& config, const std::string& value) {
+  const std::filesystem::path p(value);
+  if (value.empty() || p.is_absolute()) return value;
+  return (std::filesystem::path(config).parent_path() / p).lexically_normal().string();
+}
+}  // namespace
+
 void finish_parsing(Command& c) {
   running() = c.app;
   if (!c.config.empty()) {
@@ -82,15 +103,24 @@ void finish_parsing(Command& c) {
       CLI::Option* option = c.app->get_option_no_throw("--" + s.key);
       if (!option) option = c.app->get_option_no_throw(s.key);  // a positional argument by name
       if (!option || s.key == "config" || s.key == "help") {
-        throw std::invalid_argument(fmt::format("{}:{}: unknown setting '{}' for pdp {}; use the names of pdp {} --help",
-                                                c.config, s.line, s.key, c.app->get_name(), c.app->get_name()));
+        std::vector<std::string> names;
+        for (const auto* o : c.app->get_options()) {
+          for (const auto& l : o->get_lnames()) names.push_back(l);
+          if (o->get_lnames().empty() && o->get_snames().empty()) names.push_back(o->get_name(true));  // positional
+        }
+        std::erase_if(names, [](const std::string& n) { return n == "config" || n == "help"; });
+        const auto near = did_you_mean(s.key, names);
+        throw std::invalid_argument(fmt::format(
+            "{}:{}: unknown setting '{}' for pdp {}{}{}", c.config, s.line, s.key, c.app->get_name(), near,
+            near.empty() ? fmt::format("; use the names of pdp {} --help", c.app->get_name()) : std::string()));
       }
       if (option->count() > 0) continue;  // the command line wins
+      const bool path = path_options().count(option) > 0;
       try {
         if (option->get_items_expected_max() > 1) {
-          for (const auto& item : s.items) option->add_result(item);
+          for (const auto& item : s.items) option->add_result(path ? from_settings_folder(c.config, item) : item);
         } else {
-          option->add_result(s.text);
+          option->add_result(path ? from_settings_folder(c.config, s.text) : s.text);
         }
         option->run_callback();
         origins()[s.key] = fmt::format("{}:{}", c.config, s.line);

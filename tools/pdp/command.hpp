@@ -31,6 +31,11 @@ struct Command {
 
 /// Adds --config to the subcommand.
 void add_config_option(Command& command);
+/// Declares that an option's values are paths (inputs or outputs): given in
+/// a settings file, a relative path is taken from the settings file's
+/// folder, as one typed on the command line is from the current folder.
+/// Returns the option.
+CLI::Option* path_option(CLI::Option* option);
 /// Applies the config file's settings to the options not given on the command
 /// line, then checks the required ones. Throws std::invalid_argument naming
 /// the file, the line and the setting.

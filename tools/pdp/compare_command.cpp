@@ -12,7 +12,7 @@ void setup_compare(CLI::App& app, Command& command, CompareOptions& o) {
   auto* cmd = app.add_subcommand("compare", "FSCC and AWCC side by side on a recording (or a synthesised scene)");
   command.app = cmd;
   add_config_option(command);
-  cmd->add_option("file", o.file, "recording (without it, the scene given by the options is synthesised)")
+  path_option(cmd->add_option("file", o.file, "recording (without it, the scene given by the options is synthesised)"))
       ->check(CLI::ExistingFile);
   cmd->add_option("--rec-dx", o.dx, "recording: streamwise tip separation, m (units allowed)")->capture_default_str();
   cmd->add_option("--rec-fs", o.fs, "recording: sampling rate when the file lacks it, Hz");

@@ -19,12 +19,13 @@ void setup_correct(CLI::App& app, Command& command, CorrectOptions& o) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      cmd->add_option("input", o.input, "pdp process JSON (one recording or a profile) or profile CSV")
+      path_option(cmd->add_option("input", o.input, "pdp process JSON (one recording or a profile) or profile CSV"))
           ->check(CLI::ExistingFile));
   command.required.push_back(
-      cmd->add_option("-m,--model", o.model, "correction model (.qrf, from pdp train; samples/model/awcc.qrf ships)")
+      path_option(cmd->add_option("-m,--model", o.model,
+                                  "correction model (.qrf, from pdp train; samples/model/awcc.qrf ships)"))
           ->check(CLI::ExistingFile));
-  cmd->add_option("-o,--output", o.output, "output file (same format as the input) [default: stdout]");
+  path_option(cmd->add_option("-o,--output", o.output, "output file (same format as the input) [default: stdout]"));
   cmd->add_option("--dx", o.dx, "streamwise tip separation, m (units allowed), where the input has none");
   cmd->add_option("--dy", o.dy, "lateral tip separation, m (units allowed), where the input has none");
   cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(1, 1000));

@@ -30,9 +30,11 @@ void setup_design(CLI::App& app, Command& command, DesignOptions& o) {
                       "the design (TOML): [conditions.NAME] flows, [candidates], optional [current] probe and "
                       "[design] settings (docs/design.md)")
           ->check(CLI::ExistingFile));
-  command.required.push_back(cmd->add_option("-o,--output", o.output, "ranked CSV: one row per candidate and condition"));
-  cmd->add_option("--report", o.report, "HTML page: error maps over (dx, dy) per condition, the ranking");
-  cmd->add_option("--model", o.model, "correction model (.qrf, e.g. samples/model/awcc.qrf); without one, raw AWCC is ranked")
+  command.required.push_back(
+      path_option(cmd->add_option("-o,--output", o.output, "ranked CSV: one row per candidate and condition")));
+  path_option(cmd->add_option("--report", o.report, "HTML page: error maps over (dx, dy) per condition, the ranking"));
+  path_option(cmd->add_option("--model", o.model,
+                              "correction model (.qrf, e.g. samples/model/awcc.qrf); without one, raw AWCC is ranked"))
       ->check(CLI::ExistingFile);
   cmd->add_option("--runs", o.runs,
                   "runs CSVs (every record's results; an interrupted design resumes from them; shards give one each, "

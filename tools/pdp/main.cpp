@@ -5,17 +5,21 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <functional>
+#include <string>
+#include <vector>
 
+#include "arguments.hpp"
 #include "awcc/version.hpp"
 #include "bench_command.hpp"
 #include "command.hpp"
 #include "compare_command.hpp"
 #include "correct_command.hpp"
-#include "report_command.hpp"
-#include "process_command.hpp"
-#include "sweep_command.hpp"
 #include "design_command.hpp"
+#include "process_command.hpp"
+#include "report_command.hpp"
+#include "sweep_command.hpp"
 #include "synth_command.hpp"
 #include "train_command.hpp"
 #include "validate_command.hpp"
@@ -75,8 +79,15 @@ int main(int argc, char** argv) {
   pdp::setup_design(app, commands[9].command, design_options);
   commands[9].run = [&] { return pdp::run_design(design_options); };
 
+  std::vector<std::string> arguments;
   try {
-    app.parse(argc, argv);
+    arguments = pdp::arrange_arguments(app, std::vector<std::string>(argv + std::min(argc, 1), argv + argc));
+  } catch (const std::exception& e) {
+    return pdp::report_error(e);
+  }
+  try {
+    std::reverse(arguments.begin(), arguments.end());  // CLI11 parses a reversed vector
+    app.parse(arguments);
   } catch (const CLI::ParseError& e) {
     // Help and version are successes; every other parse error is bad usage.
     const int code = app.exit(e);

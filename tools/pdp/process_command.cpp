@@ -16,9 +16,10 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      cmd->add_option("files", o.files,
-                      "recordings (one: a summary; several: a profile, one CSV row each; among several, files that "
-                      "are not recordings are skipped with a warning)")
+      path_option(
+          cmd->add_option("files", o.files,
+                          "recordings (one: a summary; several: a profile, one CSV row each; among several, files that "
+                          "are not recordings are skipped with a warning)"))
           ->check(CLI::ExistingPath));
   const awcc::ProcessOptions defaults;
   o.library.add(cmd, awcc::process_option_fields(), defaults, "Probe and methods");
@@ -32,26 +33,31 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
                   "bins and defects; FSCC only); options given as well override it")
       ->group("Probe and methods");
   const auto* out = "Output";
-  cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)")->group(out);
-  cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)")->group(out);
-  cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)")->group(out);
-  cmd->add_option("--spectrum", o.spectrum,
-                  "AWCC's velocity series as CSV: Welch spectrum and autocorrelation (sample-and-hold resampling)")
+  path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"))->group(out);
+  path_option(cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)"))->group(out);
+  path_option(cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)"))->group(out);
+  path_option(
+      cmd->add_option("--spectrum", o.spectrum,
+                      "AWCC's velocity series as CSV: Welch spectrum and autocorrelation (sample-and-hold resampling)"))
       ->group(out);
-  cmd->add_option("--correlation-functions", o.correlation_functions,
-                  "FSCC's auto- and cross-correlation functions as CSV: file, lag_s, r11, r12")
+  path_option(cmd->add_option("--correlation-functions", o.correlation_functions,
+                              "FSCC's auto- and cross-correlation functions as CSV: file, lag_s, r11, r12"))
       ->group(out);
-  cmd->add_option("--report", o.report,
-                  "also write the HTML report of the results (pdp report: figures, table, provenance; needs "
-                  "python3-matplotlib and python3-jinja2)")
+  path_option(
+      cmd->add_option("--report", o.report,
+                      "also write the HTML report of the results (pdp report: figures, table, provenance; needs "
+                      "python3-matplotlib and python3-jinja2)"))
       ->group(out);
   cmd->add_option("--positions", o.positions, "profile positions, one per file: '2mm,8mm,...'")->group(out);
-  cmd->add_option("--manifest", o.manifest, "profile manifest CSV with columns file,position")
-      ->check(CLI::ExistingFile)->group(out);
-  cmd->add_option("--correct", o.correct,
+  path_option(cmd->add_option("--manifest", o.manifest, "profile manifest CSV with columns file,position"))
+      ->check(CLI::ExistingFile)
+      ->group(out);
+  path_option(cmd->add_option(
+                  "--correct", o.correct,
                   "bias-correct AWCC's velocity and Tu with this model (.qrf from pdp train; samples/model/awcc.qrf "
-                  "ships): adds quantiles to the JSON, CSV and report")
-      ->check(CLI::ExistingFile)->group("AWCC");
+                  "ships): adds quantiles to the JSON, CSV and report"))
+      ->check(CLI::ExistingFile)
+      ->group("AWCC");
 }
 
 

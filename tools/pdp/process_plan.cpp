@@ -3,9 +3,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <vector>
 
 #include "awcc/csv.hpp"
 #include "awcc/options.hpp"
+#include "awcc/sha256.hpp"
 #include "awcc/units.hpp"
 #include "process_steps.hpp"
 
@@ -41,6 +43,9 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
     }
   };
+  if (!o.positions.empty() && !o.manifest.empty()) {
+    throw std::invalid_argument("--positions and --manifest both give the positions; give one of them");
+  }
   if (!o.positions.empty()) {
     const auto items = awcc::split_cells(o.positions);
     if (items.size() != o.files.size()) {
@@ -51,6 +56,7 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
   } else if (!o.manifest.empty()) {
     std::ifstream in(o.manifest);
     std::map<std::string, double> by_name;
+    std::map<std::string, int> line_of;
     std::string line;
     int number = 0;
     while (std::getline(in, line)) {
@@ -58,13 +64,19 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       if (!line.empty() && line.back() == '\r') line.pop_back();
       const auto cells = awcc::split_cells(line);
       if (cells.size() < 2) continue;
+      double position = 0.0;
       try {
-        by_name[std::filesystem::path(cells[0]).filename().string()] =
-            awcc::parse_quantity(cells[1], awcc::Dimension::length);
+        position = awcc::parse_quantity(cells[1], awcc::Dimension::length);
       } catch (const std::invalid_argument& e) {
         if (number == 1) continue;  // header row
         throw std::invalid_argument(fmt::format("{}:{}: {}", o.manifest, number, e.what()));
       }
+      const auto name = std::filesystem::path(cells[0]).filename().string();
+      if (const auto [at, fresh] = line_of.emplace(name, number); !fresh) {
+        throw std::invalid_argument(
+            fmt::format("{}: lines {} and {} both position {}; keep one", o.manifest, at->second, number, name));
+      }
+      by_name[name] = position;
     }
     std::map<std::string, std::string> seen;
     for (std::size_t i = 0; i < o.files.size(); ++i) {
@@ -77,6 +89,18 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
       // A file without a row is refused once it proves to be a recording
       // (a README caught by the same glob is skipped, not positioned).
       if (const auto it = by_name.find(name); it != by_name.end()) out[i] = it->second;
+    }
+  }
+  // One position per recording: a position given twice is a typo (or two
+  // recordings of one position, which a profile cannot tell apart).
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      if (!out[i] || !out[j] || *out[i] != *out[j]) continue;
+      throw std::invalid_argument(
+          fmt::format("{} gives {} and {} the same position, {}; a profile has one recording "
+                      "per position: correct the position, or process the repeat on its own",
+                      o.positions.empty() ? o.manifest : std::string("--positions"), o.files[i], o.files[j],
+                      awcc::format_quantity(*out[i], awcc::Dimension::length)));
     }
   }
   return out;
@@ -111,10 +135,60 @@ void check_output_names(const ProcessCommandOptions& o) {
   }
 }
 
+// The first 64 KiB's digest: two recordings differ there (a copy does not),
+// so whole files are compared only when their sizes and heads agree.
+std::string head_digest(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> head(std::size_t{1} << 16);
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  awcc::Sha256 digest;
+  digest.update({reinterpret_cast<const std::uint8_t*>(head.data()), static_cast<std::size_t>(in.gcount())});
+  return digest.hex();
+}
+
+// A profile measures each position once: a file given twice (the same path,
+// two paths to one file, or a copy under another name) would count one
+// recording at two positions, and is refused naming both arguments.
+void check_repeated_inputs(const std::vector<std::string>& files) {
+  namespace fs = std::filesystem;
+  std::map<std::pair<std::uintmax_t, std::string>, std::vector<std::size_t>> seen;  // (size, head digest) -> files
+  std::map<std::size_t, std::string> whole;                                         // file -> digest of all its bytes
+  auto whole_digest = [&](std::size_t i) -> const std::string& {
+    auto it = whole.find(i);
+    if (it == whole.end()) it = whole.emplace(i, awcc::sha256_of_file(files[i])).first;
+    return it->second;
+  };
+  for (std::size_t j = 0; j < files.size(); ++j) {
+    std::error_code ec;
+    if (!fs::is_regular_file(files[j], ec)) continue;  // folders and README.md: skipped later, said there
+    for (std::size_t i = 0; i < j; ++i) {
+      if (files[i] == files[j] || fs::equivalent(files[i], files[j], ec)) {
+        throw std::invalid_argument(
+            fmt::format("{} and {} (files {} and {}) are one file: a profile measures each "
+                        "position once; remove the repeat",
+                        files[i], files[j], i + 1, j + 1));
+      }
+    }
+    const auto size = fs::file_size(files[j], ec);
+    if (ec) continue;
+    auto& alike = seen[{size, head_digest(files[j])}];
+    for (const std::size_t i : alike) {
+      if (whole_digest(i) != whole_digest(j)) continue;
+      throw std::invalid_argument(
+          fmt::format("{} and {} (files {} and {}) hold the same bytes: one recording copied "
+                      "under two names, not two measurements; give each position its own "
+                      "recording",
+                      files[i], files[j], i + 1, j + 1));
+    }
+    alike.push_back(j);
+  }
+}
+
 }  // namespace
 
 Plan plan_of(const ProcessCommandOptions& o) {
   Plan plan;
+  check_repeated_inputs(o.files);
   plan.options = build_options(o);
   plan.positions = positions_for(o);
   if (!o.correct.empty() && !plan.options.awcc) {

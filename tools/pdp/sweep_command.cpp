@@ -15,10 +15,10 @@ void setup_sweep(CLI::App& app, Command& command, SweepOptions& o) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      cmd->add_option("study", o.study, "sweep definition (TOML: [sweep], [base], [grid], [ranges])")
+      path_option(cmd->add_option("study", o.study, "sweep definition (TOML: [sweep], [base], [grid], [ranges])"))
           ->check(CLI::ExistingFile));
-  command.required.push_back(
-      cmd->add_option("-o,--output", o.output, "CSV of runs: appended row by row; an interrupted sweep resumes"));
+  command.required.push_back(path_option(
+      cmd->add_option("-o,--output", o.output, "CSV of runs: appended row by row; an interrupted sweep resumes")));
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 4096))
       ->capture_default_str();
   cmd->add_option("--shard", o.shard, "i/n: run only the runs whose index is i modulo n (cluster job arrays)");
@@ -61,6 +61,7 @@ int run_sweep(const SweepOptions& o) {
   int refused = 0;
   if (mpi.rank() == 0) {
     try {
+      awcc::check_output_folder(o.output);  // a folder named as the output is said as such
       done = study::finished_runs(o.output, id);
       std::error_code ec;
       if (!std::filesystem::exists(o.output, ec) || std::filesystem::file_size(o.output, ec) == 0) {

@@ -18,11 +18,11 @@ void setup_synth(CLI::App& app, Command& command, SynthOptions& options) {
   auto* cmd = app.add_subcommand("synth", "Synthesise a scene: write a recording and its <name>.truth.json sidecar");
   command.app = cmd;
   add_config_option(command);
-  command.required.push_back(
+  command.required.push_back(path_option(
       cmd->add_option("-o,--output", options.output,
                       "recording to write (.flac, .wav, .w64, .rf64; .h5 or .hdf5: pdp-sim's layout, datasets "
                       "'signal' (samples x tips, uint8 0/1, or int16 counts with 'volts_per_count' for --signal "
-                      "voltage, which pdp-sim itself does not write) and 'time')"));
+                      "voltage, which pdp-sim itself does not write) and 'time')")));
   cmd->add_option("--signal", options.signal, "binary (0 water, 1 air) or voltage (raw int16 counts)")
       ->check(CLI::IsMember({"binary", "voltage"}))
       ->capture_default_str();

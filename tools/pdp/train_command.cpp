@@ -18,15 +18,18 @@ void setup_train(CLI::App& app, Command& command, TrainCommandOptions& o) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      cmd->add_option("sweeps", o.sweeps, "pdp sweep CSVs (Monte Carlo over the ranges the model must cover)")
+      path_option(
+          cmd->add_option("sweeps", o.sweeps, "pdp sweep CSVs (Monte Carlo over the ranges the model must cover)"))
           ->check(CLI::ExistingFile));
-  command.required.push_back(cmd->add_option("-o,--output", o.output, "model file to write (.qrf)"));
+  command.required.push_back(path_option(cmd->add_option("-o,--output", o.output, "model file to write (.qrf)")));
   o.training.add(cmd, correction::training_option_fields(), correction::TrainOptions{}, "Training");
-  cmd->add_option("--predictions", o.predictions, "write the held-out predictions as CSV");
-  cmd->add_option("--learning-curve", o.learning_curve, "write the held-out scores against training runs as CSV");
-  cmd->add_option("--report", o.report, "write the report to this file too");
-  cmd->add_option("--compare-model", o.compare_model,
-                  "another model (e.g. the one shipped before) scored on the same held-out runs, band by band")
+  path_option(cmd->add_option("--predictions", o.predictions, "write the held-out predictions as CSV"));
+  path_option(
+      cmd->add_option("--learning-curve", o.learning_curve, "write the held-out scores against training runs as CSV"));
+  path_option(cmd->add_option("--report", o.report, "write the report to this file too"));
+  path_option(
+      cmd->add_option("--compare-model", o.compare_model,
+                      "another model (e.g. the one shipped before) scored on the same held-out runs, band by band"))
       ->check(CLI::ExistingFile);
 }
 

@@ -17,7 +17,7 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
   add_method_options(cmd, o.methods);
   cmd->add_option("--repeat", o.repeat, "runs with different seeds; means and 95 % intervals of every error")
       ->check(CLI::Range(1, 100000))->capture_default_str();
-  cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)");
+  path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"));
 }
 
 int run_validate(const ValidateOptions& o) {

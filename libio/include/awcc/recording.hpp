@@ -8,8 +8,9 @@
 //  - headerless raw files with a stated layout (sample type, byte order,
 //    channels, header bytes, volts per count);
 //  - column files (CSV, TSV, semicolon-separated with decimal commas, LabVIEW
-//    .lvm text, its rows with or without the empty trailing Comment cell;
-//    header row optional, a time column found by name or by its values);
+//    .lvm text, its rows with or without the trailing Comment cell, its
+//    segments read as one recording; header row optional, a time column
+//    found by name or by its values);
 //  - NI TDMS (LabVIEW's binary logger), written from NI's published format:
 //    segments of lead-in, metadata and raw data, interleaved or not, int16,
 //    int32, float32 and float64 channels with linear scaling properties,
@@ -29,7 +30,9 @@
 // Every reader hands out interleaved float volts (frames x channels) in
 // blocks, so memory does not depend on the file's length; rewind() starts
 // again for a second pass. Damaged input is refused with a message naming the
-// file, what is wrong, where, and the fix.
+// file, what is wrong, where, and the fix; so is a stated channel count (a
+// .dat or audio header, a raw layout, an .lvm Channels line) that the data
+// contradict.
 
 #include <cstdint>
 #include <filesystem>

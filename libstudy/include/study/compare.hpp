@@ -32,7 +32,8 @@ Comparison compare_recording(const std::filesystem::path& file, const awcc::Proc
 /// Both methods on a synthesised scene (synthesise_pair).
 Comparison compare_scene(const synth::Scene& scene, const RunOptions& options);
 
-/// The side-by-side table.
+/// The side-by-side table: each method's status and AWCC's quality level
+/// above the values they qualify, the reasons below.
 std::string comparison_report(const Comparison& c);
 
 }  // namespace study

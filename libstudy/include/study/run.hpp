@@ -95,7 +95,15 @@ RunResult run_scene(const synth::Scene& scene, const RunOptions& options);
 /// JSON of one run: truth, phase, fscc, awcc, error and windows objects (docs/output.md).
 nlohmann::json run_to_json(const RunResult& r);
 
-/// The readable table of one run.
+/// The readable table of one run, after each method's status and AWCC's
+/// quality level (the lines below).
 std::string run_report(const RunResult& r);
+
+/// "FSCC: status ok", or the status and why (a line): what qualifies FSCC's
+/// values in pdp validate's and pdp compare's tables.
+std::string fscc_status_line(const awcc::FsccResult& f);
+/// "AWCC: status ok, quality ok", or the status, the quality level and why,
+/// each said once (a line): what qualifies AWCC's values in those tables.
+std::string awcc_status_line(const awcc::AwccResult& a);
 
 }  // namespace study

@@ -37,13 +37,17 @@ struct ErrorSummary {
 struct RepeatSummary {
   std::vector<ErrorSummary> errors;
   std::int64_t fscc_undefined = 0, awcc_undefined = 0;  ///< runs without a velocity
+  /// Runs of each AWCC quality level (ok, low, insufficient): the AWCC
+  /// errors are over the ok and low runs.
+  std::int64_t awcc_ok = 0, awcc_low = 0, awcc_insufficient = 0;
 };
 RepeatSummary summarise_runs(const std::vector<RunResult>& runs);
 
 /// The JSON of several runs: repeat, error (each summary), runs, and the
 /// first run's truth, fscc and awcc (docs/output.md).
 nlohmann::json repeats_to_json(const std::vector<RunResult>& runs, const RepeatSummary& summary);
-/// The table of several runs of the scene whose seed is `seed`.
+/// The table of several runs of the scene whose seed is `seed`, with the
+/// runs of each AWCC quality level.
 std::string repeats_report(const std::vector<RunResult>& runs, const RepeatSummary& summary, std::uint64_t seed);
 
 }  // namespace study
