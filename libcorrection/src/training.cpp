@@ -410,6 +410,7 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
   }
   m.velocity = QuantileForest::train(data_of(rows, true, velocity_form, names), velocity_options);
   m.turbulence_intensity = QuantileForest::train(data_of(rows, false, turbulence_form, names), turbulence_options);
+  m.use_training_envelopes();
   return m;
 }
 
@@ -464,11 +465,14 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
     if (predictions) predictions->push_back({r, c[i]});
-    if (!c[i].corrected()) {
+    if (!c[i].velocity || !c[i].turbulence_intensity) {
       ++s.out_of_range;
       continue;
     }
     ++s.rows;
+    s.untrusted += c[i].status == CorrectionStatus::untrusted;
+    s.outside_envelope += c[i].outside_envelope;
+    s.multimodal += c[i].multimodal;
     const auto& u = *c[i].velocity;
     const auto& t = *c[i].turbulence_intensity;
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
@@ -526,6 +530,8 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
   // window band and Tu band (the Tu forest's median, as correct() finds it).
   std::vector<std::array<double, 6>> scores(rows.size());
   std::vector<int> band(rows.size()), tu_band(rows.size());
+  // The truth's shift from the measurement (model.hpp, trust rule (a)): velocity, Tu.
+  std::vector<std::array<double, 2>> shifts(rows.size());
   parallel_for(rows.size(), threads, [&](std::size_t i) {
     const auto& r = rows[i];
     const auto x = vector_of(r.features, names);
@@ -536,6 +542,8 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
                                    : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity);
       const auto t = forest.quantiles(x, correction_levels);
       const auto e = interval_scores(t, target);
+      const double measured = f == 0 ? r.features.velocity : r.features.turbulence_intensity;
+      shifts[i][static_cast<std::size_t>(f)] = target - to_target(form, measured, measured);
       for (std::size_t k = 0; k < 3; ++k) scores[i][static_cast<std::size_t>(3 * f) + k] = e[k];
       if (f == 1) tu_band[i] = c.tu_band(from_target(form, t[3], r.features.turbulence_intensity));
     }
@@ -571,6 +579,36 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
       c.velocity.push_back(offsets(in, 0));
       c.turbulence_intensity.push_back(offsets(in, 3));
     }
+  }
+  // The envelopes: the group's runs, else the window band's, else all of
+  // them; too few even then, the model's own (from its training targets).
+  auto envelope = [&](const std::function<bool(std::size_t)>& in, std::size_t q) {
+    std::vector<double> e;
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (in(i)) e.push_back(shifts[i][q]);
+    return envelope_of(std::move(e));
+  };
+  const std::function<bool(std::size_t)> all = [](std::size_t) { return true; };
+  if (envelope(all, 0) && envelope(all, 1)) {
+    for (std::size_t b = 0; b <= window_edges.size(); ++b) {
+      const int w = static_cast<int>(b);
+      for (std::size_t h = 0; h < c.tu_bands(); ++h) {
+        const std::function<bool(std::size_t)> in_group = [&band, &tu_band, w, h](std::size_t i) {
+          return band[i] == w && tu_band[i] == static_cast<int>(h);
+        };
+        const std::function<bool(std::size_t)> in_band = [&band, w](std::size_t i) { return band[i] == w; };
+        for (std::size_t q = 0; q < 2; ++q) {
+          auto e = envelope(in_group, q);
+          if (!e) e = envelope(in_band, q);
+          if (!e) e = envelope(all, q);
+          (q == 0 ? c.velocity_envelope : c.turbulence_envelope).push_back(*e);
+        }
+      }
+    }
+  } else {
+    c.velocity_envelope = model.calibration.velocity_envelope;
+    c.turbulence_envelope = model.calibration.turbulence_envelope;
+    c.envelope_from_training = model.calibration.envelope_from_training;
   }
   return c;
 }
@@ -661,10 +699,15 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
       q[k] = conformal_offset(std::move(e), calibration_alpha[k]);
     }
     f.calibration.velocity = {q};
+    std::vector<double> shifts;  // the truth's from FSCC's velocity (model.hpp, trust rule (a))
+    for (const auto& r : calibrating_rows) shifts.push_back(to_target(f.form, r.true_velocity, r.features.fscc_velocity) -
+                                                 to_target(f.form, r.features.fscc_velocity, r.features.fscc_velocity));
+    if (const auto e = envelope_of(std::move(shifts))) f.calibration.velocity_envelope = {*e};
   }
   CorrectionModel scorer;  // the FSCC forest alone, with the model's margin
   scorer.range_margin = result.model.range_margin;
   scorer.fscc = f;
+  scorer.use_training_envelopes();
   auto score_rows = [&](bool unserved_only) {
     FsccScores sc;
     std::vector<double> abs_raw, abs_corrected;
@@ -672,10 +715,13 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
     for (const auto& r : held_out) {
       if (unserved_only && r.awcc_served) continue;
       const auto c = scorer.correct_fscc(r.features);
-      if (!c.corrected()) {
+      if (!c.velocity) {
         ++sc.out_of_range;
         continue;
       }
+      sc.untrusted += c.status == CorrectionStatus::untrusted;
+      sc.outside_envelope += c.outside_envelope;
+      sc.multimodal += c.multimodal;
       const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
       const double corrected = c.velocity->median() / r.true_velocity - 1.0;
       sq_raw += raw * raw;
@@ -702,6 +748,7 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   result.fscc_held_out_unserved = score_rows(true);
   result.fscc_training_rows = static_cast<std::int64_t>(training.size());
   result.model.fscc = std::move(f);
+  result.model.use_training_envelopes();
 }
 
 }  // namespace
@@ -847,7 +894,15 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
         100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95);
   }
   if (!result.fscc_note.empty()) provenance += " " + result.fscc_note + ".";
-  return provenance;
+  provenance += fmt::format(" Trust rules (model.hpp): {} of the {} scored held-out runs untrusted by the AWCC forests "
+                            "({} outside the envelope, {} multimodal)",
+                            h.untrusted, h.rows, h.outside_envelope, h.multimodal);
+  if (result.model.fscc) {
+    const auto& u = result.fscc_held_out_unserved;
+    provenance += fmt::format(", {} of {} by the FSCC forest ({} outside the envelope, {} multimodal)", u.untrusted,
+                              u.rows, u.outside_envelope, u.multimodal);
+  }
+  return provenance + ".";
 }
 
 }  // namespace
@@ -914,8 +969,9 @@ std::string TrainResult::report() const {
     line(fmt::format("  ({:.1f} s)", seconds_cv));
   }
   const auto& h = held_out;
-  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored); training {} runs in {:.2f} s", h.rows,
-                   h.out_of_range, training_rows, seconds_train));
+  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored; {} of the scored untrusted by the "
+                   "trust rules: {} outside the envelope, {} multimodal); training {} runs in {:.2f} s",
+                   h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, training_rows, seconds_train));
   line("                         raw AWCC    corrected median");
   line(fmt::format("  velocity RMSE          {:7.3f} %   {:7.3f} %", 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected));
   line(fmt::format("  velocity median |err|  {:7.3f} %   {:7.3f} %", 100 * h.velocity_median_abs_raw,
@@ -1012,7 +1068,7 @@ std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& pre
     for (const auto& p : predictions) {
       if (!b.holds(p)) continue;
       ++c.runs;
-      if (!p.correction.corrected() || !p.correction.velocity || !p.correction.turbulence_intensity) continue;
+      if (!p.correction.velocity || !p.correction.turbulence_intensity) continue;  // untrusted rows scored too
       const auto& u = p.correction.velocity->quantiles;
       const auto& t = p.correction.turbulence_intensity->quantiles;
       const double uu = p.row.true_velocity, tt = p.row.true_turbulence_intensity;
@@ -1053,7 +1109,7 @@ std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPredic
     if (predictions[i].row.run != other[i].row.run || predictions[i].row.study != other[i].row.study) {
       throw std::invalid_argument("corrected_by_both: the two prediction sets are not of the same runs");
     }
-    if (predictions[i].correction.corrected() && other[i].correction.corrected()) out.push_back(predictions[i]);
+    if (predictions[i].correction.velocity && other[i].correction.velocity) out.push_back(predictions[i]);
   }
   return out;
 }
@@ -1105,17 +1161,17 @@ std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const 
 
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
   std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,fs,duration,"
-                    "true_velocity,true_turbulence_intensity,in_range";
+                    "true_velocity,true_turbulence_intensity,in_range,status";
   for (const char* q : {"velocity", "turbulence_intensity"}) {
     for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
   out += "\n";
   for (const auto& p : predictions) {
     const auto& f = p.row.features;
-    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{}",
+    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{},{}",
                        p.row.run, f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np,
                        f.windows_accepted, f.fs, f.duration, p.row.true_velocity, p.row.true_turbulence_intensity,
-                       p.correction.corrected() ? 1 : 0);
+                       p.correction.corrected() ? 1 : 0, to_string(p.correction.status));
     for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
       for (std::size_t k = 0; k < correction_levels.size(); ++k) {
         out += *q ? fmt::format(",{:.10g}", (*q)->quantiles[k]) : std::string(",");
