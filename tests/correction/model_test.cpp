@@ -316,7 +316,12 @@ TEST(Correction, CsvCellsEqualTheJsonAtTheirPointers) {
   const auto m = small_model();
   auto outside = inside();
   outside.void_fraction = 0.9;
-  for (const auto& c : {m.correct(inside()), m.correct(outside)}) {
+  // An untrusted row with notes: quantiles without a corrected median, a list joined by "; ".
+  auto untrusted = m.correct(inside());
+  untrusted.status = correction::CorrectionStatus::untrusted;
+  untrusted.message = "outside the envelope: a test";
+  untrusted.notes = {"duration 600 s is beyond the training range (20-300 s): corrected as 300 s", "a second, note"};
+  for (const auto& c : {m.correct(inside()), m.correct(outside), untrusted}) {
     const nlohmann::json row = {{"correction", correction::to_json(c)}};
     const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
     const auto columns = correction::correction_csv_columns();
@@ -329,6 +334,8 @@ TEST(Correction, CsvCellsEqualTheJsonAtTheirPointers) {
       if (value.is_boolean()) expected = value.get<bool>() ? "1" : "0";
       else if (value.is_number()) expected = fmt::format("{:.10g}", value.get<double>());
       else if (value.is_string()) expected = value.get<std::string>();
+      else if (value.is_array())
+        for (const auto& n : value) expected += (expected.empty() ? "" : "; ") + n.get<std::string>();
       EXPECT_EQ(cells[k], expected) << columns[k].name << " (" << c.message << ")";
     }
   }

@@ -24,7 +24,9 @@
 // which no density has; its quantiles are taken from the piecewise-linear
 // distribution function that spreads each value's weight evenly between the
 // midpoints to its neighbours (the first and last value: as far out as half
-// the spacing to their neighbour). A sample of a unimodal density has a
+// the spacing to their neighbour). Two lone values are so a flat density: the
+// test sees modes made of several values, as a forest's are (hundreds of
+// training targets, each held by a few trees). A sample of a unimodal density has a
 // ratio below 1 by chance; the limit a model applies (model.hpp,
 // multimodal_dip_limit) is set from held-out runs so that it rarely fires
 // on them (docs/validation.md).
