@@ -53,6 +53,7 @@ Dip dip(const WeightedDistribution& d, bool log_scale) {
     density[k] = (modality_levels[k + 1] - modality_levels[k]) / (q[k + 1] - q[k]);
   }
   for (std::size_t k = 1; k + 1 < intervals; ++k) {
+    if (modality_levels[k] < 0.25 || modality_levels[k + 1] > 0.75) continue;  // a tail's trough: the median stands
     const double left = *std::max_element(density.begin(), density.begin() + static_cast<std::ptrdiff_t>(k));
     const double right = *std::max_element(density.begin() + static_cast<std::ptrdiff_t>(k) + 1, density.end());
     const double ratio = density[k] / std::min(left, right);

@@ -389,7 +389,7 @@ Verdict untrusted_reasons(const Quantity& q, const WeightedDistribution& d,
     const double median = from_target(q.form, d.quantile(0.5), q.measured);
     out.push_back(fmt::format(
         "outside the envelope: the {} {} median {} is {} from {} {}; on {} the truth lay within {} to {} of the "
-        "measurement for {:.0f} % of them",
+        "measurement for {:g} % of them",
         q.forest, q.name, value_text(q, q.nonnegative ? std::max(0.0, median) : median), shift_text(q.form, shift, q.unit),
         q.source, value_text(q, q.measured), envelope_runs, shift_text(q.form, -(*envelope)[0], q.unit),
         shift_text(q.form, (*envelope)[1], q.unit), 100.0 * envelope_coverage));
@@ -499,7 +499,7 @@ std::string Calibration::group_text(std::int64_t windows, double tu_median) cons
 
 std::optional<std::array<double, 2>> envelope_of(std::vector<double> shifts, double coverage) {
   const auto n = static_cast<double>(shifts.size());
-  // (The rank of an exact product must not round up: 200 x 0.995 is 199.)
+  // (The rank of an exact product must not round up: 400 x 0.9975 is 399.)
   const auto k = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 + coverage) / 2.0 - 1e-9));
   if (shifts.empty() || k > shifts.size()) return std::nullopt;
   std::sort(shifts.begin(), shifts.end());

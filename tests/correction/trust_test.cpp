@@ -117,19 +117,19 @@ TEST(Modality, ValuesApartByRoundingAreOneAndOneValueDoesNotDip) {
   EXPECT_EQ(correction::dip(one, true).ratio, 1.0);
 }
 
-// A model of the seven measured features over 300 random rows whose
+// A model of the seven measured features over `rows` random rows whose
 // velocity target (ratio) is `velocity_target(i)` and whose Tu target
 // (difference) is `tu_target(i)`; the features carry no information, so the
 // forest's distribution at any row is the targets' own.
 CorrectionModel model_of(const std::function<double(int)>& velocity_target,
-                         const std::function<double(int)>& tu_target) {
+                         const std::function<double(int)>& tu_target, int rows = 300) {
   std::mt19937_64 g(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   correction::TrainingData v, t;
   v.features = t.features = Features::count;
   CorrectionModel m;
   for (int j = 0; j < Features::count; ++j) m.ranges.push_back({Features::names[static_cast<std::size_t>(j)], 0.0, 10.0});
-  for (int i = 0; i < 300; ++i) {
+  for (int i = 0; i < rows; ++i) {
     for (int j = 0; j < Features::count; ++j) {
       const double x = u(g);
       v.x.push_back(x);
@@ -140,7 +140,7 @@ CorrectionModel model_of(const std::function<double(int)>& velocity_target,
   }
   correction::ForestOptions o;
   o.trees = 20;
-  o.min_leaf = 400;  // one leaf: the root holds every row
+  o.min_leaf = rows + 1;  // one leaf: the root holds every row
   m.velocity = correction::QuantileForest::train(v, o);
   m.turbulence_intensity = correction::QuantileForest::train(t, o);
   m.min_windows = 10;
@@ -179,7 +179,7 @@ TEST(TrustRules, EnvelopeHoldsAtItsLimitAndBreaksJustBeyond) {
   EXPECT_NE(c.message.find("outside the envelope: the AWCC forest's velocity median 2.4 m/s is +20 % from AWCC's 2 m/s"),
             std::string::npos)
       << c.message;
-  EXPECT_NE(c.message.find("within -10 % to +20 % of the measurement for 99 % of them"), std::string::npos) << c.message;
+  EXPECT_NE(c.message.find("within -10 % to +20 % of the measurement for 99.5 % of them"), std::string::npos) << c.message;
   EXPECT_EQ(c.why_not(), "untrusted: " + c.message);
   // The quantiles stay for the report to draw apart; nothing presents them as corrected.
   ASSERT_TRUE(c.velocity && c.turbulence_intensity);
@@ -215,39 +215,49 @@ TEST(TrustRules, EnvelopeHoldsAtItsLimitAndBreaksJustBeyond) {
 }
 
 TEST(TrustRules, EnvelopeOfShiftsTakesTheConformalRankAndHoldsTheMeasurement) {
-  // 199 shifts -99..99: k = ceil(200 x 0.995) = 199, the extremes.
+  // At 99 %: 199 shifts -99..99, k = ceil(200 x 0.995) = 199, the extremes.
   std::vector<double> s;
   for (int i = -99; i <= 99; ++i) s.push_back(i);
-  auto e = correction::envelope_of(s);
+  auto e = correction::envelope_of(s, 0.99);
   ASSERT_TRUE(e);
   EXPECT_EQ((*e)[0], 99.0);
   EXPECT_EQ((*e)[1], 99.0);
   s.pop_back();  // 198: the rank is beyond the runs
-  EXPECT_FALSE(correction::envelope_of(s));
-  // 399 shifts 1..399: k = ceil(400 x 0.995) = 398; the upper end is the
-  // 398th smallest, the lower the 398th largest (2), which is above 0: the
-  // envelope holds the measurement.
+  EXPECT_FALSE(correction::envelope_of(s, 0.99));
+  // The rule's own 99.5 %: 399 runs at least (k = ceil(400 x 0.9975) = 399).
   s.clear();
-  for (int i = 1; i <= 399; ++i) s.push_back(i);
+  for (int i = 1; i <= 398; ++i) s.push_back(i);
+  EXPECT_FALSE(correction::envelope_of(s));
+  s.push_back(399);
   e = correction::envelope_of(s);
   ASSERT_TRUE(e);
-  EXPECT_EQ((*e)[1], 398.0);
+  EXPECT_EQ((*e)[1], 399.0);
+  // Every shift above 0: the lower end (the 399th largest, 1) is above 0,
+  // and the envelope holds the measurement instead.
   EXPECT_EQ((*e)[0], 0.0);
-  // Brute force: of random shifts, at most 0.5 % + 1 lie beyond each end.
+  // 799 shifts 1..799 at 99.5 %: k = ceil(800 x 0.9975) = 798.
+  s.clear();
+  for (int i = 1; i <= 799; ++i) s.push_back(i);
+  EXPECT_EQ((*correction::envelope_of(s))[1], 798.0);
+  // Brute force: of random shifts, at most 0.25 % + 1 lie beyond each end.
   std::mt19937_64 g(1);
   std::normal_distribution<double> n(0.0, 1.0);
   s.clear();
-  for (int i = 0; i < 1000; ++i) s.push_back(n(g));
+  for (int i = 0; i < 2000; ++i) s.push_back(n(g));
   e = correction::envelope_of(s);
   ASSERT_TRUE(e);
   EXPECT_LE(std::count_if(s.begin(), s.end(), [&](double x) { return x > (*e)[1]; }), 5);
   EXPECT_LE(std::count_if(s.begin(), s.end(), [&](double x) { return x < -(*e)[0]; }), 5);
+  EXPECT_GE(std::count_if(s.begin(), s.end(), [&](double x) { return x >= (*e)[1]; }), 5);
 }
 
 TEST(TrustRules, AModelWithoutEnvelopesTakesItsTrainingTargetsAndPerGroupEnvelopesRoundTrip) {
-  auto m = model_of([](int i) { return 0.5 + i / 300.0; }, [](int i) { return -0.1 + i / 1500.0; });
+  // Too few training targets for the rank (399): no envelope at all.
+  EXPECT_TRUE(model_of([](int) { return 1.0; }, [](int) { return 0.0; }).calibration.velocity_envelope.empty());
+  auto m = model_of([](int i) { return 0.5 + i / 500.0; }, [](int i) { return -0.1 + i / 2500.0; }, 500);
   // From the training targets: shifts t - 1 for the ratio, t for the difference.
   auto shifts = m.velocity.targets();
+  ASSERT_FALSE(m.calibration.velocity_envelope.empty());
   for (double& t : shifts) t -= 1.0;
   ASSERT_TRUE(m.calibration.envelope_from_training);
   EXPECT_EQ(m.calibration.velocity_envelope.front(), *correction::envelope_of(shifts));

@@ -17,8 +17,13 @@
 // f(b)) on it, and the intervals left of it average at most f(a), those
 // right at most f(b).) The dip ratio of a distribution is the least of
 //   d_k / min(max_{i<k} d_i, max_{i>k} d_i)
-// over the interior intervals: at least 1 when unimodal, and small when an
-// interval between two denser ones is nearly empty.
+// over the intervals between the quartiles (0.25-0.5 and 0.5-0.75): at
+// least 1 when unimodal, and small when a trough with at least a quarter of
+// the weight on each side, and the median at one of its ends, is nearly
+// empty: then the median misleads. A trough in a tail (a few per cent of the
+// weight on one training run, say) leaves the median in the bulk, and the
+// interval holds the tail: it is not looked at (on held-out runs it was 2-3
+// times as common as a central one; docs/validation.md).
 //
 // A forest's distribution is a weighted sample of training targets (atoms),
 // which no density has; its quantiles are taken from the piecewise-linear
@@ -46,7 +51,7 @@ namespace correction {
 inline constexpr std::array<double, 7> modality_levels{0.025, 0.1, 0.25, 0.5, 0.75, 0.9, 0.975};
 
 struct Dip {
-  double ratio = 1.0;       ///< the least interior d_k / min(max left, max right); 1 when no interval dips
+  double ratio = 1.0;       ///< the least central d_k / min(max left, max right); 1 when neither dips
   std::size_t interval = 0; ///< k of that interval: between modality_levels[k] and [k + 1]
   /// The quantiles of the smoothed distribution at modality_levels, on the
   /// distribution's own scale (not the logarithm).

@@ -183,6 +183,27 @@ struct TrainResult {
 TrainResult train_model(const TrainingSet& set, const TrainOptions& options,
                         const std::function<void(double)>& progress = {});
 
+/// A trained model with the envelopes of its trust rule (a) (model.hpp)
+/// measured on runs it was not trained on, and how often the trust rules
+/// fire on the held-out part of them.
+struct TrustResult {
+  CorrectionModel model;
+  std::int64_t envelope_rows = 0, fscc_envelope_rows = 0;  ///< the runs that measured them
+  HeldOutScores held_out;                 ///< the AWCC forests on the held-out runs
+  FsccScores fscc_held_out_unserved;      ///< the FSCC forest on the held-out runs AWCC cannot serve
+  std::string summary;                    ///< what was done and found (also appended to the provenance)
+};
+
+/// Measures a trained model's envelopes on `runs`: sweeps of its training
+/// distribution with other seeds, so that no run was trained on (a model of
+/// format 4 or older, which stores none, gains them so). The runs each
+/// forest takes are split as train_model splits (options.held_out, seed);
+/// the envelopes come from the rest, grouped as the model's calibration (the
+/// FSCC forest's: from the runs AWCC cannot serve), and the rules are scored
+/// on the held-out part. Throws awcc::InputError when the runs were processed
+/// otherwise than the model's training data.
+TrustResult measure_trust(CorrectionModel model, const TrainingSet& runs, const TrainOptions& options);
+
 /// Scores a model on rows.
 HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions = nullptr, int threads = 0);
@@ -195,7 +216,7 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
 
 /// The calibration of a model's intervals on runs its forests were not
 /// trained on (model.hpp), and the envelopes of its trust rule (a): per
-/// group with at least 199 runs, else the window band's, else pooled, else
+/// group with at least 399 runs, else the window band's, else pooled, else
 /// the model's own (its training targets').
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads = 0,
