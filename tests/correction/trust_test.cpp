@@ -306,24 +306,36 @@ TEST(TrustRules, AMultimodalDistributionIsUntrustedWithItsQuantilesKept) {
   EXPECT_TRUE(one.correct(middle()).corrected()) << one.correct(middle()).message;
 }
 
+// A row as pdp process measures it: AWCC's u (m/s) and Tu, the leading
+// tip's c and F (1/s), dx (m), AWCC's {accepted, formed} windows, the
+// record's {fs (Hz), duration (s)}, FSCC's {u (m/s), R12max}; Np 10, dy 0.
+correction::Measurement row(double u, double tu, double c, double rate, double dx, std::array<std::int64_t, 2> windows,
+                            std::array<double, 2> record, std::array<double, 2> fscc) {
+  correction::Measurement m;
+  m.velocity = u;
+  m.turbulence_intensity = tu;
+  m.void_fraction = c;
+  m.bubble_count_rate = rate;
+  m.dx = dx;
+  m.np = 10;
+  m.windows_accepted = windows[0];
+  m.windows_total = windows[1];
+  m.fs = record[0];
+  m.duration = record[1];
+  m.fscc_velocity = fscc[0];
+  m.r12_max = fscc[1];
+  return m;
+}
+
 TEST(TrustRules, TheTwoMillimetreRowOfTheRealProfileIsNotCorrected) {
   // Issue 29, case 1: file dc157_01 (y = 2 mm: c 0.004, 2 of 72 AWCC windows,
   // FSCC 2.80 m/s with R12max 0.041, 45 s at 20 kHz) was corrected by the
   // FSCC forest to 6.62 m/s (95 % 2.37-13.1), status corrected. Its features
   // as pdp process measures them:
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
-  correction::Measurement r;
-  r.void_fraction = 0.0036577777777777776;
-  r.bubble_count_rate = 16.133333333333333;
-  r.dx = 7.15e-3;
-  r.fs = 20e3;
-  r.duration = 45.0;
-  r.windows_accepted = 2;
-  r.windows_total = 72;
-  r.fscc_velocity = 2.803921568627451;
-  r.r12_max = 0.04131864076587361;
-  r.velocity = 1.17;  // AWCC's 2 windows: too few for the AWCC forest (10)
-  r.turbulence_intensity = 0.84;
+  // AWCC's 2 windows are too few for the AWCC forest (10).
+  const auto r = row(1.17, 0.84, 0.0036577777777777776, 16.133333333333333, 7.15e-3, {2, 72}, {20e3, 45.0},
+                     {2.803921568627451, 0.04131864076587361});
   const auto c = m.correct(r);
   EXPECT_EQ(c.status, CorrectionStatus::untrusted) << c.message;
   EXPECT_EQ(c.forest, "fscc");
@@ -343,18 +355,10 @@ TEST(LongRecords, DurationBeyondTheRangeIsHeldAtItsEndWithANote) {
   // [20.0007, 299.802]", "FSCC forest:" twice).
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
   const auto& range = *std::find_if(m.ranges.begin(), m.ranges.end(), [](const auto& r) { return r.name == "duration"; });
-  Features f;
-  f.velocity = 3.34;
-  f.turbulence_intensity = 0.207;
-  f.void_fraction = 0.273;
-  f.d32 = 3.6e-3;
-  f.dx = 5e-3;
+  // The base scene at 3 m/s and Tu 0.30 for 30 minutes at 500 kHz, as pdp process measures it.
+  auto f = correction::make_features(row(3.34, 0.207, 0.273, 376.4, 5e-3, {10042, 67751}, {500e3, 1800.0}, {3.29, 0.17}))
+               .features;
   f.dy = 1e-3;
-  f.np = 10;
-  f.fs = 500e3;
-  f.windows_accepted = 10042;
-  f.windows_total = 67751;
-  f.duration = 1800.0;
   const auto c = m.correct(f);
   ASSERT_TRUE(c.corrected()) << c.message;
   ASSERT_EQ(c.notes.size(), 1u);
@@ -393,18 +397,8 @@ TEST(LongRecords, DurationBeyondTheRangeIsHeldAtItsEndWithANote) {
 
 TEST(LongRecords, TheFsccForestHoldsTheDurationToo) {
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
-  correction::Measurement r;
-  r.void_fraction = 0.02;
-  r.bubble_count_rate = 40.0;
-  r.dx = 5e-3;
-  r.fs = 100e3;
-  r.duration = 1800.0;
-  r.windows_accepted = 5;  // too few for the AWCC forest
-  r.windows_total = 200;
-  r.fscc_velocity = 2.5;
-  r.r12_max = 0.3;
-  r.velocity = 2.4;
-  r.turbulence_intensity = 0.2;
+  // 5 windows: too few for the AWCC forest; FSCC's velocity goes to the FSCC forest.
+  const auto r = row(2.4, 0.2, 0.02, 40.0, 5e-3, {5, 200}, {100e3, 1800.0}, {2.5, 0.3});
   const auto c = m.correct(r);
   ASSERT_TRUE(c.velocity) << c.message;
   EXPECT_EQ(c.forest, "fscc");
@@ -416,19 +410,7 @@ TEST(Messages, AFeatureBothForestsRefuseIsNamedOnceWithUnits) {
   // Droplet flow: c outside both forests' ranges. Each was said in full,
   // the second time after "FSCC forest:".
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
-  correction::Measurement r;
-  r.void_fraction = 0.9;
-  r.bubble_count_rate = 100.0;
-  r.dx = 5e-3;
-  r.fs = 100e3;
-  r.duration = 100.0;
-  r.windows_accepted = 500;
-  r.windows_total = 1000;
-  r.np = 10;
-  r.fscc_velocity = 2.5;
-  r.r12_max = 0.3;
-  r.velocity = 2.4;
-  r.turbulence_intensity = 0.2;
+  auto r = row(2.4, 0.2, 0.9, 100.0, 5e-3, {500, 1000}, {100e3, 100.0}, {2.5, 0.3});
   const auto c = m.correct(r);
   EXPECT_EQ(c.status, CorrectionStatus::outside_training_range);
   const auto& a = *std::find_if(m.ranges.begin(), m.ranges.end(), [](const auto& x) { return x.name == "void_fraction"; });
