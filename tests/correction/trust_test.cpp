@@ -10,8 +10,10 @@
 #include <random>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "correction/modality.hpp"
 #include "correction/model.hpp"
+#include "correction/training.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -430,6 +432,54 @@ TEST(Messages, AFeatureBothForestsRefuseIsNamedOnceWithUnits) {
   const auto at = d.message.find("; FSCC forest: dx = 50 mm is outside the training range");
   EXPECT_NE(at, std::string::npos) << d.message;
   EXPECT_EQ(d.message.find("FSCC forest:", at + 3), std::string::npos) << d.message;
+}
+
+}  // namespace
+
+namespace {
+
+TEST(TrustRules, EnvelopesMeasuredOnFreshRunsReplaceTheTrainingTargets) {
+  // pdp train --envelope-of: a model whose forests move u by +20 % and Tu by
+  // +0.05 everywhere, measured on 1,000 runs whose truths lie 10 % and 0.02
+  // above the measurement: the envelope is [0, +10 %] and [0, +0.02] (every
+  // truth's shift the same), and every held-out row breaks it.
+  const auto model = model_of([](int) { return 1.2; }, [](int) { return 0.05; });
+  ASSERT_TRUE(model.calibration.velocity_envelope.empty());  // 300 targets: too few for the rank
+  correction::TrainingSet set;
+  std::mt19937_64 g(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 1000; ++i) {
+    correction::TrainingRow r;
+    r.study = 1;
+    r.run = i;
+    r.features = middle();
+    r.features.velocity = 1.0 + u(g);
+    r.features.turbulence_intensity = 0.1 + 0.2 * u(g);
+    r.true_velocity = 1.1 * r.features.velocity;
+    r.true_turbulence_intensity = r.features.turbulence_intensity + 0.02;
+    set.rows.push_back(r);
+  }
+  correction::TrainOptions o;
+  o.held_out = 0.2;
+  const auto t = correction::measure_trust(model, set, o);
+  EXPECT_EQ(t.envelope_rows, 800);
+  const auto& c = t.model.calibration;
+  EXPECT_FALSE(c.envelope_from_training);
+  ASSERT_EQ(c.velocity_envelope.size(), 1u);
+  EXPECT_EQ(c.velocity_envelope[0][0], 0.0);
+  EXPECT_NEAR(c.velocity_envelope[0][1], 0.1, 1e-12);
+  EXPECT_NEAR(c.turbulence_envelope[0][1], 0.02, 1e-12);
+  EXPECT_EQ(t.held_out.rows, 200);
+  EXPECT_EQ(t.held_out.untrusted, 200);
+  EXPECT_EQ(t.held_out.outside_envelope, 200);
+  EXPECT_NE(t.model.provenance.find("Trust envelopes (rule (a), model.hpp) measured by pdp train"), std::string::npos);
+  // Stored (format 5) and read back as measured.
+  const auto back = CorrectionModel::parse(t.model.serialise(), "mem");
+  EXPECT_EQ(back.calibration.velocity_envelope, c.velocity_envelope);
+  EXPECT_FALSE(back.calibration.envelope_from_training);
+  // Runs processed otherwise are refused.
+  set.processing.filter_a = 0.3;
+  EXPECT_THROW(correction::measure_trust(model, set, o), awcc::InputError);
 }
 
 }  // namespace
