@@ -346,7 +346,10 @@ std::array<double, N> group_value(const Calibration& c, const std::vector<std::a
 // A shift of a quantity's target from the measurement, in words: "+136 %"
 // for a ratio, "+0.45" (Tu) or "+1.2 m/s" otherwise.
 std::string shift_text(TargetForm form, double shift, std::string_view unit) {
-  if (form == TargetForm::ratio) return fmt::format("{:+.3g} %", 100.0 * shift);
+  if (form == TargetForm::ratio) {
+    const double percent = 100.0 * shift;
+    return std::fabs(percent) >= 100.0 ? fmt::format("{:+.0f} %", percent) : fmt::format("{:+.3g} %", percent);
+  }
   return unit.empty() ? fmt::format("{:+.3g}", shift) : fmt::format("{:+.3g} {}", shift, unit);
 }
 
@@ -369,31 +372,29 @@ std::string value_text(const Quantity& q, double v) {
 // Rule (a) and rule (b) of the trust rules (the model's header) for one
 // quantity: the reasons it breaks, empty when it holds. `envelope_runs`
 // says where the envelope was measured.
+// What the trust rules find, rule by rule, each quantity's clause apart so
+// that a rule both quantities break is named once.
 struct Verdict {
-  std::vector<std::string> reasons;
-  bool outside_envelope = false, multimodal = false;
+  std::vector<std::string> envelope, modes;
   void add(const Verdict& v) {
-    reasons.insert(reasons.end(), v.reasons.begin(), v.reasons.end());
-    outside_envelope = outside_envelope || v.outside_envelope;
-    multimodal = multimodal || v.multimodal;
+    envelope.insert(envelope.end(), v.envelope.begin(), v.envelope.end());
+    modes.insert(modes.end(), v.modes.begin(), v.modes.end());
   }
 };
 
 Verdict untrusted_reasons(const Quantity& q, const WeightedDistribution& d,
                           const std::optional<std::array<double, 2>>& envelope, const std::string& envelope_runs) {
   Verdict verdict;
-  auto& out = verdict.reasons;
   const double identity = to_target(q.form, q.measured, q.measured);
   const double shift = d.quantile(0.5) - identity;
   if (envelope && !(shift >= -(*envelope)[0] && shift <= (*envelope)[1])) {
     const double median = from_target(q.form, d.quantile(0.5), q.measured);
-    out.push_back(fmt::format(
-        "outside the envelope: the {} {} median {} is {} from {} {}; on {} the truth lay within {} to {} of the "
-        "measurement for {:g} % of them",
+    verdict.envelope.push_back(fmt::format(
+        "the {} {} median {} is {} from {} {}; on {} the truth lay within {} to {} of the measurement for {:g} % of "
+        "them",
         q.forest, q.name, value_text(q, q.nonnegative ? std::max(0.0, median) : median), shift_text(q.form, shift, q.unit),
         q.source, value_text(q, q.measured), envelope_runs, shift_text(q.form, -(*envelope)[0], q.unit),
         shift_text(q.form, (*envelope)[1], q.unit), 100.0 * envelope_coverage));
-    verdict.outside_envelope = true;
   }
   const bool log_scale = q.form == TargetForm::ratio && !d.values.empty() && d.values.front() > 0.0;
   const auto m = dip(d, log_scale);
@@ -401,11 +402,11 @@ Verdict untrusted_reasons(const Quantity& q, const WeightedDistribution& d,
     const auto lo = from_target(q.form, m.quantiles[m.interval], q.measured);
     const auto hi = from_target(q.form, m.quantiles[m.interval + 1], q.measured);
     const std::string range = *q.unit ? fmt::format("{:.3g}-{:.3g} {}", lo, hi, q.unit) : fmt::format("{:.3g}-{:.3g}", lo, hi);
-    out.push_back(fmt::format(
-        "multimodal: the {} {} distribution is {:.2f} times as dense between its {:g} and {:g} quantiles ({}) as in the "
-        "densest interval on each side (one mode gives at least 1; the limit is {:g})",
-        q.forest, q.name, m.ratio, modality_levels[m.interval], modality_levels[m.interval + 1], range, multimodal_dip_limit));
-    verdict.multimodal = true;
+    verdict.modes.push_back(fmt::format(
+        "the {} {} distribution is {:.2f} times as dense between its {:g} and {:g} quantiles ({}) as in the densest "
+        "interval on each side (one mode gives at least 1; the limit is {:g})",
+        q.forest, q.name, m.ratio, modality_levels[m.interval], modality_levels[m.interval + 1], range,
+        multimodal_dip_limit));
   }
   return verdict;
 }
@@ -426,13 +427,17 @@ std::vector<double> quantiles_of(const WeightedDistribution& d) {
   return t;
 }
 
-// The trust rules' verdict on a correction (the model's header).
+// The trust rules' verdict on a correction (the model's header): each rule
+// named once, with the clauses of the quantities that break it.
 void judge(Correction& c, const Verdict& v) {
-  if (v.reasons.empty()) return;
+  c.outside_envelope = !v.envelope.empty();
+  c.multimodal = !v.modes.empty();
+  if (!c.outside_envelope && !c.multimodal) return;
   c.status = CorrectionStatus::untrusted;
-  c.message = fmt::format("{}", fmt::join(v.reasons, "; "));
-  c.outside_envelope = v.outside_envelope;
-  c.multimodal = v.multimodal;
+  std::vector<std::string> rules;
+  if (c.outside_envelope) rules.push_back(fmt::format("outside the envelope: {}", fmt::join(v.envelope, "; ")));
+  if (c.multimodal) rules.push_back(fmt::format("multimodal: {}", fmt::join(v.modes, "; ")));
+  c.message = fmt::format("{}", fmt::join(rules, "; "));
 }
 
 // A forest's envelope when the file stores none: its training targets'

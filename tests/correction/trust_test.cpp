@@ -214,6 +214,12 @@ TEST(TrustRules, EnvelopeHoldsAtItsLimitAndBreaksJustBeyond) {
   c = m.correct(middle());
   EXPECT_EQ(c.status, CorrectionStatus::untrusted);
   EXPECT_NE(c.message.find("the AWCC forest's Tu median 0.25 is +0.05 from AWCC's 0.2"), std::string::npos) << c.message;
+  // Both broken: the rule named once, a clause for each.
+  cal.velocity_envelope = {{0.1, 0.1}};
+  c = m.correct(middle());
+  EXPECT_EQ(c.message.find("outside the envelope: the AWCC forest's velocity median"), 0u) << c.message;
+  EXPECT_EQ(c.message.find("outside the envelope", 1), std::string::npos) << c.message;
+  EXPECT_NE(c.message.find("; the AWCC forest's Tu median"), std::string::npos) << c.message;
 }
 
 TEST(TrustRules, EnvelopeOfShiftsTakesTheConformalRankAndHoldsTheMeasurement) {
