@@ -144,7 +144,7 @@ struct Correction {
 /// of one falls below 1 by chance. Of 3,000 runs the shipped model was not
 /// trained on, 0.6 % of the AWCC forest's velocity distributions, none of
 /// its Tu ones and 1.9 % of the FSCC forest's fell below 0.4, their medians
-/// off by 2-3 times the others' (docs/validation.md); the 2 mm row of the
+/// off by 1.8-2.8 times the others' (docs/validation.md); the 2 mm row of the
 /// real profile (issue 29) is at 0.31.
 inline constexpr double multimodal_dip_limit = 0.4;
 /// The share of the calibration runs' truths the envelope of rule (a) holds:
