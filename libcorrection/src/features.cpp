@@ -15,8 +15,32 @@ std::string_view to_string(CorrectionStatus status) {
     case CorrectionStatus::too_few_windows: return "too_few_windows";
     case CorrectionStatus::outside_training_range: return "outside_training_range";
     case CorrectionStatus::probe_corrected: return "probe_corrected";
+    case CorrectionStatus::untrusted: return "untrusted";
   }
   return "unknown";
+}
+
+FeatureUnit unit_of(std::string_view feature) {
+  if (feature == "velocity" || feature == "fscc_velocity") return {"m/s", 1.0};
+  if (feature == "d32" || feature == "fscc_d32" || feature == "dx" || feature == "dy") return {"mm", 1e3};
+  if (feature == "fs") return {"kHz", 1e-3};
+  if (feature == "duration") return {"s", 1.0};
+  return {"-", 1.0};
+}
+
+namespace {
+std::string number_with_unit(double v, FeatureUnit u) {
+  return u.unit == "-" ? fmt::format("{:.4g}", v * u.scale) : fmt::format("{:.4g} {}", v * u.scale, u.unit);
+}
+}  // namespace
+
+std::string feature_value_text(std::string_view feature, double value) {
+  return fmt::format("{} = {}", feature, number_with_unit(value, unit_of(feature)));
+}
+
+std::string feature_range_text(std::string_view feature, double min, double max) {
+  const auto u = unit_of(feature);
+  return fmt::format("{:.4g}-{}", min * u.scale, number_with_unit(max, u));
 }
 
 FeatureResult make_features(const Measurement& m) {

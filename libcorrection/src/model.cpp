@@ -24,6 +24,7 @@
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/read_back.hpp"
+#include "correction/modality.hpp"
 
 namespace correction {
 
@@ -185,6 +186,30 @@ QuantileForest read_forest_v2(Reader& r, const std::string& expected, TargetForm
   }
 }
 
+// Format 5: u32 E, then E x 2 values per quantity (the model's header).
+void write_envelopes(Writer& w, const Calibration& c,
+                     std::initializer_list<const std::vector<std::array<double, 2>>*> quantities) {
+  const auto count = c.envelope_from_training ? 0 : (*quantities.begin())->size();
+  w.u32(static_cast<std::uint32_t>(count));
+  if (count == 0) return;
+  for (const auto* q : quantities)
+    for (const auto& e : *q)
+      for (double v : e) w.f64(v);
+}
+
+void read_envelopes(Reader& r, std::size_t groups, std::initializer_list<std::vector<std::array<double, 2>>*> quantities) {
+  const auto count = r.count(r.u32(), 16);
+  if (count != 0 && count != 1 && count != groups) r.damaged(fmt::format("{} envelopes for {} groups", count, groups));
+  for (auto* q : quantities) {
+    q->resize(count);
+    for (auto& e : *q)
+      for (double& v : e) {
+        v = r.f64();
+        if (!(v >= 0.0 || std::isinf(v))) r.damaged("an envelope is negative or not a number");
+      }
+  }
+}
+
 }  // namespace
 
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size) {
@@ -245,14 +270,187 @@ std::string how_to_give(const std::string& feature) {
   return fmt::format("a column '{}'", feature);
 }
 
-// Why a feature value is outside its training range, in the field's words
+// What a value outside its training range means, in the field's words
 // where the flow itself is outside what the simulator models.
-std::string out_of_range_reason(const FeatureRange& r, double v) {
-  std::string why = fmt::format("{} = {:.6g} is outside the training range [{:.6g}, {:.6g}]", r.name, v, r.min, r.max);
+std::string out_of_range_meaning(const FeatureRange& r, double v) {
   if (r.name == "void_fraction" && v > 0.6) {
-    why += ": above c = 0.6 the flow is droplets in air, which the synthetic probe the model learnt from does not model";
+    return ": above c = 0.6 the flow is droplets in air, which the synthetic probe the model learnt from does not model";
   }
-  return why;
+  if (r.name == "duration" && v < r.min) return ": a shorter record holds less than any the model learnt from";
+  return {};
+}
+
+std::string out_of_range_reason(const FeatureRange& r, double v) {
+  return fmt::format("{} is outside the training range {}{}", feature_value_text(r.name, v),
+                     feature_range_text(r.name, r.min, r.max), out_of_range_meaning(r, v));
+}
+
+// A forest's features of a row: x, or why the row cannot be corrected (a
+// feature not known, or outside the training range). A record longer than
+// the longest training record is held at that length, with a note (the
+// model's header says why duration alone is held).
+struct FeatureVector {
+  std::vector<double> x;
+  CorrectionStatus status = CorrectionStatus::corrected;
+  std::string message;
+  std::vector<std::string> notes;
+  const FeatureRange* refused = nullptr;  ///< the feature outside its range
+  [[nodiscard]] bool ok() const { return status == CorrectionStatus::corrected; }
+};
+
+FeatureVector feature_vector(const std::vector<FeatureRange>& ranges, double margin, const Features& f) {
+  FeatureVector out;
+  out.x.resize(ranges.size());
+  for (std::size_t j = 0; j < ranges.size(); ++j) {
+    const auto v = f.value(ranges[j].name);
+    if (!v) {
+      out.status = CorrectionStatus::missing_feature;
+      out.message = fmt::format("the model takes the record's {} as a feature, and it is not known for this row; give it "
+                                "({})",
+                                ranges[j].name, how_to_give(ranges[j].name));
+      return out;
+    }
+    out.x[j] = *v;
+  }
+  for (std::size_t j = 0; j < ranges.size(); ++j) {
+    const auto& r = ranges[j];
+    const double pad = margin * (r.max - r.min);
+    if (r.name == "duration" && out.x[j] > r.max + pad) {
+      out.notes.push_back(fmt::format("duration {} s is beyond the training range ({}): corrected as {:.4g} s",
+                                      fmt::format("{:.4g}", out.x[j]), feature_range_text(r.name, r.min, r.max), r.max));
+      out.x[j] = r.max;
+    } else if (!(out.x[j] >= r.min - pad && out.x[j] <= r.max + pad)) {
+      out.status = CorrectionStatus::outside_training_range;
+      out.message = out_of_range_reason(r, out.x[j]);
+      out.refused = &r;
+      return out;
+    }
+  }
+  return out;
+}
+
+// The offsets or envelope of a row's group (Calibration::offsets).
+template <std::size_t N>
+std::array<double, N> group_value(const Calibration& c, const std::vector<std::array<double, N>>& groups,
+                                  std::int64_t windows, double tu_median) {
+  const auto h = static_cast<std::size_t>(c.tu_band(tu_median));
+  const int w = c.band(windows);
+  if (w >= 0) return groups[static_cast<std::size_t>(w) * c.tu_bands() + h];
+  std::array<double, N> o;
+  o.fill(-std::numeric_limits<double>::infinity());
+  for (std::size_t b = 0; b <= c.window_edges.size(); ++b)
+    for (std::size_t k = 0; k < N; ++k) o[k] = std::max(o[k], groups[b * c.tu_bands() + h][k]);
+  return o;
+}
+
+// A shift of a quantity's target from the measurement, in words: "+136 %"
+// for a ratio, "+0.45" (Tu) or "+1.2 m/s" otherwise.
+std::string shift_text(TargetForm form, double shift, std::string_view unit) {
+  if (form == TargetForm::ratio) {
+    const double percent = 100.0 * shift;
+    return std::fabs(percent) >= 100.0 ? fmt::format("{:+.0f} %", percent) : fmt::format("{:+.3g} %", percent);
+  }
+  return unit.empty() ? fmt::format("{:+.3g}", shift) : fmt::format("{:+.3g} {}", shift, unit);
+}
+
+// One corrected quantity, the forest's distribution at the row and what the
+// trust rules need to say about it.
+struct Quantity {
+  const char* forest;      // "AWCC forest's", "FSCC forest's"
+  const char* name;        // "velocity", "Tu"
+  const char* unit;        // "m/s", "" (dimensionless)
+  const char* source;      // "AWCC's", "FSCC's"
+  TargetForm form;
+  double measured;
+  bool nonnegative;
+};
+
+std::string value_text(const Quantity& q, double v) {
+  return *q.unit ? fmt::format("{:.3g} {}", v, q.unit) : fmt::format("{:.3g}", v);
+}
+
+// Rule (a) and rule (b) of the trust rules (the model's header) for one
+// quantity: the reasons it breaks, empty when it holds. `envelope_runs`
+// says where the envelope was measured.
+// What the trust rules find, rule by rule, each quantity's clause apart so
+// that a rule both quantities break is named once.
+struct Verdict {
+  std::vector<std::string> envelope, modes;
+  void add(const Verdict& v) {
+    envelope.insert(envelope.end(), v.envelope.begin(), v.envelope.end());
+    modes.insert(modes.end(), v.modes.begin(), v.modes.end());
+  }
+};
+
+Verdict untrusted_reasons(const Quantity& q, const WeightedDistribution& d,
+                          const std::optional<std::array<double, 2>>& envelope, const std::string& envelope_runs) {
+  Verdict verdict;
+  const double identity = to_target(q.form, q.measured, q.measured);
+  const double shift = d.quantile(0.5) - identity;
+  if (envelope && !(shift >= -(*envelope)[0] && shift <= (*envelope)[1])) {
+    const double median = from_target(q.form, d.quantile(0.5), q.measured);
+    verdict.envelope.push_back(fmt::format(
+        "the {} {} median {} is {} from {} {}; on {} the truth lay within {} to {} of the measurement for {:g} % of "
+        "them",
+        q.forest, q.name, value_text(q, q.nonnegative ? std::max(0.0, median) : median), shift_text(q.form, shift, q.unit),
+        q.source, value_text(q, q.measured), envelope_runs, shift_text(q.form, -(*envelope)[0], q.unit),
+        shift_text(q.form, (*envelope)[1], q.unit), 100.0 * envelope_coverage));
+  }
+  const bool log_scale = q.form == TargetForm::ratio && !d.values.empty() && d.values.front() > 0.0;
+  const auto m = dip(d, log_scale);
+  if (m.ratio < multimodal_dip_limit) {
+    const auto lo = from_target(q.form, m.quantiles[m.interval], q.measured);
+    const auto hi = from_target(q.form, m.quantiles[m.interval + 1], q.measured);
+    const std::string range = *q.unit ? fmt::format("{:.3g}-{:.3g} {}", lo, hi, q.unit) : fmt::format("{:.3g}-{:.3g}", lo, hi);
+    verdict.modes.push_back(fmt::format(
+        "the {} {} distribution is {:.2f} times as dense between its {:g} and {:g} quantiles ({}) as in the densest "
+        "interval on each side (one mode gives at least 1; the limit is {:g})",
+        q.forest, q.name, m.ratio, modality_levels[m.interval], modality_levels[m.interval + 1], range,
+        multimodal_dip_limit));
+  }
+  return verdict;
+}
+
+CorrectedQuantity corrected_quantity(const Quantity& q, const std::vector<double>& t) {
+  CorrectedQuantity c;
+  c.measured = q.measured;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    c.quantiles[k] = from_target(q.form, t[k], q.measured);
+    if (q.nonnegative) c.quantiles[k] = std::max(0.0, c.quantiles[k]);
+  }
+  return c;
+}
+
+std::vector<double> quantiles_of(const WeightedDistribution& d) {
+  std::vector<double> t;
+  for (double a : correction_levels) t.push_back(d.quantile(a));
+  return t;
+}
+
+// The trust rules' verdict on a correction (the model's header): each rule
+// named once, with the clauses of the quantities that break it.
+void judge(Correction& c, const Verdict& v) {
+  c.outside_envelope = !v.envelope.empty();
+  c.multimodal = !v.modes.empty();
+  if (!c.outside_envelope && !c.multimodal) return;
+  c.status = CorrectionStatus::untrusted;
+  std::vector<std::string> rules;
+  if (c.outside_envelope) rules.push_back(fmt::format("outside the envelope: {}", fmt::join(v.envelope, "; ")));
+  if (c.multimodal) rules.push_back(fmt::format("multimodal: {}", fmt::join(v.modes, "; ")));
+  c.message = fmt::format("{}", fmt::join(rules, "; "));
+}
+
+// A forest's envelope when the file stores none: its training targets'
+// shifts from the measurement, pooled (the model's header). None for the
+// value form, whose shift needs the measurement the targets do not keep.
+std::vector<std::array<double, 2>> training_envelope(const QuantileForest& forest, TargetForm form) {
+  if (form == TargetForm::value || forest.target_count() == 0) return {};
+  const double identity = form == TargetForm::ratio ? 1.0 : 0.0;
+  auto shifts = forest.targets();
+  for (double& t : shifts) t -= identity;
+  const auto e = envelope_of(std::move(shifts));
+  if (!e) return {};
+  return {*e};
 }
 
 }  // namespace
@@ -272,14 +470,52 @@ int Calibration::tu_band(double tu_median) const {
 
 std::array<double, 3> Calibration::offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
                                            double tu_median) const {
-  const auto h = static_cast<std::size_t>(tu_band(tu_median));
+  return group_value(*this, groups, windows, tu_median);
+}
+
+std::optional<std::array<double, 2>> Calibration::envelope(const std::vector<std::array<double, 2>>& groups,
+                                                           std::int64_t windows, double tu_median) const {
+  if (groups.empty()) return std::nullopt;
+  if (groups.size() == 1) return groups.front();
+  return group_value(*this, groups, windows, tu_median);
+}
+
+std::string Calibration::group_text(std::int64_t windows, double tu_median) const {
+  std::string out;
   const int w = band(windows);
-  if (w >= 0) return groups[static_cast<std::size_t>(w) * tu_bands() + h];
-  std::array<double, 3> o;
-  o.fill(-std::numeric_limits<double>::infinity());
-  for (std::size_t b = 0; b <= window_edges.size(); ++b)
-    for (std::size_t k = 0; k < 3; ++k) o[k] = std::max(o[k], groups[b * tu_bands() + h][k]);
-  return o;
+  if (window_edges.empty()) {
+    out = "all windows";
+  } else if (w < 0) {
+    out = "windows unknown: the widest band";
+  } else if (w == 0) {
+    out = fmt::format("windows up to {}", window_edges.front() - 1);
+  } else if (w == static_cast<int>(window_edges.size())) {
+    out = fmt::format("windows {}+", window_edges.back());
+  } else {
+    out = fmt::format("windows {}-{}", window_edges[static_cast<std::size_t>(w) - 1],
+                      window_edges[static_cast<std::size_t>(w)] - 1);
+  }
+  if (tu_edges.empty()) return out;
+  const auto h = static_cast<std::size_t>(tu_band(tu_median));
+  if (h == 0) return fmt::format("{}, model Tu below {:g}", out, tu_edges.front());
+  if (h == tu_edges.size()) return fmt::format("{}, model Tu {:g}+", out, tu_edges.back());
+  return fmt::format("{}, model Tu {:g}-{:g}", out, tu_edges[h - 1], tu_edges[h]);
+}
+
+std::optional<std::array<double, 2>> envelope_of(std::vector<double> shifts, double coverage) {
+  const auto n = static_cast<double>(shifts.size());
+  // (The rank of an exact product must not round up: 400 x 0.9975 is 399.)
+  const auto k = static_cast<std::size_t>(std::ceil((n + 1.0) * (1.0 + coverage) / 2.0 - 1e-9));
+  if (shifts.empty() || k > shifts.size()) return std::nullopt;
+  std::sort(shifts.begin(), shifts.end());
+  // The rule bounds how far from the measurement a median may move: a
+  // median nearer to it than the truths lay is not farther, so 0 is inside.
+  return std::array<double, 2>{std::max(0.0, -shifts[shifts.size() - k]), std::max(0.0, shifts[k - 1])};
+}
+
+std::string Correction::why_not() const {
+  if (corrected()) return {};
+  return status == CorrectionStatus::untrusted ? "untrusted: " + message : message;
 }
 
 void Calibration::apply(const std::array<double, 3>& offsets, std::vector<double>& t) {
@@ -293,54 +529,104 @@ void Calibration::apply(const std::array<double, 3>& offsets, std::vector<double
   for (std::size_t k = 4; k < 7; ++k) t[k] = std::max(t[k], t[k - 1]);
 }
 
-Correction CorrectionModel::correct(const Features& f) const {
-  if (f.windows_accepted >= 0 && f.windows_accepted < min_windows) {
-    return not_corrected(CorrectionStatus::too_few_windows,
-                         fmt::format("{} accepted windows; the model was trained on runs with at least {}",
-                                     f.windows_accepted, min_windows));
+namespace {
+
+// A forest's correction of a row, and the feature that kept it from the row
+// (to say once what both forests refuse).
+struct Attempt {
+  Correction correction;
+  const FeatureRange* refused = nullptr;
+  double value = 0.0;
+};
+
+Attempt refused(const FeatureVector& x, const Features& f) {
+  Attempt a{not_corrected(x.status, x.message), x.refused, 0.0};
+  if (x.refused) a.value = f.value(x.refused->name).value_or(0.0);
+  return a;
+}
+
+Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
+  if (f.windows_accepted >= 0 && f.windows_accepted < m.min_windows) {
+    return {not_corrected(CorrectionStatus::too_few_windows,
+                          fmt::format("{} accepted windows; the model was trained on runs with at least {}",
+                                      f.windows_accepted, m.min_windows))};
   }
-  std::vector<double> x(ranges.size());
-  for (std::size_t j = 0; j < ranges.size(); ++j) {
-    const auto v = f.value(ranges[j].name);
-    if (!v) {
-      return not_corrected(CorrectionStatus::missing_feature,
-                           fmt::format("the model takes the record's {} as a feature, and it is not known for this row; "
-                                       "give it ({})",
-                                       ranges[j].name, how_to_give(ranges[j].name)));
-    }
-    x[j] = *v;
+  const auto x = feature_vector(m.ranges, m.range_margin, f);
+  if (!x.ok()) return refused(x, f);
+  const auto& cal = m.calibration;
+  const auto velocity_d = m.velocity.distribution(x.x);
+  const auto tu_d = m.turbulence_intensity.distribution(x.x);
+  auto velocity_t = quantiles_of(velocity_d);
+  auto tu_t = quantiles_of(tu_d);
+  // The group's Tu band: the Tu forest's own median, before calibration.
+  const double tu_median = from_target(m.turbulence_form, tu_t[3], f.turbulence_intensity);
+  if (!cal.empty()) {
+    Calibration::apply(cal.offsets(cal.velocity, f.windows_accepted, tu_median), velocity_t);
+    Calibration::apply(cal.offsets(cal.turbulence_intensity, f.windows_accepted, tu_median), tu_t);
   }
-  for (std::size_t j = 0; j < ranges.size(); ++j) {
-    const auto& r = ranges[j];
-    const double pad = range_margin * (r.max - r.min);
-    if (!(x[j] >= r.min - pad && x[j] <= r.max + pad)) {
-      return not_corrected(CorrectionStatus::outside_training_range, out_of_range_reason(r, x[j]));
-    }
-  }
+  const Quantity u{"AWCC forest's", "velocity", "m/s", "AWCC's", m.velocity_form, f.velocity, false};
+  const Quantity tu{"AWCC forest's", "Tu", "", "AWCC's", m.turbulence_form, f.turbulence_intensity, true};
   Correction c;
   c.status = CorrectionStatus::corrected;
-  auto velocity_t = velocity.quantiles(x, correction_levels);
-  auto tu_t = turbulence_intensity.quantiles(x, correction_levels);
-  if (!calibration.empty()) {
-    // The group's Tu band: the Tu forest's own median, before calibration.
-    const double tu_median = from_target(turbulence_form, tu_t[3], f.turbulence_intensity);
-    Calibration::apply(calibration.offsets(calibration.velocity, f.windows_accepted, tu_median), velocity_t);
-    Calibration::apply(calibration.offsets(calibration.turbulence_intensity, f.windows_accepted, tu_median), tu_t);
-  }
-  auto one = [&](const std::vector<double>& t, TargetForm form, double measured, bool nonnegative) {
-    CorrectedQuantity q;
-    q.measured = measured;
-    for (std::size_t k = 0; k < t.size(); ++k) {
-      q.quantiles[k] = from_target(form, t[k], measured);
-      if (nonnegative) q.quantiles[k] = std::max(0.0, q.quantiles[k]);
-    }
-    return q;
-  };
   c.forest = "awcc";
-  c.velocity = one(velocity_t, velocity_form, f.velocity, false);
-  c.turbulence_intensity = one(tu_t, turbulence_form, f.turbulence_intensity, true);
-  return c;
+  c.velocity = corrected_quantity(u, velocity_t);
+  c.turbulence_intensity = corrected_quantity(tu, tu_t);
+  c.notes = x.notes;
+  const std::string runs = cal.envelope_from_training
+                               ? "the forest's training runs"
+                               : fmt::format("runs the model was not trained on ({})",
+                                             cal.group_text(f.windows_accepted, tu_median));
+  auto verdict =
+      untrusted_reasons(u, velocity_d, cal.envelope(cal.velocity_envelope, f.windows_accepted, tu_median), runs);
+  verdict.add(untrusted_reasons(tu, tu_d, cal.envelope(cal.turbulence_envelope, f.windows_accepted, tu_median), runs));
+  judge(c, verdict);
+  return {c};
 }
+
+Attempt fscc_attempt(const CorrectionModel& m, const Features& f) {
+  if (!m.fscc) return {not_corrected(CorrectionStatus::no_awcc_velocity, "the model has no FSCC forest")};
+  if (const auto why = fscc_unusable(f); !why.empty()) return {not_corrected(CorrectionStatus::no_awcc_velocity, why)};
+  const auto& forest = *m.fscc;
+  const auto x = feature_vector(forest.ranges, m.range_margin, f);
+  if (!x.ok()) return refused(x, f);
+  const auto d = forest.velocity.distribution(x.x);
+  auto t = quantiles_of(d);
+  const auto& cal = forest.calibration;
+  if (!cal.empty()) Calibration::apply(cal.velocity.front(), t);
+  const Quantity u{"FSCC forest's", "velocity", "m/s", "FSCC's", forest.form, f.fscc_velocity, false};
+  Correction c;
+  c.status = CorrectionStatus::corrected;
+  c.forest = "fscc";
+  c.velocity = corrected_quantity(u, t);
+  c.notes = x.notes;
+  judge(c, untrusted_reasons(u, d, cal.envelope(cal.velocity_envelope, -1, 0.0),
+                             cal.envelope_from_training ? "the FSCC forest's training runs"
+                                                        : "the FSCC forest's calibration runs"));
+  return {c};
+}
+
+// The FSCC forest's answer when the AWCC forest's is not a correction: its
+// correction or its untrusted quantiles, else AWCC's status with both
+// reasons, each said once (a feature both forests refuse is named once).
+Correction after_awcc(const Attempt& first, const Attempt& fscc) {
+  const auto& c = fscc.correction;
+  if (c.corrected() || c.status == CorrectionStatus::untrusted) return c;
+  Correction awcc = first.correction;
+  const auto* a = first.refused;
+  const auto* b = fscc.refused;
+  if (a && b && a->name == b->name) {
+    awcc.message = fmt::format("{} is outside the training ranges of both forests (AWCC forest {}, FSCC forest {}){}",
+                               feature_value_text(a->name, first.value), feature_range_text(a->name, a->min, a->max),
+                               feature_range_text(b->name, b->min, b->max), out_of_range_meaning(*a, first.value));
+  } else {
+    awcc.message = fmt::format("{}; FSCC forest: {}", awcc.message, c.message);
+  }
+  return awcc;
+}
+
+}  // namespace
+
+Correction CorrectionModel::correct(const Features& f) const { return awcc_attempt(*this, f).correction; }
 
 namespace {
 
@@ -361,59 +647,32 @@ bool CorrectionModel::falls_back_to_fscc(CorrectionStatus awcc_status) const {
   return fscc.has_value() && fscc_may_follow(awcc_status);
 }
 
-Correction CorrectionModel::correct_fscc(const Features& f) const {
-  if (!fscc) return not_corrected(CorrectionStatus::no_awcc_velocity, "the model has no FSCC forest");
-  if (const auto why = fscc_unusable(f); !why.empty()) return not_corrected(CorrectionStatus::no_awcc_velocity, why);
-  std::vector<double> x(fscc->ranges.size());
-  for (std::size_t j = 0; j < x.size(); ++j) {
-    const auto& r = fscc->ranges[j];
-    const auto v = f.value(r.name);
-    if (!v) {
-      return not_corrected(CorrectionStatus::missing_feature,
-                           fmt::format("the FSCC forest takes the record's {}, which is not known for this row; give it ({})",
-                                       r.name, how_to_give(r.name)));
-    }
-    const double pad = range_margin * (r.max - r.min);
-    if (!(*v >= r.min - pad && *v <= r.max + pad)) {
-      return not_corrected(CorrectionStatus::outside_training_range, "FSCC forest: " + out_of_range_reason(r, *v));
-    }
-    x[j] = *v;
-  }
-  auto t = fscc->velocity.quantiles(x, correction_levels);
-  if (!fscc->calibration.empty()) Calibration::apply(fscc->calibration.velocity.front(), t);
-  CorrectedQuantity q;
-  q.measured = f.fscc_velocity;
-  for (std::size_t k = 0; k < t.size(); ++k) q.quantiles[k] = from_target(fscc->form, t[k], f.fscc_velocity);
-  Correction c;
-  c.status = CorrectionStatus::corrected;
-  c.forest = "fscc";
-  c.velocity = q;
-  return c;
-}
+Correction CorrectionModel::correct_fscc(const Features& f) const { return fscc_attempt(*this, f).correction; }
 
 Correction CorrectionModel::correct(const Measurement& m) const {
   const auto f = make_features(m);
-  Correction awcc = f.ok() ? correct(f.features) : not_corrected(f.status, f.message);
-  if (awcc.corrected() || !fscc || !fscc_may_follow(awcc.status)) return awcc;
-  auto c = correct_fscc(f.features);
-  if (!c.corrected()) {
-    // Neither forest: AWCC's status, with both reasons.
-    c.status = awcc.status;
-    c.message = fmt::format("{}; FSCC forest: {}", awcc.message, c.message);
-  }
-  return c;
+  const Attempt awcc = f.ok() ? awcc_attempt(*this, f.features) : Attempt{not_corrected(f.status, f.message)};
+  if (awcc.correction.corrected() || !fscc || !fscc_may_follow(awcc.correction.status)) return awcc.correction;
+  return after_awcc(awcc, fscc_attempt(*this, f.features));
 }
 
 Correction CorrectionModel::correct(const MeasurementResult& m) const {
   if (m.status == CorrectionStatus::corrected) return correct(m.measurement);
-  Correction awcc = not_corrected(m.status, m.message);
-  if (!fscc || !fscc_may_follow(m.status)) return awcc;
-  auto c = correct_fscc(make_features(m.measurement).features);
-  if (!c.corrected()) {
-    c.status = awcc.status;
-    c.message = fmt::format("{}; FSCC forest: {}", awcc.message, c.message);
+  const Attempt awcc{not_corrected(m.status, m.message)};
+  if (!fscc || !fscc_may_follow(m.status)) return awcc.correction;
+  return after_awcc(awcc, fscc_attempt(*this, make_features(m.measurement).features));
+}
+
+void CorrectionModel::use_training_envelopes() {
+  if (calibration.velocity_envelope.empty()) {
+    calibration.velocity_envelope = training_envelope(velocity, velocity_form);
+    calibration.turbulence_envelope = training_envelope(turbulence_intensity, turbulence_form);
+    calibration.envelope_from_training = true;
   }
-  return c;
+  if (fscc && fscc->calibration.velocity_envelope.empty()) {
+    fscc->calibration.velocity_envelope = training_envelope(fscc->velocity, fscc->form);
+    fscc->calibration.envelope_from_training = true;
+  }
 }
 
 std::string CorrectionModel::mismatch(const Processing& results) const {
@@ -445,6 +704,8 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
       for (const auto& b : *bands)
         for (double o : b) payload.f64(o);
   }
+  // Envelopes taken from the training targets are not stored: a reader takes them again.
+  write_envelopes(payload, calibration, {&calibration.velocity_envelope, &calibration.turbulence_envelope});
   payload.u32(2);
   write_forest(payload, "velocity", velocity_form, velocity);
   write_forest(payload, "turbulence_intensity", turbulence_form, turbulence_intensity);
@@ -459,6 +720,7 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
     payload.u32(fscc->calibration.empty() ? 0 : 1);
     if (!fscc->calibration.empty())
       for (double o : fscc->calibration.velocity.front()) payload.f64(o);
+    write_envelopes(payload, fscc->calibration, {&fscc->calibration.velocity_envelope});
     write_forest(payload, "fscc_velocity", fscc->form, fscc->velocity);
   }
   Writer w;
@@ -556,6 +818,10 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
       }
     }
   }
+  if (version >= 5) {
+    read_envelopes(r, std::max<std::size_t>(m.calibration.velocity.size(), 1),
+                   {&m.calibration.velocity_envelope, &m.calibration.turbulence_envelope});
+  }
   if (r.u32() != 2) r.damaged("the model holds other than two forests");
   const auto p = static_cast<std::uint32_t>(m.ranges.size());
   auto forest = [&](const std::string& forest_name, TargetForm& form, std::uint32_t features) {
@@ -588,11 +854,13 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
           if (!std::isfinite(o)) r.damaged("a calibration offset is not finite");
         }
       }
+      if (version >= 5) read_envelopes(r, 1, {&f.calibration.velocity_envelope});
       f.velocity = forest("fscc_velocity", f.form, static_cast<std::uint32_t>(fscc_names.size()));
       m.fscc = std::move(f);
     }
   }
   if (!r.done()) r.damaged("bytes after the last forest");
+  m.use_training_envelopes();
   return m;
 }
 
@@ -647,21 +915,29 @@ std::span<const awcc::ProfileColumn> correction_csv_columns() {
     auto keep = [](std::string s) -> std::string_view { return text.emplace_back(std::move(s)); };
     std::vector<awcc::ProfileColumn> out{
         {"correction_in_range", "", "/correction/in_range", "1 when the row was corrected"},
-        {"correction_reason", "", "/correction/reason", "why the row was not corrected"},
-        {"correction_forest", "", "/correction/forest", "the forest that corrected the row: awcc, or fscc (velocity only)"}};
+        {"correction_reason", "", "/correction/reason",
+         "why the row was not corrected (untrusted: which trust rule its quantiles break, with the numbers)"},
+        {"correction_forest", "", "/correction/forest",
+         "the forest that gave the quantiles: awcc, or fscc (velocity only)"}};
     for (const char* q : {"velocity", "turbulence_intensity"}) {
       const bool u = std::string_view(q) == "velocity";
       const char* unit = u ? "m/s" : "-";
       const char* what = u ? "velocity" : "turbulence intensity";
       out.push_back({keep(fmt::format("corrected_{}", q)), unit, keep(fmt::format("/correction/{}/median", q)),
-                     keep(fmt::format("corrected {} (median of the truth given the measurement)", what))});
+                     keep(fmt::format("corrected {} (median of the truth given the measurement; empty when not "
+                                      "corrected, untrusted included)",
+                                      what))});
       for (const char* l : correction_level_names) {
         out.push_back({keep(fmt::format("corrected_{}_q{}", q, l)), unit,
                        keep(fmt::format("/correction/{}/quantiles/{}", q, l)),
-                       keep(fmt::format("quantile {} of the true {}", l, what))});
+                       keep(fmt::format("quantile {} of the true {} (of an untrusted row too: not a corrected value)",
+                                        l, what))});
       }
     }
-    out.push_back({"correction_status", "", "/correction/status", "corrected, or why not"});
+    out.push_back({"correction_status", "", "/correction/status", "corrected, untrusted, or why not"});
+    out.push_back({"correction_notes", "", "/correction/notes",
+                   "what to know of the correction (a record longer than the training records, held at their "
+                   "length), joined by '; '"});
     return out;
   }();
   return columns;
@@ -673,32 +949,46 @@ std::string correction_csv_header() {
   return out;
 }
 
-std::string correction_csv_cells(const Correction& c) {
-  std::string out = fmt::format("{},{},{}", c.corrected() ? 1 : 0,
-                                awcc::csv_cell(c.corrected() ? std::string() : c.message), c.forest);
+std::string quantile_cells(const Correction& c) {
+  std::string out;
   for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
     if (*q) {
-      out += fmt::format(",{:.10g}", (*q)->median());
+      // An untrusted row's median is not a corrected value: its quantiles only.
+      out += c.corrected() ? fmt::format(",{:.10g}", (*q)->median()) : ",";
       for (double v : (*q)->quantiles) out += fmt::format(",{:.10g}", v);
     } else {
       out += std::string(1 + correction_levels.size(), ',');
     }
   }
-  return out + "," + std::string(to_string(c.status));
+  return out;
+}
+
+std::string notes_text(const Correction& c) {
+  std::string notes;
+  for (const auto& n : c.notes) notes += (notes.empty() ? "" : "; ") + n;
+  return notes;
+}
+
+std::string correction_csv_cells(const Correction& c) {
+  return fmt::format("{},{},{}{},{},{}", c.corrected() ? 1 : 0, awcc::csv_cell(c.corrected() ? std::string() : c.message),
+                     c.forest, quantile_cells(c), to_string(c.status), awcc::csv_cell(notes_text(c)));
 }
 
 nlohmann::json to_json(const Correction& c) {
   using nlohmann::json;
-  auto quantity = [](const std::optional<CorrectedQuantity>& q) {
+  // An untrusted row's median is not a corrected value: null, its quantiles kept.
+  auto quantity = [&c](const std::optional<CorrectedQuantity>& q) {
     if (!q) return json(nullptr);
     json levels = json::object();
     for (std::size_t k = 0; k < correction_levels.size(); ++k) levels[correction_level_names[k]] = q->quantiles[k];
-    return json{{"measured", q->measured}, {"median", q->median()}, {"quantiles", levels}};
+    return json{{"measured", q->measured}, {"median", c.corrected() ? json(q->median()) : json(nullptr)},
+                {"quantiles", levels}};
   };
   return json{{"status", to_string(c.status)},
               {"in_range", c.corrected()},
               {"forest", c.forest.empty() ? json(nullptr) : json(c.forest)},
               {"reason", c.corrected() ? json(nullptr) : json(c.message)},
+              {"notes", c.notes},
               {"velocity", quantity(c.velocity)},
               {"turbulence_intensity", quantity(c.turbulence_intensity)}};
 }

@@ -150,6 +150,12 @@ Correction correct_row(const CorrectionModel& model, const MeasurementResult& ou
   return model.correct(result);
 }
 
+// A row's notes go to the file's warnings too (the user reads them on
+// stderr), named by the row.
+void add_notes(const Correction& c, const std::string& where, std::vector<std::string>& warnings) {
+  for (const auto& n : c.notes) warnings.push_back(fmt::format("{}: {}", where, n));
+}
+
 // Calls fn(line, cells, "FILE:LINE") for every non-empty row after the
 // header; a row with another number of cells than the header is refused.
 template <class Fn>
@@ -198,7 +204,7 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     out.text += fmt::format(",{}_corrected [{}]", q, unit);
     for (const char* l : correction_level_names) out.text += fmt::format(",{}_q{} [{}]", q, l, unit);
   }
-  out.text += ",correction_status [-],correction_reason [-]\n";
+  out.text += ",correction_status [-],correction_reason [-],correction_notes [-]\n";
   for_each_row(in, file, header.size(), [&](const std::string& row, const std::vector<std::string>& cells,
                                             const std::string& where) {
     auto value = [&](const char* name) -> std::optional<double> {
@@ -226,16 +232,9 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     if (const auto w = optional("awcc_windows_total")) m.windows_total = whole(*w, where, "awcc_windows_total");
     const auto c = c_value ? model.correct(m)
                            : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
-    out.text += row;
-    for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
-      if (*q) {
-        out.text += fmt::format(",{:.10g}", (*q)->median());
-        for (double v : (*q)->quantiles) out.text += fmt::format(",{:.10g}", v);
-      } else {
-        out.text += std::string(1 + correction_levels.size(), ',');
-      }
-    }
-    out.text += fmt::format(",{},{}\n", to_string(c.status), awcc::csv_cell(c.message));
+    add_notes(c, where, out.warnings);
+    out.text += fmt::format("{}{},{},{},{}\n", row, quantile_cells(c), to_string(c.status), awcc::csv_cell(c.message),
+                            awcc::csv_cell(notes_text(c)));
   });
   return out;
 }
@@ -306,9 +305,11 @@ FileCorrection correct_process_json(const CorrectionModel& model, const std::str
   // A row is named by its JSON pointer: "" for a recording's file, "/profile/3" in a profile.
   auto add = [&](json& r, const std::string& row) {
     const auto outcome = measurement_of(awcc_outcome_of(r, row, file));
-    auto c = to_json(correct_row(
+    const auto correction = correct_row(
         model, outcome, [&] { return measurement_of_json(r, d, file, row); },
-        [&] { return processing_of_json(r, row, file); }, file, out.warnings));
+        [&] { return processing_of_json(r, row, file); }, file, out.warnings);
+    add_notes(correction, row.empty() ? file : file + ":" + row, out.warnings);
+    auto c = to_json(correction);
     c["model"] = model_name;
     r["correction"] = c;
   };
@@ -429,6 +430,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       return pr;
     };
     const auto c = correct_row(model, outcome, measurement, processing, where, out.warnings);
+    add_notes(c, where, out.warnings);
     out.text += row + "," + correction_csv_cells(c) + "\n";
   });
   return out;

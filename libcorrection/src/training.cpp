@@ -410,6 +410,7 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
   }
   m.velocity = QuantileForest::train(data_of(rows, true, velocity_form, names), velocity_options);
   m.turbulence_intensity = QuantileForest::train(data_of(rows, false, turbulence_form, names), turbulence_options);
+  m.use_training_envelopes();
   return m;
 }
 
@@ -464,11 +465,14 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
     if (predictions) predictions->push_back({r, c[i]});
-    if (!c[i].corrected()) {
+    if (!c[i].velocity || !c[i].turbulence_intensity) {
       ++s.out_of_range;
       continue;
     }
     ++s.rows;
+    s.untrusted += c[i].status == CorrectionStatus::untrusted;
+    s.outside_envelope += c[i].outside_envelope;
+    s.multimodal += c[i].multimodal;
     const auto& u = *c[i].velocity;
     const auto& t = *c[i].turbulence_intensity;
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
@@ -514,6 +518,59 @@ std::array<double, 3> interval_scores(const std::vector<double>& t, double targe
 
 }  // namespace
 
+namespace {
+
+// The envelopes of trust rule (a) (model.hpp) from rows' shifts {velocity,
+// Tu} and their groups: the group's rows, else the window band's, else all
+// of them; too few even then, the model's own (its training targets').
+void set_envelopes(Calibration& c, const CorrectionModel& model, const std::vector<int>& band,
+                   const std::vector<int>& tu_band, const std::vector<std::array<double, 2>>& shifts) {
+  auto envelope = [&](const std::function<bool(std::size_t)>& in, std::size_t q) {
+    std::vector<double> e;
+    for (std::size_t i = 0; i < shifts.size(); ++i)
+      if (in(i)) e.push_back(shifts[i][q]);
+    return envelope_of(std::move(e));
+  };
+  c.velocity_envelope.clear();
+  c.turbulence_envelope.clear();
+  const std::function<bool(std::size_t)> all = [](std::size_t) { return true; };
+  if (!envelope(all, 0) || !envelope(all, 1)) {
+    c.velocity_envelope = model.calibration.velocity_envelope;
+    c.turbulence_envelope = model.calibration.turbulence_envelope;
+    c.envelope_from_training = model.calibration.envelope_from_training;
+    return;
+  }
+  c.envelope_from_training = false;
+  for (std::size_t b = 0; b <= c.window_edges.size(); ++b) {
+    const int w = static_cast<int>(b);
+    for (std::size_t h = 0; h < c.tu_bands(); ++h) {
+      const std::function<bool(std::size_t)> in_group = [&band, &tu_band, w, h](std::size_t i) {
+        return band[i] == w && tu_band[i] == static_cast<int>(h);
+      };
+      const std::function<bool(std::size_t)> in_band = [&band, w](std::size_t i) { return band[i] == w; };
+      for (std::size_t q = 0; q < 2; ++q) {
+        auto e = envelope(in_group, q);
+        if (!e) e = envelope(in_band, q);
+        if (!e) e = envelope(all, q);
+        (q == 0 ? c.velocity_envelope : c.turbulence_envelope).push_back(*e);
+      }
+    }
+  }
+}
+
+// The FSCC forest's envelope from rows' truths (its target's shift from FSCC's velocity).
+std::vector<std::array<double, 2>> fscc_envelope(const FsccForest& f, const std::vector<TrainingRow>& rows) {
+  std::vector<double> shifts;
+  for (const auto& r : rows) {
+    const double v = r.features.fscc_velocity;
+    shifts.push_back(to_target(f.form, r.true_velocity, v) - to_target(f.form, v, v));
+  }
+  const auto e = envelope_of(std::move(shifts));
+  return e ? std::vector<std::array<double, 2>>{*e} : std::vector<std::array<double, 2>>{};
+}
+
+}  // namespace
+
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads,
                       const std::vector<double>& tu_edges) {
@@ -526,6 +583,8 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
   // window band and Tu band (the Tu forest's median, as correct() finds it).
   std::vector<std::array<double, 6>> scores(rows.size());
   std::vector<int> band(rows.size()), tu_band(rows.size());
+  // The truth's shift from the measurement (model.hpp, trust rule (a)): velocity, Tu.
+  std::vector<std::array<double, 2>> shifts(rows.size());
   parallel_for(rows.size(), threads, [&](std::size_t i) {
     const auto& r = rows[i];
     const auto x = vector_of(r.features, names);
@@ -536,6 +595,8 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
                                    : to_target(form, r.true_turbulence_intensity, r.features.turbulence_intensity);
       const auto t = forest.quantiles(x, correction_levels);
       const auto e = interval_scores(t, target);
+      const double measured = f == 0 ? r.features.velocity : r.features.turbulence_intensity;
+      shifts[i][static_cast<std::size_t>(f)] = target - to_target(form, measured, measured);
       for (std::size_t k = 0; k < 3; ++k) scores[i][static_cast<std::size_t>(3 * f) + k] = e[k];
       if (f == 1) tu_band[i] = c.tu_band(from_target(form, t[3], r.features.turbulence_intensity));
     }
@@ -572,6 +633,7 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
       c.turbulence_intensity.push_back(offsets(in, 3));
     }
   }
+  set_envelopes(c, model, band, tu_band, shifts);
   return c;
 }
 
@@ -594,6 +656,45 @@ Split split_runs(std::vector<TrainingRow> rows, const TrainOptions& o) {
   const auto calibrating = static_cast<std::size_t>(std::llround(o.calibration * static_cast<double>(rows.size() - held)));
   const auto at = [&](std::size_t i) { return rows.begin() + static_cast<std::ptrdiff_t>(i); };
   return {{rows.begin(), at(held)}, {at(held), at(held + calibrating)}, {at(held + calibrating), rows.end()}};
+}
+
+// The FSCC forest's scores on held-out rows (all with an FSCC velocity, or
+// those AWCC cannot serve: where the forest is applied).
+FsccScores score_fscc(const CorrectionModel& scorer, const std::vector<TrainingRow>& held_out, bool unserved_only) {
+  FsccScores sc;
+  std::vector<double> abs_raw, abs_corrected;
+  double sq_raw = 0.0, sq_corrected = 0.0;
+  for (const auto& r : held_out) {
+    if (unserved_only && r.awcc_served) continue;
+    const auto c = scorer.correct_fscc(r.features);
+    if (!c.velocity) {
+      ++sc.out_of_range;
+      continue;
+    }
+    sc.untrusted += c.status == CorrectionStatus::untrusted;
+    sc.outside_envelope += c.outside_envelope;
+    sc.multimodal += c.multimodal;
+    const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
+    const double corrected = c.velocity->median() / r.true_velocity - 1.0;
+    sq_raw += raw * raw;
+    sq_corrected += corrected * corrected;
+    abs_raw.push_back(std::fabs(raw));
+    abs_corrected.push_back(std::fabs(corrected));
+    const auto& q = c.velocity->quantiles;
+    sc.coverage80 += q[1] <= r.true_velocity && r.true_velocity <= q[5];
+    sc.coverage95 += q[0] <= r.true_velocity && r.true_velocity <= q[6];
+    ++sc.rows;
+  }
+  if (sc.rows > 0) {
+    const auto n = static_cast<double>(sc.rows);
+    sc.rmse_raw = std::sqrt(sq_raw / n);
+    sc.rmse_corrected = std::sqrt(sq_corrected / n);
+    sc.median_abs_raw = awcc::median(abs_raw);
+    sc.median_abs_corrected = awcc::median(abs_corrected);
+    sc.coverage80 /= n;
+    sc.coverage95 /= n;
+  }
+  return sc;
 }
 
 // The FSCC forest (model.hpp, FsccForest) on its own rows: the same held-out
@@ -661,47 +762,17 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
       q[k] = conformal_offset(std::move(e), calibration_alpha[k]);
     }
     f.calibration.velocity = {q};
+    f.calibration.velocity_envelope = fscc_envelope(f, calibrating_rows);
   }
   CorrectionModel scorer;  // the FSCC forest alone, with the model's margin
   scorer.range_margin = result.model.range_margin;
   scorer.fscc = f;
-  auto score_rows = [&](bool unserved_only) {
-    FsccScores sc;
-    std::vector<double> abs_raw, abs_corrected;
-    double sq_raw = 0.0, sq_corrected = 0.0;
-    for (const auto& r : held_out) {
-      if (unserved_only && r.awcc_served) continue;
-      const auto c = scorer.correct_fscc(r.features);
-      if (!c.corrected()) {
-        ++sc.out_of_range;
-        continue;
-      }
-      const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
-      const double corrected = c.velocity->median() / r.true_velocity - 1.0;
-      sq_raw += raw * raw;
-      sq_corrected += corrected * corrected;
-      abs_raw.push_back(std::fabs(raw));
-      abs_corrected.push_back(std::fabs(corrected));
-      const auto& q = c.velocity->quantiles;
-      sc.coverage80 += q[1] <= r.true_velocity && r.true_velocity <= q[5];
-      sc.coverage95 += q[0] <= r.true_velocity && r.true_velocity <= q[6];
-      ++sc.rows;
-    }
-    if (sc.rows > 0) {
-      const auto n = static_cast<double>(sc.rows);
-      sc.rmse_raw = std::sqrt(sq_raw / n);
-      sc.rmse_corrected = std::sqrt(sq_corrected / n);
-      sc.median_abs_raw = awcc::median(abs_raw);
-      sc.median_abs_corrected = awcc::median(abs_corrected);
-      sc.coverage80 /= n;
-      sc.coverage95 /= n;
-    }
-    return sc;
-  };
-  result.fscc_held_out = score_rows(false);
-  result.fscc_held_out_unserved = score_rows(true);
+  scorer.use_training_envelopes();
+  result.fscc_held_out = score_fscc(scorer, held_out, false);
+  result.fscc_held_out_unserved = score_fscc(scorer, held_out, true);
   result.fscc_training_rows = static_cast<std::int64_t>(training.size());
   result.model.fscc = std::move(f);
+  result.model.use_training_envelopes();
 }
 
 }  // namespace
@@ -847,7 +918,15 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
         100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95);
   }
   if (!result.fscc_note.empty()) provenance += " " + result.fscc_note + ".";
-  return provenance;
+  provenance += fmt::format(" Trust rules (model.hpp): {} of the {} scored held-out runs untrusted by the AWCC forests "
+                            "({} outside the envelope, {} multimodal)",
+                            h.untrusted, h.rows, h.outside_envelope, h.multimodal);
+  if (result.model.fscc) {
+    const auto& u = result.fscc_held_out_unserved;
+    provenance += fmt::format(", {} of {} by the FSCC forest ({} outside the envelope, {} multimodal)", u.untrusted,
+                              u.rows, u.outside_envelope, u.multimodal);
+  }
+  return provenance + ".";
 }
 
 }  // namespace
@@ -901,6 +980,74 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   return result;
 }
 
+TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const TrainOptions& o) {
+  o.validate().throw_if_failed();
+  if (const auto why = model.mismatch(set.processing); !why.empty()) {
+    throw awcc::InputError(fmt::format("the runs were processed differently from the model's training data ({}); "
+                                       "run the sweeps with the model's method options",
+                                       why));
+  }
+  TrainOptions split_options = o;
+  split_options.calibration = 0.0;  // held out, and the rest measures the envelopes
+  std::vector<std::string> names;
+  for (const auto& r : model.ranges) names.push_back(r.name);
+  // The rows each forest takes (inside its ranges, enough windows).
+  std::vector<TrainingRow> rows, fscc_rows;
+  for (const auto& r : set.rows)
+    if (model.correct(r.features).velocity) rows.push_back(r);
+  if (model.fscc) {
+    for (const auto& r : set.fscc_rows)
+      if (!r.awcc_served && model.correct_fscc(r.features).velocity) fscc_rows.push_back(r);
+  }
+  const Split split = split_runs(rows, split_options);
+  const Split fscc_split = split_runs(fscc_rows, split_options);
+  const auto& measuring = split.training;
+  auto& c = model.calibration;
+  std::vector<int> band(measuring.size()), tu_band(measuring.size());
+  std::vector<std::array<double, 2>> shifts(measuring.size());
+  parallel_for(measuring.size(), o.threads, [&](std::size_t i) {
+    const auto& r = measuring[i];
+    const auto& f = r.features;
+    const auto tu = model.turbulence_intensity.quantiles(vector_of(f, names), std::array<double, 1>{0.5});
+    band[i] = c.band(f.windows_accepted);
+    tu_band[i] = c.tu_band(from_target(model.turbulence_form, tu[0], f.turbulence_intensity));
+    shifts[i] = {to_target(model.velocity_form, r.true_velocity, f.velocity) -
+                     to_target(model.velocity_form, f.velocity, f.velocity),
+                 to_target(model.turbulence_form, r.true_turbulence_intensity, f.turbulence_intensity) -
+                     to_target(model.turbulence_form, f.turbulence_intensity, f.turbulence_intensity)};
+  });
+  set_envelopes(c, model, band, tu_band, shifts);
+  TrustResult result;
+  result.envelope_rows = static_cast<std::int64_t>(measuring.size());
+  if (model.fscc) {
+    if (auto e = fscc_envelope(*model.fscc, fscc_split.training); !e.empty()) {
+      model.fscc->calibration.velocity_envelope = std::move(e);
+      model.fscc->calibration.envelope_from_training = false;
+    }
+    result.fscc_envelope_rows = static_cast<std::int64_t>(fscc_split.training.size());
+  }
+  result.held_out = score(model, split.held_out, nullptr, o.threads);
+  if (model.fscc) result.fscc_held_out_unserved = score_fscc(model, fscc_split.held_out, true);
+  std::string sources;
+  for (const auto& src : set.sources) sources += (sources.empty() ? "" : ", ") + src;
+  const auto& h = result.held_out;
+  const auto& u = result.fscc_held_out_unserved;
+  result.summary = fmt::format(
+      "Trust envelopes (rule (a), model.hpp) measured by pdp train {} on runs the model was not trained on ({}): the "
+      "AWCC forests' on {} runs{}, {}; the FSCC forest's on {} runs it takes that AWCC cannot serve{}. Held out of "
+      "those runs: {} of {} untrusted by the AWCC forests ({} outside the envelope, {} multimodal), {} of {} by the "
+      "FSCC forest ({} outside the envelope, {} multimodal).",
+      awcc::version, sources, measuring.size(),
+      c.envelope_from_training ? " (too few: the training targets' kept)" : "",
+      c.envelope_from_training ? "pooled" : "per window and Tu band where a band has 399 runs",
+      fscc_split.training.size(),
+      model.fscc && model.fscc->calibration.envelope_from_training ? " (too few: the training targets' kept)" : "",
+      h.untrusted, h.rows, h.outside_envelope, h.multimodal, u.untrusted, u.rows, u.outside_envelope, u.multimodal);
+  model.provenance += " " + result.summary;
+  result.model = std::move(model);
+  return result;
+}
+
 std::string TrainResult::report() const {
   std::string out = model.provenance + "\n\n";
   auto line = [&out](const std::string& s) { out += s + "\n"; };
@@ -914,8 +1061,9 @@ std::string TrainResult::report() const {
     line(fmt::format("  ({:.1f} s)", seconds_cv));
   }
   const auto& h = held_out;
-  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored); training {} runs in {:.2f} s", h.rows,
-                   h.out_of_range, training_rows, seconds_train));
+  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored; {} of the scored untrusted by the "
+                   "trust rules: {} outside the envelope, {} multimodal); training {} runs in {:.2f} s",
+                   h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, training_rows, seconds_train));
   line("                         raw AWCC    corrected median");
   line(fmt::format("  velocity RMSE          {:7.3f} %   {:7.3f} %", 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected));
   line(fmt::format("  velocity median |err|  {:7.3f} %   {:7.3f} %", 100 * h.velocity_median_abs_raw,
@@ -1012,7 +1160,7 @@ std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& pre
     for (const auto& p : predictions) {
       if (!b.holds(p)) continue;
       ++c.runs;
-      if (!p.correction.corrected() || !p.correction.velocity || !p.correction.turbulence_intensity) continue;
+      if (!p.correction.velocity || !p.correction.turbulence_intensity) continue;  // untrusted rows scored too
       const auto& u = p.correction.velocity->quantiles;
       const auto& t = p.correction.turbulence_intensity->quantiles;
       const double uu = p.row.true_velocity, tt = p.row.true_turbulence_intensity;
@@ -1053,7 +1201,7 @@ std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPredic
     if (predictions[i].row.run != other[i].row.run || predictions[i].row.study != other[i].row.study) {
       throw std::invalid_argument("corrected_by_both: the two prediction sets are not of the same runs");
     }
-    if (predictions[i].correction.corrected() && other[i].correction.corrected()) out.push_back(predictions[i]);
+    if (predictions[i].correction.velocity && other[i].correction.velocity) out.push_back(predictions[i]);
   }
   return out;
 }
@@ -1105,17 +1253,17 @@ std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const 
 
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
   std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,fs,duration,"
-                    "true_velocity,true_turbulence_intensity,in_range";
+                    "true_velocity,true_turbulence_intensity,in_range,status";
   for (const char* q : {"velocity", "turbulence_intensity"}) {
     for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
   out += "\n";
   for (const auto& p : predictions) {
     const auto& f = p.row.features;
-    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{}",
+    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{},{}",
                        p.row.run, f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np,
                        f.windows_accepted, f.fs, f.duration, p.row.true_velocity, p.row.true_turbulence_intensity,
-                       p.correction.corrected() ? 1 : 0);
+                       p.correction.corrected() ? 1 : 0, to_string(p.correction.status));
     for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
       for (std::size_t k = 0; k < correction_levels.size(); ++k) {
         out += *q ? fmt::format(",{:.10g}", (*q)->quantiles[k]) : std::string(",");

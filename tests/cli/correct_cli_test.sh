@@ -54,7 +54,7 @@ out=$("$pdp" train "$dir/mc.csv" -o "$dir/c.qrf" --trees 5 --folds 0 --min-windo
   --dx 4.5mm --dy 0.5mm --seed 9 -o "$dir/rec.flac" || fail "synth"
 out=$("$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0.5mm --np 6 --method awcc --correct "$dir/a.qrf" \
   --json "$dir/rec.json") || fail "process --correct"
-grep -q "correction (quantile regression forest)" <<<"$out" || fail "no correction in the summary: $out"
+grep -q "correction (quantile regression forest, AWCC forest)" <<<"$out" || fail "no correction in the summary: $out"
 python3 - "$dir/rec.json" <<'PY' || fail "process --correct JSON"
 import json, sys
 j = json.load(open(sys.argv[1]))
@@ -115,7 +115,7 @@ grep -q "no dx in the file; state the streamwise tip separation (--dx)" <<<"$err
 
 # Outside the training ranges (dx 20 mm): flagged, not corrected.
 "$pdp" correct "$dir/bare.csv" -m "$dir/a.qrf" --dx 20mm --dy 0.5mm --np 6 -o "$dir/outside.csv" || fail "correct outside"
-[[ $(column "$dir/outside.csv" correction_reason | tail -1) == "dx = 0.02 is outside the training range"* ]] ||
+[[ $(column "$dir/outside.csv" correction_reason | tail -1) == "dx = 20 mm is outside the training range"* ]] ||
   fail "out-of-range row not flagged"
 [[ $(column "$dir/outside.csv" correction_status | tail -1) == "outside_training_range" ]] || fail "out-of-range status"
 
@@ -166,7 +166,7 @@ q=c['velocity']['quantiles']; t=c['turbulence_intensity']['quantiles']
 sys.exit(0 if c['in_range'] and c['forest'] == 'awcc' and q['0.025'] <= q['0.5'] <= q['0.975'] and t['0.1'] <= t['0.9'] else 1)" ||
     fail "shipped model did not correct"
   "$pdp" correct "$dir/rec.json" -m "$shipped" -o "$dir/short.json" || fail "shipped model on a short record"
-  grep -q '"reason": "duration = 4 is outside the training range' "$dir/short.json" || fail "a 4 s record is not named outside the ranges: $(grep -o '"reason": "[^"]*' "$dir/short.json")"
+  grep -q '"reason": "duration = 4 s is outside the training range' "$dir/short.json" || fail "a 4 s record is not named outside the ranges: $(grep -o '"reason": "[^"]*' "$dir/short.json")"
 else
   fail "samples/model/awcc.qrf is missing"
 fi

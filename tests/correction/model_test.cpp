@@ -51,7 +51,7 @@ CorrectionModel small_model(std::uint64_t seed = 3) {
   }
   for (std::size_t j = 0; j < 7; ++j) m.ranges.push_back({Features::names[j], lo[j], hi[j]});
   correction::ForestOptions o;
-  o.trees = 10;
+  o.trees = 50;
   o.seed = seed;
   m.velocity = correction::QuantileForest::train(v, o);
   m.turbulence_intensity = correction::QuantileForest::train(t, o);
@@ -143,8 +143,8 @@ TEST(Correction, RoundTripGivesTheSameBytesAndPredictions) {
   EXPECT_EQ(back.serialise(), bytes);
   EXPECT_EQ(back.provenance, "test model");
   const auto a = m.correct(inside()), b = back.correct(inside());
-  ASSERT_TRUE(a.corrected());
-  ASSERT_TRUE(b.corrected());
+  ASSERT_TRUE(a.corrected()) << a.message;
+  ASSERT_TRUE(b.corrected()) << b.message;
   EXPECT_EQ(a.velocity->quantiles, b.velocity->quantiles);
   EXPECT_EQ(a.turbulence_intensity->quantiles, b.turbulence_intensity->quantiles);
   // The learnt factor: truth ~ measured * 1.05 at dy = 1 mm (within the leaf's spread).
@@ -181,8 +181,8 @@ TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "pdp-qrf\n");
-  // Format version 4 as u32 little-endian.
-  EXPECT_EQ(bytes[8], 4);
+  // Format version 5 as u32 little-endian.
+  EXPECT_EQ(bytes[8], 5);
   EXPECT_EQ(bytes[9], 0);
   EXPECT_EQ(bytes[10], 0);
   EXPECT_EQ(bytes[11], 0);
@@ -214,8 +214,8 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   const std::string text = "velocity,turbulence_intensity\n1,2\n";
   EXPECT_NE(message({text.begin(), text.end()}).find("not a pdp model file"), std::string::npos);
   auto newer = bytes;
-  newer[8] = 5;
-  EXPECT_NE(message(newer).find("version 5"), std::string::npos) << message(newer);
+  newer[8] = 6;
+  EXPECT_NE(message(newer).find("version 6"), std::string::npos) << message(newer);
   // A structural fault with a valid checksum: the reader checks the trees too.
   auto forged = bytes;
   // The first tree's root node follows the velocity targets; find it by
@@ -316,7 +316,12 @@ TEST(Correction, CsvCellsEqualTheJsonAtTheirPointers) {
   const auto m = small_model();
   auto outside = inside();
   outside.void_fraction = 0.9;
-  for (const auto& c : {m.correct(inside()), m.correct(outside)}) {
+  // An untrusted row with notes: quantiles without a corrected median, a list joined by "; ".
+  auto untrusted = m.correct(inside());
+  untrusted.status = correction::CorrectionStatus::untrusted;
+  untrusted.message = "outside the envelope: a test";
+  untrusted.notes = {"duration 600 s is beyond the training range (20-300 s): corrected as 300 s", "a second, note"};
+  for (const auto& c : {m.correct(inside()), m.correct(outside), untrusted}) {
     const nlohmann::json row = {{"correction", correction::to_json(c)}};
     const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
     const auto columns = correction::correction_csv_columns();
@@ -329,6 +334,8 @@ TEST(Correction, CsvCellsEqualTheJsonAtTheirPointers) {
       if (value.is_boolean()) expected = value.get<bool>() ? "1" : "0";
       else if (value.is_number()) expected = fmt::format("{:.10g}", value.get<double>());
       else if (value.is_string()) expected = value.get<std::string>();
+      else if (value.is_array())
+        for (const auto& n : value) expected += (expected.empty() ? "" : "; ") + n.get<std::string>();
       EXPECT_EQ(cells[k], expected) << columns[k].name << " (" << c.message << ")";
     }
   }
@@ -440,7 +447,7 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   const auto bytes = m.serialise();
   std::uint32_t version = 0;
   std::memcpy(&version, bytes.data() + 8, 4);
-  EXPECT_EQ(version, 4u);
+  EXPECT_EQ(version, 5u);
   EXPECT_EQ(CorrectionModel::parse(bytes, "x.qrf").serialise(), bytes);
   // The data yield: accepted over formed windows, when both are known.
   Features y = inside();
@@ -574,7 +581,7 @@ TEST(Correction, Format2FilesStillCorrectAsTheyDid) {
     EXPECT_EQ(a.velocity->quantiles, b.velocity->quantiles);
     EXPECT_EQ(a.turbulence_intensity->quantiles, b.turbulence_intensity->quantiles);
   }
-  // Saved again, it is format 3 with the same forests.
+  // Saved again, it is format 5 with the same forests.
   EXPECT_EQ(old.serialise(), m.serialise());
 }
 

@@ -61,9 +61,9 @@ std::vector<correction::Correction> corrections_of(const Plan& plan, const Proce
   if (!plan.model) return corrections;
   for (const auto& r : p.results) {
     corrections.push_back(plan.model->correct(correction::measurement_of(r)));
-    if (!corrections.back().corrected()) {
-      spdlog::warn("{}: not corrected: {}", r.info.path.string(), corrections.back().message);
-    }
+    const auto& c = corrections.back();
+    if (!c.corrected()) spdlog::warn("{}: not corrected: {}", r.info.path.string(), c.why_not());
+    for (const auto& n : c.notes) spdlog::warn("{}: {}", r.info.path.string(), n);
   }
   return corrections;
 }

@@ -18,16 +18,30 @@ namespace pdp {
 
 namespace {
 
+// The correction of one recording: the corrected values, or why there are
+// none, and the notes. A row the FSCC forest corrected has no corrected Tu,
+// and says so (a number there would read as one).
 std::string correction_report(const correction::Correction& c) {
-  if (!c.corrected()) return fmt::format("  correction: not corrected: {}\n", c.message);
-  const auto& u = *c.velocity;
-  const auto& t = *c.turbulence_intensity;
-  return fmt::format(
-      "  correction (quantile regression forest):\n"
-      "    velocity             {:.4f} m/s median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n"
-      "    turbulence intensity {:.4f} median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
-      u.median(), u.quantiles[1], u.quantiles[5], u.quantiles[0], u.quantiles[6], u.measured, t.median(),
-      t.quantiles[1], t.quantiles[5], t.quantiles[0], t.quantiles[6], t.measured);
+  std::string out;
+  if (!c.corrected()) {
+    out = fmt::format("  correction: not corrected: {}\n", c.why_not());
+  } else {
+    const auto& u = *c.velocity;
+    out = fmt::format(
+        "  correction (quantile regression forest, {} forest):\n"
+        "    velocity             {:.4f} m/s median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
+        c.forest == "fscc" ? "FSCC" : "AWCC", u.median(), u.quantiles[1], u.quantiles[5], u.quantiles[0],
+        u.quantiles[6], u.measured);
+    if (const auto& t = c.turbulence_intensity) {
+      out += fmt::format(
+          "    turbulence intensity {:.4f} median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
+          t->median(), t->quantiles[1], t->quantiles[5], t->quantiles[0], t->quantiles[6], t->measured);
+    } else {
+      out += "    turbulence intensity not corrected (the FSCC forest corrects the velocity only)\n";
+    }
+  }
+  for (const auto& n : c.notes) out += fmt::format("    note: {}\n", n);
+  return out;
 }
 
 }  // namespace

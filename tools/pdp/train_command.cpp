@@ -31,7 +31,29 @@ void setup_train(CLI::App& app, Command& command, TrainCommandOptions& o) {
       cmd->add_option("--compare-model", o.compare_model,
                       "another model (e.g. the one shipped before) scored on the same held-out runs, band by band"))
       ->check(CLI::ExistingFile);
+  cmd->add_option("--envelope-of", o.envelope_of,
+                  "a trained model: instead of training, measure the envelopes of its trust rule (a) on the sweeps' "
+                  "runs (its training distribution with other seeds: runs it was not trained on) and write it with "
+                  "them")
+      ->check(CLI::ExistingFile);
 }
+
+namespace {
+
+int run_envelope(const TrainCommandOptions& o, const correction::TrainOptions& t) {
+  const auto model = correction::CorrectionModel::load(o.envelope_of);
+  std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
+  const auto set = correction::load_training_set(csvs, model.min_windows);
+  const auto result = correction::measure_trust(model, set, t);
+  awcc::check_output_folder(o.output);
+  if (!o.report.empty()) awcc::check_output_folder(o.report);
+  result.model.save(o.output);
+  if (!o.report.empty()) awcc::write_text_atomically(o.report, result.summary + "\n");
+  fmt::print("{}\n", result.summary);
+  return exit_ok;
+}
+
+}  // namespace
 
 
 int run_train(const TrainCommandOptions& o) {
@@ -45,6 +67,7 @@ int run_train(const TrainCommandOptions& o) {
     return report_error(e);
   }
   try {
+    if (!o.envelope_of.empty()) return run_envelope(o, t);
     std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
     const auto set = correction::load_training_set(csvs, t.min_windows);
     spdlog::info("{} runs read, {} used: {} failed, {} without an AWCC velocity, {} with fewer than {} accepted windows",

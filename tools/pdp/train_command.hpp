@@ -20,6 +20,7 @@ struct TrainCommandOptions {
   std::string learning_curve;       ///< learning curve CSV
   std::string report;               ///< the report as a text file (also on stdout)
   std::string compare_model;        ///< another model scored on the same held-out runs
+  std::string envelope_of;          ///< a trained model whose trust envelopes the sweeps measure (no training)
 };
 
 void setup_train(CLI::App& app, Command& command, TrainCommandOptions& options);

@@ -53,6 +53,7 @@ enum class CorrectionStatus {
   too_few_windows,         ///< fewer accepted windows than the model's training runs had
   outside_training_range,  ///< a feature outside the model's training data
   probe_corrected,         ///< AWCC was bubble-probe corrected: the model corrects uncorrected AWCC
+  untrusted,               ///< the forest gave quantiles outside the envelope its inputs allow (model.hpp, trust rules)
 };
 std::string_view to_string(CorrectionStatus status);
 
@@ -72,6 +73,19 @@ struct Measurement {
   std::optional<double> fscc_velocity;         ///< FSCC's velocity, m/s (empty: none)
   std::optional<double> r12_max;               ///< FSCC's correlation peak, -
 };
+
+/// How a feature is written in messages: its unit and the factor from SI
+/// to it ("mm", 1e3 for d32 and the tip separations; "kHz", 1e-3 for fs;
+/// "-", 1 for the dimensionless ones).
+struct FeatureUnit {
+  std::string_view unit;
+  double scale = 1.0;
+};
+FeatureUnit unit_of(std::string_view feature);
+/// "duration = 1800 s", "d32 = 0.954 mm", "void_fraction = 0.00366".
+std::string feature_value_text(std::string_view feature, double value);
+/// "20-299.8 s" (4 significant digits, the unit once).
+std::string feature_range_text(std::string_view feature, double min, double max);
 
 /// The features of one measurement.
 struct Features {

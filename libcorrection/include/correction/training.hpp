@@ -116,9 +116,14 @@ struct CvEntry {
   double pinball = 0.0;                 ///< mean over folds and rows
 };
 
-/// Scores of predictions against truth on some rows.
+/// Scores of predictions against truth on some rows: every row the forests
+/// give quantiles for, those the trust rules (model.hpp) leave untrusted
+/// included (so that two models or two training sizes score the same rows).
 struct HeldOutScores {
   std::int64_t rows = 0, out_of_range = 0;
+  /// Of the scored rows, those the trust rules leave untrusted, and by rule
+  /// (a row may break both).
+  std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0;
   double velocity_rmse_raw = 0.0, velocity_rmse_corrected = 0.0;  ///< relative (u/u_true - 1)
   double velocity_bias_raw = 0.0, velocity_bias_corrected = 0.0;  ///< mean relative error
   double velocity_median_abs_raw = 0.0, velocity_median_abs_corrected = 0.0;  ///< median |relative error|
@@ -149,6 +154,7 @@ struct HeldOutPrediction {
 /// Held-out scores of the FSCC forest (velocity only, relative errors).
 struct FsccScores {
   std::int64_t rows = 0, out_of_range = 0;
+  std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0;  ///< as HeldOutScores
   double rmse_raw = 0.0, rmse_corrected = 0.0;
   double median_abs_raw = 0.0, median_abs_corrected = 0.0;
   double coverage80 = 0.0, coverage95 = 0.0;
@@ -177,6 +183,27 @@ struct TrainResult {
 TrainResult train_model(const TrainingSet& set, const TrainOptions& options,
                         const std::function<void(double)>& progress = {});
 
+/// A trained model with the envelopes of its trust rule (a) (model.hpp)
+/// measured on runs it was not trained on, and how often the trust rules
+/// fire on the held-out part of them.
+struct TrustResult {
+  CorrectionModel model;
+  std::int64_t envelope_rows = 0, fscc_envelope_rows = 0;  ///< the runs that measured them
+  HeldOutScores held_out;                 ///< the AWCC forests on the held-out runs
+  FsccScores fscc_held_out_unserved;      ///< the FSCC forest on the held-out runs AWCC cannot serve
+  std::string summary;                    ///< what was done and found (also appended to the provenance)
+};
+
+/// Measures a trained model's envelopes on `runs`: sweeps of its training
+/// distribution with other seeds, so that no run was trained on (a model of
+/// format 4 or older, which stores none, gains them so). The runs each
+/// forest takes are split as train_model splits (options.held_out, seed);
+/// the envelopes come from the rest, grouped as the model's calibration (the
+/// FSCC forest's: from the runs AWCC cannot serve), and the rules are scored
+/// on the held-out part. Throws awcc::InputError when the runs were processed
+/// otherwise than the model's training data.
+TrustResult measure_trust(CorrectionModel model, const TrainingSet& runs, const TrainOptions& options);
+
 /// Scores a model on rows.
 HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions = nullptr, int threads = 0);
@@ -187,7 +214,10 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
                                 const ForestOptions& turbulence_options, std::int64_t min_windows,
                                 const std::vector<std::string>& names = feature_set_names("measured"));
 
-/// The calibration of a model's intervals on runs its forests were not trained on (model.hpp).
+/// The calibration of a model's intervals on runs its forests were not
+/// trained on (model.hpp), and the envelopes of its trust rule (a): per
+/// group with at least 399 runs, else the window band's, else pooled, else
+/// the model's own (its training targets').
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads = 0,
                       const std::vector<double>& tu_edges = {});
@@ -224,7 +254,8 @@ std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPredic
 std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const std::vector<HeldOutPrediction>& other,
                               const std::string& other_name);
 
-/// Held-out predictions as CSV: run, features, truth, raw, quantiles.
+/// Held-out predictions as CSV: run, features, truth, in_range (1: corrected), status
+/// (corrected, untrusted, ...), the quantiles (of untrusted rows too).
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions);
 /// The learning curve as CSV.
 std::string learning_curve_csv(const std::vector<LearningPoint>& curve);

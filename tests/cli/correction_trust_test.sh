@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Issue 29, cases 1 and 6, end to end with the shipped model:
+#  1. the 2 mm row of the real profile (c 0.004, AWCC insufficient, FSCC
+#     2.80 m/s) was corrected by the FSCC forest to 6.62 m/s (95 % 2.37-13.1,
+#     quartiles 2.84 and 10.1), status corrected. Now untrusted: the summary
+#     says "not corrected: untrusted: multimodal: ...", the JSON and the CSV
+#     keep the quantiles but no corrected median.
+#  6. a 30-minute record (truth 3.00 m/s, Tu 0.30) was refused ("duration =
+#     1800 is outside the training range [20.0007, 299.802]", "FSCC forest:"
+#     twice). Now corrected as a record of the longest training length, with
+#     a note in the summary, stderr, the JSON and the CSV, each said once. The
+#     record is synthesised at 20 kHz (the scene allows it: a lag of 5 mm at
+#     3 m/s is 33 samples), 8 s of CPU instead of a minute at 500 kHz.
+# A row the FSCC forest corrects says its Tu is not corrected (it printed 0.0000).
+# Usage: correction_trust_test.sh PDP SCRATCH_DIR SOURCE_DIR
+set -u
+pdp=$1
+dir=$2/correction_trust
+src=$3
+rm -rf "$dir" && mkdir -p "$dir"
+source "$(dirname "$0")/lib.sh"
+model=$src/samples/model/awcc.qrf
+data=$src/../shared/data/felder-stepped-spillway
+
+# Case 1.
+if [[ -d $data ]]; then
+  "$pdp" process "$data/dc157_01.dat" --fs 20kHz --dx 7.15mm --correct "$model" --json "$dir/row2mm.json" \
+    >"$dir/row2mm.txt" 2>"$dir/row2mm.err" || fail "case 1: process"
+  grep -q "  correction: not corrected: untrusted: multimodal: the FSCC forest's velocity distribution is" "$dir/row2mm.txt" ||
+    fail "case 1: summary: $(grep correction "$dir/row2mm.txt")"
+  grep -q "dc157_01.dat: not corrected: untrusted: multimodal" "$dir/row2mm.err" || fail "case 1: stderr: $(cat "$dir/row2mm.err")"
+  grep -q "m/s median;" "$dir/row2mm.txt" && fail "case 1: the summary still presents a corrected velocity"
+  /usr/bin/python3 - "$dir/row2mm.json" <<'PY' || fail "case 1: the JSON"
+import json, sys
+c = json.load(open(sys.argv[1]))["correction"]
+assert c["status"] == "untrusted" and c["in_range"] is False, c
+assert c["forest"] == "fscc" and c["reason"].startswith("multimodal:"), c
+assert c["velocity"]["median"] is None, c  # no corrected value
+q = c["velocity"]["quantiles"]            # the quantiles, for the report to draw apart
+assert 6.5 < q["0.5"] < 6.7 and q["0.025"] < 2.8 < q["0.975"], q
+assert c["turbulence_intensity"] is None and c["notes"] == [], c
+PY
+  "$pdp" --log-level error process "$data/dc157_01.dat" "$data/dc157_02.dat" --fs 20kHz --dx 7.15mm --positions 2mm,8mm \
+    --correct "$model" --csv "$dir/rows.csv" || fail "case 1: profile"
+  [[ $(column "$dir/rows.csv" correction_status | tr '\n' ' ') == "untrusted corrected " ]] ||
+    fail "case 1: CSV statuses: $(column "$dir/rows.csv" correction_status | tr '\n' ' ')"
+  [[ -z $(column "$dir/rows.csv" corrected_velocity | head -1) ]] || fail "case 1: CSV presents a corrected velocity"
+  [[ -n $(column "$dir/rows.csv" corrected_velocity_q0.5 | head -1) ]] || fail "case 1: CSV lost the quantiles"
+  # pdp correct on the written JSON says the same.
+  "$pdp" --log-level error process "$data/dc157_01.dat" --fs 20kHz --dx 7.15mm --json "$dir/raw2mm.json" >/dev/null ||
+    fail "case 1: process without correction"
+  "$pdp" correct "$dir/raw2mm.json" -m "$model" -o "$dir/corrected2mm.json" || fail "case 1: pdp correct"
+  /usr/bin/python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['correction']; sys.exit(c['status'] != 'untrusted')" \
+    "$dir/corrected2mm.json" || fail "case 1: pdp correct did not say untrusted"
+else
+  echo "skipped case 1: no real recordings at $data"
+fi
+
+# Case 6.
+"$pdp" --log-level error synth --config "$src/samples/base.toml" --velocity 3m/s --tu 0.3 --duration 1800s --fs 20kHz \
+  --seed 1 -q -o "$dir/long.flac" || fail "case 6: synth"
+"$pdp" process "$dir/long.flac" --dx 5mm --dy 1mm --correct "$model" --json "$dir/long.json" --csv "$dir/long.csv" \
+  2>"$dir/long.err" || fail "case 6: process"
+"$pdp" process "$dir/long.flac" --dx 5mm --dy 1mm --correct "$model" >"$dir/long.txt" 2>/dev/null || fail "case 6: summary"
+note="duration 1800 s is beyond the training range (20-299.8 s): corrected as 299.8 s"
+[[ $(grep -c "note: $note" "$dir/long.txt") == 1 ]] || fail "case 6: the summary's note: $(grep -i note "$dir/long.txt")"
+[[ $(grep -cF "$note" "$dir/long.err") == 1 ]] || fail "case 6: stderr: $(cat "$dir/long.err")"
+grep -q "outside the training range" "$dir/long.err" && fail "case 6: still refused"
+grep -qE "FSCC forest: .*FSCC forest:" "$dir/long.err" && fail "case 6: 'FSCC forest:' twice"
+[[ $(column "$dir/long.csv" correction_notes) == "$note" ]] || fail "case 6: CSV notes: $(column "$dir/long.csv" correction_notes)"
+[[ $(column "$dir/long.csv" correction_status) == corrected ]] || fail "case 6: CSV status"
+/usr/bin/python3 - "$dir/long.json" "$note" <<'PY' || fail "case 6: the JSON"
+import json, sys
+c = json.load(open(sys.argv[1]))["correction"]
+assert c["status"] == "corrected" and c["forest"] == "awcc", c
+assert c["notes"] == [sys.argv[2]], c["notes"]
+# The truth, 3.00 m/s and Tu 0.30, inside the 95 % intervals (docs/validation.md
+# measures the coverage on 600-1800 s records).
+u, t = c["velocity"]["quantiles"], c["turbulence_intensity"]["quantiles"]
+assert u["0.025"] <= 3.0 <= u["0.975"], u
+assert t["0.025"] <= 0.3 <= t["0.975"], t
+PY
+
+# A row the FSCC forest corrects: its Tu is said to be not corrected, never printed as 0.
+"$pdp" --log-level error synth --config "$src/samples/base.toml" --velocity 2m/s --tu 0.15 --void-fraction 0.01 \
+  --bubble-diameter 2mm --duration 30s --fs 50kHz --seed 3 -q -o "$dir/sparse.flac" || fail "FSCC row: synth"
+"$pdp" process "$dir/sparse.flac" --dx 5mm --dy 0mm --correct "$model" >"$dir/sparse.txt" 2>/dev/null ||
+  fail "FSCC row: process"
+grep -q "correction (quantile regression forest, FSCC forest):" "$dir/sparse.txt" || fail "FSCC row: not corrected by the FSCC forest"
+grep -q "    turbulence intensity not corrected (the FSCC forest corrects the velocity only)" "$dir/sparse.txt" ||
+  fail "FSCC row: Tu line: $(grep 'turbulence intensity' "$dir/sparse.txt" | tail -1)"
+grep -q "0.0000 median" "$dir/sparse.txt" && fail "FSCC row: a Tu of 0 printed as corrected"
+
+if ((failures)); then
+  echo "$failures failures"
+  exit 1
+fi
+echo "correction trust CLI: all checks passed"
