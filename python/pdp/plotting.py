@@ -425,7 +425,9 @@ def _untrusted_medians(ax, y, rows, quantity, unit):
     """Untrusted corrections' medians, drawn apart (hollow, grey, no band)
     once the axes' limits are set, which they leave as they are: one beyond
     them is drawn at the edge, pointing out, with its value."""
-    points = [(y[i], number(get(r, "correction", quantity, "median"))) for i, r in enumerate(rows) if _untrusted(r)]
+    # An untrusted row's median is null: the forest's answer is its 0.5 quantile.
+    points = [(y[i], number(get(r, "correction", quantity, "quantiles", "0.5"))) for i, r in enumerate(rows)
+              if _untrusted(r)]
     points = [(yi, v) for yi, v in points if v is not None]
     if not points:
         return

@@ -155,6 +155,8 @@ def gap_reason(row, pointer, have_positions):
         if c.get("in_range") and c.get("forest") == "fscc":
             return ("Tu not corrected: AWCC gave no usable result, and the FSCC forest that corrected this row's "
                     "velocity corrects the velocity only")
+        if c.get("status") == "untrusted":
+            return "not corrected: untrusted (its quantiles are drawn apart): " + str(c.get("reason"))
         return "not corrected: " + (c.get("reason") or str(c.get("status")))
     if section == "velocity_spectrum":
         s = row.get("velocity_spectrum")
@@ -317,7 +319,7 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
 
     text_columns = [c for c in columns if c["name"].endswith("reason") or c["name"] == "warnings"]
     # A row's flags are codes, each with its text among the warnings: an empty list is no gap.
-    list_columns = text_columns + [c for c in columns if c["name"] == "flags"]
+    list_columns = text_columns + [c for c in columns if c["name"] == "flags" or c["name"].endswith("notes")]
     gaps, table = {}, []
     for c in columns:
         cells = []

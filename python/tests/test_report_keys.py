@@ -25,11 +25,18 @@ def rows(real_files, tmp_path_factory):
 
 
 def edited(rows, index, status="untrusted"):
+    """The rows with one row's correction given this status (None: removed).
+    An untrusted correction's median is null (its quantiles kept), a
+    corrected one's is its 0.5 quantile, as pdp writes them."""
     out = copy.deepcopy(rows)
     if status is None:
         out[index]["correction"] = None
-    else:
-        out[index]["correction"]["status"] = status
+        return out
+    c = out[index]["correction"]
+    c["status"] = status
+    for quantity in ("velocity", "turbulence_intensity"):
+        if c.get(quantity):
+            c[quantity]["median"] = None if status == "untrusted" else c[quantity]["quantiles"]["0.5"]
     return out
 
 
@@ -47,7 +54,7 @@ def drawn_xs(ax):
     (plotting.profile_turbulence, "turbulence_intensity", 5),
 ])
 def test_an_untrusted_correction_is_drawn_apart_and_sets_no_limit(rows, figure, quantity, index):
-    median = rows[index]["correction"][quantity]["median"]
+    median = rows[index]["correction"][quantity]["quantiles"]["0.5"]
     fig = figure(edited(rows, index))
     ax = fig.axes[0]
     # The axis is the one drawn without that row's correction at all: an exact identity.
@@ -74,8 +81,9 @@ def test_the_2mm_correction_no_longer_stretches_the_velocity_axis(rows):
     """The issue's case: 6.62 m/s, band to 13.1 m/s, neighbours 1.6-3.4 m/s.
     Corrected, it stretches the axis past 13 m/s; untrusted, the axis ends
     below 4 m/s (FSCC's 3.40 m/s and AWCC's intervals are the widest left)."""
-    assert plotting.profile_velocity(rows).axes[0].get_xlim()[1] > 13
-    assert plotting.profile_velocity(edited(rows, 0)).axes[0].get_xlim()[1] < 4
+    assert rows[0]["correction"]["status"] == "untrusted"
+    assert plotting.profile_velocity(edited(rows, 0, "corrected")).axes[0].get_xlim()[1] > 13
+    assert plotting.profile_velocity(rows).axes[0].get_xlim()[1] < 4
 
 
 def test_a_list_columns_codes_are_checked_one_by_one(tmp_path):

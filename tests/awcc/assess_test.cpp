@@ -274,14 +274,23 @@ TEST(ChannelsIgnored, AFourChannelRecordingNamesTheChannelsNotProcessed) {
   o.awcc = false;
   auto recording = four_channels();
   const auto r = awcc::process_recording(*recording, o);
-  ASSERT_EQ(r.warnings.size(), 1u);
-  EXPECT_EQ(r.warnings[0].flag, awcc::Flag::channels_ignored);
-  EXPECT_EQ(r.warnings[0].text,
+  // The telegraph's tips are air 3 in 4 of the time: each also carries the
+  // signal check's air_continuous flag, which is not this test's.
+  std::vector<awcc::Warning> kept;
+  for (const auto& x : r.warnings) {
+    if (x.flag != awcc::Flag::signal_check) kept.push_back(x);
+  }
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].flag, awcc::Flag::channels_ignored);
+  EXPECT_EQ(kept[0].text,
             "channels 2 and 3 of 4 are not processed (a 4-tip probe?): this version processes one tip pair, channels "
             "0 and 1 (leading-channel, trailing-channel)");
   o.trailing_channel = 3;
-  EXPECT_TRUE(contains(awcc::process_recording(*recording, o).warnings.at(0).text,
-                       "channels 1 and 2 of 4 are not processed"));
+  const auto other = awcc::process_recording(*recording, o);
+  const auto ignored = std::find_if(other.warnings.begin(), other.warnings.end(),
+                                    [](const awcc::Warning& x) { return x.flag == awcc::Flag::channels_ignored; });
+  ASSERT_NE(ignored, other.warnings.end());
+  EXPECT_TRUE(contains(ignored->text, "channels 1 and 2 of 4 are not processed"));
   // Two channels: nothing ignored.
   o.trailing_channel = 1;
   std::vector<float> two;
