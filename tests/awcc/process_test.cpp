@@ -3,7 +3,6 @@
 // and bad input.
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/serialise.hpp"
-#include "awcc/flags.hpp"
 #include "awcc/process.hpp"
 
 #include <gtest/gtest.h>
@@ -16,17 +15,11 @@
 #include "synth/recording.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
+#include "result_warnings.hpp"
 
 namespace {
 
-// The texts of a result's signal-check warnings (its flag signal_check).
-std::vector<std::string> signal_texts(const awcc::ProcessResult& r) {
-  std::vector<std::string> out;
-  for (const auto& w : r.warnings) {
-    if (w.flag == awcc::Flag::signal_check) out.push_back(w.text);
-  }
-  return out;
-}
+using pdp_test::signal_texts;
 
 
 namespace fs = std::filesystem;

@@ -13,22 +13,15 @@
 #include <random>
 
 #include "awcc/errors.hpp"
-#include "awcc/flags.hpp"
 #include "awcc/process.hpp"
 #include "synth/recording.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
+#include "result_warnings.hpp"
 
 namespace {
 
-// The texts of a result's signal-check warnings (its flag signal_check).
-std::vector<std::string> signal_texts(const awcc::ProcessResult& r) {
-  std::vector<std::string> out;
-  for (const auto& w : r.warnings) {
-    if (w.flag == awcc::Flag::signal_check) out.push_back(w.text);
-  }
-  return out;
-}
+using pdp_test::signal_texts;
 
 
 using awcc::SignalStatus;
