@@ -25,6 +25,16 @@ void reader_fail(const std::filesystem::path& path, std::string_view what, std::
 // To 1e-6 by default: a CSV's time stamps are rounded.
 double stated_rate(const std::filesystem::path& path, const ReaderOptions& options, double recorded,
                    const std::string& where, double tolerance) {
+  // A denormal increment gives an infinite rate (found by fuzz_read_tdms):
+  // no recording has one, so the header is damaged.
+  if (!std::isfinite(recorded) || !(recorded > 0.0)) {
+    if (options.fs > 0.0 && options.override_fs) return options.fs;
+    reader_fail(path,
+                fmt::format("{} gives a sampling rate of {} Hz, which no recording has: the header is damaged; state "
+                            "the rate and force it",
+                            where, recorded),
+                "fs,override-fs");
+  }
   if (!(options.fs > 0.0)) return recorded;
   if (options.override_fs || std::fabs(options.fs - recorded) <= tolerance * recorded) return options.fs;
   reader_fail(path,

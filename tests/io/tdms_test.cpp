@@ -219,6 +219,30 @@ TEST(TdmsReader, InterleavedFloatChannelsAndTheStatedRate) {
   EXPECT_THROW((void)awcc::open_recording(p, stated), awcc::InputError);  // contradicts wf_increment
 }
 
+// Found by fuzz_read_tdms: a denormal wf_increment gave an infinite rate,
+// which the reader handed on as the recording's.
+TEST(TdmsReader, AnIncrementGivingNoFiniteRateIsRefusedNamingIt) {
+  Bytes file;
+  const Bytes m = metadata({{"/'g'/'a'", 20, 9, 5, {{"wf_increment", 10, 1e-320, ""}}},
+                            {"/'g'/'b'", 20, 9, 5, {{"wf_increment", 10, 1e-320, ""}}}});
+  Bytes raw;
+  for (int i = 0; i < 5; ++i) raw.put(static_cast<float>(i)).put(static_cast<float>(10 + i));
+  file.add(segment(kMeta | kNewList | kRaw | kInterleaved, &m, raw));
+  const auto p = scratch("denormal-increment.tdms");
+  write(p, file);
+  try {
+    (void)awcc::open_recording(p, {});
+    ADD_FAILURE() << "an infinite sampling rate was accepted";
+  } catch (const awcc::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(p.string() + ": its wf_increment gives a sampling rate of inf Hz", 0), 0u) << what;
+  }
+  awcc::ReaderOptions forced;
+  forced.fs = 20e3;
+  forced.override_fs = true;
+  EXPECT_DOUBLE_EQ(awcc::open_recording(p, forced)->info().fs, 20e3);
+}
+
 TEST(TdmsReader, ATruncatedLastSegmentIsNamedAndReadOnlyWhenAllowed) {
   const auto p = three_segments(true);
   awcc::ReaderOptions o;
