@@ -26,6 +26,17 @@ Validation ProcessOptions::validate() const {
         "leading-channel,trailing-channel",
         fmt::format("the leading and trailing tips are both channel {}; choose two channels", leading_channel));
   }
+  const std::vector<int> tips = tip_channels();
+  for (std::size_t k = 2; k < tips.size(); ++k) {
+    if (tips[k] < 0) return Validation::invalid("further-channels", "channel indices must be >= 0");
+    for (std::size_t j = 0; j < k; ++j) {
+      if (tips[j] == tips[k]) {
+        return Validation::invalid("further-channels",
+                                   fmt::format("tips {} and {} are both channel {}; give each tip its own channel", j,
+                                               k, tips[k]));
+      }
+    }
+  }
   if (!(dx >= 0.0 && std::isfinite(dx))) return Validation::invalid("dx", fmt::format("dx = {} m must be >= 0", dx));
   for (const auto& part : {binarisation.validate(), signal_check.validate(), fscc_options.validate(),
                            awcc_options.validate(), structure.validate(), spectrum.validate()}) {
@@ -34,6 +45,12 @@ Validation ProcessOptions::validate() const {
   if (block_frames < 1) return Validation::invalid("", "block_frames must be >= 1");
   if (!allow_unusual) return implausible();
   return {};
+}
+
+std::vector<int> ProcessOptions::tip_channels() const {
+  std::vector<int> out{leading_channel, trailing_channel};
+  out.insert(out.end(), further_channels.begin(), further_channels.end());
+  return out;
 }
 
 Validation ProcessOptions::implausible() const {
@@ -67,9 +84,23 @@ Validation ProcessOptions::implausible() const {
 
 namespace {
 
+// The tips' channels among `stride` interleaved ones, the leading tip first.
 struct ChannelSelection {
-  std::size_t stride, lead, trail;
+  std::size_t stride;
+  std::vector<std::size_t> tips;
 };
+
+// What binarisation gives for one tip.
+struct TipSignal {
+  Threshold threshold;
+  AirIntervals signal;
+  std::optional<VoltageHistogram> histogram;
+};
+
+// The threshold options of tip k: every tip but the leading one is a trailing tip.
+BinarisationOptions tip_options(const BinarisationOptions& bopt, std::size_t k) {
+  return k == 0 ? bopt : bopt.for_trailing_tip();
+}
 
 // Blocks of a recording in order, read one ahead on a second thread where the
 // options allow it and a second core exists (same blocks either way).
@@ -91,40 +122,42 @@ detail::ReadAhead<Sample> blocks(Recording& recording, const ProcessOptions& opt
 }
 
 // Two passes over floating (or non-16-bit) samples: histograms, then thresholds.
-void binarise_two_pass(Recording& recording, const ProcessOptions& options, const BinarisationOptions& bopt,
-                       const ChannelSelection& ch, BinarisedRecording& out) {
+std::vector<TipSignal> binarise_two_pass(Recording& recording, const ProcessOptions& options,
+                                         const BinarisationOptions& bopt, const ChannelSelection& ch) {
   const auto& path = recording.info().path;
-  VoltageHistogram h_lead(recording.info().quantum), h_trail(recording.info().quantum);
+  const std::size_t tips = ch.tips.size();
+  std::vector<VoltageHistogram> histograms(tips, VoltageHistogram(recording.info().quantum));
   std::int64_t frames = 0;
   {
     auto reader = blocks<float>(recording, options, ch);
     for (auto used = reader.next(); !used.empty(); used = reader.next()) {
-      h_lead.add(used, ch.lead, ch.stride);
-      h_trail.add(used, ch.trail, ch.stride);
+      for (std::size_t k = 0; k < tips; ++k) histograms[k].add(used, ch.tips[k], ch.stride);
       frames += static_cast<std::int64_t>(used.size() / ch.stride);
     }
   }
   if (frames == 0) throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
-  out.leading_threshold = choose_threshold(h_lead, bopt);
-  out.trailing_threshold = choose_threshold(h_trail, bopt.for_trailing_tip());
-  out.leading_histogram = std::move(h_lead);
-  out.trailing_histogram = std::move(h_trail);
+  std::vector<TipSignal> out(tips);
+  std::vector<Binariser> binarisers;
+  binarisers.reserve(tips);
+  for (std::size_t k = 0; k < tips; ++k) {
+    out[k].threshold = choose_threshold(histograms[k], tip_options(bopt, k));
+    out[k].histogram = std::move(histograms[k]);
+    binarisers.emplace_back(out[k].threshold, recording.info().fs);
+  }
   recording.rewind();
-  Binariser b_lead(out.leading_threshold, recording.info().fs), b_trail(out.trailing_threshold, recording.info().fs);
   {
     auto reader = blocks<float>(recording, options, ch);
     for (auto used = reader.next(); !used.empty(); used = reader.next()) {
-      b_lead.feed(used, ch.lead, ch.stride);
-      b_trail.feed(used, ch.trail, ch.stride);
+      for (std::size_t k = 0; k < tips; ++k) binarisers[k].feed(used, ch.tips[k], ch.stride);
     }
   }
-  out.leading = b_lead.finish();
-  out.trailing = b_trail.finish();
-  if (out.leading.sample_count != frames) {
+  for (std::size_t k = 0; k < tips; ++k) out[k].signal = binarisers[k].finish();
+  if (out[0].signal.sample_count != frames) {
     throw InputError(fmt::format("{}: the second reading gave {} frames instead of {}; the file changed while "
                                          "being read",
-                                         path.string(), out.leading.sample_count, frames));
+                                         path.string(), out[0].signal.sample_count, frames));
   }
+  return out;
 }
 
 // One pass over 16-bit samples. The thresholds depend on the histogram of the
@@ -269,17 +302,21 @@ void check_tips(BinarisedRecording& out, const ProcessOptions& options, std::opt
     const std::optional<VoltageHistogram>& histogram;
     SignalCheck& check;
     int channel;
-    const char* name;
+    std::string name;
   };
-  const Tip tips[] = {{out.leading_histogram, out.leading_signal, options.leading_channel, "leading"},
-                      {out.trailing_histogram, out.trailing_signal, options.trailing_channel, "trailing"}};
+  std::vector<Tip> tips{{out.leading_histogram, out.leading_signal, options.leading_channel, "leading tip"},
+                        {out.trailing_histogram, out.trailing_signal, options.trailing_channel, "trailing tip"}};
+  for (std::size_t k = 0; k < out.further_tips.size(); ++k) {
+    BinarisedTip& tip = out.further_tips[k];
+    tips.push_back({tip.histogram, tip.check, tip.channel, fmt::format("tip {}", k + 2)});
+  }
   const bool allowed = options.signal_check.allow_bad_signal;
   std::string refusal, quantity = "allow-bad-signal";
   const SignalCheck* first = nullptr;
   for (const Tip& tip : tips) {
     if (!tip.histogram) continue;
     tip.check = check_signal(*tip.histogram, options.binarisation.probe, limits, options.signal_check);
-    const std::string where = fmt::format("channel {} ({} tip)", tip.channel, tip.name);
+    const std::string where = fmt::format("channel {} ({})", tip.channel, tip.name);
     if (!tip.check.failed()) continue;  // a flag, if any, is the result's warning (assess)
     if (allowed) {
       tip.check.overridden = true;
@@ -303,6 +340,75 @@ void check_tips(BinarisedRecording& out, const ProcessOptions& options, std::opt
 
 }  // namespace
 
+namespace {
+
+// The tips' signals by the fastest exact path the recording allows: a binary
+// 16-bit recording by its level changes; other 16-bit recordings in one pass
+// (BandRecorder) when the whole record's thresholds fall in the first block's
+// bands; anything else in two passes. Every path gives the same signals.
+std::vector<TipSignal> binarise_tips(Recording& recording, const ProcessOptions& options,
+                                     const BinarisationOptions& bopt, const ChannelSelection& ch) {
+  const RecordingInfo& info = recording.info();
+  const std::size_t tips = ch.tips.size();
+  if (options.single_pass && recording.has_int16() && info.quantum > 0.0) {
+    // A binary recording (two levels per tip): its level changes only.
+    {
+      auto reader = blocks<std::int16_t>(recording, options, ch);
+      detail::TwoLevelScan binary(ch.stride, ch.tips);
+      bool two_levels = true;
+      for (auto used = reader.next(); two_levels && !used.empty(); used = reader.next()) {
+        two_levels = binary.feed(used.data(), used.size() / ch.stride);
+      }
+      if (two_levels && binary.samples() > 0) {
+        std::vector<TipSignal> out(tips);
+        for (std::size_t k = 0; k < tips; ++k) {
+          const int tip = static_cast<int>(k);
+          out[k].histogram = binary.histogram(tip, info.quantum);
+          out[k].threshold = choose_threshold(*out[k].histogram, tip_options(bopt, k));
+          out[k].signal = binary.intervals(tip, out[k].threshold, info.quantum, info.fs);
+        }
+        return out;
+      }
+    }
+    // Not binary: a band of candidate thresholds per tip from the first block, then one pass.
+    recording.rewind();
+    {
+      auto reader = blocks<std::int16_t>(recording, options, ch);
+      auto used = reader.next();
+      const std::size_t n = used.size() / ch.stride;
+      std::vector<BandRecorder> recorders;
+      recorders.reserve(tips);
+      for (std::size_t k = 0; k < tips && n > 0; ++k) {
+        const auto band = band_from(used.data(), n, ch.stride, ch.tips[k], info.quantum, tip_options(bopt, k));
+        if (!band) break;
+        recorders.emplace_back(band->first, band->second);
+      }
+      if (n > 0 && recorders.size() == tips) {
+        for (; !used.empty(); used = reader.next()) {
+          for (std::size_t k = 0; k < tips; ++k) {
+            recorders[k].feed(used.data(), used.size() / ch.stride, ch.stride, ch.tips[k]);
+          }
+        }
+        std::vector<TipSignal> out(tips);
+        bool covered = true;
+        for (std::size_t k = 0; k < tips; ++k) {
+          out[k].histogram = recorders[k].histogram(info.quantum);
+          out[k].threshold = choose_threshold(*out[k].histogram, tip_options(bopt, k));
+          covered = covered && recorders[k].covers(out[k].threshold, info.quantum);
+        }
+        if (covered) {
+          for (std::size_t k = 0; k < tips; ++k) out[k].signal = recorders[k].resolve(out[k].threshold, info.quantum, info.fs);
+          return out;
+        }
+      }
+    }
+    recording.rewind();
+  }
+  return binarise_two_pass(recording, options, bopt, ch);
+}
+
+}  // namespace
+
 BinarisedRecording binarise_recording(const std::filesystem::path& path, const ProcessOptions& options) {
   options.validate().throw_if_failed();
   auto recording = open_recording(path, options.reader);
@@ -315,16 +421,24 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
   const RecordingInfo& info = recording->info();
   const std::filesystem::path& path = info.path;
   const int channels = info.channels;
-  for (int c : {options.leading_channel, options.trailing_channel}) {
+  const std::vector<int> tip_channels = options.tip_channels();
+  if (channels < 2) {
+    throw InputError(fmt::format("{}: the recording has {} channel{}, but pdp processes the tips of a probe together "
+                                 "(at least a leading and a trailing tip): give a recording holding both tips' "
+                                 "signals, a column or channel per tip",
+                                 path.string(), channels, channels == 1 ? "" : "s"));
+  }
+  for (std::size_t k = 0; k < tip_channels.size(); ++k) {
+    const int c = tip_channels[k];
     if (c >= channels) {
-      throw InputError(fmt::format("{}: channel {} requested but the recording has {} channel{} (numbered from 0); "
-                                   "choose the tips' channels within range",
-                                   path.string(), c, channels, channels == 1 ? "" : "s"),
-                       "leading-channel,trailing-channel");
+      throw InputError(fmt::format("{}: tip {} is channel {}, but the recording has {} channels (numbered from 0 to "
+                                   "{}); choose the tips' channels within range",
+                                   path.string(), k, c, channels, channels - 1),
+                       k < 2 ? "leading-channel,trailing-channel" : "further-channels");
     }
   }
-  const ChannelSelection ch{static_cast<std::size_t>(channels), static_cast<std::size_t>(options.leading_channel),
-                            static_cast<std::size_t>(options.trailing_channel)};
+  ChannelSelection ch{static_cast<std::size_t>(channels), {}};
+  for (int c : tip_channels) ch.tips.push_back(static_cast<std::size_t>(c));
   if (!options.allow_unusual && (info.fs < plausible_fs_min || info.fs > plausible_fs_max)) {
     throw InputError(fmt::format("{}: the file records a sampling rate of {}, outside 1 kHz to 100 MHz: is it a probe "
                                  "recording? If so, allow unusual values",
@@ -342,62 +456,29 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& o
 
   BinarisedRecording out;
   out.info = info;
+  std::vector<TipSignal> tips;
   try {
-    bool done = false;
-    if (options.single_pass && recording->has_int16() && info.quantum > 0.0) {
-      // A binary recording (two levels per tip): its level changes only.
-      {
-        auto reader = blocks<std::int16_t>(*recording, options, ch);
-        detail::TwoLevelScan binary(ch.stride, ch.lead, ch.trail);
-        bool two_levels = true;
-        for (auto used = reader.next(); two_levels && !used.empty(); used = reader.next()) {
-          two_levels = binary.feed(used.data(), used.size() / ch.stride);
-        }
-        if (two_levels && binary.samples() > 0) {
-          out.leading_histogram = binary.histogram(0, info.quantum);
-          out.trailing_histogram = binary.histogram(1, info.quantum);
-          out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
-          out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt.for_trailing_tip());
-          out.leading = binary.intervals(0, out.leading_threshold, info.quantum, info.fs);
-          out.trailing = binary.intervals(1, out.trailing_threshold, info.quantum, info.fs);
-          done = true;
-        }
-      }
-      if (!done) {
-        // Not binary: a band of candidate thresholds from the first block, then one pass.
-        recording->rewind();
-        auto reader = blocks<std::int16_t>(*recording, options, ch);
-        auto used = reader.next();
-        const std::size_t n = used.size() / ch.stride;
-        const auto band_lead = band_from(used.data(), n, ch.stride, ch.lead, info.quantum, bopt);
-        const auto band_trail = band_from(used.data(), n, ch.stride, ch.trail, info.quantum, bopt.for_trailing_tip());
-        if (n > 0 && band_lead && band_trail) {
-          BandRecorder lead(band_lead->first, band_lead->second), trail(band_trail->first, band_trail->second);
-          for (; !used.empty(); used = reader.next()) {
-            lead.feed(used.data(), used.size() / ch.stride, ch.stride, ch.lead);
-            trail.feed(used.data(), used.size() / ch.stride, ch.stride, ch.trail);
-          }
-          out.leading_histogram = lead.histogram(info.quantum);
-          out.trailing_histogram = trail.histogram(info.quantum);
-          out.leading_threshold = choose_threshold(*out.leading_histogram, bopt);
-          out.trailing_threshold = choose_threshold(*out.trailing_histogram, bopt.for_trailing_tip());
-          if (lead.covers(out.leading_threshold, info.quantum) && trail.covers(out.trailing_threshold, info.quantum)) {
-            out.leading = lead.resolve(out.leading_threshold, info.quantum, info.fs);
-            out.trailing = trail.resolve(out.trailing_threshold, info.quantum, info.fs);
-            done = true;
-          }
-        }
-      }
-      if (!done) recording->rewind();
-    }
-    if (!done) binarise_two_pass(*recording, options, bopt, ch, out);
+    tips = binarise_tips(*recording, options, bopt, ch);
   } catch (const InputError& e) {
     const std::string what = e.what();
     if (what.rfind(path.string(), 0) == 0) throw;
     throw InputError(fmt::format("{}: {}", path.string(), what), e.quantity());
   }
-  if (out.leading.sample_count == 0) {
+  if (tips.at(0).signal.sample_count == 0) {
     throw InputError(fmt::format("{}: the recording holds no samples", path.string()));
+  }
+  out.leading_threshold = tips[0].threshold;
+  out.leading = std::move(tips[0].signal);
+  out.leading_histogram = std::move(tips[0].histogram);
+  out.trailing_threshold = tips[1].threshold;
+  out.trailing = std::move(tips[1].signal);
+  out.trailing_histogram = std::move(tips[1].histogram);
+  for (std::size_t k = 2; k < tips.size(); ++k) {
+    BinarisedTip& further = out.further_tips.emplace_back();
+    further.channel = options.further_channels[k - 2];
+    further.threshold = tips[k].threshold;
+    further.signal = std::move(tips[k].signal);
+    further.histogram = std::move(tips[k].histogram);
   }
   out.info.frames = out.leading.sample_count;
   check_tips(out, options,

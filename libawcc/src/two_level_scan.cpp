@@ -13,12 +13,12 @@
 
 namespace awcc::detail {
 
-TwoLevelScan::TwoLevelScan(std::size_t stride, std::size_t lead, std::size_t trail)
-    : stride_(stride), tip_of_channel_(stride, -1), last_frame_(stride, 0) {
-  tips_[0].channel = lead;
-  tips_[1].channel = trail;
-  tip_of_channel_[lead] = 0;
-  tip_of_channel_[trail] = 1;
+TwoLevelScan::TwoLevelScan(std::size_t stride, std::span<const std::size_t> channels)
+    : stride_(stride), tips_(channels.size()), tip_of_channel_(stride, -1), last_frame_(stride, 0) {
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    tips_[k].channel = channels[k];
+    tip_of_channel_[channels[k]] = static_cast<int>(k);
+  }
 }
 
 bool TwoLevelScan::change(Tip& tip, std::int64_t index, std::int16_t value) {
@@ -144,7 +144,7 @@ bool TwoLevelScan::feed(const std::int16_t* data, std::size_t frames) {
       const std::size_t k = *o;
       const std::size_t channel = s == 2 ? (k & 1u) : k % s;
       const int t = tip_of_channel_[channel];
-      if (t >= 0 && !change(tips_[t], position_ + static_cast<std::int64_t>(k / s), data[k])) return false;
+      if (t >= 0 && !change(tips_[static_cast<std::size_t>(t)], position_ + static_cast<std::int64_t>(k / s), data[k])) return false;
     }
   }
   std::copy(data + n - s, data + n, last_frame_.begin());
@@ -153,7 +153,7 @@ bool TwoLevelScan::feed(const std::int16_t* data, std::size_t frames) {
 }
 
 VoltageHistogram TwoLevelScan::histogram(int tip, double quantum) const {
-  const Tip& t = tips_[tip];
+  const Tip& t = tips_[static_cast<std::size_t>(tip)];
   std::int64_t count[2] = {0, 0};
   for (std::size_t c = 0; c < t.changes.size(); ++c) {
     const std::int64_t end = c + 1 < t.changes.size() ? t.changes[c + 1].index : position_;
@@ -168,7 +168,7 @@ VoltageHistogram TwoLevelScan::histogram(int tip, double quantum) const {
 }
 
 AirIntervals TwoLevelScan::intervals(int tip, const Threshold& threshold, double quantum, double fs) const {
-  const Tip& t = tips_[tip];
+  const Tip& t = tips_[static_cast<std::size_t>(tip)];
   // Each level's decision is the binariser's own, asked once per level; the
   // runs then become intervals without a decision per change.
   bool air[2] = {false, false};

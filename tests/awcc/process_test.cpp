@@ -420,12 +420,72 @@ TEST(ProcessInput, ChannelProblemsAreNamed) {
   write_dat(single, std::vector<std::int16_t>(1000, 100), 1);
   awcc::ProcessOptions o;
   o.reader.fs = 1000;
-  EXPECT_NE(process_error(single, o).find("channel 1 requested but the recording has 1 channel"), std::string::npos)
-      << process_error(single, o);
+  // One channel: not a channel choice to correct but a recording of one tip.
+  const std::string one = process_error(single, o);
+  EXPECT_NE(one.find("the recording has 1 channel, but pdp processes the tips of a probe together"),
+            std::string::npos)
+      << one;
+  EXPECT_EQ(one.find("within range"), std::string::npos) << one;
   const auto two = pdp_test::temp_dir() / "two.dat";
   write_dat(two, std::vector<std::int16_t>(1000, 100), 2);
   o.trailing_channel = 5;
-  EXPECT_NE(process_error(two, o).find("channel 5"), std::string::npos);
+  EXPECT_NE(process_error(two, o).find("tip 1 is channel 5, but the recording has 2 channels"), std::string::npos)
+      << process_error(two, o);
+  // A further tip beyond the recording, and one sharing a tip's channel.
+  o.trailing_channel = 1;
+  o.further_channels = {2};
+  EXPECT_NE(process_error(two, o).find("tip 2 is channel 2, but the recording has 2 channels"), std::string::npos)
+      << process_error(two, o);
+  o.further_channels = {1};
+  EXPECT_NE(process_error(two, o).find("tips 1 and 2 are both channel 1"), std::string::npos)
+      << process_error(two, o);
+}
+
+// A probe of four tips: the further tips are binarised by the same paths as
+// the pair (binary 16-bit, one-pass 16-bit, two-pass float), each tip's
+// signal equal to the one it gets when it is itself processed as the
+// trailing tip of a pair, on every path.
+TEST(ProcessInput, FurtherTipsAreBinarisedAsTheTrailingTip) {
+  for (const bool binary : {true, false}) {
+    const auto path = pdp_test::temp_dir() / (binary ? "four-binary.dat" : "four.dat");
+    std::vector<std::int16_t> data;
+    for (int i = 0; i < 40000; ++i) {
+      for (int tip = 0; tip < 4; ++tip) {
+        const bool air = ((i + 13 * tip) / (29 + tip)) % 4 == 0;
+        const int jitter = binary ? 0 : (i * (tip + 1)) % 7;
+        data.push_back(static_cast<std::int16_t>((air ? 2000 : 27000) + jitter));
+      }
+    }
+    write_dat(path, data, 4);
+    for (const bool single_pass : {true, false}) {
+      const auto options = [&](int trailing, std::vector<int> further) {
+        awcc::ProcessOptions o;
+        o.reader.fs = 20000;
+        o.single_pass = single_pass;
+        o.trailing_channel = trailing;
+        o.further_channels = std::move(further);
+        return o;
+      };
+      const auto probe = awcc::binarise_recording(path, options(1, {2, 3}));
+      ASSERT_EQ(probe.further_tips.size(), 2u);
+      EXPECT_EQ(probe.leading.intervals, awcc::binarise_recording(path, options(1, {})).leading.intervals);
+      for (int k = 1; k < 4; ++k) {
+        const auto alone = awcc::binarise_recording(path, options(k, {}));
+        const auto& got = k == 1 ? probe.trailing : probe.further_tips[static_cast<std::size_t>(k - 2)].signal;
+        EXPECT_EQ(got.intervals, alone.trailing.intervals) << "tip " << k << " binary " << binary << " single pass "
+                                                           << single_pass;
+        EXPECT_FALSE(got.intervals.empty());
+        if (k >= 2) {
+          const auto& tip = probe.further_tips[static_cast<std::size_t>(k - 2)];
+          EXPECT_EQ(tip.channel, k);
+          EXPECT_EQ(tip.threshold.lower, alone.trailing_threshold.lower);
+          EXPECT_EQ(tip.check.status, alone.trailing_signal.status);
+          ASSERT_TRUE(tip.histogram);
+          EXPECT_EQ(tip.histogram->total(), 40000);
+        }
+      }
+    }
+  }
 }
 
 TEST(ProcessInput, AConstantChannelIsRefusedUnlessAllowed) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <random>
@@ -21,18 +22,19 @@ struct Interleaved {
 
 // `frames` frames of `stride` channels; the tips hold two levels each with a
 // run length drawn around `mean_run`, every other channel is noise.
-Interleaved binary_frames(std::size_t frames, std::size_t stride, std::size_t lead, std::size_t trail,
+Interleaved binary_frames(std::size_t frames, std::size_t stride, const std::vector<std::size_t>& tips,
                           double mean_run, unsigned seed) {
   std::mt19937 rng(seed);
   std::exponential_distribution<double> run(1.0 / mean_run);
   Interleaved out{std::vector<std::int16_t>(frames * stride), stride};
-  const std::int16_t levels[2][2] = {{0, 1}, {-1200, 31000}};
+  const std::int16_t levels[3][2] = {{0, 1}, {-1200, 31000}, {-32768, 32767}};
   for (std::size_t c = 0; c < stride; ++c) {
-    if (c != lead && c != trail) {
+    const auto tip = std::find(tips.begin(), tips.end(), c);
+    if (tip == tips.end()) {
       for (std::size_t i = 0; i < frames; ++i) out.data[i * stride + c] = static_cast<std::int16_t>(rng() % 65536);
       continue;
     }
-    const auto& l = levels[c == lead ? 0 : 1];
+    const auto& l = levels[std::min<std::ptrdiff_t>(tip - tips.begin(), 2)];
     int state = static_cast<int>(rng() % 2);
     std::size_t i = 0;
     while (i < frames) {
@@ -79,25 +81,26 @@ Expected brute_force(const Interleaved& x, std::size_t channel, double quantum) 
 
 TEST(TwoLevelScan, EqualsBruteForceForAnyStrideAndBlockSplit) {
   struct Case {
-    std::size_t stride, lead, trail;
+    std::size_t stride;
+    std::vector<std::size_t> tips;
     double mean_run;
   };
-  for (const Case c : {Case{2, 0, 1, 150.0}, Case{2, 1, 0, 3.0}, Case{3, 2, 0, 20.0},
-                       Case{5, 1, 3, 70.0}, Case{2, 0, 1, 1.0}}) {
+  // Two tips in any order among noise channels, and probes of 4 and 5 tips.
+  for (const Case& c : {Case{2, {0, 1}, 150.0}, Case{2, {1, 0}, 3.0}, Case{3, {2, 0}, 20.0}, Case{5, {1, 3}, 70.0},
+                        Case{2, {0, 1}, 1.0}, Case{4, {0, 1, 2, 3}, 40.0}, Case{6, {5, 0, 2, 3, 1}, 9.0}}) {
     for (unsigned seed = 1; seed <= 3; ++seed) {
-      const auto x = binary_frames(30011, c.stride, c.lead, c.trail, c.mean_run, seed);
-      TwoLevelScan scan(c.stride, c.lead, c.trail);
+      const auto x = binary_frames(30011, c.stride, c.tips, c.mean_run, seed);
+      TwoLevelScan scan(c.stride, c.tips);
       ASSERT_TRUE(feed_in_blocks(scan, x, seed + 100)) << "stride " << c.stride;
       EXPECT_EQ(scan.samples(), 30011);
       const double quantum = 1.0 / 32768.0;
-      for (int tip = 0; tip < 2; ++tip) {
-        const std::size_t channel = tip == 0 ? c.lead : c.trail;
-        const auto e = brute_force(x, channel, quantum);
-        const auto h = scan.histogram(tip, quantum);
+      for (std::size_t tip = 0; tip < c.tips.size(); ++tip) {
+        const auto e = brute_force(x, c.tips[tip], quantum);
+        const auto h = scan.histogram(static_cast<int>(tip), quantum);
         EXPECT_EQ(h.values(), e.values) << "stride " << c.stride << " tip " << tip;
         const auto t = awcc::choose_threshold(h, {});
         ASSERT_TRUE(t.binary_input);
-        const auto got = scan.intervals(tip, t, quantum, 1000.0);
+        const auto got = scan.intervals(static_cast<int>(tip), t, quantum, 1000.0);
         EXPECT_EQ(got.intervals, e.intervals.intervals) << "stride " << c.stride << " tip " << tip << " seed " << seed;
         EXPECT_EQ(got.sample_count, 30011);
         EXPECT_EQ(got.check(), "");
@@ -107,16 +110,17 @@ TEST(TwoLevelScan, EqualsBruteForceForAnyStrideAndBlockSplit) {
 }
 
 TEST(TwoLevelScan, AThirdValueOnATipEndsTheScanButNotOnAnotherChannel) {
-  auto x = binary_frames(20000, 3, 0, 2, 50.0, 7);  // channel 1 is noise: ignored
+  const std::vector<std::size_t> tips{0, 2};
+  auto x = binary_frames(20000, 3, tips, 50.0, 7);  // channel 1 is noise: ignored
   {
-    TwoLevelScan scan(3, 0, 2);
+    TwoLevelScan scan(3, tips);
     EXPECT_TRUE(feed_in_blocks(scan, x, 1));
   }
   // One sample of a third value, deep inside a block and at a block's first frame.
   for (std::size_t frame : {std::size_t{12345}, std::size_t{0}, std::size_t{19999}}) {
     auto y = x;
     y.data[frame * 3 + 2] = 555;
-    TwoLevelScan scan(3, 0, 2);
+    TwoLevelScan scan(3, tips);
     EXPECT_FALSE(feed_in_blocks(scan, y, 1)) << frame;
   }
 }
@@ -124,7 +128,8 @@ TEST(TwoLevelScan, AThirdValueOnATipEndsTheScanButNotOnAnotherChannel) {
 TEST(TwoLevelScan, AConstantTipIsOneLevel) {
   Interleaved x{std::vector<std::int16_t>(2 * 5000, 7), 2};
   for (std::size_t i = 0; i < 5000; i += 2) x.data[2 * i] = 9;  // lead alternates, trail constant at 7
-  TwoLevelScan scan(2, 0, 1);
+  const std::vector<std::size_t> tips{0, 1};
+  TwoLevelScan scan(2, tips);
   ASSERT_TRUE(scan.feed(x.data.data(), 5000));
   const auto h = scan.histogram(1, 1.0);
   EXPECT_EQ(h.values(), (std::vector<std::pair<double, std::int64_t>>{{7.0, 5000}}));

@@ -26,6 +26,10 @@ struct ProcessOptions {
   ReaderOptions reader;
   int leading_channel = 0;            ///< channel index of the leading tip
   int trailing_channel = 1;           ///< channel index of the trailing tip
+  /// Channels of a probe's further trailing tips (tips 2, 3, ... in the
+  /// order their positions are declared); empty for a dual-tip probe. They
+  /// are binarised with the trailing tip's options and checked like it.
+  std::vector<int> further_channels;
   BinarisationOptions binarisation;
   /// Each tip's voltage must be a two-level signal of the stated polarity
   /// (awcc/signal_check.hpp) before any statistics.
@@ -56,6 +60,8 @@ struct ProcessOptions {
   /// cache then overlaps with the work on the samples).
   bool read_ahead = true;
 
+  /// The tips' channels: leading, trailing, then further_channels.
+  [[nodiscard]] std::vector<int> tip_channels() const;
   /// Every part's validate(), then implausible() unless allow_unusual.
   [[nodiscard]] Validation validate() const;
   /// Ok when every stated value is plausible for a phase-detection probe:
@@ -80,7 +86,17 @@ struct TipResult {
   SignalCheck signal;                 ///< the signal check of its voltage
 };
 
-/// The two binary signals of a recording (what AWCC and FSCC consume).
+/// A further tip of a probe of more than two tips, binarised like the trailing tip.
+struct BinarisedTip {
+  int channel = 0;
+  Threshold threshold;
+  AirIntervals signal;
+  std::optional<VoltageHistogram> histogram;  ///< the histogram its threshold came from
+  SignalCheck check;                          ///< the signal check of its histogram
+};
+
+/// The two binary signals of a recording (what AWCC and FSCC consume), and
+/// those of a probe's further tips when asked (ProcessOptions::further_channels).
 struct BinarisedRecording {
   RecordingInfo info;
   Threshold leading_threshold, trailing_threshold;
@@ -89,6 +105,7 @@ struct BinarisedRecording {
   std::optional<VoltageHistogram> leading_histogram, trailing_histogram;
   /// The signal check of each tip's histogram (unchecked without one).
   SignalCheck leading_signal, trailing_signal;
+  std::vector<BinarisedTip> further_tips;   ///< tips 2, 3, ... in the order of further_channels
 };
 
 struct ProcessResult {

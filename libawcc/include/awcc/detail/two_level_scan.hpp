@@ -6,14 +6,15 @@
 // A binary channel needs neither a histogram of every sample nor a threshold
 // test per sample: its level changes say everything. The scan compares every
 // sample with the one a frame earlier (all channels at once, eight counts per
-// vector comparison), keeps the changes of the two tips, and stops as soon as
-// either tip shows a third value (then the recording is not binary and the
+// vector comparison), keeps the changes of the tips' channels, and stops as
+// soon as any tip shows a third value (then the recording is not binary and the
 // caller binarises it the general way). The levels' counts follow from the
 // run lengths, so the histogram, the threshold and the air intervals equal
 // those of the general path on the same counts.
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "awcc/air_intervals.hpp"
@@ -23,8 +24,9 @@ namespace awcc::detail {
 
 class TwoLevelScan {
  public:
-  /// Frames of `stride` interleaved channels; the tips are channels `lead` and `trail`.
-  TwoLevelScan(std::size_t stride, std::size_t lead, std::size_t trail);
+  /// Frames of `stride` interleaved channels; tip k is channel `channels[k]`
+  /// (distinct, below stride).
+  TwoLevelScan(std::size_t stride, std::span<const std::size_t> channels);
 
   /// Scans the next `frames` frames. False once a tip has shown a third
   /// distinct value: the recording is not binary, and the scan is spent.
@@ -32,9 +34,9 @@ class TwoLevelScan {
 
   [[nodiscard]] std::int64_t samples() const { return position_; }
 
-  /// Histogram of tip 0 (lead) or 1 (trail) at `quantum` volts per count.
+  /// Histogram of tip k (the order of `channels`) at `quantum` volts per count.
   [[nodiscard]] VoltageHistogram histogram(int tip, double quantum) const;
-  /// The air intervals of tip 0 or 1 under `threshold` (chosen on histogram(tip)).
+  /// The air intervals of tip k under `threshold` (chosen on histogram(tip)).
   [[nodiscard]] AirIntervals intervals(int tip, const Threshold& threshold, double quantum, double fs) const;
 
  private:
@@ -51,8 +53,8 @@ class TwoLevelScan {
   [[nodiscard]] bool change(Tip& tip, std::int64_t index, std::int16_t value);
 
   std::size_t stride_;
-  Tip tips_[2];
-  std::vector<signed char> tip_of_channel_;  // -1 for channels that are not a tip
+  std::vector<Tip> tips_;
+  std::vector<int> tip_of_channel_;     // -1 for channels that are not a tip
   std::vector<std::int16_t> last_frame_;
   std::vector<std::uint32_t> offsets_;  // scratch: changed counts of one block
   std::int64_t position_ = 0;
