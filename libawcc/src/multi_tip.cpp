@@ -365,6 +365,13 @@ std::string MultiTipResult::report() const {
     out += fmt::format("mean diameter {:.4g} mm (front interfaces), {:.4g} mm (rear); interfacial area {:.4g} 1/m "
                        "(of the bubbles with a vector)\n",
                        1e3 * *diameter_front, 1e3 * *diameter_rear, *interfacial_area);
+    if (const auto missed = count(BubbleFate::too_few_tips); missed > 0) {
+      // Spheres pierced off-centre miss the trailing tips first, and those
+      // are the ones with the largest 1 / |V . n|: the sum under-counts.
+      out += fmt::format("  {} of {} leading bubbles ({:.0f} %) pierce fewer than three trailing tips and add no "
+                         "area: the interfacial area is low by more than that share\n",
+                         missed, bubbles_total, 100.0 * static_cast<double>(missed) / static_cast<double>(bubbles_total));
+    }
   } else {
     out += "no sizes or interfacial area: Tian et al. 2015 gives velocities only\n";
   }
