@@ -388,6 +388,26 @@ const OptionField<A> kAwcc[] = {
      [](const A& o) { return name_of(o.path, kPaths); }},
 };
 
+using M = MultiTipOptions;
+const OptionField<M> kMultiTip[] = {
+    {"velocity-algorithm", "",
+     "multi-tip velocity per bubble: shen-nakamura (Shen & Nakamura 2014: also each bubble's diameter, normals and "
+     "interfacial area) | tian (Tian et al. 2015: the same velocity, no sizes)",
+     [](M& o, std::string_view t) { o.algorithm = choice(t, velocity_algorithms); },
+     [](const M& o) { return name_of(o.algorithm); }},
+    {"conditioning-min", "-",
+     "multi-tip: least |det A_0| (0-1) of the direction cosines of three trailing tips; a combination below it is "
+     "skipped (timing errors amplified up to 1.5 / |det A_0| times)",
+     [](M& o, std::string_view t) { o.conditioning_min = quantity(t, Dimension::dimensionless); },
+     [](const M& o) { return fmt::format("{:g}", o.conditioning_min); }},
+    {"vector-roc", "", "multi-tip: robust outlier cutoff of the per-bubble velocity vectors, per component: on | off",
+     [](M& o, std::string_view t) { o.roc = on_off(t); },
+     [](const M& o) { return std::string(switch_text(o.roc)); }},
+    {"vectors-reported", "-", "multi-tip: fewest accepted bubbles whose mean vector, stresses and Tu are reported",
+     [](M& o, std::string_view t) { o.vectors_reported = static_cast<int>(whole(t, 2, 1000000000)); },
+     [](const M& o) { return std::to_string(o.vectors_reported); }},
+};
+
 using P = ProcessOptions;
 constexpr std::array<std::pair<const char*, int>, 4> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}, {"none", 0}}};
 const OptionField<P> kProcess[] = {
@@ -437,6 +457,7 @@ std::span<const OptionField<FsccOptions>> fscc_option_fields() { return kFscc; }
 std::span<const OptionField<AwccOptions>> awcc_option_fields() { return kAwcc; }
 std::span<const OptionField<ProcessOptions>> process_option_fields() { return kProcess; }
 std::span<const OptionField<StructureOptions>> structure_option_fields() { return kStructure; }
+std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields() { return kMultiTip; }
 
 std::span<const PresetSetting> preset_settings(std::string_view name) {
   if (name == "felder") return kFelder;

@@ -12,6 +12,7 @@
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
 #include "awcc/fscc.hpp"
+#include "awcc/multi_tip.hpp"
 #include "awcc/option_field.hpp"
 #include "awcc/process.hpp"
 #include "awcc/recording.hpp"
@@ -26,6 +27,8 @@ std::span<const OptionField<AwccOptions>> awcc_option_fields();
 /// tip separations, channels, methods, histogram bins.
 std::span<const OptionField<ProcessOptions>> process_option_fields();
 std::span<const OptionField<StructureOptions>> structure_option_fields();
+/// The multi-tip solvers' options (awcc/multi_tip.hpp).
+std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields();
 
 /// A named set of option values (the setting `preset = felder`): applied to
 /// the options the user does not give.

@@ -1,0 +1,206 @@
+#pragma once
+// Multi-tip probes bubble by bubble (METHOD 11.3-11.6): from the times a
+// bubble's interfaces reach the leading tip 0 and three or more trailing tips,
+// its 3-D velocity vector, its size, its interface normals and its share of
+// the interfacial area; then the statistics of the per-bubble vectors.
+//
+// Per bubble and per combination of three paired trailing tips k (lags
+// dt_0k,2h = t_k,2h - t_0,2h of the front interfaces, dt_0k,2h+1 of the
+// rear, dt_0,h the chord time at tip 0):
+//  - Shen & Nakamura 2014 (Eqs. 30-54): 1/V_m0k = (dt_0k,2h + dt_0k,2h+1) /
+//    (2 |S_0k|); w = A_0^-1 (1/V_m0k), whose entries are Cramer's det A_0j /
+//    det A_0; |V| = 1 / |w| (= |det A_0| / sqrt(sum det A_0j^2)), V = w / |w|^2.
+//    E_0k,2h = |V|^2 dt_0k,2h (dt_0k,2h+1 + dt_0,h) / |S_0k| - |S_0k|,
+//    E_0k,2h+1 = |V|^2 dt_0k,2h+1 (dt_0k,2h - dt_0,h) / |S_0k| - |S_0k|;
+//    A_0^-1 E = D n (entries det B_0j / det A_0): the interface's diameter D =
+//    |A_0^-1 E| (Eq. 50) and unit normal n (Eq. 51, outward from the bubble's
+//    centre); the IAC share of the front interface 1 / |V . n| =
+//    |w|^2 D / |w . D n| (Eq. 54). Exact for a sphere in uniform motion, for
+//    any offset at which it pierces every tip.
+//  - Tian et al. 2015: S w = dt (rows S_0k, dt the mean of the front and rear
+//    lags), V = w / |w|^2. The same linear system written in S_0k instead of
+//    its direction cosines, so its velocity equals Shen & Nakamura's to
+//    rounding; it gives no size, normal or interfacial area (pdp-sim's
+//    neither).
+// A combination with conditioning |det A_0| below conditioning-min
+// (awcc/probe_geometry.hpp) is skipped and counted. A combination whose lags
+// vanish (within the rounding of the times), or whose solution is not finite
+// or has |w| = 0 or D = 0, is degenerate: rejected and counted, never a huge
+// number. A bubble's vector is the mean over its solved combinations, with
+// their spread (population sd per component) kept; its diameters and IAC
+// share the means, its normals the normalised mean.
+//
+// Statistics (METHOD 11.6), over the solved bubbles:
+//  - robust outlier cutoff (METHOD 4 item 6) per component, the three in
+//    turn until none rejects more; a bubble rejected on one component leaves
+//    the sample (its vector is one measurement);
+//  - weights: the bubble's interaction time span, from its front interface
+//    at the leading tip to the last rear interface at any tip it was paired
+//    at. It is about (D + |S|) / |V|: like AWCC's window durations (Buchhave
+//    1979) it removes the over-sampling of fast bubbles;
+//  - mean vector, Reynolds-stress tensor R = mean outer product of the
+//    fluctuations (same weights), Tu_i = sqrt(R_ii) / |mean vector|;
+//  - 95 % intervals as METHOD 4 item 8 per component (N accepted bubbles):
+//    mean +/- 1.96 rms / sqrt(N), rms +/- 1.96 rms / sqrt(2N), Tu +/- 1.96
+//    sqrt(Tu^2 (Tu^2 / N + 1 / (2N)));
+//  - mean diameters (number mean of the accepted bubbles' front and rear
+//    interface diameters) and the interfacial area concentration
+//    a = (2 / T) sum over accepted bubbles of 1 / |V . n| (two interfaces a
+//    bubble; Shen & Nakamura only). Bubbles without a vector (fewer than three
+//    paired tips, grazing ones above all) add nothing: a is of the bubbles
+//    that pierce three trailing tips, and the fate counts say how many did not.
+//    It is biased low: off-centre spheres miss the trailing tips first and
+//    carry the largest 1 / |V . n| (E[1 / cos theta] = 2 over the pierced
+//    disk, half of it from sin theta > 0.87). For pdp's four-tip sample (tips
+//    1.5 mm apart) and 4 mm spheres moving along x, 30 % of the leading
+//    bubbles pierce all three trailing tips and carry 23 % of the sum
+//    (Monte Carlo over the disk); a missed-bubble correction is not made here.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "awcc/interface_times.hpp"
+#include "awcc/phase_statistics.hpp"
+#include "awcc/probe_geometry.hpp"
+#include "awcc/validation.hpp"
+
+namespace awcc {
+
+enum class VelocityAlgorithm { shen_nakamura, tian };
+/// Every value, in the order the option lists them (its text is to_string's).
+inline constexpr VelocityAlgorithm velocity_algorithms[] = {VelocityAlgorithm::shen_nakamura, VelocityAlgorithm::tian};
+std::string_view to_string(VelocityAlgorithm algorithm);  ///< "shen-nakamura", "tian"
+
+/// Every leading bubble with its partner, or none, at each trailing tip: what
+/// interface pairing gives the solvers. Flat and bubble-major, so that a
+/// record of 380,000 bubbles is two allocations, not 380,000.
+struct PiercedBubbles {
+  /// As many as ProbeGeometry::trailing_tips(), in that order.
+  std::size_t trailing_tips = 0;
+  std::vector<Crossing> leading;                  ///< bubble h at the leading tip
+  /// Bubble h's partner at trailing tip k: trailing[h * trailing_tips + k];
+  /// none when the pairing found none.
+  std::vector<std::optional<Crossing>> trailing;
+
+  PiercedBubbles() = default;
+  explicit PiercedBubbles(std::size_t trailing_count) : trailing_tips(trailing_count) {}
+  [[nodiscard]] std::size_t size() const { return leading.size(); }
+  [[nodiscard]] const std::optional<Crossing>& partner(std::size_t bubble, std::size_t k) const {
+    return trailing[bubble * trailing_tips + k];
+  }
+  void reserve(std::size_t bubbles);
+  /// Appends one bubble; throws std::invalid_argument unless it has
+  /// trailing_tips partners.
+  void add(const Crossing& at_leading, std::span<const std::optional<Crossing>> partners);
+};
+
+/// What became of a leading bubble.
+enum class BubbleFate {
+  solved,           ///< a vector, accepted by the outlier cutoff
+  censored,         ///< cut by the record's start or end at the leading tip
+  too_few_tips,     ///< fewer than three trailing tips paired (a censored partner does not count)
+  ill_conditioned,  ///< every combination of its paired tips is below conditioning-min
+  degenerate,       ///< every well-conditioned combination degenerate (vanishing lags, no finite solution)
+  roc,              ///< solved, rejected by the robust outlier cutoff
+};
+inline constexpr std::array<std::string_view, 6> bubble_fate_names{"solved",          "censored",   "too_few_tips",
+                                                                   "ill_conditioned", "degenerate", "roc"};
+inline constexpr std::size_t bubble_fate_count = bubble_fate_names.size();
+static_assert(static_cast<std::size_t>(BubbleFate::roc) + 1 == bubble_fate_count,
+              "a fate added to BubbleFate needs its name in bubble_fate_names");
+std::string_view to_string(BubbleFate fate);
+
+/// One leading bubble's solution (NaN where it has none).
+struct BubbleVector {
+  double time = 0.0;               ///< front interface at the leading tip, s
+  double weight = 0.0;             ///< interaction time span, s
+  Vec3 velocity{};                 ///< mean over the solved combinations, m/s
+  Vec3 velocity_spread{};          ///< population sd over the solved combinations, m/s (0 with one)
+  double diameter_front = 0.0;     ///< m (Shen & Nakamura; NaN with Tian)
+  double diameter_rear = 0.0;      ///< m
+  Vec3 normal_front{};             ///< unit, outward (Shen & Nakamura; NaN with Tian)
+  Vec3 normal_rear{};
+  double area_share = 0.0;         ///< 1 / |V . n| of the front interface, s/m (Eq. 54; NaN with Tian)
+  int combinations = 0;            ///< combinations solved and averaged
+  int combinations_skipped = 0;    ///< of its paired tips, below conditioning-min
+  BubbleFate fate = BubbleFate::degenerate;
+};
+
+struct MultiTipOptions {
+  /// Shen & Nakamura 2014 by default: the same velocity as Tian et al. 2015
+  /// (one linear system, see above) and, besides, each bubble's diameter,
+  /// normals and interfacial area. Tian: to reproduce pdp-sim's choice.
+  VelocityAlgorithm algorithm = VelocityAlgorithm::shen_nakamura;
+  /// Least conditioning |det A_0| of a combination of three trailing tips, -.
+  /// Below it timing errors reach the velocity amplified more than 1.5 / 0.05
+  /// = 30 times (probe_geometry.hpp). 0.05 admits tips on a cone of half-angle
+  /// 8 degrees and more around the leading tip, and pdp's own four-tip
+  /// sample (0.083); combinations of a five-tip probe that are nearly
+  /// coplanar with tip 0 fall below it.
+  double conditioning_min = 0.05;
+  /// Robust outlier cutoff of the per-bubble vectors (METHOD 4 item 6):
+  /// mis-paired bubbles give wild vectors.
+  bool roc = true;
+  /// Fewest accepted bubbles whose statistics are reported: fewer give a
+  /// Tu whose 95 % interval is wider than +/- 45 % (METHOD 4 item 10).
+  int vectors_reported = 10;
+
+  [[nodiscard]] Validation validate() const;
+};
+
+enum class MultiTipStatus {
+  ok,
+  too_few_bubbles,  ///< fewer accepted bubbles than vectors_reported: no statistics
+};
+std::string_view to_string(MultiTipStatus status);
+
+struct MultiTipResult {
+  MultiTipStatus status = MultiTipStatus::too_few_bubbles;
+  std::string message;  ///< why not ok (empty when ok)
+  [[nodiscard]] bool ok() const { return status == MultiTipStatus::ok; }
+  MultiTipOptions options;      ///< the options that made this result
+  double record_length = 0.0;   ///< T, s
+  std::size_t leading_tip = 0;  ///< index of the leading tip
+
+  Vec3 velocity{};              ///< duration-weighted mean vector, m/s (0 unless ok)
+  double speed = 0.0;           ///< |mean vector|, m/s
+  Vec3 velocity_rms{};          ///< sqrt(R_ii), m/s
+  std::array<Vec3, 3> reynolds_stress{};  ///< R_ij = mean (v_i - V_i)(v_j - V_j), m^2/s^2
+  Vec3 turbulence_intensity{};  ///< Tu_i = sqrt(R_ii) / |mean vector|
+  std::array<Interval95, 3> velocity_ci95{}, velocity_rms_ci95{}, turbulence_intensity_ci95{};
+  /// Shen & Nakamura only (none with Tian or unless ok): number means of the
+  /// accepted bubbles' interface diameters, m, and the interfacial area
+  /// concentration (2 / T) sum 1 / |V . n|, 1/m.
+  std::optional<double> diameter_front, diameter_rear, interfacial_area;
+
+  std::int64_t bubbles_total = 0;
+  std::int64_t bubbles_accepted = 0;  ///< count(BubbleFate::solved), the N of the statistics
+  std::array<std::int64_t, bubble_fate_count> bubbles_by_fate{};
+  [[nodiscard]] std::int64_t count(BubbleFate fate) const { return bubbles_by_fate[static_cast<std::size_t>(fate)]; }
+  std::int64_t partners_censored = 0;         ///< paired trailing crossings cut by the record's ends (not used)
+  std::int64_t combinations_solved = 0;
+  std::int64_t combinations_ill_conditioned = 0;  ///< skipped: below conditioning-min
+  std::int64_t combinations_degenerate = 0;
+  int roc_passes = 0;                         ///< passes over the three components
+
+  std::vector<BubbleVector> bubbles;  ///< one per leading bubble, in input order
+
+  /// A few readable lines: the vector, the stresses, Tu, sizes, IAC, fates.
+  [[nodiscard]] std::string report() const;
+};
+
+/// Solves every bubble through the combinations of its paired trailing tips
+/// and summarises them. Throws OptionError when the options or the geometry
+/// are refused (check() names the tip), std::invalid_argument when
+/// `bubbles` does not match the geometry or record_length (T, s) is not
+/// positive.
+MultiTipResult multi_tip(const ProbeGeometry& geometry, const PiercedBubbles& bubbles, double record_length,
+                         const MultiTipOptions& options = {});
+
+}  // namespace awcc
