@@ -530,10 +530,36 @@ class Hdf5Recording final : public Recording {
     return yes;
   }
 
+  // Whether the file links every component of an absolute path: 1 yes, 0
+  // no (or a dataset on the way), negative when a look-up fails (damaged).
+  htri_t holds(const std::string& path) {
+    htri_t held = 1;
+    for (std::size_t end = 0; held > 0 && end != std::string::npos;) {
+      end = path.find('/', end + 1);
+      const std::string part = path.substr(0, end);
+      held = H5Lexists(file_.get(), part.c_str(), H5P_DEFAULT);
+      H5O_info_t info;
+      if (held > 0 && end != std::string::npos) {
+        if (H5Oget_info_by_name2(file_.get(), part.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) < 0) {
+          held = -1;
+        } else if (info.type != H5O_TYPE_GROUP) {
+          held = 0;
+        }
+      }
+    }
+    H5Eclear2(H5E_DEFAULT);
+    return held;
+  }
+
   Handle open_named(const std::string& name) {
     Handle object(H5Oopen(file_.get(), name.c_str(), H5P_DEFAULT));
     if (!object.valid()) {
-      H5Eclear2(H5E_DEFAULT);
+      const std::string says = hdf5_says();
+      // A name the file holds whose object cannot be read, or a look-up that
+      // fails on the way, is a damaged file, not a wrong name.
+      if (holds(absolute(name)) != 0) {
+        fail(fmt::format("'{}' cannot be opened{}: the file is damaged", absolute(name), says));
+      }
       fail(fmt::format("no dataset or group '{}'; its numeric datasets: {}", absolute(name), listing(list_datasets())),
            "dataset");
     }

@@ -544,6 +544,43 @@ TEST(Hdf5Reader, AbsentOrAmbiguousDatasetsAreRefusedWithTheList) {
   EXPECT_TRUE(has(message, "no numeric 2-D dataset") && has(message, "/c/vector")) << message;
 }
 
+// Found by fuzz_read_hdf5 once a NULL from malloc reached libhdf5 (as in
+// production): a named dataset whose object header cannot be read was
+// refused as "no dataset or group", sending the user to look for a wrong name
+// in a damaged file.
+TEST(Hdf5Reader, ANamedDatasetThatCannotBeReadIsADamagedFileNotAWrongName) {
+  const std::vector<float> v(40, 1.0f);
+  const auto p = scratch("damaged_header.h5");
+  haddr_t header = HADDR_UNDEF;
+  {
+    Writer w(p);
+    w.dataset("/g/run", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {40}, v.data());
+    w.number("/", "fs", 1e3);
+    w.close_datasets();
+    H5O_info_t info;
+    ASSERT_GE(H5Oget_info_by_name2(w.file(), "/g/run", &info, H5O_INFO_BASIC, H5P_DEFAULT), 0);
+    header = info.addr;
+  }
+  awcc::ReaderOptions o;
+  o.datasets = {"/g/run/x"};
+  std::string quantity;
+  auto message = refusal([&] { (void)awcc::open_recording(p, o); }, &quantity);
+  EXPECT_TRUE(has(message, "no dataset or group '/g/run/x'") && has(message, "/g/run")) << message;
+  EXPECT_EQ(quantity, "dataset");
+  {
+    // The dataset's object header overwritten: its link in /g is intact.
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(header));
+    const std::string garbage(16, '\xff');
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  o.datasets = {"/g/run"};
+  message = refusal([&] { (void)awcc::open_recording(p, o); });
+  EXPECT_TRUE(has(message, p.string()) && has(message, "'/g/run' cannot be opened") && has(message, "damaged"))
+      << message;
+  EXPECT_FALSE(has(message, "no dataset")) << message;
+}
+
 TEST(Hdf5Reader, ATimeBaseThatIsNotUniformOrIncreasingIsRefused) {
   const std::size_t n = 1000;
   const auto signal = air_pattern(n, 2);
