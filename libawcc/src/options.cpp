@@ -79,6 +79,12 @@ std::string cells_or(const std::vector<std::string>& names, const char* empty) {
   return out.empty() ? std::string(empty) : out;
 }
 
+std::string cells_of(const std::vector<int>& values) {
+  std::string out;
+  for (int v : values) out += (out.empty() ? "" : ",") + std::to_string(v);
+  return out;
+}
+
 // The recording formats as the registry (awcc/recording.hpp) names them: "auto | sndfile | dat | ...".
 const std::string& format_choices() {
   static const std::string choices = [] {
@@ -410,7 +416,28 @@ const OptionField<M> kMultiTip[] = {
 
 using P = ProcessOptions;
 constexpr std::array<std::pair<const char*, int>, 4> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}, {"none", 0}}};
+// The probe's tips first: probe_option_fields() is their span, and a later
+// option's parse may read them.
+constexpr std::size_t kProbeFields = 3;
 const OptionField<P> kProcess[] = {
+    {"tips", "m",
+     "the probe's tip positions x,y,z (x streamwise), a unit on each value, tips separated by ';' (e.g. "
+     "'0mm,0mm,0mm;5mm,0mm,0mm;5mm,1.5mm,0mm;5mm,0mm,1.5mm'): instead of dx and dy",
+     [](P& o, std::string_view t) {
+       o.probe.positions = parse_points(t);
+       if (const auto why = tips_problem(o.probe.positions); !why.empty()) throw std::invalid_argument(why);
+     },
+     [](const P& o) { return o.probe.declared() ? format_points(o.probe.positions) : std::string("dx and dy"); }},
+    {"leading-tip", "-", "with tips: the leading tip, by its place in the list (from 0)",
+     [](P& o, std::string_view t) { o.probe.leading = static_cast<int>(whole(t, 0, 1023)); },
+     [](const P& o) { return std::to_string(o.probe.leading); }},
+    {"tip-channels", "-", "with tips: each tip's recording channel (from 0), in the order of the tips, e.g. 0,1,3,2",
+     [](P& o, std::string_view t) {
+       o.probe.channels.clear();
+       for (const auto& cell : split_cells(t)) o.probe.channels.push_back(static_cast<int>(whole(cell, 0, 1023)));
+       if (const auto why = channels_problem(o.probe.channels); !why.empty()) throw std::invalid_argument(why);
+     },
+     [](const P& o) { return o.probe.channels.empty() ? std::string("tip k on channel k") : cells_of(o.probe.channels); }},
     {"dx", "m", "streamwise tip separation (e.g. 7.15mm); 0 = no velocity",
      [](P& o, std::string_view t) { o.dx = quantity(t, Dimension::length); },
      [](const P& o) { return format_quantity(o.dx, Dimension::length); }},
@@ -456,6 +483,9 @@ std::span<const OptionField<BinarisationOptions>> binarisation_option_fields() {
 std::span<const OptionField<FsccOptions>> fscc_option_fields() { return kFscc; }
 std::span<const OptionField<AwccOptions>> awcc_option_fields() { return kAwcc; }
 std::span<const OptionField<ProcessOptions>> process_option_fields() { return kProcess; }
+std::span<const OptionField<ProcessOptions>> probe_option_fields() {
+  return std::span<const OptionField<ProcessOptions>>(kProcess).first(kProbeFields);
+}
 std::span<const OptionField<StructureOptions>> structure_option_fields() { return kStructure; }
 std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields() { return kMultiTip; }
 

@@ -26,18 +26,28 @@ Validation ProcessOptions::validate() const {
         "leading-channel,trailing-channel",
         fmt::format("the leading and trailing tips are both channel {}; choose two channels", leading_channel));
   }
-  const std::vector<int> tips = tip_channels();
-  for (std::size_t k = 2; k < tips.size(); ++k) {
-    if (tips[k] < 0) return Validation::invalid("further-channels", "channel indices must be >= 0");
+  const std::vector<int> channels = tip_channels();
+  for (std::size_t k = 2; k < channels.size(); ++k) {
+    if (channels[k] < 0) return Validation::invalid("further-channels", "channel indices must be >= 0");
     for (std::size_t j = 0; j < k; ++j) {
-      if (tips[j] == tips[k]) {
+      if (channels[j] == channels[k]) {
         return Validation::invalid("further-channels",
                                    fmt::format("tips {} and {} are both channel {}; give each tip its own channel", j,
-                                               k, tips[k]));
+                                               k, channels[k]));
       }
     }
   }
   if (!(dx >= 0.0 && std::isfinite(dx))) return Validation::invalid("dx", fmt::format("dx = {} m must be >= 0", dx));
+  if (const auto tips = probe.validate(); !tips.ok()) return tips;
+  if (probe.declared() && (dx != 0.0 || dy != 0.0)) {
+    return Validation::invalid("dx,tips", "dx (or dy) and tips both declare the probe's geometry: give the tips "
+                                          "alone (the pair's separation follows from them)");
+  }
+  if (probe.declared() && (leading_channel != 0 || trailing_channel != 1)) {
+    return Validation::invalid("leading-channel,trailing-channel",
+                               "with tips declared, tip-channels maps each tip to its channel and leading-tip names "
+                               "the leading one: give those instead of the pair's channels");
+  }
   for (const auto& part : {binarisation.validate(), signal_check.validate(), fscc_options.validate(),
                            awcc_options.validate(), structure.validate(), spectrum.validate()}) {
     if (!part.ok()) return part;
@@ -50,6 +60,65 @@ Validation ProcessOptions::validate() const {
 std::vector<int> ProcessOptions::tip_channels() const {
   std::vector<int> out{leading_channel, trailing_channel};
   out.insert(out.end(), further_channels.begin(), further_channels.end());
+  return out;
+}
+
+ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingInfo& info) {
+  const ProbeTips probe = probe_of(options.probe, info);
+  ProcessOptions out = options;
+  out.probe = {};
+  if (!probe.declared()) return out;
+  const std::string file = info.path.string();
+  const bool declared = options.probe.declared();
+  // The pair's positions: a declared probe's by tip, a file's by channel.
+  std::size_t a = 0, b = 0;
+  if (declared) {
+    a = b = static_cast<std::size_t>(probe.leading);
+    for (std::size_t k = 0; k < probe.positions.size() && b == a; ++k) {
+      if (k != a && probe.positions[k][0] > probe.positions[a][0]) b = k;
+    }
+    if (b == a) {
+      throw InputError(fmt::format("{}: no declared tip lies downstream of the leading tip {} (none has a larger x): "
+                                   "the tip pair needs one; check the order of the coordinates x,y,z, or name the "
+                                   "leading tip",
+                                   file, a),
+                       "leading-tip");
+    }
+    out.leading_channel = probe.channel_of(a);
+    out.trailing_channel = probe.channel_of(b);
+  } else {
+    if (options.leading_channel >= info.channels || options.trailing_channel >= info.channels) {
+      return out;  // binarise_recording() names the channel
+    }
+    a = static_cast<std::size_t>(options.leading_channel);
+    b = static_cast<std::size_t>(options.trailing_channel);
+  }
+  const auto& p = probe.positions;
+  const double along = p[b][0] - p[a][0], across = std::hypot(p[b][1] - p[a][1], p[b][2] - p[a][2]);
+  if (declared) {
+    out.dx = along;
+    out.dy = across;
+    return out;
+  }
+  const auto stated = [&](const char* name, double given, double file_value) {
+    if (given == 0.0) return file_value;
+    if (std::fabs(given - file_value) <= separation_tolerance) return given;
+    throw InputError(fmt::format("{}: {} = {} is given, but the file states the tips of channels {} and {} {} apart: "
+                                 "one of them is wrong; correct {}, or leave it out to use the file's",
+                                 file, name, format_quantity(given, Dimension::length), a, b,
+                                 format_quantity(file_value, Dimension::length), name),
+                     name);
+  };
+  out.dx = stated("dx", options.dx, along);
+  out.dy = stated("dy", options.dy, across);
+  if (!(out.dx > 0.0)) {
+    throw InputError(fmt::format("{}: the file states the tip of channel {} at x = {} and that of channel {} at x = "
+                                 "{}: the trailing tip is not downstream; choose leading-channel and "
+                                 "trailing-channel",
+                                 file, a, format_quantity(p[a][0], Dimension::length), b,
+                                 format_quantity(p[b][0], Dimension::length)),
+                     "leading-channel,trailing-channel");
+  }
   return out;
 }
 
@@ -415,8 +484,9 @@ BinarisedRecording binarise_recording(const std::filesystem::path& path, const P
   return binarise_recording(*recording, options);
 }
 
-BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& options) {
-  options.validate().throw_if_failed();
+BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& given) {
+  given.validate().throw_if_failed();
+  const ProcessOptions options = tip_pair_options(given, opened.info());
   Recording* recording = &opened;
   const RecordingInfo& info = recording->info();
   const std::filesystem::path& path = info.path;
@@ -564,7 +634,8 @@ std::string_view to_string(VelocitySource source) {
   return "?";
 }
 
-ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOptions& options) {
+ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOptions& given) {
+  const ProcessOptions options = tip_pair_options(given, r.info);
   ProcessResult out;
   out.info = r.info;
   out.dx = options.dx;
@@ -671,8 +742,9 @@ AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const Pro
   return awcc_raw(recording, b, options, workspace);
 }
 
-AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options,
+AwccResult awcc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& given,
                     AwccWorkspace& workspace) {
+  const ProcessOptions options = tip_pair_options(given, b.info);
   const AwccOptions& ao = options.awcc_options;
   ao.validate().throw_if_failed();
   RawVoltageCorrelations voltages(recording, options);
@@ -688,8 +760,9 @@ FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const Pro
   return fscc_raw(recording, b, options, plans);
 }
 
-FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& options,
+FsccResult fscc_raw(Recording& recording, const BinarisedRecording& b, const ProcessOptions& given,
                     FftPlanCache& plans) {
+  const ProcessOptions options = tip_pair_options(given, b.info);
   const std::filesystem::path& path = recording.info().path;
   recording.rewind();
   const auto stride = static_cast<std::size_t>(recording.info().channels);
@@ -756,8 +829,11 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& opti
   return process_recording(recording, options, workspace);
 }
 
-ProcessResult process_recording(Recording& recording, const ProcessOptions& options, ProcessWorkspace& workspace) {
+ProcessResult process_recording(Recording& recording, const ProcessOptions& given, ProcessWorkspace& workspace) {
   const auto start = std::chrono::steady_clock::now();
+  given.validate().throw_if_failed();
+  // The tip pair of a declared (or recorded) probe, once: every step below reads it.
+  const ProcessOptions options = tip_pair_options(given, recording.info());
   recording.rewind();
   const auto binarised = binarise_recording(recording, options);
   ProcessResult out;

@@ -197,4 +197,41 @@ long long parse_whole(std::string_view text, long long lo, long long hi) {
   return static_cast<long long>(v);
 }
 
+std::vector<std::array<double, 3>> parse_points(std::string_view text) {
+  std::vector<std::array<double, 3>> points;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t end = std::min(text.find(';', pos), text.size());
+    const std::string_view point = text.substr(pos, end - pos);
+    const auto index = points.size();
+    if (std::count(point.begin(), point.end(), ',') != 2) {
+      throw std::invalid_argument(fmt::format("point {} '{}' needs exactly three coordinates x,y,z", index, point));
+    }
+    std::array<double, 3> c{};
+    std::size_t p = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::size_t comma = k < 2 ? point.find(',', p) : point.size();
+      try {
+        c[k] = parse_quantity(point.substr(p, comma - p), Dimension::length);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(fmt::format("point {} '{}', coordinate {}: {}", index, point, "xyz"[k], e.what()));
+      }
+      p = comma + 1;
+    }
+    points.push_back(c);
+    if (end == text.size()) break;
+    pos = end + 1;
+  }
+  return points;
+}
+
+std::string format_points(std::span<const std::array<double, 3>> points) {
+  std::string out;
+  for (const auto& p : points) {
+    out += fmt::format("{}{},{},{}", out.empty() ? "" : ";", format_quantity(p[0], Dimension::length),
+                       format_quantity(p[1], Dimension::length), format_quantity(p[2], Dimension::length));
+  }
+  return out;
+}
+
 }  // namespace awcc

@@ -41,6 +41,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -276,6 +277,7 @@ class Hdf5Recording final : public Recording {
     tune_chunk_cache();
     scale(options);
     name_channels();
+    locate_tips();
     info_.fs = rate(options);
     describe();
   }
@@ -876,20 +878,154 @@ class Hdf5Recording final : public Recording {
     }
   }
 
-  // Column names from a `sensor_id` attribute (numbers or strings), else the datasets' paths.
+  // Column names from a `sensor_id` attribute (numbers: "sensor 3"; strings
+  // as they are), else the datasets' paths. The ids themselves are the
+  // recording's sensor_ids when one dataset holds every channel.
   void name_channels() {
     for (const auto& s : sources_) {
-      std::vector<std::string> names;
-      if (s.dims.size() == 2) names = sensor_ids(s);
+      bool numeric = false;
+      std::vector<std::string> ids;
+      if (s.dims.size() == 2) ids = sensor_ids(s, numeric);
+      if (sources_.size() == 1) info_.sensor_ids = ids;
       for (int c = 0; c < s.channels; ++c) {
-        if (!names.empty()) info_.channel_names.push_back(names[static_cast<std::size_t>(c)]);
+        const auto column = static_cast<std::size_t>(c);
+        if (!ids.empty()) info_.channel_names.push_back(numeric ? "sensor " + ids[column] : ids[column]);
         else if (s.dims.size() == 1 || s.channels == 1) info_.channel_names.push_back(s.name);
         else info_.channel_names.push_back(fmt::format("{}[{}]", s.name, c));
       }
     }
   }
 
-  std::vector<std::string> sensor_ids(const Source& s) {
+  // Where the tips are: the `relative_location` attribute pdp synth writes on
+  // pdp-sim's `signal`, and pdp-sim's config.json beside the file (sensors
+  // matched by id); both when both, which must agree.
+  void locate_tips() {
+    if (!pdpsim_) return;
+    const auto& s = sources_.front();
+    const auto written = location_attribute(s);
+    const auto configured = configured_locations();
+    if (written && configured) {
+      for (std::size_t c = 0; c < written->size(); ++c) {
+        const auto& a = (*written)[c];
+        const auto& b = (*configured)[c];
+        if (std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]) > 1e-9) {
+          fail(fmt::format("attribute '{}' of '{}' places the tip of column {} at ({}, {}, {}) m, but {} places "
+                           "sensor {} at ({}, {}, {}) m: one of them describes another probe; correct or remove one",
+                           pdpsim::tip_position_attribute, s.name, c, a[0], a[1], a[2], config_path().string(),
+                           info_.sensor_ids.empty() ? std::to_string(c) : info_.sensor_ids[c], b[0], b[1], b[2]));
+        }
+      }
+    }
+    if (written) info_.tip_positions = *written;
+    else if (configured) info_.tip_positions = *configured;
+    else return;
+    // pdp-sim's leading tip is sensor id 0 (mssp.py: S_0k from sensor 0).
+    const auto zero = std::find(info_.sensor_ids.begin(), info_.sensor_ids.end(), "0");
+    info_.leading_tip = zero == info_.sensor_ids.end() ? 0 : static_cast<int>(zero - info_.sensor_ids.begin());
+  }
+
+  fs::path config_path() const { return info_.path.parent_path() / pdpsim::config_file; }
+
+  std::optional<std::vector<std::array<double, 3>>> location_attribute(const Source& s) {
+    const char* name = pdpsim::tip_position_attribute;
+    if (H5Aexists(s.dataset.get(), name) <= 0) {
+      H5Eclear2(H5E_DEFAULT);
+      return std::nullopt;
+    }
+    Handle attribute(H5Aopen(s.dataset.get(), name, H5P_DEFAULT));
+    Handle type(attribute.valid() ? H5Aget_type(attribute.get()) : H5I_INVALID_HID);
+    Handle space(attribute.valid() ? H5Aget_space(attribute.get()) : H5I_INVALID_HID);
+    if (!type.valid() || !space.valid()) {
+      fail(fmt::format("attribute '{}' of '{}' cannot be read{}: the file is damaged", name, s.name, hdf5_says()));
+    }
+    if (!numeric_class(type.get()) || damaged_number_type(type.get())) {
+      fail(fmt::format("attribute '{}' of '{}' does not hold numbers: the file is damaged", name, s.name));
+    }
+    hsize_t dims[2] = {0, 0};
+    if (H5Sget_simple_extent_ndims(space.get()) != 2 || H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 2 ||
+        dims[0] != static_cast<hsize_t>(s.channels) || dims[1] != 3) {
+      fail(fmt::format("attribute '{}' of '{}' must hold one position x, y, z per column ({} x 3 values): the file "
+                       "is damaged",
+                       name, s.name, s.channels));
+    }
+    std::vector<double> values(static_cast<std::size_t>(s.channels) * 3);
+    if (H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, values.data()) < 0) {
+      fail(fmt::format("attribute '{}' of '{}' cannot be read{}: the file is damaged", name, s.name, hdf5_says()));
+    }
+    std::vector<std::array<double, 3>> out;
+    for (std::size_t c = 0; c < values.size(); c += 3) {
+      if (!std::isfinite(values[c]) || !std::isfinite(values[c + 1]) || !std::isfinite(values[c + 2])) {
+        fail(fmt::format("attribute '{}' of '{}': the position of column {} is not finite: the file is damaged",
+                         name, s.name, c / 3));
+      }
+      out.push_back({values[c], values[c + 1], values[c + 2]});
+    }
+    return out;
+  }
+
+  // pdp-sim's config.json beside the file, by sensor id; none when there is
+  // no such file or it describes no probe (another program's config.json).
+  std::optional<std::vector<std::array<double, 3>>> configured_locations() const {
+    const fs::path path = config_path();
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return std::nullopt;
+    std::ifstream in(path);
+    nlohmann::json config;
+    try {
+      config = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+      fail(fmt::format("{} beside it (pdp-sim's configuration, which states the tips) is not valid JSON ({}): "
+                       "correct it, or move it away and declare the tips",
+                       path.string(), e.what()));
+    }
+    if (!config.is_object() || !config.contains(pdpsim::config_probe)) return std::nullopt;
+    const std::string where = fmt::format("{} ({}.{})", path.string(), pdpsim::config_probe, pdpsim::config_sensors);
+    const auto& probe = config[pdpsim::config_probe];
+    if (!probe.is_object() || !probe.contains(pdpsim::config_sensors) || !probe[pdpsim::config_sensors].is_array()) {
+      fail(fmt::format("{} lists no sensors: correct it, or move it away and declare the tips", where));
+    }
+    std::vector<std::pair<std::string, std::array<double, 3>>> sensors;
+    for (const auto& sensor : probe[pdpsim::config_sensors]) {
+      const auto index = sensors.size();
+      if (!sensor.is_object() || !sensor.contains(pdpsim::config_sensor_id) ||
+          !sensor[pdpsim::config_sensor_id].is_number_integer() || !sensor.contains(pdpsim::config_location) ||
+          !sensor[pdpsim::config_location].is_array() || sensor[pdpsim::config_location].size() != 3) {
+        fail(fmt::format("{}: sensor {} needs an integer '{}' and a '{}' of three numbers (m)", where, index,
+                         pdpsim::config_sensor_id, pdpsim::config_location));
+      }
+      std::array<double, 3> at{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto& v = sensor[pdpsim::config_location][k];
+        if (!v.is_number() || !std::isfinite(v.get<double>())) {
+          fail(fmt::format("{}: the '{}' of sensor {} holds a value that is not a finite number", where,
+                           pdpsim::config_location, index));
+        }
+        at[k] = v.get<double>();
+      }
+      sensors.emplace_back(std::to_string(sensor[pdpsim::config_sensor_id].get<long long>()), at);
+    }
+    const auto columns = static_cast<std::size_t>(info_.channels);
+    if (sensors.size() != columns) {
+      fail(fmt::format("{} describes {} sensors but the file records {} channel{}: they belong to different runs; "
+                       "correct config.json, or move it away and declare the tips recorded",
+                       where, sensors.size(), columns, columns == 1 ? "" : "s"));
+    }
+    std::vector<std::array<double, 3>> out;
+    for (std::size_t c = 0; c < columns; ++c) {
+      // pdp-sim writes the ids in config.json's order; without ids, that order is the columns'.
+      const std::string id = info_.sensor_ids.empty() ? sensors[c].first : info_.sensor_ids[c];
+      const auto it = std::find_if(sensors.begin(), sensors.end(), [&id](const auto& x) { return x.first == id; });
+      if (it == sensors.end()) {
+        fail(fmt::format("column {} is sensor {}, which {} does not describe: they belong to different runs; "
+                         "correct config.json, or move it away and declare the tips",
+                         c, id, where));
+      }
+      out.push_back(it->second);
+    }
+    return out;
+  }
+
+  std::vector<std::string> sensor_ids(const Source& s, bool& numeric) {
     const char* name = pdpsim::sensor_id_attribute;
     if (H5Aexists(s.dataset.get(), name) <= 0) {
       H5Eclear2(H5E_DEFAULT);
@@ -917,9 +1053,10 @@ class Hdf5Recording final : public Recording {
       if (H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, values.data()) < 0) {
         fail(fmt::format("attribute '{}' of '{}' cannot be read{}: the file is damaged", name, s.name, hdf5_says()));
       }
+      numeric = true;
       for (double v : values) {
-        ids.push_back(std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("sensor {:.0f}", v)
-                                                                                     : fmt::format("sensor {}", v));
+        ids.push_back(std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v)
+                                                                                     : fmt::format("{}", v));
       }
     } else if (H5Tget_class(type.get()) == H5T_STRING) {
       ids = strings(attribute.get(), type.get(), space.get(), count, name, s.name);

@@ -119,6 +119,20 @@ void write_hdf5(const std::filesystem::path& file, const std::filesystem::path& 
   for (std::size_t j = 0; j < tips; ++j) ids[j] = static_cast<std::int64_t>(j);
   attribute(awcc::pdpsim::sensor_id_attribute, H5T_STD_I64LE, H5T_NATIVE_INT64, ids.data(), tips, false);
   attribute(awcc::pdpsim::fs_attribute, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &scene.fs, 1, true);
+  {
+    // The tips' positions (m) by column, the key of pdp-sim's config.json, so
+    // the file carries its probe (pdp process needs no declaration of it).
+    std::vector<double> at;
+    for (const auto& t : scene.probe_tips()) at.insert(at.end(), {t.x, t.y, t.z});
+    const hsize_t dims[2] = {static_cast<hsize_t>(tips), 3};
+    Handle space(H5Screate_simple(2, dims, nullptr));
+    Handle a(space.valid() ? H5Acreate2(signal.get(), awcc::pdpsim::tip_position_attribute, H5T_IEEE_F64LE,
+                                        space.get(), H5P_DEFAULT, H5P_DEFAULT)
+                           : H5I_INVALID_HID);
+    if (at.size() != 3 * tips || !a.valid() || H5Awrite(a.get(), H5T_NATIVE_DOUBLE, at.data()) < 0) {
+      fail(fmt::format("cannot write the attribute '{}'", awcc::pdpsim::tip_position_attribute));
+    }
+  }
   std::optional<VoltageRenderer> renderer;
   if (!binary) {
     renderer.emplace(scene, tips);

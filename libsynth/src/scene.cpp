@@ -1,6 +1,7 @@
 #include "synth/scene.hpp"
 
 #include <Eigen/Dense>
+#include <array>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -229,40 +230,19 @@ std::int64_t integer(std::string_view text, std::string_view name) {
   return static_cast<std::int64_t>(v);
 }
 
+// The tips' text is read and written by libcore's point lists (awcc/units.hpp),
+// as pdp process reads its `tips` option: one form of a probe for both.
 std::vector<Vec3> parse_tips(std::string_view text) {
-  // "x,y,z;x,y,z;..." with units on each coordinate.
   std::vector<Vec3> tips;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    const std::size_t end = std::min(text.find(';', pos), text.size());
-    const std::string_view tip = text.substr(pos, end - pos);
-    double c[3];
-    std::size_t p = 0;
-    for (int k = 0; k < 3; ++k) {
-      const std::size_t comma = k < 2 ? tip.find(',', p) : tip.size();
-      if (comma == std::string_view::npos)
-        throw std::invalid_argument(fmt::format("tip '{}' needs three coordinates x,y,z", tip));
-      c[k] = parse_quantity(tip.substr(p, comma - p), Dimension::length);
-      p = comma + 1;
-    }
-    if (tip.find(',', tip.rfind(',') + 1) != std::string_view::npos || std::count(tip.begin(), tip.end(), ',') != 2)
-      throw std::invalid_argument(fmt::format("tip '{}' needs exactly three coordinates x,y,z", tip));
-    tips.push_back({c[0], c[1], c[2]});
-    if (end == text.size()) break;
-    pos = end + 1;
-  }
+  for (const auto& p : awcc::parse_points(text)) tips.push_back({p[0], p[1], p[2]});
   return tips;
 }
 
 std::string format_tips(const Scene& s) {
   if (s.tips.empty()) return "(two tips from dx, dy, dz)";
-  std::string out;
-  for (const auto& t : s.tips) {
-    if (!out.empty()) out += ";";
-    out += fmt::format("{},{},{}", format_quantity(t.x, Dimension::length), format_quantity(t.y, Dimension::length),
-                       format_quantity(t.z, Dimension::length));
-  }
-  return out;
+  std::vector<std::array<double, 3>> points;
+  for (const auto& t : s.tips) points.push_back({t.x, t.y, t.z});
+  return awcc::format_points(points);
 }
 
 #define PDP_QUANTITY_FIELD(NAME, MEMBER, DIM, HELP)                                               \

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -776,3 +777,110 @@ TEST(Hdf5Reader, RecordingsReadFromSeveralThreadsAtOnce) {
 }
 
 }  // namespace
+
+namespace {
+
+// pdp-sim's run folder of a four-sensor probe: binary_signal.h5 with the ids
+// of config.json's sensors in its order, and config.json (PROBE.sensors: id,
+// relative_location in m), as pdp-sim's sbg.py writes them. Each test has
+// its own folder: config.json's name is fixed.
+struct PdpSimRun {
+  fs::path folder, signal;
+};
+
+PdpSimRun pdpsim_run(const std::string& name, const std::string& config, std::size_t frames = 2000,
+                     const std::vector<std::int64_t>& ids = {0, 1, 2, 3}) {
+  PdpSimRun run{scratch(name), {}};
+  fs::remove_all(run.folder);
+  fs::create_directories(run.folder);
+  run.signal = run.folder / "binary_signal.h5";
+  const auto signal = air_pattern(frames, ids.size());
+  std::vector<double> time(frames);
+  for (std::size_t i = 0; i < frames; ++i) time[i] = static_cast<double>(i) / 40e3;
+  {
+    Writer w(run.signal);
+    w.dataset("time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {frames}, time.data());
+    const hid_t s = w.dataset("signal", H5T_STD_U8LE, H5T_NATIVE_UINT8, {frames, ids.size()}, signal.data());
+    Writer::integers(s, "sensor_id", ids);
+    w.close_datasets();
+  }
+  if (!config.empty()) std::ofstream(run.folder / "config.json") << config;
+  return run;
+}
+
+// pdp-sim's tests/1_SBG_Timeseries/D_Frequency/input/config.json, its PROBE
+// block (the sensors listed out of id order here, to show they are matched by id).
+const char* const kFourSensorConfig = R"({
+  "FLOW_PROPERTIES": {"mean_velocity": [5.0, 0.0, 0.0]},
+  "PROBE": {
+    "sampling_frequency": 40000,
+    "sensors": [
+      {"id": 0, "relative_location": [0.0, 0.0, 0.0]},
+      {"id": 2, "relative_location": [0.001, -0.0001, -0.0001]},
+      {"id": 1, "relative_location": [0.001, 0.0, 0.0002]},
+      {"id": 3, "relative_location": [0.001, 0.0001, -0.0001]}
+    ]
+  },
+  "REPRODUCIBLE": "yes"
+})";
+
+}  // namespace
+
+TEST(Hdf5Reader, PdpSimMultiTipRunGivesEveryChannelItsSensorIdAndTipPosition) {
+  const std::size_t n = 2000;
+  const auto run = pdpsim_run("multi_tip_run", kFourSensorConfig, n);
+  auto r = awcc::open_recording(run.signal, {});
+  const auto& info = r->info();
+  EXPECT_EQ(info.channels, 4);
+  EXPECT_EQ(info.sensor_ids, (std::vector<std::string>{"0", "1", "2", "3"}));
+  EXPECT_EQ(info.channel_names, (std::vector<std::string>{"sensor 0", "sensor 1", "sensor 2", "sensor 3"}));
+  // Column k holds sensor id k: its position is config.json's entry of that id, whatever the list's order.
+  const std::vector<std::array<double, 3>> expected = {
+      {0.0, 0.0, 0.0}, {0.001, 0.0, 0.0002}, {0.001, -0.0001, -0.0001}, {0.001, 0.0001, -0.0001}};
+  EXPECT_EQ(info.tip_positions, expected);
+  EXPECT_EQ(info.leading_tip, 0);
+  // Every channel is delivered: the four columns' samples as written.
+  const auto pattern = air_pattern(n, 4);
+  const auto values = read_all(*r, 333);
+  ASSERT_EQ(values.size(), pattern.size());
+  for (std::size_t i = 0; i < values.size(); ++i) ASSERT_EQ(values[i], pattern[i] / 256.0f) << i;
+
+  // The leading tip is sensor id 0 wherever its column is.
+  const auto moved = pdpsim_run("multi_tip_leading", kFourSensorConfig, 200, {2, 0, 1, 3});
+  const auto opened = awcc::open_recording(moved.signal, {});
+  const auto& m = opened->info();
+  EXPECT_EQ(m.leading_tip, 1);
+  EXPECT_EQ(m.tip_positions[0], expected[2]);
+  EXPECT_EQ(m.tip_positions[1], expected[0]);
+
+  // Without config.json (or with another program's), no positions are claimed.
+  const auto bare = pdpsim_run("multi_tip_bare", "", 200);
+  EXPECT_TRUE(awcc::open_recording(bare.signal, {})->info().tip_positions.empty());
+  const auto other = pdpsim_run("multi_tip_other_config", R"({"name": "not pdp-sim's"})", 200);
+  EXPECT_TRUE(awcc::open_recording(other.signal, {})->info().tip_positions.empty());
+}
+
+TEST(Hdf5Reader, APdpSimRunWhoseConfigDescribesOtherSensorsIsRefusedNamingBoth) {
+  // config.json of three sensors beside a recording of four: a recording with more channels than the probe's tips.
+  const std::string three = R"({"PROBE": {"sensors": [
+      {"id": 0, "relative_location": [0, 0, 0]}, {"id": 1, "relative_location": [0.001, 0, 0]},
+      {"id": 2, "relative_location": [0.001, 0.001, 0]}]}})";
+  const auto a = pdpsim_run("config_three", three, 200);
+  const auto why = refusal([&] { awcc::open_recording(a.signal, {}); });
+  EXPECT_TRUE(has(why, "binary_signal.h5")) << why;
+  EXPECT_TRUE(has(why, "config.json (PROBE.sensors) describes 3 sensors but the file records 4 channels")) << why;
+  // A column whose sensor id config.json does not list.
+  const auto b = pdpsim_run("config_other_ids", kFourSensorConfig, 200, {0, 1, 2, 9});
+  const auto unknown = refusal([&] { awcc::open_recording(b.signal, {}); });
+  EXPECT_TRUE(has(unknown, "column 3 is sensor 9, which")) << unknown;
+  // A location that is not three numbers.
+  const auto c = pdpsim_run("config_bad_location", R"({"PROBE": {"sensors": [
+      {"id": 0, "relative_location": [0, 0]}]}})", 200, {0});
+  const auto bad = refusal([&] { awcc::open_recording(c.signal, {}); });
+  EXPECT_TRUE(has(bad, "sensor 0 needs an integer 'id' and a 'relative_location' of three numbers")) << bad;
+  // Not JSON at all.
+  const auto d = pdpsim_run("config_not_json", "{PROBE:", 200);
+  const auto broken = refusal([&] { awcc::open_recording(d.signal, {}); });
+  EXPECT_TRUE(has(broken, "config.json beside it (pdp-sim's configuration, which states the tips) is not valid JSON"))
+      << broken;
+}

@@ -753,3 +753,28 @@ TEST(MatFile, ARecordingIsProcessedEndToEnd) {
 }
 
 }  // namespace
+
+// A four-tip probe's recording: every column is a channel, in every version.
+TEST(MatFile, AFourColumnMatrixDeliversAllFourChannels) {
+  const std::size_t n = 257, channels = 4;
+  std::vector<double> x(channels * n);  // column-major: one tip after another
+  for (std::size_t c = 0; c < channels; ++c) {
+    for (std::size_t i = 0; i < n; ++i) x[c * n + i] = static_cast<double>(c) + 0.001 * static_cast<double>(i);
+  }
+  double fs = 40000.0;
+  for (const auto& f : kFlavours) {
+    SCOPED_TRACE(f.name);
+    const auto p = scratch(std::string(f.name) + "_four.mat");
+    write_mat(p, f.version, f.compression,
+              {{"x", MAT_C_DOUBLE, MAT_T_DOUBLE, {n, channels}, x.data()},
+               {"fs", MAT_C_DOUBLE, MAT_T_DOUBLE, {1, 1}, &fs}});
+    auto r = awcc::open_recording(p, {});
+    ASSERT_EQ(r->info().channels, 4);
+    EXPECT_EQ(r->info().channel_names, (std::vector<std::string>{"x(:,1)", "x(:,2)", "x(:,3)", "x(:,4)"}));
+    const auto whole = read_all(*r, 50);
+    ASSERT_EQ(whole.size(), channels * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t c = 0; c < channels; ++c) ASSERT_EQ(whole[channels * i + c], static_cast<float>(x[c * n + i]));
+    }
+  }
+}

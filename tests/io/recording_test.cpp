@@ -457,3 +457,62 @@ TEST(Lvm, RowsWithoutTheEmptyCommentCellReadLikeRowsWithIt) {
   EXPECT_NE(error_of(p).find("line 13 has 2 cells where the first row has 4"), std::string::npos) << error_of(p);
 }
 
+
+// A four-tip probe's recording in each column format: every channel is
+// delivered, in order, each sample as written (channel c, frame i holds a
+// value of its own, so a channel read from another column shows).
+TEST(FourChannels, EveryColumnFormatDeliversAllFourChannels) {
+  constexpr int channels = 4, frames = 50;
+  auto count = [](int i, int c) { return static_cast<std::int16_t>(1000 * c + i - 20); };
+  std::vector<std::int16_t> counts;
+  for (int i = 0; i < frames; ++i)
+    for (int c = 0; c < channels; ++c) counts.push_back(count(i, c));
+  auto check = [&](const fs::path& p, const ReaderOptions& o, double volts_per_count) {
+    SCOPED_TRACE(p.filename().string());
+    auto r = open_recording(p, o);
+    ASSERT_EQ(r->info().channels, channels);
+    const auto v = read_all(*r, 3);
+    ASSERT_EQ(v.size(), counts.size());
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      ASSERT_FLOAT_EQ(v[k], static_cast<float>(counts[k] * volts_per_count)) << "frame " << k / 4 << ", channel " << k % 4;
+    }
+  };
+  ReaderOptions o;
+  o.fs = 20e3;
+  const auto dat = scratch("four.dat");
+  write_binary(dat, counts, dat_header(frames, channels));
+  check(dat, o, 5.0 / 32768.0);
+
+  const auto raw = scratch("four.raw");
+  write_binary(raw, counts);
+  ReaderOptions r = o;
+  r.format = "raw";
+  r.raw.channels = channels;
+  check(raw, r, 1.0);
+
+  const auto csv = scratch("four.csv");
+  {
+    std::ofstream f(csv);
+    f << "time,tip0,tip1,tip2,tip3\n";
+    for (int i = 0; i < frames; ++i) {
+      f << fmt::format("{:.6f}", i / 20e3);
+      for (int c = 0; c < channels; ++c) f << "," << count(i, c);
+      f << "\n";
+    }
+  }
+  check(csv, {}, 1.0);
+  EXPECT_EQ(open_recording(csv)->info().channel_names, (std::vector<std::string>{"tip0", "tip1", "tip2", "tip3"}));
+
+  const auto wav = scratch("four.wav");
+  SF_INFO info{};
+  info.samplerate = 20000;
+  info.channels = channels;
+  info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
+  SNDFILE* f = sf_open(wav.c_str(), SFM_WRITE, &info);
+  ASSERT_NE(f, nullptr);
+  sf_writef_short(f, counts.data(), frames);
+  sf_close(f);
+  ReaderOptions w;
+  w.volts_per_count = 1.0;
+  check(wav, w, 1.0);
+}

@@ -362,3 +362,29 @@ TEST(TdmsReader, HostileBytesAreRefusedWithAMessage) {
 }
 
 }  // namespace
+
+// A four-tip probe's recording: four channels of one group, all delivered in order.
+TEST(TdmsReader, FourChannelsOfAGroupAreAllDelivered) {
+  Bytes file;
+  const Bytes m = metadata({{"/'probe'/'tip0'", 20, 10, 6, {{"wf_increment", 10, 2.5e-5, ""}}},
+                            {"/'probe'/'tip1'", 20, 10, 6, {{"wf_increment", 10, 2.5e-5, ""}}},
+                            {"/'probe'/'tip2'", 20, 10, 6, {{"wf_increment", 10, 2.5e-5, ""}}},
+                            {"/'probe'/'tip3'", 20, 10, 6, {{"wf_increment", 10, 2.5e-5, ""}}}});
+  Bytes raw;
+  for (int c = 0; c < 4; ++c) {
+    for (int i = 0; i < 6; ++i) raw.put(static_cast<double>(c) + 0.125 * i);
+  }
+  file.add(segment(kMeta | kNewList | kRaw, &m, raw));
+  const auto p = scratch("four_tips.tdms");
+  write(p, file);
+  auto r = awcc::open_recording(p, {});
+  ASSERT_EQ(r->info().channels, 4);
+  EXPECT_DOUBLE_EQ(r->info().fs, 40000.0);
+  const auto v = read_all(*r);
+  ASSERT_EQ(v.size(), 24u);
+  for (int i = 0; i < 6; ++i) {
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_EQ(v[static_cast<std::size_t>(4 * i + c)], static_cast<float>(c + 0.125 * i)) << i << "," << c;
+    }
+  }
+}

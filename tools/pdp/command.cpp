@@ -95,7 +95,31 @@ void finish_parsing(Command& c) {
           others.push_back(sub->get_name());
         }
       }
+      for (const auto& [table, names] : c.option_tables) others.push_back(table);
       settings = awcc::read_settings(c.config, c.app->get_name(), others);
+      if (!c.option_tables.empty()) {
+        for (const auto& t : awcc::read_setting_tables(c.config)) {
+          const auto held = std::find_if(c.option_tables.begin(), c.option_tables.end(),
+                                         [&t](const auto& x) { return x.first == t.name; });
+          if (held == c.option_tables.end()) continue;
+          for (const auto& s : t.settings) {
+            const auto& names = held->second;
+            if (std::find(names.begin(), names.end(), s.key) == names.end()) {
+              std::string listed;
+              for (const auto& n : names) listed += (listed.empty() ? "" : ", ") + n;
+              throw awcc::InputError(fmt::format("{}:{}: [{}] holds {}; '{}' belongs at the top level or in [{}]",
+                                                 c.config, s.line, t.name, listed, s.key, c.app->get_name()));
+            }
+            const auto twice = std::find_if(settings.begin(), settings.end(),
+                                            [&s](const awcc::Setting& x) { return x.key == s.key; });
+            if (twice != settings.end()) {
+              throw awcc::InputError(fmt::format("{}:{}: {} is given again in [{}] (line {}); keep one", c.config,
+                                                 twice->line, s.key, t.name, s.line));
+            }
+            settings.push_back(s);
+          }
+        }
+      }
     } catch (const awcc::InputError& e) {
       throw std::invalid_argument(std::string("--config: ") + e.what());
     }

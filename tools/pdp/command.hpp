@@ -9,6 +9,7 @@
 #include <exception>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace pdp {
@@ -27,6 +28,9 @@ struct Command {
   CLI::App* app = nullptr;
   std::string config;                  ///< --config FILE.toml
   std::vector<CLI::Option*> required;  ///< given on the command line or in the config file
+  /// A settings file's tables that hold some of this command's options
+  /// beside its own ([probe]: the tips), each with the names it may hold.
+  std::vector<std::pair<std::string, std::vector<std::string>>> option_tables;
 };
 
 /// Adds --config to the subcommand.

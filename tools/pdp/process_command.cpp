@@ -23,6 +23,8 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
           ->check(CLI::ExistingPath));
   const awcc::ProcessOptions defaults;
   o.library.add(cmd, awcc::process_option_fields(), defaults, "Probe and methods");
+  auto& probe = command.option_tables.emplace_back("probe", std::vector<std::string>{});
+  for (const auto& f : awcc::probe_option_fields()) probe.second.emplace_back(f.name);
   o.library.add(cmd, awcc::reader_option_fields(), defaults.reader, "Input");
   o.library.add(cmd, awcc::binarisation_option_fields(), defaults.binarisation, "Binarisation");
   o.library.add(cmd, awcc::fscc_option_fields(), defaults.fscc_options, "FSCC");

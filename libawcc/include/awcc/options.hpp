@@ -26,6 +26,9 @@ std::span<const OptionField<AwccOptions>> awcc_option_fields();
 /// The options of a whole processing run that belong to none of the above:
 /// tip separations, channels, methods, histogram bins.
 std::span<const OptionField<ProcessOptions>> process_option_fields();
+/// The declaration of the probe's tips among them (tips, leading-tip,
+/// tip-channels): the keys a settings file's [probe] table holds.
+std::span<const OptionField<ProcessOptions>> probe_option_fields();
 std::span<const OptionField<StructureOptions>> structure_option_fields();
 /// The multi-tip solvers' options (awcc/multi_tip.hpp).
 std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields();

@@ -15,6 +15,7 @@
 #include "awcc/flags.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
+#include "awcc/probe_tips.hpp"
 #include "awcc/recording.hpp"
 #include "awcc/signal_check.hpp"
 #include "awcc/structure.hpp"
@@ -36,6 +37,10 @@ struct ProcessOptions {
   SignalCheckOptions signal_check;
   double dx = 0.0;                    ///< streamwise tip separation, m (required for velocities)
   double dy = 0.0;                    ///< lateral tip separation, m (reported)
+  /// The probe's tips as declared (tips, leading-tip, tip-channels): one
+  /// declaration instead of dx, dy and the two channels, which follow from
+  /// it per recording (tip_pair_options()).
+  ProbeTips probe;
   bool fscc = true;                   ///< run FSCC
   FsccOptions fscc_options;
   bool awcc = true;                   ///< run AWCC
@@ -70,6 +75,21 @@ struct ProcessOptions {
   /// and the value, its range and the likely slip.
   [[nodiscard]] Validation implausible() const;
 };
+
+/// The options of the dual-tip processing of a recording: where tips are
+/// declared (options.probe) or the recording states them
+/// (RecordingInfo::tip_positions), the tip pair is the leading tip and the
+/// first tip after it, in the order of the tips, that lies downstream of it
+/// (positive x separation); dx is their streamwise separation, dy their
+/// distance across the flow (hypot of the y and z separations), and the
+/// channels theirs. A declared probe of two tips processes exactly as dx and
+/// dy of the same separation. With only dx (and dy) given, a recording
+/// stating its tips must agree on the pair's separation (a zero dx or dy
+/// takes the file's). The result has no declared tips (it is its own
+/// tip_pair_options()). Throws InputError naming the file, the tips and the
+/// fix (probe_of(), no tip downstream of the leading one, a dx that
+/// disagrees with the file's).
+[[nodiscard]] ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingInfo& info);
 
 /// The plausible sampling rates of a probe recording, Hz (a file's own rate is checked too).
 inline constexpr double plausible_fs_min = 1e3, plausible_fs_max = 100e6;

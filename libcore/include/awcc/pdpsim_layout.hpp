@@ -6,10 +6,19 @@
 //  - root dataset `time`, float64 seconds, one value per sample, from 0;
 //  - attribute `sensor_id` on `signal`: the sensors' ids, one per column
 //    (integers from pdp-sim's configuration).
+// The probe's tips are in pdp-sim's run folder beside the file: config.json
+// (its input, validated by schemadef/config_schema.json) holds
+// `PROBE.sensors`, a list of {"id": integer, "relative_location": [x, y, z]}
+// in metres (x streamwise); the column of sensor id k is the one whose
+// `sensor_id` is k (pdp-sim writes the ids in the order of that list), and
+// its `mssp.py` takes sensor id 0 as the leading tip and the separations
+// S_0k = location(k) - location(0).
 // pdp's writer adds what pdp-sim leaves out, without changing the layout
-// pdp-sim's tools read: an `fs` attribute (Hz) on `signal`, and for raw
-// voltages (int16 counts, which pdp-sim does not produce) a `volts_per_count`
-// attribute on `signal`.
+// pdp-sim's tools read: an `fs` attribute (Hz) on `signal`; for raw voltages
+// (int16 counts, which pdp-sim does not produce) a `volts_per_count`
+// attribute on `signal`; and the tips' positions as a `relative_location`
+// attribute on `signal` (float64, sensors x 3, m, row j the tip of column
+// j), config.json's key, so that a single file carries its probe.
 
 #include <mutex>
 #include <string>
@@ -21,6 +30,13 @@ inline constexpr char time_dataset[] = "time";
 inline constexpr char sensor_id_attribute[] = "sensor_id";
 inline constexpr char volts_per_count_attribute[] = "volts_per_count";
 inline constexpr char fs_attribute[] = "fs";
+inline constexpr char tip_position_attribute[] = "relative_location";
+/// pdp-sim's configuration beside the file, and its keys for the probe's tips.
+inline constexpr char config_file[] = "config.json";
+inline constexpr char config_probe[] = "PROBE";
+inline constexpr char config_sensors[] = "sensors";
+inline constexpr char config_sensor_id[] = "id";
+inline constexpr char config_location[] = "relative_location";
 
 /// libhdf5 may be built without thread safety (awcc/recording.hpp's
 /// readers, detail::hdf5_library_mutex): whoever calls into it holds this lock. One instance per program (an inline function's static),

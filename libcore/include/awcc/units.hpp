@@ -5,8 +5,11 @@
 // is refused (but 0), because "7.15" for a tip separation in millimetres
 // would silently be 7.15 m. Dimensionless ones take bare numbers.
 
+#include <array>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace awcc {
 
@@ -37,6 +40,16 @@ double parse_quantity(std::string_view text, Dimension dimension);
 /// A whole number in [lo, hi] ("15", "1e3"); throws std::invalid_argument
 /// naming the text and the range.
 long long parse_whole(std::string_view text, long long lo, long long hi);
+
+/// Points in space, such as a probe's tips: "x,y,z;x,y,z;..." (a settings
+/// file's [["0mm","0mm","0mm"], ["5mm","0mm","0mm"]] arrives in this form),
+/// each coordinate a length with its unit, in metres. Throws
+/// std::invalid_argument naming the point (from 0) and its text: a point
+/// without exactly three coordinates, a coordinate without its unit.
+std::vector<std::array<double, 3>> parse_points(std::string_view text);
+
+/// The points as parse_points() reads them ("0mm,0mm,0mm;5mm,0mm,0mm").
+std::string format_points(std::span<const std::array<double, 3>> points);
 
 /// Formats an SI value with a readable unit ("5mm", "500kHz", "0.1s").
 std::string format_quantity(double value, Dimension dimension);

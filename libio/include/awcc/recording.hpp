@@ -34,6 +34,7 @@
 // .dat or audio header, a raw layout, an .lvm Channels line) that the data
 // contradict.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -110,6 +111,19 @@ struct RecordingInfo {
   bool volts_known = false;        ///< values are in volts (not normalised units)
   std::vector<std::string> warnings;  ///< what the reader accepted but the user must know (a truncated file)
   std::vector<std::string> channel_names;  ///< a column file's names of its data channels (header or "column k")
+  /// The sensor id of each channel as the file states it (pdp-sim's
+  /// `sensor_id` attribute, numbers written as whole numbers: "0", "3"), or
+  /// empty when the file states none.
+  std::vector<std::string> sensor_ids;
+  /// Where the file states each channel's tip is, m, one per channel (x
+  /// streamwise, y lateral, z vertical; pdp-sim's config.json
+  /// `relative_location` of the channel's sensor, or the `relative_location`
+  /// attribute pdp synth writes), or empty when it states none. Only the tips'
+  /// separations matter, not the origin.
+  std::vector<std::array<double, 3>> tip_positions;
+  /// The channel of the leading tip when tip_positions are stated (pdp-sim's
+  /// sensor id 0; else channel 0).
+  int leading_tip = 0;
 };
 
 class Recording {
