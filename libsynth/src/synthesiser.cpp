@@ -812,7 +812,8 @@ class Synthesiser {
     }
     table_.id.push_back(b.serial);
     table_.diameter.push_back(2.0 * b.radius);
-    table_.semi_axes.push_back({1.0 / b.inv_axes.x, 1.0 / b.inv_axes.y, 1.0 / b.inv_axes.z});
+    const double lateral = b.radius * sizes_.lateral_factor;  // as try_place sizes it, not 1 / (1 / a)
+    table_.semi_axes.push_back({b.a_x, lateral, lateral});
     table_.velocity.push_back(velocity);
     table_.interaction_start.push_back(p.first.t);
     table_.interaction_end.push_back(p.last.t);
