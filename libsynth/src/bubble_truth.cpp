@@ -218,11 +218,4 @@ BubbleTruth read_bubble_truth_csv(const std::filesystem::path& path) {
   return t;
 }
 
-std::filesystem::path bubble_truth_path(const std::filesystem::path& recording) {
-  std::filesystem::path p = recording;
-  p.replace_extension();
-  p += ".truth.bubbles.csv";
-  return p;
-}
-
 }  // namespace synth

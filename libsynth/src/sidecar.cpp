@@ -138,6 +138,10 @@ std::filesystem::path sidecar_path(const std::filesystem::path& recording) {
   return p;
 }
 
+std::filesystem::path bubble_truth_path(const std::filesystem::path& recording) {
+  return sidecar_path(recording).replace_extension(".bubbles.csv");
+}
+
 std::optional<double> sidecar_volts_per_count(const std::filesystem::path& recording) {
   std::ifstream in(sidecar_path(recording));
   if (!in) return std::nullopt;

@@ -11,6 +11,7 @@
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/interface_times.hpp"
+#include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
 
@@ -51,16 +52,11 @@ Scene straight_scene() {
 // with ellipsoids of several sizes: every path of the table's code.
 Scene turbulent_scene() {
   Scene s;
-  s.velocity = 1.0;
-  s.tu = 0.7;
-  s.tu_y = s.tu_z = 0.2;
-  s.time_scale = 2e-3;
-  s.duration = 3.0;
-  s.fs = 50e3;
-  s.bubble_diameter = 2e-3;
-  s.diameter_log_sd = 0.3;
-  s.aspect_ratio = 0.7;
-  s.tips = {{0, 0, 0}, {2e-3, 0, 0}, {2e-3, 0.8e-3, 0}, {2e-3, 0, 0.8e-3}};
+  const std::pair<const char*, const char*> fields[] = {
+      {"velocity", "1m/s"},      {"tu", "0.7"},      {"tu-y", "0.2"},         {"tu-z", "0.2"},
+      {"time-scale", "2ms"},     {"duration", "3s"}, {"fs", "50kHz"},         {"bubble-diameter", "2mm"},
+      {"diameter-log-sd", "0.3"}, {"aspect-ratio", "0.7"}, {"tips", "0,0,0;2mm,0,0;2mm,0.8mm,0;2mm,0,0.8mm"}};
+  for (const auto& [name, value] : fields) synth::set_scene_field(s, name, value);
   return s;
 }
 
@@ -388,12 +384,10 @@ TEST(BubbleTruth, OffByDefaultAndChangesNothingElse) {
 //    the truncation moves the mean by E[X; X > m] / 2 = 1 / m.
 // The bound is 4 (sd(dN) + sd(dX)) + 1 / m: with N ~ 60,000 about 5 %.
 TEST(BubbleTruth, InterfacialAreaOfOneSphereSizeIsSixCOverD) {
-  Scene s;
+  Scene s = straight_scene();  // Tu = 0, d_b = 4 mm, four tips
   s.velocity = 5.0;
-  s.tu = s.tu_y = s.tu_z = 0.0;
   s.arrival = synth::ArrivalRule::equal_space;
   s.void_fraction = 0.1;
-  s.bubble_diameter = 4e-3;
   s.fs = 20e3;
   s.realisation_step = 1e-3;  // the path is exact at any step without turbulence
   const double rate = 1.5 * s.void_fraction * s.velocity / s.bubble_diameter;

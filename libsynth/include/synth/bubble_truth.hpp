@@ -103,7 +103,4 @@ void write_bubble_truth_csv(const std::filesystem::path& path, const BubbleTruth
 /// the file, the line and the column for anything else.
 BubbleTruth read_bubble_truth_csv(const std::filesystem::path& path);
 
-/// "dir/rec.flac" -> "dir/rec.truth.bubbles.csv", beside the sidecar.
-std::filesystem::path bubble_truth_path(const std::filesystem::path& recording);
-
 }  // namespace synth

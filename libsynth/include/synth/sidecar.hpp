@@ -28,6 +28,10 @@ nlohmann::json sidecar_json(const Truth& truth, const RecordingOptions& options,
 /// "dir/rec.flac" -> "dir/rec.truth.json".
 std::filesystem::path sidecar_path(const std::filesystem::path& recording);
 
+/// "dir/rec.flac" -> "dir/rec.truth.bubbles.csv", the truth per bubble
+/// beside the sidecar (pdp synth with bubble-truth).
+std::filesystem::path bubble_truth_path(const std::filesystem::path& recording);
+
 /// The volts per count a synthetic recording's sidecar states, if it has one
 /// that does (readers of the recording use it to give voltages).
 std::optional<double> sidecar_volts_per_count(const std::filesystem::path& recording);
