@@ -958,8 +958,8 @@ Synthesis synthesise(const Scene& scene, const SynthesisOptions& options) {
 std::span<const awcc::OptionField<SynthesisOptions>> synthesis_option_fields() {
   static const awcc::OptionField<SynthesisOptions> fields[] = {
       {"bubble-truth", "",
-       "also give the truth per pierced bubble (pdp synth: <name>.truth.bubbles.csv beside the sidecar) and the "
-       "interfacial area concentration at each tip; costs time and about 180 bytes a bubble",
+       "also give the truth per pierced bubble (a table <name>.truth.bubbles.csv beside a recording's sidecar) "
+       "and the true interfacial area concentration at each tip; 84 bytes plus 48 a tip per pierced bubble",
        [](SynthesisOptions& o, std::string_view t) {
          if (t == "on" || t == "true") o.bubble_truth = true;
          else if (t == "off" || t == "false") o.bubble_truth = false;
