@@ -54,11 +54,12 @@ json scene_to_json(const Scene& s) {
 json truth_to_json(const Truth& t) {
   const Scene& s = t.imposed;
   const auto& r = t.realised;
-  json void_fraction = json::array(), pierced = json::array(), chords = json::array();
+  json void_fraction = json::array(), pierced = json::array(), chords = json::array(), area = json::array();
   for (const auto& tip : t.tips) {
     void_fraction.push_back(tip.void_fraction);
     pierced.push_back(tip.bubbles_pierced);
     chords.push_back(tip.chords);
+    area.push_back(optional_number(tip.interfacial_area));
   }
   json pairs = json::array();
   for (const auto& p : t.pairs) {
@@ -76,7 +77,8 @@ json truth_to_json(const Truth& t) {
         {"rho_yz", s.rho_yz},
         {"void_fraction", s.void_fraction},
         {"bubble_diameter", s.bubble_diameter},
-        {"pierce_rate", t.expected_pierce_rate}}},
+        {"pierce_rate", t.expected_pierce_rate},
+        {"interfacial_area", t.expected_interfacial_area}}},
       {"realised",
        {{"mean_velocity", r.mean_velocity},
         {"rms_velocity", r.rms_velocity},
@@ -88,6 +90,7 @@ json truth_to_json(const Truth& t) {
         {"void_fraction", void_fraction},
         {"bubbles_pierced", pierced},
         {"chords", chords},
+        {"interfacial_area", area},
         {"pierced_by_both", pairs},
         {"bubbles_generated", t.bubbles_generated},
         {"overlaps_unresolved", t.overlaps_unresolved},
@@ -100,7 +103,8 @@ json truth_to_json(const Truth& t) {
   };
 }
 
-json sidecar_json(const Truth& truth, const RecordingOptions& options, const std::filesystem::path& recording) {
+json sidecar_json(const Truth& truth, const RecordingOptions& options, const std::filesystem::path& recording,
+                  const BubbleTruth* bubbles) {
   json out = truth_to_json(truth);
   json tips = json::array();
   for (const auto& tip : truth.tips) tips.push_back(vec(tip.position));
@@ -118,6 +122,10 @@ json sidecar_json(const Truth& truth, const RecordingOptions& options, const std
                                               : json(nullptr)}};
   out["scene"] = scene_to_json(truth.imposed);
   out["probe"] = {{"tips", tips}, {"leading_tip", 0}};
+  out["bubble_truth"] = bubbles ? json{{"file", bubble_truth_path(recording).filename().string()},
+                                        {"bubbles", bubbles->size()},
+                                        {"columns", bubble_truth_columns(bubbles->tip_count)}}
+                                  : json(nullptr);
   out["fs"] = truth.imposed.fs;
   out["seed"] = truth.imposed.seed;
   return out;
@@ -128,6 +136,10 @@ std::filesystem::path sidecar_path(const std::filesystem::path& recording) {
   p.replace_extension();
   p += ".truth.json";
   return p;
+}
+
+std::filesystem::path bubble_truth_path(const std::filesystem::path& recording) {
+  return sidecar_path(recording).replace_extension(".bubbles.csv");
 }
 
 std::optional<double> sidecar_volts_per_count(const std::filesystem::path& recording) {

@@ -67,9 +67,12 @@ std::string Truth::report() const {
   for (std::size_t j = 0; j < tips.size(); ++j) {
     const auto& t = tips[j];
     line(fmt::format("    tip {} at ({:.3f}, {:.3f}, {:.3f}) mm: void fraction {:.5f}, {} bubbles pierced "
-                     "({:.2f} /s), {} chords",
+                     "({:.2f} /s), {} chords{}",
                      j, t.position.x * 1e3, t.position.y * 1e3, t.position.z * 1e3, t.void_fraction, t.bubbles_pierced,
-                     static_cast<double>(t.bubbles_pierced) / s.duration, t.chords));
+                     static_cast<double>(t.bubbles_pierced) / s.duration, t.chords,
+                     t.interfacial_area ? fmt::format(", interfacial area {:.2f} 1/m (expected {:.2f})",
+                                                      *t.interfacial_area, expected_interfacial_area)
+                                        : std::string()));
   }
   for (const auto& p : pairs) {
     line(fmt::format("    tips {} and {}: {} bubbles pierced by both", p.first, p.second, p.pierced_by_both));

@@ -75,6 +75,31 @@ grep -q "extension" <<<"$err" || fail "unknown extension: $err"
 "$pdp" --log-level warn synth -q --config "$src/samples/four-tip.toml" --duration 0.2s -o "$dir/four.w64" || fail "four-tip sample"
 grep -q '"pierced_by_both"' "$dir/four.truth.json" || fail "four-tip sidecar"
 
+# The truth per bubble: off by default, on with --bubble-truth or a settings
+# key; the CSV beside the sidecar, which names it and states the IAC truth.
+[[ ! -e $dir/four.truth.bubbles.csv ]] || fail "a bubble table without bubble-truth"
+grep -q '"bubble_truth": null' "$dir/four.truth.json" || fail "sidecar: bubble_truth is not null when off"
+grep -q -- "--bubble-truth" <<<"$help" || fail "--help does not list --bubble-truth"
+"$pdp" --log-level warn synth -q --config "$src/samples/four-tip.toml" --duration 0.5s --bubble-truth \
+  -o "$dir/bt.flac" || fail "bubble-truth run"
+csv=$dir/bt.truth.bubbles.csv
+[[ -s $csv ]] || fail "no bubble table beside the sidecar"
+head -1 "$csv" | grep -q "^id,diameter,.*,tip3_rear_normal_z$" || fail "bubble table header: $(head -1 "$csv")"
+python3 - "$dir/bt.truth.json" "$csv" <<'PY' || fail "sidecar and table disagree"
+import csv, json, sys
+j = json.load(open(sys.argv[1]))
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert j["bubble_truth"]["file"] == "bt.truth.bubbles.csv", j["bubble_truth"]
+assert j["bubble_truth"]["bubbles"] == len(rows) > 0
+for k, pierced in enumerate(j["realised"]["bubbles_pierced"]):
+    assert sum(r[f"tip{k}_pierced"] == "1" for r in rows) == pierced, k
+    assert j["realised"]["interfacial_area"][k] > 0
+assert abs(j["imposed"]["interfacial_area"] - 6 * 0.1 / 4e-3) < 1e-9
+PY
+printf 'duration = "0.2s"\nbubble-truth = true\n' >"$dir/bt.toml"
+"$pdp" --log-level warn synth -q --config "$dir/bt.toml" -o "$dir/bt2.wav" || fail "bubble-truth from a settings file"
+[[ -s $dir/bt2.truth.bubbles.csv ]] || fail "bubble-truth = true in a settings file wrote no table"
+
 if ((failures)); then
   echo "$failures failures"
   exit 1

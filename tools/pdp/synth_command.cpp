@@ -34,12 +34,17 @@ void setup_synth(CLI::App& app, Command& command, SynthOptions& options) {
   cmd->add_flag("-q,--quiet", options.quiet, "do not print the truth summary");
 
   add_scene_options(cmd, options.scene);
+  options.synthesis.add(cmd, synth::synthesis_option_fields(), synth::SynthesisOptions{}, "Synthesis");
 }
 
 int run_synth(const SynthOptions& options) {
   synth::Scene scene;
+  synth::SynthesisOptions so;
   try {
     scene = build_scene(options.scene);
+    const auto given = options.synthesis.settings();
+    std::vector<bool> used(given.size(), false);
+    awcc::apply_settings(synth::synthesis_option_fields(), std::span<const awcc::OptionSetting>(given), so, used);
   } catch (const std::exception& e) {
     return report_error(e);
   }
@@ -66,7 +71,6 @@ int run_synth(const SynthOptions& options) {
     synth::Synthesis synthesis;
     {
       Progress progress("synthesising");
-      synth::SynthesisOptions so;
       so.progress = [&progress](double f) { progress(f); };
       synthesis = synth::synthesise(scene, so);
     }
@@ -82,11 +86,25 @@ int run_synth(const SynthOptions& options) {
       recording.progress = [&progress](double f) { progress(f); };
       const std::filesystem::path out = options.output;
       const auto sidecar = synth::sidecar_path(out);
+      const synth::BubbleTruth* bubbles = synthesis.bubbles ? &*synthesis.bubbles : nullptr;
       awcc::write_atomically(out, [&](const std::filesystem::path& temporary) {
         synth::write_recording(temporary, scene, synthesis.signals, recording);
-        awcc::write_text_atomically(sidecar, awcc::json_text(synth::sidecar_json(synthesis.truth, recording, out)));
+        if (bubbles) synth::write_bubble_truth_csv(synth::bubble_truth_path(out), *bubbles);
+        try {
+          awcc::write_text_atomically(sidecar,
+                                      awcc::json_text(synth::sidecar_json(synthesis.truth, recording, out, bubbles)));
+        } catch (...) {
+          // No table without its sidecar and recording.
+          if (bubbles) std::filesystem::remove(synth::bubble_truth_path(out));
+          throw;
+        }
       });
-      spdlog::info("wrote {} and {}", out.string(), sidecar.string());
+      if (bubbles) {
+        spdlog::info("wrote {}, {} and {} ({} bubbles)", out.string(), sidecar.string(),
+                     synth::bubble_truth_path(out).string(), bubbles->size());
+      } else {
+        spdlog::info("wrote {} and {}", out.string(), sidecar.string());
+      }
     }
     spdlog::info("synthesis {:.2f} s, file {:.2f} s, peak memory {:.0f} MB", t_synth, study::seconds_since(write_start),
                  peak_memory_mb());

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_options.hpp"
 #include "command.hpp"
 #include "scene_cli.hpp"
 
@@ -12,6 +13,7 @@ namespace pdp {
 
 struct SynthOptions {
   SceneCli scene;                        ///< scene fields
+  OptionSet synthesis;                   ///< synth::synthesis_option_fields() (bubble-truth)
   std::string output;                    ///< recording path (.flac, .wav, .w64, .rf64)
   std::string signal = "binary";         ///< binary | voltage
   std::string format;                    ///< flac | wav | w64 | rf64; default from the extension

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "synth/bubble_truth.hpp"
 #include "synth/recording.hpp"
 #include "synth/truth.hpp"
 
@@ -18,12 +19,18 @@ nlohmann::json scene_to_json(const Scene& scene);
 /// The truth as JSON: "imposed" and "realised" objects and more.
 nlohmann::json truth_to_json(const Truth& truth);
 
-/// The whole sidecar for a recording written with `options`.
+/// The whole sidecar for a recording written with `options`. With
+/// `bubbles` (the table written beside it at bubble_truth_path(recording)),
+/// "bubble_truth" names that file, its rows and columns; else it is null.
 nlohmann::json sidecar_json(const Truth& truth, const RecordingOptions& options,
-                            const std::filesystem::path& recording);
+                            const std::filesystem::path& recording, const BubbleTruth* bubbles = nullptr);
 
 /// "dir/rec.flac" -> "dir/rec.truth.json".
 std::filesystem::path sidecar_path(const std::filesystem::path& recording);
+
+/// "dir/rec.flac" -> "dir/rec.truth.bubbles.csv", the truth per bubble
+/// beside the sidecar (pdp synth with bubble-truth).
+std::filesystem::path bubble_truth_path(const std::filesystem::path& recording);
 
 /// The volts per count a synthetic recording's sidecar states, if it has one
 /// that does (readers of the recording use it to give voltages).

@@ -32,6 +32,24 @@ struct TipTruth {
   double void_fraction = 0.0;         ///< air samples / samples, -
   std::int64_t bubbles_pierced = 0;   ///< distinct bubbles whose piercing overlaps the record
   std::int64_t chords = 0;            ///< air intervals in the sampled signal
+  /// The true local interfacial area concentration at the tip, 1/m, with
+  /// SynthesisOptions::bubble_truth (else empty): the time average of the
+  /// interfaces passing the point,
+  ///
+  ///   a = (1/T) sum over interfaces i crossing the tip in [0, T) of 1 / |u_i . n_i|,
+  ///
+  /// u_i the bubble's velocity at the instant of crossing, n_i the surface's
+  /// unit normal there (Ishii 1975; Kataoka et al. 1986). It is the
+  /// definition of the local time-averaged IAC, so it is what a probe's
+  /// estimator (Shen & Nakamura 2014 Eq. 54 sums the same terms from
+  /// estimated velocities and normals) converges to, and it holds whatever
+  /// the shapes, sizes and velocity fluctuations. Taken over the control
+  /// volume instead (bubble surface per volume), it would miss what the
+  /// point sees: the tip's void fraction is c (1 + Tu_x^2) under equal-time
+  /// arrivals, and the IAC at the point scales with it. For one sphere size
+  /// its expectation is 6 c_tip / d_b: a pierce at a uniform offset on the
+  /// disc gives E[1 / cos theta] = 2 per interface.
+  std::optional<double> interfacial_area;
 };
 
 struct PairTruth {
@@ -45,6 +63,10 @@ struct Truth {
   double control_volume[3] = {0, 0, 0};    ///< edges L_x, L_y, L_z, m
   double bubble_rate = 0.0;                ///< bubbles entering the control volume per second, 1/s
   double expected_pierce_rate = 0.0;       ///< mean pierce rate of a tip, c u E[pi a_y a_z] / E[V], 1/s
+  /// c E[S_b] / E[V_b] of the imposed population (S_b the surface of the
+  /// bubble's ellipsoid): 6 c / d_b for one sphere size, 1/m. The realised
+  /// value at each tip is TipTruth::interfacial_area.
+  double expected_interfacial_area = 0.0;
   RealisedFlow realised;
   std::vector<TipTruth> tips;
   std::vector<PairTruth> pairs;
