@@ -69,6 +69,27 @@ std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const do
 /// flag of the rejected ones. Returns the number of iterations.
 int robust_outlier_cutoff(std::span<const double> velocities, std::vector<bool>& keep);
 
+/// The moments of METHOD 4 item 7 over accepted values, each with its
+/// weight (a window's duration, a bubble's interaction time span, or 1):
+/// mean = sum w u / sum w, rms = sqrt(sum w (u - mean)^2 / sum w). AWCC and
+/// event detection both take them from here.
+struct WeightedMoments {
+  double mean = 0.0;
+  double rms = 0.0;
+};
+WeightedMoments weighted_moments(std::span<const double> values, std::span<const double> weights);
+
+/// The 95 % intervals of METHOD 4 item 8 from N accepted values: mean +/-
+/// 1.96 rms / sqrt(N), rms +/- 1.96 rms / sqrt(2N), Tu = rms / mean +/- 1.96
+/// sigma_T with sigma_T^2 = Tu^2 (Tu^2 / N + 1 / (2N)); the half-widths too
+/// (a quality reason quotes Tu's).
+struct MomentIntervals {
+  double turbulence_intensity = 0.0;   ///< rms / mean
+  double mean_half = 0.0, rms_half = 0.0, turbulence_intensity_half = 0.0;
+  Interval95 mean, rms, tu;
+};
+MomentIntervals moment_intervals95(double mean, double rms, std::int64_t n);
+
 /// Lags searched in a window of `length` samples: all, or those of the
 /// stated velocity range (k_max < k_min: the window is too short for it).
 std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double dx, double fs,
