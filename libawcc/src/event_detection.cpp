@@ -63,8 +63,9 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 std::string refuse_first_velocity(const EventOptions& options, const std::optional<double>& first_velocity) {
   if (options.pairing != Pairing::shen) return {};
   if (!first_velocity) {
-    return "Shen pairing needs a first estimate of the mean velocity (V_gas in its lag limit |S| / (0.3 V_gas)) and "
-           "none was given: give FSCC's or AWCC's velocity, or use Kramer pairing";
+    return fmt::format("Shen pairing needs a first velocity estimate V_gas (its lag limit is |S| / ({:g} V_gas)) and "
+                       "none was given: give FSCC's or AWCC's velocity, or set pairing to kramer",
+                       options.shen_lag_factor);
   }
   if (!(*first_velocity > 0.0) || !std::isfinite(*first_velocity)) {
     return fmt::format("Shen pairing needs a positive first velocity estimate; {} m/s was given", *first_velocity);
