@@ -616,17 +616,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     if (w.fate == WindowFate::accepted) ++clear_positive;
     if (w.fate == WindowFate::lag && w.lag_samples < 0 && clear) ++clear_negative;
   }
-  std::vector<double> u(windows.size());
-  std::vector<bool> keep(windows.size());
-  for (std::size_t i = 0; i < windows.size(); ++i) {
-    u[i] = windows[i].velocity;
-    keep[i] = windows[i].fate == WindowFate::accepted;
-  }
-  if (options.roc) {
-    result.roc_iterations = robust_outlier_cutoff(u, keep);
-    for (std::size_t i = 0; i < windows.size(); ++i)
-      if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
-  }
+  if (options.roc) result.roc_iterations = cut_outliers(windows, WindowFate::accepted, WindowFate::roc);
   result.windows_by_fate.fill(0);
   result.lag_zero_windows = result.negative_lag_windows = 0;
   for (const auto& w : windows) {

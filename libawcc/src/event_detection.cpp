@@ -166,17 +166,7 @@ void no_velocity(EventResult& result, EventStatus status, std::string why) {
 // The moments, intervals, quality and chord lengths of the paired bubbles.
 void summarise_events(EventResult& result, const EventOptions& options) {
   auto& bubbles = result.bubbles;
-  std::vector<double> u(bubbles.size());
-  std::vector<bool> keep(bubbles.size());
-  for (std::size_t i = 0; i < bubbles.size(); ++i) {
-    u[i] = bubbles[i].velocity;
-    keep[i] = bubbles[i].fate == BubbleFate::paired;
-  }
-  if (options.roc) {
-    result.roc_iterations = detail::robust_outlier_cutoff(u, keep);
-    for (std::size_t i = 0; i < bubbles.size(); ++i)
-      if (bubbles[i].fate == BubbleFate::paired && !keep[i]) bubbles[i].fate = BubbleFate::roc;
-  }
+  if (options.roc) result.roc_iterations = detail::cut_outliers(bubbles, BubbleFate::paired, BubbleFate::roc);
   result.bubbles_by_fate.fill(0);
   for (const auto& b : bubbles) ++result.bubbles_by_fate[static_cast<std::size_t>(b.fate)];
   result.bubbles_paired = result.count(BubbleFate::paired);

@@ -10,13 +10,13 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <set>
 #include <string>
 #include <vector>
 
 #include "awcc/awcc.hpp"
 #include "awcc/options.hpp"
 #include "awcc/serialise.hpp"
+#include "clean_scene.hpp"
 #include "synth/synthesiser.hpp"
 
 namespace {
@@ -516,24 +516,20 @@ TEST(EventDetection, BubbleTableHasOneRowPerLeadingBubbleAndEmptyCellsWithoutAVa
 }
 
 TEST(EventDetection, OptionsAreDeclaredOnceAndValidatedByName) {
-  // Each declared default reads back as itself; every name is new among the
-  // declarations of the processing options.
-  std::set<std::string> names;
-  auto add = [&](auto fields) {
-    for (const auto& f : fields) EXPECT_TRUE(names.insert(std::string(f.name)).second) << f.name;
-  };
-  add(awcc::process_option_fields());
-  add(awcc::reader_option_fields());
-  add(awcc::binarisation_option_fields());
-  add(awcc::fscc_option_fields());
-  add(awcc::awcc_option_fields());
-  add(awcc::structure_option_fields());
-  add(awcc::event_option_fields());
-  EventOptions o;
+  // Each declared default reads back as itself, and no name is already an
+  // option of a processing run (a shared name would set two options).
+  const EventOptions o;
   for (const auto& f : awcc::event_option_fields()) {
     EventOptions p;
     f.parse(p, f.format(o));
     EXPECT_EQ(f.format(p), f.format(o)) << f.name;
+    const std::vector<awcc::OptionSetting> s{{std::string(f.name), f.format(o), ""}};
+    try {
+      (void)awcc::process_options(s);
+      ADD_FAILURE() << f.name << " is also an option of a processing run";
+    } catch (const awcc::OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find("is not the declared name of an option"), std::string::npos) << e.what();
+    }
   }
   EventOptions s;
   for (const auto& f : awcc::event_option_fields()) {
@@ -542,37 +538,35 @@ TEST(EventDetection, OptionsAreDeclaredOnceAndValidatedByName) {
   }
   EXPECT_EQ(s.pairing, Pairing::shen);
   EXPECT_DOUBLE_EQ(s.disparity_max, 0.25);
-  auto invalid = [](auto change) {
+  // Each limit: valid at it, refused beyond it naming the declared option.
+  auto quantity = [](auto change) {
     EventOptions e;
     change(e);
-    return e.validate().quantity;
+    const auto v = e.validate();
+    EXPECT_EQ(v.message.find("--"), std::string::npos) << v.message;
+    return v.quantity;
   };
-  EXPECT_EQ(invalid([](EventOptions& e) { e.disparity_max = 0.0; }), "chord-disparity-max");
-  EXPECT_EQ(invalid([](EventOptions& e) { e.shen_lag_factor = 1.5; }), "shen-lag-factor");
-  EXPECT_EQ(invalid([](EventOptions& e) { e.bubbles_reported = 1; }), "bubbles-reported");
-  EXPECT_EQ(invalid([](EventOptions& e) { e.bubbles_ok = 5; }), "bubbles-ok");
-  EXPECT_EQ(invalid([](EventOptions& e) { e.pairing_yield_ok = 2.0; }), "pairing-yield-ok");
-  EXPECT_TRUE(invalid([](EventOptions&) {}).empty());
+  EXPECT_EQ(quantity([](EventOptions& e) { e.disparity_max = 1e-12; }), "");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.disparity_max = 0.0; }), "chord-disparity-max");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.shen_lag_factor = 1.0; }), "");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.shen_lag_factor = 1.0 + 1e-12; }), "shen-lag-factor");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.bubbles_reported = 2, e.bubbles_ok = 2; }), "");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.bubbles_reported = 1; }), "bubbles-reported");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.bubbles_ok = e.bubbles_reported - 1; }), "bubbles-ok");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.pairing_yield_ok = 1.0; }), "");
+  EXPECT_EQ(quantity([](EventOptions& e) { e.pairing_yield_ok = 1.0 + 1e-12; }), "pairing-yield-ok");
 }
 
 // ---- a synthetic dual-tip scene ------------------------------------------
 
 TEST(EventDetectionSynthetic, MeanVelocityMatchesTheTruthAndAgreesWithAwcc) {
-  // AWCC's clean scene (awcc_synthetic_test.cpp): large bubbles (6 mm
-  // against dx = 5 mm), aligned tips, Tu = 0.05 with a 1 s time scale. Each
-  // bubble crosses both tips on one straight path, so its centre lag is its
+  // The clean scene (clean_scene.hpp), as AWCC's test uses it. Each bubble crosses both tips on one straight path, so its centre lag is its
   // transit time to within the 2 us sample (0.4 % of the 0.5 ms lag, zero
   // mean) and the velocity change during the transit; the interaction-span
   // weights undo the flux's excess of fast bubbles. Bound: 1 % of the
   // realised mean (as AWCC's test), and ED and AWCC within the sum of their
   // 95 % half-widths.
-  synth::Scene s;
-  s.bubble_diameter = 6e-3;
-  s.dy = 0.0;
-  s.tu = 0.05;
-  s.tu_y = s.tu_z = 0.025;
-  s.time_scale = 1.0;
-  s.duration = 20.0;
+  const synth::Scene s = pdp_test::clean_scene(20.0);
   const auto syn = synth::synthesise(s);
   const auto ed = awcc::event_detection(syn.signals[0], syn.signals[1], s.dx);
   ASSERT_TRUE(ed.ok()) << ed.message;

@@ -69,6 +69,23 @@ std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const do
 /// flag of the rejected ones. Returns the number of iterations.
 int robust_outlier_cutoff(std::span<const double> velocities, std::vector<bool>& keep);
 
+/// The robust outlier cutoff over the `velocity` of the items (AWCC's
+/// windows, event detection's bubbles) whose fate is `accepted`; those it
+/// rejects get fate `rejected`. Returns the number of iterations.
+template <class Item, class Fate>
+int cut_outliers(std::vector<Item>& items, Fate accepted, Fate rejected) {
+  std::vector<double> u(items.size());
+  std::vector<bool> keep(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    u[i] = items[i].velocity;
+    keep[i] = items[i].fate == accepted;
+  }
+  const int iterations = robust_outlier_cutoff(u, keep);
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (items[i].fate == accepted && !keep[i]) items[i].fate = rejected;
+  return iterations;
+}
+
 /// The moments of METHOD 4 item 7 over accepted values, each with its
 /// weight (a window's duration, a bubble's interaction time span, or 1):
 /// mean = sum w u / sum w, rms = sqrt(sum w (u - mean)^2 / sum w). AWCC and
