@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 namespace awcc {
 
@@ -554,6 +555,23 @@ MomentIntervals moment_intervals95(double mean, double rms, std::int64_t count) 
   return out;
 }
 
+std::pair<AwccQuality, std::string> reported_quality(std::int64_t accepted, std::int64_t total, std::int64_t ok_count,
+                                                     double yield_ok, const MomentIntervals& intervals,
+                                                     const QualityWords& words) {
+  if (accepted < ok_count) {
+    return {AwccQuality::low,
+            fmt::format("{} {} (fewer than {}): Tu's 95 % interval is +/- {:.0f} %", accepted, words.counted, ok_count,
+                        100.0 * intervals.turbulence_intensity_half / std::max(intervals.turbulence_intensity, 1e-300))};
+  }
+  const double yield = static_cast<double>(accepted) / static_cast<double>(total);
+  if (yield < yield_ok) {
+    return {AwccQuality::low, fmt::format("{} {:.1f} % ({} of {} {}, below {:g} %): {} may not represent the flow",
+                                          words.yield, 100.0 * yield, accepted, total, words.ratio, 100.0 * yield_ok,
+                                          words.selection)};
+  }
+  return {AwccQuality::ok, std::string()};
+}
+
 std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double dx, double fs,
                                                       const AwccOptions& options) {
   if (options.velocity_min && options.velocity_max && dx > 0.0) {
@@ -684,8 +702,6 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.velocity_rms = rms;
   const auto intervals = moment_intervals95(mean, rms, result.windows_accepted);
   result.turbulence_intensity = intervals.turbulence_intensity;
-  const double tu = result.turbulence_intensity;
-  const double ht = intervals.turbulence_intensity_half;
   if (result.probe_corrected) {
     // The measured moments over the same windows, for comparison.
     const auto [measured_mean, measured_rms] = moments(&AwccWindow::measured_velocity);
@@ -696,21 +712,9 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.velocity_ci95 = intervals.mean;
   result.velocity_rms_ci95 = intervals.rms;
   result.turbulence_intensity_ci95 = intervals.tu;
-  const double yield = static_cast<double>(result.windows_accepted) / static_cast<double>(result.windows_total);
-  result.quality = AwccQuality::ok;
-  result.quality_reason.clear();
-  if (result.windows_accepted < options.windows_ok) {
-    result.quality = AwccQuality::low;
-    result.quality_reason = fmt::format("{} accepted windows (fewer than {}): Tu's 95 % interval is +/- {:.0f} %",
-                                        result.windows_accepted, options.windows_ok,
-                                        100.0 * ht / std::max(tu, 1e-300));
-  } else if (yield < options.yield_ok) {
-    result.quality = AwccQuality::low;
-    result.quality_reason = fmt::format("data yield {:.1f} % ({} of {} windows accepted, below {:g} %): the accepted "
-                                        "windows may not represent the flow",
-                                        100.0 * yield, result.windows_accepted, result.windows_total,
-                                        100.0 * options.yield_ok);
-  }
+  std::tie(result.quality, result.quality_reason) =
+      reported_quality(result.windows_accepted, result.windows_total, options.windows_ok, options.yield_ok, intervals,
+                       {"accepted windows", "data yield", "windows accepted", "the accepted windows"});
 }
 
 }  // namespace detail

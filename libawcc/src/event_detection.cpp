@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tuple>
 
 #include "awcc/detail/awcc_steps.hpp"
 
@@ -170,9 +171,6 @@ void summarise_events(EventResult& result, const EventOptions& options) {
   result.bubbles_by_fate.fill(0);
   for (const auto& b : bubbles) ++result.bubbles_by_fate[static_cast<std::size_t>(b.fate)];
   result.bubbles_paired = result.count(BubbleFate::paired);
-  const double yield = result.bubbles_complete > 0 ? static_cast<double>(result.bubbles_paired) /
-                                                         static_cast<double>(result.bubbles_complete)
-                                                   : 0.0;
   if (result.bubbles_paired < options.bubbles_reported) {
     no_velocity(result, EventStatus::too_few_bubbles,
                 fmt::format("{} of {} complete leading bubbles paired ({} without a later trailing bubble, {} beyond "
@@ -208,21 +206,10 @@ void summarise_events(EventResult& result, const EventOptions& options) {
   result.turbulence_intensity_ci95 = intervals.tu;
   result.chord_length = summarise(std::move(lengths));
   result.sauter_diameter = 1.5 * result.chord_length.mean;
-  result.quality = AwccQuality::ok;
-  result.quality_reason.clear();
-  if (result.bubbles_paired < options.bubbles_ok) {
-    result.quality = AwccQuality::low;
-    result.quality_reason =
-        fmt::format("{} paired bubbles (fewer than {}): Tu's 95 % interval is +/- {:.0f} %", result.bubbles_paired,
-                    options.bubbles_ok,
-                    100.0 * intervals.turbulence_intensity_half / std::max(result.turbulence_intensity, 1e-300));
-  } else if (yield < options.pairing_yield_ok) {
-    result.quality = AwccQuality::low;
-    result.quality_reason = fmt::format("pairing yield {:.1f} % ({} of {} complete leading bubbles paired, below "
-                                        "{:g} %): the paired bubbles may not represent the flow",
-                                        100.0 * yield, result.bubbles_paired, result.bubbles_complete,
-                                        100.0 * options.pairing_yield_ok);
-  }
+  std::tie(result.quality, result.quality_reason) =
+      detail::reported_quality(result.bubbles_paired, result.bubbles_complete, options.bubbles_ok,
+                               options.pairing_yield_ok, intervals,
+                               {"paired bubbles", "pairing yield", "complete leading bubbles paired", "the paired bubbles"});
 }
 
 }  // namespace

@@ -228,7 +228,9 @@ struct EventResult {
   std::int64_t bubbles_total = 0;     ///< leading bubbles (crossings), censored included
   std::int64_t bubbles_complete = 0;  ///< leading bubbles not censored: the yield's denominator
   std::int64_t bubbles_paired = 0;    ///< count(BubbleFate::paired), the N of the moments
-  /// Leading bubbles of each fate, indexed by BubbleFate; they sum to bubbles_total.
+  /// Leading bubbles of each fate, indexed by BubbleFate; they sum to
+  /// bubbles_total once the pairing ran (all zero, and `bubbles` empty, when
+  /// it was refused: no_tip_separation, no_first_velocity).
   std::array<std::int64_t, bubble_fate_count> bubbles_by_fate{};
   [[nodiscard]] std::int64_t count(BubbleFate fate) const { return bubbles_by_fate[static_cast<std::size_t>(fate)]; }
   int roc_iterations = 0;

@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -106,6 +108,20 @@ struct MomentIntervals {
   Interval95 mean, rms, tu;
 };
 MomentIntervals moment_intervals95(double mean, double rms, std::int64_t n);
+
+/// The words of a quality reason: what is counted ("accepted windows"),
+/// the yield's name ("data yield"), its ratio ("windows accepted") and the
+/// selection it may bias ("the accepted windows").
+struct QualityWords {
+  std::string_view counted, yield, ratio, selection;
+};
+/// METHOD 4 item 10 for a result whose moments are reported: low below
+/// `ok_count` accepted items (the reason quotes Tu's interval) or below the
+/// least yield accepted / total, ok otherwise (empty reason). AWCC's windows
+/// and event detection's bubbles are judged by this one rule.
+std::pair<AwccQuality, std::string> reported_quality(std::int64_t accepted, std::int64_t total, std::int64_t ok_count,
+                                                     double yield_ok, const MomentIntervals& intervals,
+                                                     const QualityWords& words);
 
 /// Lags searched in a window of `length` samples: all, or those of the
 /// stated velocity range (k_max < k_min: the window is too short for it).
