@@ -21,12 +21,9 @@ using bench::now;
 using bench::peak_mb;
 
 int main(int argc, char** argv) {
-  double duration = 300.0;
-  int repeat = 3;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
-  }
+  const auto args = bench::base_case_args(argc, argv);
+  const double duration = args.duration;
+  const int repeat = args.repeat;
   synth::Scene scene;
   scene.duration = duration;
   const auto syn = synth::synthesise(scene);

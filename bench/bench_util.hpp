@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 namespace bench {
@@ -23,6 +25,20 @@ inline double peak_mb() {
 inline double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
+}
+
+/// The base-case benchmarks' arguments: --duration SECONDS (300) and --repeat N (3).
+struct BaseCaseArgs {
+  double duration = 300.0;
+  int repeat = 3;
+};
+inline BaseCaseArgs base_case_args(int argc, char** argv) {
+  BaseCaseArgs out;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) out.duration = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) out.repeat = std::atoi(argv[++i]);
+  }
+  return out;
 }
 
 }  // namespace bench

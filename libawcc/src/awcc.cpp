@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 namespace awcc {
 
@@ -528,6 +529,49 @@ int robust_outlier_cutoff(std::span<const double> u, std::vector<bool>& keep) {
   }
 }
 
+WeightedMoments weighted_moments(std::span<const double> values, std::span<const double> weights) {
+  double total = 0, sum = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    total += weights[i];
+    sum += weights[i] * values[i];
+  }
+  const double m = sum / total;
+  double squares = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) squares += weights[i] * (values[i] - m) * (values[i] - m);
+  return {m, std::sqrt(squares / total)};
+}
+
+MomentIntervals moment_intervals95(double mean, double rms, std::int64_t count) {
+  MomentIntervals out;
+  const double n = static_cast<double>(count);
+  const double tu = rms / mean;
+  out.turbulence_intensity = tu;
+  out.mean_half = 1.96 * rms / std::sqrt(n);
+  out.rms_half = 1.96 * rms / std::sqrt(2.0 * n);
+  out.turbulence_intensity_half = 1.96 * std::sqrt(tu * tu * (tu * tu / n + 1.0 / (2.0 * n)));
+  out.mean = {mean - out.mean_half, mean + out.mean_half};
+  out.rms = {rms - out.rms_half, rms + out.rms_half};
+  out.tu = {tu - out.turbulence_intensity_half, tu + out.turbulence_intensity_half};
+  return out;
+}
+
+std::pair<AwccQuality, std::string> reported_quality(std::int64_t accepted, std::int64_t total, std::int64_t ok_count,
+                                                     double yield_ok, const MomentIntervals& intervals,
+                                                     const QualityWords& words) {
+  if (accepted < ok_count) {
+    return {AwccQuality::low,
+            fmt::format("{} {} (fewer than {}): Tu's 95 % interval is +/- {:.0f} %", accepted, words.counted, ok_count,
+                        100.0 * intervals.turbulence_intensity_half / std::max(intervals.turbulence_intensity, 1e-300))};
+  }
+  const double yield = static_cast<double>(accepted) / static_cast<double>(total);
+  if (yield < yield_ok) {
+    return {AwccQuality::low, fmt::format("{} {:.1f} % ({} of {} {}, below {:g} %): {} may not represent the flow",
+                                          words.yield, 100.0 * yield, accepted, total, words.ratio, 100.0 * yield_ok,
+                                          words.selection)};
+  }
+  return {AwccQuality::ok, std::string()};
+}
+
 std::pair<std::int64_t, std::int64_t> awcc_lag_range(std::int64_t length, double dx, double fs,
                                                       const AwccOptions& options) {
   if (options.velocity_min && options.velocity_max && dx > 0.0) {
@@ -590,17 +634,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     if (w.fate == WindowFate::accepted) ++clear_positive;
     if (w.fate == WindowFate::lag && w.lag_samples < 0 && clear) ++clear_negative;
   }
-  std::vector<double> u(windows.size());
-  std::vector<bool> keep(windows.size());
-  for (std::size_t i = 0; i < windows.size(); ++i) {
-    u[i] = windows[i].velocity;
-    keep[i] = windows[i].fate == WindowFate::accepted;
-  }
-  if (options.roc) {
-    result.roc_iterations = robust_outlier_cutoff(u, keep);
-    for (std::size_t i = 0; i < windows.size(); ++i)
-      if (windows[i].fate == WindowFate::accepted && !keep[i]) windows[i].fate = WindowFate::roc;
-  }
+  if (options.roc) result.roc_iterations = cut_outliers(windows, WindowFate::accepted, WindowFate::roc);
   result.windows_by_fate.fill(0);
   result.lag_zero_windows = result.negative_lag_windows = 0;
   for (const auto& w : windows) {
@@ -653,33 +687,21 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   }
   // The weighted mean and rms of one velocity of the accepted windows (METHOD 4).
   const auto moments = [&](double AwccWindow::*velocity) {
-    double weights = 0, sum = 0;
+    std::vector<double> values, weights;
     for (const auto& w : windows) {
       if (w.fate != WindowFate::accepted) continue;
-      const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
-      weights += weight;
-      sum += weight * w.*velocity;
+      values.push_back(w.*velocity);
+      weights.push_back(options.weighting == Weighting::duration ? w.duration : 1.0);
     }
-    const double m = sum / weights;
-    double squares = 0;
-    for (const auto& w : windows) {
-      if (w.fate != WindowFate::accepted) continue;
-      const double weight = options.weighting == Weighting::duration ? w.duration : 1.0;
-      squares += weight * (w.*velocity - m) * (w.*velocity - m);
-    }
-    return std::pair{m, std::sqrt(squares / weights)};
+    return weighted_moments(values, weights);
   };
   const auto [mean, rms] = moments(&AwccWindow::velocity);
-  const double n = static_cast<double>(result.windows_accepted);
   result.status = AwccStatus::ok;
   result.message.clear();
   result.velocity = mean;
   result.velocity_rms = rms;
-  result.turbulence_intensity = rms / mean;
-  const double tu = result.turbulence_intensity;
-  const double hu = 1.96 * rms / std::sqrt(n);
-  const double hr = 1.96 * rms / std::sqrt(2.0 * n);
-  const double ht = 1.96 * std::sqrt(tu * tu * (tu * tu / n + 1.0 / (2.0 * n)));
+  const auto intervals = moment_intervals95(mean, rms, result.windows_accepted);
+  result.turbulence_intensity = intervals.turbulence_intensity;
   if (result.probe_corrected) {
     // The measured moments over the same windows, for comparison.
     const auto [measured_mean, measured_rms] = moments(&AwccWindow::measured_velocity);
@@ -687,24 +709,12 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     result.velocity_rms_measured = measured_rms;
     result.turbulence_intensity_measured = measured_rms / measured_mean;
   }
-  result.velocity_ci95 = {mean - hu, mean + hu};
-  result.velocity_rms_ci95 = {rms - hr, rms + hr};
-  result.turbulence_intensity_ci95 = {tu - ht, tu + ht};
-  const double yield = static_cast<double>(result.windows_accepted) / static_cast<double>(result.windows_total);
-  result.quality = AwccQuality::ok;
-  result.quality_reason.clear();
-  if (result.windows_accepted < options.windows_ok) {
-    result.quality = AwccQuality::low;
-    result.quality_reason = fmt::format("{} accepted windows (fewer than {}): Tu's 95 % interval is +/- {:.0f} %",
-                                        result.windows_accepted, options.windows_ok,
-                                        100.0 * ht / std::max(tu, 1e-300));
-  } else if (yield < options.yield_ok) {
-    result.quality = AwccQuality::low;
-    result.quality_reason = fmt::format("data yield {:.1f} % ({} of {} windows accepted, below {:g} %): the accepted "
-                                        "windows may not represent the flow",
-                                        100.0 * yield, result.windows_accepted, result.windows_total,
-                                        100.0 * options.yield_ok);
-  }
+  result.velocity_ci95 = intervals.mean;
+  result.velocity_rms_ci95 = intervals.rms;
+  result.turbulence_intensity_ci95 = intervals.tu;
+  std::tie(result.quality, result.quality_reason) =
+      reported_quality(result.windows_accepted, result.windows_total, options.windows_ok, options.yield_ok, intervals,
+                       {"accepted windows", "data yield", "windows accepted", "the accepted windows"});
 }
 
 }  // namespace detail

@@ -24,7 +24,7 @@ Vec3 times(const std::array<Vec3, 3>& m, const Vec3& b) { return {dot(m[0], b), 
 
 bool finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
-void no_solution(BubbleVector& v, BubbleFate fate) {
+void no_solution(BubbleVector& v, VectorFate fate) {
   v.velocity = v.velocity_spread = v.normal_front = v.normal_rear = kNaN3;
   v.diameter_front = v.diameter_rear = v.area_share = kNaN;
   v.fate = fate;
@@ -71,9 +71,9 @@ struct Combined {
 
 std::string fate_counts(const MultiTipResult& r) {
   std::string out;
-  for (std::size_t f = 0; f < bubble_fate_count; ++f) {
+  for (std::size_t f = 0; f < vector_fate_count; ++f) {
     if (r.bubbles_by_fate[f] == 0) continue;
-    out += fmt::format("{}{} {}", out.empty() ? "" : ", ", r.bubbles_by_fate[f], bubble_fate_names[f]);
+    out += fmt::format("{}{} {}", out.empty() ? "" : ", ", r.bubbles_by_fate[f], vector_fate_names[f]);
   }
   return out.empty() ? std::string("none") : out;
 }
@@ -88,7 +88,7 @@ std::string_view to_string(VelocityAlgorithm algorithm) {
   return "?";
 }
 
-std::string_view to_string(BubbleFate fate) { return bubble_fate_names[static_cast<std::size_t>(fate)]; }
+std::string_view to_string(VectorFate fate) { return vector_fate_names[static_cast<std::size_t>(fate)]; }
 
 std::string_view to_string(MultiTipStatus status) {
   switch (status) {
@@ -179,7 +179,7 @@ bool solve_combination(const TipCombination& c, const Crossing& leading, const s
 void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options) {
   auto& bubbles = result.bubbles;
   std::vector<bool> keep(bubbles.size());
-  for (std::size_t i = 0; i < bubbles.size(); ++i) keep[i] = bubbles[i].fate == BubbleFate::solved;
+  for (std::size_t i = 0; i < bubbles.size(); ++i) keep[i] = bubbles[i].fate == VectorFate::solved;
   result.roc_passes = 0;
   if (options.roc) {
     std::vector<double> u(bubbles.size());
@@ -194,12 +194,12 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
       }
     }
     for (std::size_t i = 0; i < bubbles.size(); ++i)
-      if (bubbles[i].fate == BubbleFate::solved && !keep[i]) bubbles[i].fate = BubbleFate::roc;
+      if (bubbles[i].fate == VectorFate::solved && !keep[i]) bubbles[i].fate = VectorFate::roc;
   }
   result.bubbles_total = static_cast<std::int64_t>(bubbles.size());
   result.bubbles_by_fate.fill(0);
   for (const auto& b : bubbles) ++result.bubbles_by_fate[static_cast<std::size_t>(b.fate)];
-  result.bubbles_accepted = result.count(BubbleFate::solved);
+  result.bubbles_accepted = result.count(VectorFate::solved);
   result.velocity = result.velocity_rms = result.turbulence_intensity = {};
   result.reynolds_stress = {};
   result.speed = 0.0;
@@ -217,7 +217,7 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
   double weights = 0.0;
   Vec3 sum{};
   for (const auto& b : bubbles) {
-    if (b.fate != BubbleFate::solved) continue;
+    if (b.fate != VectorFate::solved) continue;
     weights += b.weight;
     for (std::size_t j = 0; j < 3; ++j) sum[j] += b.weight * b.velocity[j];
   }
@@ -225,7 +225,7 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
   std::array<Vec3, 3> stress{};
   double diameter_front = 0.0, diameter_rear = 0.0, shares = 0.0;
   for (const auto& b : bubbles) {
-    if (b.fate != BubbleFate::solved) continue;
+    if (b.fate != VectorFate::solved) continue;
     Vec3 d{};
     for (std::size_t j = 0; j < 3; ++j) d[j] = b.velocity[j] - result.velocity[j];
     for (std::size_t j = 0; j < 3; ++j)
@@ -285,7 +285,7 @@ MultiTipResult multi_tip(const ProbeGeometry& geometry, const PiercedBubbles& bu
     const Crossing& lead = bubbles.leading[h];
     v.time = lead.front;
     if (lead.censored) {
-      no_solution(v, BubbleFate::censored);
+      no_solution(v, VectorFate::censored);
       continue;
     }
     int paired = 0;
@@ -304,7 +304,7 @@ MultiTipResult multi_tip(const ProbeGeometry& geometry, const PiercedBubbles& bu
     }
     v.weight = last - lead.front;
     if (paired < 3) {
-      no_solution(v, BubbleFate::too_few_tips);
+      no_solution(v, VectorFate::too_few_tips);
       continue;
     }
     Combined combined;
@@ -328,11 +328,11 @@ MultiTipResult multi_tip(const ProbeGeometry& geometry, const PiercedBubbles& bu
     result.combinations_solved += combined.count;
     v.combinations = combined.count;
     if (combined.count == 0 || !(v.weight > 0.0 && std::isfinite(v.weight))) {
-      no_solution(v, degenerate > 0 || combined.count > 0 ? BubbleFate::degenerate : BubbleFate::ill_conditioned);
+      no_solution(v, degenerate > 0 || combined.count > 0 ? VectorFate::degenerate : VectorFate::ill_conditioned);
       continue;
     }
     combined.into(v);
-    v.fate = BubbleFate::solved;
+    v.fate = VectorFate::solved;
   }
   detail::multi_tip_summarise(result, options);
   return result;
@@ -365,7 +365,7 @@ std::string MultiTipResult::report() const {
     out += fmt::format("mean diameter {:.4g} mm (front interfaces), {:.4g} mm (rear); interfacial area {:.4g} 1/m "
                        "(of the bubbles with a vector)\n",
                        1e3 * *diameter_front, 1e3 * *diameter_rear, *interfacial_area);
-    if (const auto missed = count(BubbleFate::too_few_tips); missed > 0) {
+    if (const auto missed = count(VectorFate::too_few_tips); missed > 0) {
       // Spheres pierced off-centre miss the trailing tips first, and those
       // are the ones with the largest 1 / |V . n|: the sum under-counts.
       out += fmt::format("  {} of {} leading bubbles ({:.0f} %) pierce fewer than three trailing tips and add no "

@@ -414,6 +414,35 @@ const OptionField<M> kMultiTip[] = {
      [](const M& o) { return std::to_string(o.vectors_reported); }},
 };
 
+using E = EventOptions;
+const OptionField<E> kEvents[] = {
+    {"pairing", "",
+     "event detection's interface pairing: kramer (Kramer et al. 2020: centre lag and chord-time disparity) | shen "
+     "(Shen et al. 2005: lags within |S| / (f V_gas), V_gas from FSCC or AWCC)",
+     [](E& o, std::string_view t) { o.pairing = choice(t, values::pairing); },
+     [](const E& o) { return name_of(o.pairing); }},
+    {"chord-disparity-max", "-",
+     "Kramer pairing: largest relative chord-time disparity |dt_0 - dt_k| / dt_0 of a pair (lower refuses more "
+     "off-centre true pairs, higher accepts more wrong ones)",
+     [](E& o, std::string_view t) { o.disparity_max = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}", o.disparity_max); }},
+    {"shen-lag-factor", "-",
+     "Shen pairing: f in the lag limit |S| / (f V_gas); 0.3 pairs bubbles down to 30 % of the mean velocity",
+     [](E& o, std::string_view t) { o.shen_lag_factor = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}", o.shen_lag_factor); }},
+    {"bubbles-reported", "-",
+     "event detection quality: fewest paired bubbles whose velocity and Tu are reported (insufficient below)",
+     [](E& o, std::string_view t) { o.bubbles_reported = static_cast<int>(whole(t, 2, 1000000000)); },
+     [](const E& o) { return std::to_string(o.bubbles_reported); }},
+    {"bubbles-ok", "-", "event detection quality: fewest paired bubbles of quality ok (low below)",
+     [](E& o, std::string_view t) { o.bubbles_ok = static_cast<int>(whole(t, 2, 1000000000)); },
+     [](const E& o) { return std::to_string(o.bubbles_ok); }},
+    {"pairing-yield-ok", "-",
+     "event detection quality: least pairing yield (paired / complete leading bubbles) of quality ok, e.g. 5%",
+     [](E& o, std::string_view t) { o.pairing_yield_ok = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}%", 100.0 * o.pairing_yield_ok); }},
+};
+
 using P = ProcessOptions;
 constexpr std::array<std::pair<const char*, int>, 4> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}, {"none", 0}}};
 // The probe's tips first: probe_option_fields() is their span, and a later
@@ -488,6 +517,7 @@ std::span<const OptionField<ProcessOptions>> probe_option_fields() {
 }
 std::span<const OptionField<StructureOptions>> structure_option_fields() { return kStructure; }
 std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields() { return kMultiTip; }
+std::span<const OptionField<EventOptions>> event_option_fields() { return kEvents; }
 
 std::span<const PresetSetting> preset_settings(std::string_view name) {
   if (name == "felder") return kFelder;

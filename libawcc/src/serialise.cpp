@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <span>
@@ -36,6 +37,57 @@ constexpr WindowColumnFormat kWindowColumns[] = {
     {{"fate", "", nullptr, [](const AwccWindow& w) { return to_string(w.fate); }}, "{}"},
     {{"measured_velocity", "m/s", [](const AwccWindow& w) { return w.measured_velocity; }, nullptr}, "{:.9g}"},
 };
+
+// Each column of the bubble table with its CSV number format.
+struct BubbleColumnFormat {
+  BubbleColumn column;
+  std::string_view format;
+};
+constexpr BubbleColumnFormat kBubbleColumns[] = {
+    {{"leading_front", "s", [](const EventBubble& b) { return b.leading_front; }, nullptr}, "{:.9g}"},
+    {{"leading_rear", "s", [](const EventBubble& b) { return b.leading_rear; }, nullptr}, "{:.9g}"},
+    {{"trailing_front", "s", [](const EventBubble& b) { return b.trailing_front; }, nullptr}, "{:.9g}"},
+    {{"trailing_rear", "s", [](const EventBubble& b) { return b.trailing_rear; }, nullptr}, "{:.9g}"},
+    {{"front_lag", "s", [](const EventBubble& b) { return b.front_lag; }, nullptr}, "{:.9g}"},
+    {{"rear_lag", "s", [](const EventBubble& b) { return b.rear_lag; }, nullptr}, "{:.9g}"},
+    {{"centre_lag", "s", [](const EventBubble& b) { return b.centre_lag; }, nullptr}, "{:.9g}"},
+    {{"disparity", "-", [](const EventBubble& b) { return b.disparity; }, nullptr}, "{:.6f}"},
+    {{"velocity", "m/s", [](const EventBubble& b) { return b.velocity; }, nullptr}, "{:.9g}"},
+    {{"chord_length", "m", [](const EventBubble& b) { return b.chord_length; }, nullptr}, "{:.9g}"},
+    {{"weight", "s", [](const EventBubble& b) { return b.weight; }, nullptr}, "{:.9g}"},
+    {{"fate", "", nullptr, [](const EventBubble& b) { return to_string(b.fate); }}, "{}"},
+};
+
+// The columns of a table without their formats.
+template <class Format, std::size_t N>
+auto columns_of(const Format (&formats)[N]) {
+  std::vector<decltype(formats[0].column)> out;
+  for (const auto& c : formats) out.push_back(c.column);
+  return out;
+}
+
+// A table's CSV from its formatted columns: a header of their names, one
+// line per row, an empty cell for a number that is not finite.
+template <class Format, std::size_t N, class Row>
+std::string table_csv(const Format (&columns)[N], const std::vector<Row>& rows) {
+  std::string out;
+  for (const auto& c : columns) out += fmt::format("{}{}", out.empty() ? "" : ",", c.column.name);
+  out += '\n';
+  for (const auto& row : rows) {
+    bool first = true;
+    for (const auto& c : columns) {
+      if (!first) out += ',';
+      first = false;
+      if (c.column.text) {
+        out += c.column.text(row);
+      } else if (const double v = c.column.value(row); std::isfinite(v)) {
+        out += fmt::format(fmt::runtime(c.format), v);
+      }
+    }
+    out += '\n';
+  }
+  return out;
+}
 
 // The JSON's count of the windows of a fate: windows_accepted, windows_rejected_<fate>.
 std::string window_count_key(WindowFate fate) {
@@ -152,30 +204,18 @@ std::vector<std::string_view> written_values(std::string_view column) {
 }
 
 std::span<const WindowColumn> awcc_window_columns() {
-  static const auto columns = [] {
-    std::vector<WindowColumn> out;
-    for (const auto& c : kWindowColumns) out.push_back(c.column);
-    return out;
-  }();
+  static const auto columns = columns_of(kWindowColumns);
   return columns;
 }
 
-std::string awcc_windows_csv(const AwccResult& result) {
-  std::string out;
-  for (const auto& c : kWindowColumns) out += fmt::format("{}{}", out.empty() ? "" : ",", c.column.name);
-  out += '\n';
-  for (const auto& w : result.windows) {
-    bool first = true;
-    for (const auto& c : kWindowColumns) {
-      if (!first) out += ',';
-      first = false;
-      if (c.column.text) out += c.column.text(w);
-      else out += fmt::format(fmt::runtime(c.format), c.column.value(w));
-    }
-    out += '\n';
-  }
-  return out;
+std::string awcc_windows_csv(const AwccResult& result) { return table_csv(kWindowColumns, result.windows); }
+
+std::span<const BubbleColumn> event_bubble_columns() {
+  static const auto columns = columns_of(kBubbleColumns);
+  return columns;
 }
+
+std::string event_bubbles_csv(const EventResult& result) { return table_csv(kBubbleColumns, result.bubbles); }
 
 namespace {
 

@@ -4,23 +4,16 @@
 #include <cmath>
 
 #include "awcc/awcc.hpp"
+#include "clean_scene.hpp"
 #include "synth/synthesiser.hpp"
 
 namespace {
 
 TEST(AwccSynthetic, RecoversMeanAndTurbulenceWhereTheErrorMechanismsVanish) {
-  // Large bubbles (6 mm against dx = 5 mm), aligned tips (dy = 0), weak
-  // turbulence (Tu = 0.05) with a long time scale (1 s against windows of
-  // ~10 ms): no selective sampling, no oblique impacts, no decorrelation, no
-  // window averaging. The estimate must then sit within 1 % (mean) and 10 %
-  // (Tu) of the realised truth of the same series.
-  synth::Scene s;
-  s.bubble_diameter = 6e-3;
-  s.dy = 0.0;
-  s.tu = 0.05;
-  s.tu_y = s.tu_z = 0.025;
-  s.time_scale = 1.0;
-  s.duration = 60.0;
+  // The clean scene (clean_scene.hpp; its 1 s time scale against windows of
+  // ~10 ms): the estimate must sit within 1 % (mean) and 10 % (Tu) of the
+  // realised truth of the same series.
+  const synth::Scene s = pdp_test::clean_scene(60.0);
   synth::SynthesisOptions so;
   so.keep_velocity_history = true;
   const auto syn = synth::synthesise(s, so);

@@ -25,7 +25,7 @@
 
 namespace {
 
-using awcc::BubbleFate;
+using awcc::VectorFate;
 using awcc::Crossing;
 using awcc::MultiTipOptions;
 using awcc::PiercedBubbles;
@@ -125,7 +125,7 @@ TEST(MultiTip, ShenNakamuraRecoversTheVelocityDiameterAndNormalsOfASphere) {
     for (std::size_t i = 0; i < spheres.size(); ++i) {
       const auto& b = result.bubbles[i];
       const auto& s = spheres[i];
-      ASSERT_EQ(b.fate, BubbleFate::solved);
+      ASSERT_EQ(b.fate, VectorFate::solved);
       EXPECT_EQ(b.combinations, tips == 4 ? 1 : 4);
       EXPECT_LT(relative(b.velocity, v), 1e-9) << "tips " << tips << " bubble " << i;
       EXPECT_LT(norm(b.velocity_spread) / norm(v), 1e-9) << "an exact sphere: every combination agrees";
@@ -258,20 +258,20 @@ TEST(MultiTip, FatesOfBubblesWithoutAVectorAreCountedNeverAHugeNumber) {
   const Crossing ulp{std::nextafter(0.2, 1.0), std::nextafter(0.203, 1.0), false};
   bubbles.add(lead, std::vector<std::optional<Crossing>>{ulp, lead, lead});
   const auto r = awcc::multi_tip(g, bubbles, 1.0, no_statistics());
-  const std::vector<BubbleFate> want{BubbleFate::solved,     BubbleFate::too_few_tips, BubbleFate::censored,
-                                     BubbleFate::too_few_tips, BubbleFate::degenerate, BubbleFate::degenerate,
-                                     BubbleFate::degenerate};
+  const std::vector<VectorFate> want{VectorFate::solved,     VectorFate::too_few_tips, VectorFate::censored,
+                                     VectorFate::too_few_tips, VectorFate::degenerate, VectorFate::degenerate,
+                                     VectorFate::degenerate};
   ASSERT_EQ(r.bubbles.size(), want.size());
   for (std::size_t i = 0; i < want.size(); ++i) {
     EXPECT_EQ(r.bubbles[i].fate, want[i]) << i;
-    if (want[i] != BubbleFate::solved) {
+    if (want[i] != VectorFate::solved) {
       EXPECT_TRUE(std::isnan(r.bubbles[i].velocity[0])) << i;
     }
   }
   EXPECT_LT(relative(r.bubbles[0].velocity, {2e-3 / 1.6e-3, 0, 0}), 1e-9);
   EXPECT_EQ(r.partners_censored, 1);
   EXPECT_EQ(r.combinations_degenerate, 3);
-  EXPECT_EQ(r.count(BubbleFate::too_few_tips), 2);
+  EXPECT_EQ(r.count(VectorFate::too_few_tips), 2);
   EXPECT_FALSE(r.ok()) << "one vector is too few for statistics";
   EXPECT_NE(r.message.find("1 of 7 leading bubbles have an accepted velocity vector (1 solved, 1 censored, 2 "
                            "too_few_tips, 3 degenerate)"),
@@ -290,7 +290,7 @@ TEST(MultiTip, FiveTipsAverageTheCombinationsAndKeepTheirSpread) {
   bubbles.trailing[2]->front += 40e-6;
   bubbles.trailing[2]->rear += 40e-6;
   const auto r = awcc::multi_tip(g, bubbles, 1.0, no_statistics());
-  ASSERT_EQ(r.bubbles[0].fate, BubbleFate::solved);
+  ASSERT_EQ(r.bubbles[0].fate, VectorFate::solved);
   ASSERT_EQ(r.bubbles[0].combinations, 4);
   std::array<Vec3, 4> each{};
   for (std::size_t i = 0; i < 4; ++i) {
@@ -328,7 +328,7 @@ TEST(MultiTip, IllConditionedCombinationsAreSkippedAndCountedAtAndAroundTheLimit
     const double det = g.combinations()[0].conditioning();
     if (factor == 1.0) o.conditioning_min = det;  // exactly at the limit
     const auto r = awcc::multi_tip(g, pierce(g, {sphere_through(v, 8e-3, {0, 0, 0}, 0.1)}), 1.0, o);
-    ASSERT_EQ(r.bubbles[0].fate, BubbleFate::solved);
+    ASSERT_EQ(r.bubbles[0].fate, VectorFate::solved);
     const bool skipped = factor < 1.0;
     EXPECT_EQ(r.combinations_ill_conditioned, skipped ? 1 : 0) << factor;
     EXPECT_EQ(r.bubbles[0].combinations_skipped, skipped ? 1 : 0);
@@ -344,7 +344,7 @@ TEST(MultiTip, IllConditionedCombinationsAreSkippedAndCountedAtAndAroundTheLimit
   auto bubbles = pierce(g, {sphere_through(v, 8e-3, {0, 0, 0}, 0.1)});
   bubbles.trailing[3].reset();
   const auto r = awcc::multi_tip(g, bubbles, 1.0, o);
-  EXPECT_EQ(r.bubbles[0].fate, BubbleFate::ill_conditioned);
+  EXPECT_EQ(r.bubbles[0].fate, VectorFate::ill_conditioned);
   EXPECT_TRUE(std::isnan(r.bubbles[0].velocity[0]));
 }
 
@@ -357,7 +357,7 @@ TEST(MultiTip, StatisticsAreTheWeightedMomentsOfABruteForceComputation) {
   const int n = 5000;
   for (int i = 0; i < n; ++i) {
     awcc::BubbleVector b;
-    b.fate = i % 7 == 3 ? BubbleFate::too_few_tips : BubbleFate::solved;
+    b.fate = i % 7 == 3 ? VectorFate::too_few_tips : VectorFate::solved;
     b.weight = span(rng);
     b.velocity = {3.0 + 0.4 * n01(rng), -0.2 + 0.3 * n01(rng), 0.1 + 0.2 * n01(rng)};
     b.velocity[1] += 0.5 * (b.velocity[0] - 3.0);  // correlated: a non-zero off-diagonal stress
@@ -375,7 +375,7 @@ TEST(MultiTip, StatisticsAreTheWeightedMomentsOfABruteForceComputation) {
   std::array<std::array<long double, 3>, 3> rs{};
   long double accepted = 0;
   for (const auto& b : r.bubbles) {
-    if (b.fate != BubbleFate::solved) continue;
+    if (b.fate != VectorFate::solved) continue;
     ++accepted;
     w += b.weight;
     shares += b.area_share;
@@ -384,7 +384,7 @@ TEST(MultiTip, StatisticsAreTheWeightedMomentsOfABruteForceComputation) {
   }
   for (auto& x : m) x /= w;
   for (const auto& b : r.bubbles) {
-    if (b.fate != BubbleFate::solved) continue;
+    if (b.fate != VectorFate::solved) continue;
     for (std::size_t j = 0; j < 3; ++j)
       for (std::size_t k = 0; k < 3; ++k) rs[j][k] += b.weight * (b.velocity[j] - m[j]) * (b.velocity[k] - m[k]);
   }
@@ -416,14 +416,14 @@ TEST(MultiTip, TheOutlierCutoffRejectsABubbleOnAnyComponent) {
   r.record_length = 10.0;
   for (int i = 0; i < 400; ++i) {
     awcc::BubbleVector b;
-    b.fate = BubbleFate::solved;
+    b.fate = VectorFate::solved;
     b.weight = 1e-3;
     b.velocity = {2.0 + 0.1 * n01(rng), 0.1 * n01(rng), 0.1 * n01(rng)};
     r.bubbles.push_back(b);
   }
   r.bubbles[17].velocity[2] = 3.0;  // normal in x and y, wild in z (a mis-paired tip)
   awcc::detail::multi_tip_summarise(r, MultiTipOptions{});
-  EXPECT_EQ(r.bubbles[17].fate, BubbleFate::roc);
+  EXPECT_EQ(r.bubbles[17].fate, VectorFate::roc);
   // The same cutoff as AWCC's, on z alone, rejects it too.
   std::vector<double> z;
   std::vector<bool> keep(400, true);
@@ -536,7 +536,7 @@ TEST(MultiTip, GrazingBubblesErrorMeasuredAndBounded) {
       bubbles.add(sampled(*lead), at);
       const auto res = awcc::multi_tip(g, bubbles, 1.0, MultiTipOptions{.roc = false, .vectors_reported = 2});
       const auto& b = res.bubbles[0];
-      ASSERT_EQ(b.fate, BubbleFate::solved);
+      ASSERT_EQ(b.fate, VectorFate::solved);
       worst_speed = std::max(worst_speed, std::fabs(norm(b.velocity) - norm(v)) / norm(v));
       worst_d = std::max(worst_d, std::fabs(b.diameter_front - d) / d);
       const Vec3 nf = sphere.normal({0, 0, 0}, lead->front);

@@ -101,7 +101,7 @@ struct PiercedBubbles {
 };
 
 /// What became of a leading bubble.
-enum class BubbleFate {
+enum class VectorFate {
   solved,           ///< a vector, accepted by the outlier cutoff
   censored,         ///< cut by the record's start or end at the leading tip
   too_few_tips,     ///< fewer than three trailing tips paired (a censored partner does not count)
@@ -109,12 +109,12 @@ enum class BubbleFate {
   degenerate,       ///< every well-conditioned combination degenerate (vanishing lags, no finite solution)
   roc,              ///< solved, rejected by the robust outlier cutoff
 };
-inline constexpr std::array<std::string_view, 6> bubble_fate_names{"solved",          "censored",   "too_few_tips",
+inline constexpr std::array<std::string_view, 6> vector_fate_names{"solved",          "censored",   "too_few_tips",
                                                                    "ill_conditioned", "degenerate", "roc"};
-inline constexpr std::size_t bubble_fate_count = bubble_fate_names.size();
-static_assert(static_cast<std::size_t>(BubbleFate::roc) + 1 == bubble_fate_count,
-              "a fate added to BubbleFate needs its name in bubble_fate_names");
-std::string_view to_string(BubbleFate fate);
+inline constexpr std::size_t vector_fate_count = vector_fate_names.size();
+static_assert(static_cast<std::size_t>(VectorFate::roc) + 1 == vector_fate_count,
+              "a fate added to VectorFate needs its name in vector_fate_names");
+std::string_view to_string(VectorFate fate);
 
 /// One leading bubble's solution (NaN where it has none).
 struct BubbleVector {
@@ -129,7 +129,7 @@ struct BubbleVector {
   double area_share = 0.0;         ///< 1 / |V . n| of the front interface, s/m (Eq. 54; NaN with Tian)
   int combinations = 0;            ///< combinations solved and averaged
   int combinations_skipped = 0;    ///< of its paired tips, below conditioning-min
-  BubbleFate fate = BubbleFate::degenerate;
+  VectorFate fate = VectorFate::degenerate;
 };
 
 struct MultiTipOptions {
@@ -180,9 +180,9 @@ struct MultiTipResult {
   std::optional<double> diameter_front, diameter_rear, interfacial_area;
 
   std::int64_t bubbles_total = 0;
-  std::int64_t bubbles_accepted = 0;  ///< count(BubbleFate::solved), the N of the statistics
-  std::array<std::int64_t, bubble_fate_count> bubbles_by_fate{};
-  [[nodiscard]] std::int64_t count(BubbleFate fate) const { return bubbles_by_fate[static_cast<std::size_t>(fate)]; }
+  std::int64_t bubbles_accepted = 0;  ///< count(VectorFate::solved), the N of the statistics
+  std::array<std::int64_t, vector_fate_count> bubbles_by_fate{};
+  [[nodiscard]] std::int64_t count(VectorFate fate) const { return bubbles_by_fate[static_cast<std::size_t>(fate)]; }
   std::int64_t partners_censored = 0;         ///< paired trailing crossings cut by the record's ends (not used)
   std::int64_t combinations_solved = 0;
   std::int64_t combinations_ill_conditioned = 0;  ///< skipped: below conditioning-min

@@ -11,6 +11,7 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
+#include "awcc/event_detection.hpp"
 #include "awcc/fscc.hpp"
 #include "awcc/multi_tip.hpp"
 #include "awcc/option_field.hpp"
@@ -32,6 +33,11 @@ std::span<const OptionField<ProcessOptions>> probe_option_fields();
 std::span<const OptionField<StructureOptions>> structure_option_fields();
 /// The multi-tip solvers' options (awcc/multi_tip.hpp).
 std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields();
+/// Event detection's own options (awcc/event_detection.hpp). Its `roc` and
+/// `weighting` are AWCC's declared ones (one switch for both methods, so that
+/// their velocities compare like with like): a front end copies them from
+/// the AwccOptions it applied, as FSCC takes AWCC's `subsample`.
+std::span<const OptionField<EventOptions>> event_option_fields();
 
 /// A named set of option values (the setting `preset = felder`): applied to
 /// the options the user does not give.

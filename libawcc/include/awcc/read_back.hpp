@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "awcc/awcc.hpp"
+#include "awcc/event_detection.hpp"
 #include "awcc/binarisation.hpp"
 #include "awcc/flags.hpp"
 #include "awcc/fscc.hpp"
@@ -31,6 +32,7 @@ inline constexpr ThresholdRule threshold_rule[] = {ThresholdRule::histogram, Thr
                                                    ThresholdRule::kramer, ThresholdRule::fixed,
                                                    ThresholdRule::hysteresis};
 inline constexpr ProbeType probe[] = {ProbeType::conductivity, ProbeType::optical};
+inline constexpr Pairing pairing[] = {Pairing::kramer, Pairing::shen};
 }  // namespace values
 
 /// A switch as pdp writes it (a profile CSV's "on"/"off", an option's value).

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "awcc/event_detection.hpp"
 #include "awcc/process.hpp"
 
 namespace awcc {
@@ -46,6 +47,22 @@ std::span<const WindowColumn> awcc_window_columns();
 
 /// The per-window table of AWCC as CSV.
 std::string awcc_windows_csv(const AwccResult& result);
+
+/// A column of event detection's bubble table (awcc/event_detection.hpp,
+/// EventBubble): the CSV's and the Python module's.
+struct BubbleColumn {
+  std::string_view name;
+  std::string_view unit;                          ///< "s", "m/s", "m", "-", "" (text)
+  double (*value)(const EventBubble&);            ///< numeric columns (NaN: the bubble has no value)
+  std::string_view (*text)(const EventBubble&);   ///< the text column (fate); null for numeric ones
+};
+/// The columns of the bubble table, in order: times at each tip, lags,
+/// disparity, velocity, chord length, weight, fate.
+std::span<const BubbleColumn> event_bubble_columns();
+
+/// Event detection's per-bubble table as CSV, one row per leading bubble; an
+/// empty cell where the bubble has no value (no candidate, no velocity).
+std::string event_bubbles_csv(const EventResult& result);
 
 /// A profile CSV column: its name, its unit ("" for text, "-" for a
 /// dimensionless number), where the same value is in the recording's JSON

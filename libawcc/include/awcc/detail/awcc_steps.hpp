@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -68,6 +70,58 @@ std::vector<std::pair<std::int64_t, double>> peak_prominences(std::span<const do
 /// Robust outlier cutoff over the velocities whose flag is true; clears the
 /// flag of the rejected ones. Returns the number of iterations.
 int robust_outlier_cutoff(std::span<const double> velocities, std::vector<bool>& keep);
+
+/// The robust outlier cutoff over the `velocity` of the items (AWCC's
+/// windows, event detection's bubbles) whose fate is `accepted`; those it
+/// rejects get fate `rejected`. Returns the number of iterations.
+template <class Item, class Fate>
+int cut_outliers(std::vector<Item>& items, Fate accepted, Fate rejected) {
+  std::vector<double> u(items.size());
+  std::vector<bool> keep(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    u[i] = items[i].velocity;
+    keep[i] = items[i].fate == accepted;
+  }
+  const int iterations = robust_outlier_cutoff(u, keep);
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (items[i].fate == accepted && !keep[i]) items[i].fate = rejected;
+  return iterations;
+}
+
+/// The moments of METHOD 4 item 7 over accepted values, each with its
+/// weight (a window's duration, a bubble's interaction time span, or 1):
+/// mean = sum w u / sum w, rms = sqrt(sum w (u - mean)^2 / sum w). AWCC and
+/// event detection both take them from here.
+struct WeightedMoments {
+  double mean = 0.0;
+  double rms = 0.0;
+};
+WeightedMoments weighted_moments(std::span<const double> values, std::span<const double> weights);
+
+/// The 95 % intervals of METHOD 4 item 8 from N accepted values: mean +/-
+/// 1.96 rms / sqrt(N), rms +/- 1.96 rms / sqrt(2N), Tu = rms / mean +/- 1.96
+/// sigma_T with sigma_T^2 = Tu^2 (Tu^2 / N + 1 / (2N)); the half-widths too
+/// (a quality reason quotes Tu's).
+struct MomentIntervals {
+  double turbulence_intensity = 0.0;   ///< rms / mean
+  double mean_half = 0.0, rms_half = 0.0, turbulence_intensity_half = 0.0;
+  Interval95 mean, rms, tu;
+};
+MomentIntervals moment_intervals95(double mean, double rms, std::int64_t n);
+
+/// The words of a quality reason: what is counted ("accepted windows"),
+/// the yield's name ("data yield"), its ratio ("windows accepted") and the
+/// selection it may bias ("the accepted windows").
+struct QualityWords {
+  std::string_view counted, yield, ratio, selection;
+};
+/// METHOD 4 item 10 for a result whose moments are reported: low below
+/// `ok_count` accepted items (the reason quotes Tu's interval) or below the
+/// least yield accepted / total, ok otherwise (empty reason). AWCC's windows
+/// and event detection's bubbles are judged by this one rule.
+std::pair<AwccQuality, std::string> reported_quality(std::int64_t accepted, std::int64_t total, std::int64_t ok_count,
+                                                     double yield_ok, const MomentIntervals& intervals,
+                                                     const QualityWords& words);
 
 /// Lags searched in a window of `length` samples: all, or those of the
 /// stated velocity range (k_max < k_min: the window is too short for it).
