@@ -378,4 +378,43 @@ std::string MultiTipResult::report() const {
   return out;
 }
 
+ProbePairing pair_probe(const ProbeGeometry& geometry, std::span<const std::vector<Crossing>> tips,
+                        const EventOptions& options, std::optional<double> first_velocity) {
+  if (tips.size() != geometry.tip_count()) {
+    throw std::invalid_argument(fmt::format("pair_probe: {} tips' crossings for a probe of {} tips", tips.size(),
+                                            geometry.tip_count()));
+  }
+  const std::vector<Crossing>& leading = tips[geometry.leading()];
+  const std::vector<std::size_t>& trailing = geometry.trailing_tips();
+  ProbePairing out;
+  out.bubbles = PiercedBubbles(trailing.size());
+  std::vector<PairingResult> pairings;
+  pairings.reserve(trailing.size());
+  for (std::size_t k = 0; k < trailing.size(); ++k) {
+    PairingResult pairing = pair_bubbles(leading, tips[trailing[k]], geometry.distance(k), options, first_velocity);
+    if (!pairing.ok()) {
+      out.status = pairing.status;
+      out.message = fmt::format("{} with {}: {}", geometry.tip_name(geometry.leading()),
+                                geometry.tip_name(trailing[k]), pairing.message);
+      out.fates.clear();
+      return out;
+    }
+    auto& fates = out.fates.emplace_back();
+    fates.fill(0);
+    for (const BubblePairing& b : pairing.bubbles) ++fates[static_cast<std::size_t>(b.fate)];
+    pairings.push_back(std::move(pairing));
+  }
+  out.bubbles.reserve(leading.size());
+  std::vector<std::optional<Crossing>> partners(trailing.size());
+  for (std::size_t h = 0; h < leading.size(); ++h) {
+    for (std::size_t k = 0; k < trailing.size(); ++k) {
+      const BubblePairing& b = pairings[k].bubbles[h];
+      partners[k].reset();
+      if (b.fate == BubbleFate::paired && b.candidate) partners[k] = tips[trailing[k]][*b.candidate];
+    }
+    out.bubbles.add(leading[h], partners);
+  }
+  return out;
+}
+
 }  // namespace awcc

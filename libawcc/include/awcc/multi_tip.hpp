@@ -65,6 +65,7 @@
 #include <string_view>
 #include <vector>
 
+#include "awcc/event_detection.hpp"
 #include "awcc/interface_times.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/probe_geometry.hpp"
@@ -202,5 +203,23 @@ struct MultiTipResult {
 /// positive.
 MultiTipResult multi_tip(const ProbeGeometry& geometry, const PiercedBubbles& bubbles, double record_length,
                          const MultiTipOptions& options = {});
+
+/// Each leading bubble with its partner at every trailing tip: event
+/// detection's pairing (awcc/event_detection.hpp) of the leading tip with
+/// each trailing tip in turn, |S_0k| as the tip distance; a refused pairing
+/// leaves that partner empty. `tips` holds every tip's crossings in the
+/// geometry's tip order. The pairing's status is returned when it is not ok
+/// (Shen pairing without a first velocity), with no bubbles.
+struct ProbePairing {
+  EventStatus status = EventStatus::ok;
+  std::string message;  ///< why not ok
+  [[nodiscard]] bool ok() const { return status == EventStatus::ok; }
+  PiercedBubbles bubbles;
+  /// Per trailing tip (order of trailing_tips()), its pairing's fate counts,
+  /// indexed by BubbleFate: what a lab reads to see which tip loses bubbles.
+  std::vector<std::array<std::int64_t, bubble_fate_count>> fates;
+};
+ProbePairing pair_probe(const ProbeGeometry& geometry, std::span<const std::vector<Crossing>> tips,
+                        const EventOptions& options, std::optional<double> first_velocity = std::nullopt);
 
 }  // namespace awcc
