@@ -7,6 +7,20 @@
 
 namespace awcc {
 
+namespace {
+
+// The 95 % half-width of estimate - reference: the half-widths of the two
+// intervals on the sides that face each other, added in quadrature.
+double allowed_difference(double estimate, const Interval95& estimate_ci, double reference,
+                          const Interval95& reference_ci) {
+  const bool below = estimate < reference;
+  const double h_reference = below ? reference - reference_ci.lower : reference_ci.upper - reference;
+  const double h_estimate = below ? estimate_ci.upper - estimate : estimate - estimate_ci.lower;
+  return std::hypot(h_reference, h_estimate);
+}
+
+}  // namespace
+
 std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const AwccResult& awcc) {
   if (!fscc.ok() || !fscc.velocity_ci95 || !awcc.ok()) return std::nullopt;
   MethodsComparison c;
@@ -15,12 +29,30 @@ std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const A
   c.fscc_ci95 = *fscc.velocity_ci95;
   c.awcc_ci95 = awcc.velocity_ci95;
   c.difference = c.awcc - c.fscc;
-  // The sides of the intervals that face each other.
-  const bool awcc_below = c.difference < 0.0;
-  const double h_fscc = awcc_below ? c.fscc - c.fscc_ci95.lower : c.fscc_ci95.upper - c.fscc;
-  const double h_awcc = awcc_below ? c.awcc_ci95.upper - c.awcc : c.awcc - c.awcc_ci95.lower;
-  c.allowed = std::hypot(h_fscc, h_awcc);
+  c.allowed = allowed_difference(c.awcc, c.awcc_ci95, c.fscc, c.fscc_ci95);
   c.relative = std::abs(c.difference) / c.fscc;
+  return c;
+}
+
+std::optional<EventsComparison> compare_events(const EventResult& events, const ProcessResult& r) {
+  if (!events.ok()) return std::nullopt;
+  EventsComparison c;
+  c.events = events.velocity;
+  c.events_ci95 = events.velocity_ci95;
+  if (r.fscc && r.fscc->ok() && r.fscc->velocity_ci95) {
+    c.reference = "FSCC";
+    c.reference_velocity = r.fscc->velocity;
+    c.reference_ci95 = *r.fscc->velocity_ci95;
+  } else if (r.awcc && r.awcc->ok() && r.awcc->quality == AwccQuality::ok) {
+    c.reference = "AWCC";
+    c.reference_velocity = r.awcc->velocity;
+    c.reference_ci95 = r.awcc->velocity_ci95;
+  } else {
+    return std::nullopt;
+  }
+  c.difference = c.events - c.reference_velocity;
+  c.allowed = allowed_difference(c.events, c.events_ci95, c.reference_velocity, c.reference_ci95);
+  c.relative = std::abs(c.difference) / c.reference_velocity;
   return c;
 }
 
@@ -43,14 +75,16 @@ std::string channel_list(const std::vector<int>& channels, const std::vector<std
 std::optional<Warning> channels_ignored(const ProcessResult& r) {
   std::vector<int> ignored;
   for (int c = 0; c < r.info.channels; ++c) {
-    if (std::none_of(r.tips.begin(), r.tips.end(), [c](const TipResult& t) { return t.channel == c; })) {
-      ignored.push_back(c);
-    }
+    const bool tip = std::any_of(r.tips.begin(), r.tips.end(), [c](const TipResult& t) { return t.channel == c; });
+    const bool probe_tip = r.probe && std::find(r.probe->channels.begin(), r.probe->channels.end(), c) !=
+                                          r.probe->channels.end();
+    if (!tip && !probe_tip) ignored.push_back(c);
   }
   if (ignored.empty() || r.tips.size() < 2) return std::nullopt;
   return Warning{Flag::channels_ignored,
-                 fmt::format("{} of {} {} not processed (a {}-tip probe?): this version processes one tip pair, "
-                             "channels {} and {} (leading-channel, trailing-channel)",
+                 fmt::format("{} of {} {} not processed (a {}-tip probe?): the tip pair alone was processed, "
+                             "channels {} and {}; to process every tip as a probe of four or more, declare their "
+                             "positions (tips, tip-channels)",
                              channel_list(ignored, r.info.channel_names), r.info.channels,
                              ignored.size() == 1 ? "is" : "are", r.info.channels, r.tips[0].channel, r.tips[1].channel)};
 }
@@ -91,6 +125,24 @@ std::optional<Warning> methods_disagree(const ProcessResult& r) {
   return Warning{Flag::methods_disagree, std::move(text)};
 }
 
+std::optional<Warning> events_disagree(const ProcessResult& r) {
+  if (!r.events) return std::nullopt;
+  const auto c = compare_events(*r.events, r);
+  if (!c || !c->disagree()) return std::nullopt;
+  const auto& e = *r.events;
+  return Warning{
+      Flag::events_disagree,
+      fmt::format("event detection's velocity {:.3f} m/s (95 % sampling interval {:.3f}-{:.3f}, {} paired bubbles of "
+                  "{}) and {}'s {:.3f} m/s ({:.3f}-{:.3f}) differ by {:.0f} % ({} {}), more than their sampling "
+                  "intervals allow together ({:.3f} m/s): the pairing ({}) is biased here (partners taken from later, "
+                  "unrelated bubbles where bubbles are sparse or the tips offset); use {}'s velocity, and event "
+                  "detection's per-bubble table only to see the pairing's fates",
+                  c->events, c->events_ci95.lower, c->events_ci95.upper, e.bubbles_paired, e.bubbles_complete,
+                  c->reference, c->reference_velocity, c->reference_ci95.lower, c->reference_ci95.upper,
+                  100.0 * c->relative, c->difference < 0.0 ? "below" : "above", c->reference, c->allowed,
+                  to_string(e.options.pairing), c->reference)};
+}
+
 }  // namespace
 
 std::vector<Warning> assess(const ProcessResult& r) {
@@ -109,6 +161,7 @@ std::vector<Warning> assess(const ProcessResult& r) {
                    r.spectrum->warning});
   }
   if (auto w = methods_disagree(r)) out.push_back(std::move(*w));
+  if (auto w = events_disagree(r)) out.push_back(std::move(*w));
   return out;
 }
 

@@ -445,6 +445,45 @@ const OptionField<E> kEvents[] = {
 
 using P = ProcessOptions;
 constexpr std::array<std::pair<const char*, int>, 4> kMethods{{{"both", 3}, {"awcc", 2}, {"fscc", 1}, {"none", 0}}};
+
+// The method option: names joined by '+'. A correlation choice (kMethods),
+// auto (multi-tip for a probe of four or more tips), events, multi-tip;
+// without a correlation choice, both (bubble-by-bubble methods are checked
+// against FSCC and AWCC). Every combination of the fields is written so that
+// it reads back the same: auto, both, events, auto+events, fscc+auto, ...
+void set_method(P& o, std::string_view text) {
+  o.events = false;
+  o.multi_tip = MultiTipChoice::off;
+  std::optional<int> correlations;
+  for (const auto& cell : split_cells(text, '+')) {
+    if (cell == "auto") {
+      o.multi_tip = MultiTipChoice::automatic;
+    } else if (cell == "events") {
+      o.events = true;
+    } else if (cell == "multi-tip") {
+      o.multi_tip = MultiTipChoice::on;
+    } else {
+      if (correlations) throw std::invalid_argument(fmt::format("'{}' names two correlation choices", text));
+      correlations = choice(cell, kMethods);
+    }
+  }
+  const int m = correlations.value_or(3);
+  o.fscc = (m & 1) != 0;
+  o.awcc = (m & 2) != 0;
+}
+
+std::string method_text(const P& o) {
+  std::vector<std::string> names;
+  const std::string base = name_of((o.fscc ? 1 : 0) | (o.awcc ? 2 : 0), kMethods);
+  if (o.multi_tip == MultiTipChoice::automatic) names.emplace_back("auto");
+  if (o.multi_tip == MultiTipChoice::on) names.emplace_back("multi-tip");
+  if (o.events) names.emplace_back("events");
+  if (base != "both" || names.empty()) names.insert(names.begin(), base);
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : "+") + n;
+  return out;
+}
+
 // The probe's tips first: probe_option_fields() is their span, and a later
 // option's parse may read them.
 constexpr std::size_t kProbeFields = 3;
@@ -479,13 +518,12 @@ const OptionField<P> kProcess[] = {
     {"trailing-channel", "-", "channel of the trailing tip (from 0)",
      [](P& o, std::string_view t) { o.trailing_channel = static_cast<int>(whole(t, 0, 1023)); },
      [](const P& o) { return std::to_string(o.trailing_channel); }},
-    {"method", "", "velocity methods: both | awcc | fscc | none (phase statistics only)",
-     [](P& o, std::string_view t) {
-       const int m = choice(t, kMethods);
-       o.fscc = (m & 1) != 0;
-       o.awcc = (m & 2) != 0;
-     },
-     [](const P& o) { return name_of((o.fscc ? 1 : 0) | (o.awcc ? 2 : 0), kMethods); }},
+    {"method", "",
+     "velocity methods: auto (both; multi-tip for a probe of four or more tips) | both (FSCC and AWCC) | awcc | fscc | "
+     "none (phase statistics only) | events (event detection on the tip pair, a velocity per bubble, checked against "
+     "FSCC and AWCC) | multi-tip (3-D velocity, size and interfacial area bubble by bubble, FSCC and AWCC on every tip "
+     "pair); fscc+events, awcc+multi-tip, ... run fewer correlations",
+     set_method, method_text},
     {"histogram-bins", "-", "bins of the chord-time histograms",
      [](P& o, std::string_view t) { o.histogram_bins = static_cast<int>(whole(t, 1, 100000)); },
      [](const P& o) { return std::to_string(o.histogram_bins); }},
@@ -583,6 +621,8 @@ ProcessOptions process_options(std::span<const OptionSetting> given) {
   apply_settings(binarisation_option_fields(), std::span<const OptionSetting>(settings), p.binarisation, used);
   apply_methods(settings, used, p.awcc_options, p.fscc_options);
   apply_settings(structure_option_fields(), std::span<const OptionSetting>(settings), p.structure, used);
+  apply_settings(event_option_fields(), std::span<const OptionSetting>(settings), p.event_options, used);
+  apply_settings(multi_tip_option_fields(), std::span<const OptionSetting>(settings), p.multi_tip_options, used);
   refuse_unknown(settings, used, "a processing run");
   // An implausible value is named before a combination it may cause.
   if (!p.allow_unusual) p.implausible().throw_if_failed();

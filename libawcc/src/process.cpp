@@ -28,10 +28,10 @@ Validation ProcessOptions::validate() const {
   }
   const std::vector<int> channels = tip_channels();
   for (std::size_t k = 2; k < channels.size(); ++k) {
-    if (channels[k] < 0) return Validation::invalid("further-channels", "channel indices must be >= 0");
+    if (channels[k] < 0) return Validation::invalid("tip-channels", "channel indices must be >= 0");
     for (std::size_t j = 0; j < k; ++j) {
       if (channels[j] == channels[k]) {
-        return Validation::invalid("further-channels",
+        return Validation::invalid("tip-channels",
                                    fmt::format("tips {} and {} are both channel {}; give each tip its own channel", j,
                                                k, channels[k]));
       }
@@ -49,7 +49,8 @@ Validation ProcessOptions::validate() const {
                                "the leading one: give those instead of the pair's channels");
   }
   for (const auto& part : {binarisation.validate(), signal_check.validate(), fscc_options.validate(),
-                           awcc_options.validate(), structure.validate(), spectrum.validate()}) {
+                           awcc_options.validate(), structure.validate(), spectrum.validate(),
+                           event_options.validate(), multi_tip_options.validate()}) {
     if (!part.ok()) return part;
   }
   if (block_frames < 1) return Validation::invalid("", "block_frames must be >= 1");
@@ -63,12 +64,44 @@ std::vector<int> ProcessOptions::tip_channels() const {
   return out;
 }
 
-ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingInfo& info) {
+EventOptions ProcessOptions::effective_event_options() const {
+  EventOptions out = event_options;
+  out.roc = awcc_options.roc;
+  out.weighting = awcc_options.weighting;
+  return out;
+}
+
+namespace {
+
+// The tip pair's options and the positions of the tips processed, in
+// processing order (leading, trailing, further tips): tip_pair_options()
+// and binarise_recording() read them from here.
+struct ResolvedTips {
+  ProcessOptions options;
+  std::vector<Vec3> positions;
+};
+
+bool wants_multi_tip(MultiTipChoice choice, std::size_t tips) {
+  return choice == MultiTipChoice::on || (choice == MultiTipChoice::automatic && tips >= 4);
+}
+
+ResolvedTips resolve_tips(const ProcessOptions& options, const RecordingInfo& info) {
   const ProbeTips probe = probe_of(options.probe, info);
-  ProcessOptions out = options;
+  ResolvedTips resolved{options, {}};
+  ProcessOptions& out = resolved.options;
   out.probe = {};
-  if (!probe.declared()) return out;
   const std::string file = info.path.string();
+  const bool resolved_before = !options.further_channels.empty();
+  if (!probe.declared()) {
+    if (options.multi_tip == MultiTipChoice::on && !resolved_before) {
+      throw InputError(fmt::format("{}: multi-tip processing needs the probe's tip positions, which neither the options "
+                                   "nor the file give: declare them (tips, or a [probe] table), or choose another "
+                                   "method",
+                                   file),
+                       "tips");
+    }
+    return resolved;
+  }
   const bool declared = options.probe.declared();
   // The pair's positions: a declared probe's by tip, a file's by channel.
   std::size_t a = 0, b = 0;
@@ -88,17 +121,38 @@ ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingIn
     out.trailing_channel = probe.channel_of(b);
   } else {
     if (options.leading_channel >= info.channels || options.trailing_channel >= info.channels) {
-      return out;  // binarise_recording() names the channel
+      return resolved;  // binarise_recording() names the channel
     }
     a = static_cast<std::size_t>(options.leading_channel);
     b = static_cast<std::size_t>(options.trailing_channel);
   }
   const auto& p = probe.positions;
+  resolved.positions = {p[a], p[b]};
+  if (wants_multi_tip(options.multi_tip, p.size())) {
+    if (p.size() < 4) {
+      throw InputError(fmt::format("{}: multi-tip processing needs a leading tip and at least three trailing tips, "
+                                   "but the probe {} {} tips: declare every tip, or choose another method",
+                                   file, declared ? "is declared with" : "stated by the file has", p.size()),
+                       "method");
+    }
+    if (!resolved_before) {
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        if (k != a && k != b) out.further_channels.push_back(probe.channel_of(k));
+      }
+    }
+    // The further tips' positions, in the order of their channels.
+    for (int c : out.further_channels) {
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        if (k != a && k != b && probe.channel_of(k) == c) resolved.positions.push_back(p[k]);
+      }
+    }
+    if (resolved.positions.size() != 2 + out.further_channels.size()) resolved.positions.clear();
+  }
   const double along = p[b][0] - p[a][0], across = std::hypot(p[b][1] - p[a][1], p[b][2] - p[a][2]);
   if (declared) {
     out.dx = along;
     out.dy = across;
-    return out;
+    return resolved;
   }
   const auto stated = [&](const char* name, double given, double file_value) {
     if (given == 0.0) return file_value;
@@ -119,7 +173,13 @@ ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingIn
                                  format_quantity(p[b][0], Dimension::length)),
                      "leading-channel,trailing-channel");
   }
-  return out;
+  return resolved;
+}
+
+}  // namespace
+
+ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingInfo& info) {
+  return resolve_tips(options, info).options;
 }
 
 Validation ProcessOptions::implausible() const {
@@ -486,7 +546,8 @@ BinarisedRecording binarise_recording(const std::filesystem::path& path, const P
 
 BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& given) {
   given.validate().throw_if_failed();
-  const ProcessOptions options = tip_pair_options(given, opened.info());
+  ResolvedTips resolved = resolve_tips(given, opened.info());
+  const ProcessOptions& options = resolved.options;
   Recording* recording = &opened;
   const RecordingInfo& info = recording->info();
   const std::filesystem::path& path = info.path;
@@ -504,7 +565,7 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& g
       throw InputError(fmt::format("{}: tip {} is channel {}, but the recording has {} channels (numbered from 0 to "
                                    "{}); choose the tips' channels within range",
                                    path.string(), k, c, channels, channels - 1),
-                       k < 2 ? "leading-channel,trailing-channel" : "further-channels");
+                       k < 2 ? "leading-channel,trailing-channel" : "tip-channels");
     }
   }
   ChannelSelection ch{static_cast<std::size_t>(channels), {}};
@@ -551,6 +612,7 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& g
     further.histogram = std::move(tips[k].histogram);
   }
   out.info.frames = out.leading.sample_count;
+  out.tip_positions = std::move(resolved.positions);
   check_tips(out, options,
              recording->has_int16() && info.quantum > 0.0 ? std::optional(int16_limits(info.quantum)) : std::nullopt);
   return out;
@@ -634,6 +696,99 @@ std::string_view to_string(VelocitySource source) {
   return "?";
 }
 
+namespace {
+
+// Shen's first velocity V_gas (METHOD 11.2): FSCC's of the tip pair, else AWCC's.
+std::optional<double> first_velocity(const ProcessResult& out) {
+  if (out.fscc && out.fscc->ok()) return out.fscc->velocity;
+  if (out.awcc && out.awcc->ok()) return out.awcc->velocity;
+  return std::nullopt;
+}
+
+// Event detection's velocity against FSCC's (else AWCC's of quality ok), by
+// the rule FSCC and AWCC are compared by (awcc/assess.hpp): differing by more
+// than their 95 % intervals allow together, event detection's quality is at
+// most low and says why. Its Kramer pairing takes unrelated later bubbles as
+// partners where bubbles are sparse or the tips offset, inside the outlier
+// band (event_detection.hpp): the comparison is what catches that.
+void check_events(EventResult& e, const ProcessResult& out) {
+  if (!e.ok()) return;
+  const auto c = compare_events(e, out);
+  if (!c || !c->disagree()) return;
+  if (e.quality == AwccQuality::ok) e.quality = AwccQuality::low;
+  const std::string why = fmt::format("its velocity differs from {}'s by {:.0f} %, more than their sampling intervals "
+                                      "allow: its pairing is biased here",
+                                      c->reference, 100.0 * c->relative);
+  e.quality_reason = e.quality_reason.empty() ? why : e.quality_reason + "; " + why;
+}
+
+// The bubble-by-bubble methods on the binarised tips: event detection on
+// the pair, the multi-tip vectors with FSCC and AWCC on every further pair.
+void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const ProcessOptions& options) {
+  const std::string file = r.info.path.string();
+  const auto velocity = first_velocity(out);
+  const EventOptions event_options = options.effective_event_options();
+  if (options.events) {
+    out.events = event_detection(r.leading, r.trailing, options.dx, event_options, velocity);
+    check_events(*out.events, out);
+  }
+  const std::size_t tips = r.tip_positions.size();
+  if (!wants_multi_tip(options.multi_tip, tips)) return;
+  if (tips < 4 || tips != 2 + r.further_tips.size()) {
+    throw InputError(fmt::format("{}: multi-tip processing needs every tip's position and signal (at least four "
+                                 "tips), but {} positions and {} binarised tips are known: declare the probe's tips",
+                                 file, tips, 2 + r.further_tips.size()),
+                     "tips");
+  }
+  ProbeResult probe;
+  probe.geometry = ProbeGeometry(r.tip_positions, 0);
+  if (const auto v = probe.geometry.check(options.multi_tip_options.conditioning_min); !v.ok()) {
+    throw InputError(fmt::format("{}: {} (or process the tip pair alone: method both)", file, v.message), v.quantity);
+  }
+  probe.channels = options.tip_channels();
+  PhaseStatisticsOptions po;
+  po.histogram_bins = options.histogram_bins;
+  po.velocity = out.velocity();
+  std::vector<std::vector<Crossing>> crossings;
+  crossings.reserve(tips);
+  crossings.push_back(awcc::crossings(r.leading));
+  crossings.push_back(awcc::crossings(r.trailing));
+  for (const auto& t : r.further_tips) {
+    crossings.push_back(awcc::crossings(t.signal));
+    const auto& names = r.info.channel_names;
+    const auto c = static_cast<std::size_t>(t.channel);
+    probe.further_tips.push_back(
+        {t.channel, c < names.size() ? names[c] : std::string(), t.threshold, phase_statistics(t.signal, po), t.check});
+  }
+  probe.pairing = pair_probe(probe.geometry, crossings, event_options, velocity);
+  const double record_length = static_cast<double>(r.leading.sample_count) / r.leading.fs;
+  if (probe.pairing.ok()) {
+    probe.vectors = multi_tip(probe.geometry, probe.pairing.bubbles, record_length, options.multi_tip_options);
+  } else {
+    probe.vectors.options = options.multi_tip_options;
+    probe.vectors.record_length = record_length;
+    probe.vectors.message = probe.pairing.message;
+  }
+  const bool binary = options.awcc_options.signal == CorrelationSignal::binary;
+  for (std::size_t k = 2; binary && k < tips; ++k) {
+    const Vec3& a = r.tip_positions[0];
+    const Vec3& b = r.tip_positions[k];
+    TipPairResult pair;
+    pair.tip = k;
+    pair.channel = probe.channels[k];
+    pair.dx = b[0] - a[0];
+    pair.dy = std::hypot(b[1] - a[1], b[2] - a[2]);
+    if (!(pair.dx > 0.0)) continue;  // not downstream: no streamwise velocity
+    const AirIntervals& trailing = r.further_tips[k - 2].signal;
+    if (options.fscc) pair.fscc = fscc(r.leading, trailing, pair.dx, options.fscc_options);
+    if (options.awcc) pair.awcc = awcc::awcc(r.leading, trailing, pair.dx, options.awcc_options);
+    probe.pairs.push_back(std::move(pair));
+  }
+  out.probe = std::move(probe);
+}
+
+}  // namespace
+
 ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOptions& given) {
   const ProcessOptions options = tip_pair_options(given, r.info);
   ProcessResult out;
@@ -648,6 +803,7 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   }
   apply_tip_order(out);
   out.tips = tip_results(r, options, out.velocity());
+  add_bubble_methods(out, r, options);
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     add_structure(out, r, options);
     add_spectrum(out, options);
@@ -835,7 +991,8 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
   // The tip pair of a declared (or recorded) probe, once: every step below reads it.
   const ProcessOptions options = tip_pair_options(given, recording.info());
   recording.rewind();
-  const auto binarised = binarise_recording(recording, options);
+  // From the options as given: a declared probe's positions are the binarised tips'.
+  const auto binarised = binarise_recording(recording, given);
   ProcessResult out;
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     out = process_binarised(binarised, options);
@@ -848,6 +1005,7 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
     if (options.awcc) out.awcc = awcc_raw(recording, binarised, options, workspace.awcc);
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
+    add_bubble_methods(out, binarised, options);
     add_structure(out, binarised, options);
     add_spectrum(out, options);
     out.warnings = assess(out);

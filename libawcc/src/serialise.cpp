@@ -58,6 +58,35 @@ constexpr BubbleColumnFormat kBubbleColumns[] = {
     {{"fate", "", nullptr, [](const EventBubble& b) { return to_string(b.fate); }}, "{}"},
 };
 
+struct VectorColumnFormat {
+  VectorColumn column;
+  std::string_view format;
+};
+constexpr VectorColumnFormat kVectorColumns[] = {
+    {{"time", "s", [](const BubbleVector& b) { return b.time; }, nullptr}, "{:.9g}"},
+    {{"velocity_x", "m/s", [](const BubbleVector& b) { return b.velocity[0]; }, nullptr}, "{:.9g}"},
+    {{"velocity_y", "m/s", [](const BubbleVector& b) { return b.velocity[1]; }, nullptr}, "{:.9g}"},
+    {{"velocity_z", "m/s", [](const BubbleVector& b) { return b.velocity[2]; }, nullptr}, "{:.9g}"},
+    {{"speed", "m/s", [](const BubbleVector& b) { return std::hypot(b.velocity[0], b.velocity[1], b.velocity[2]); },
+      nullptr},
+     "{:.9g}"},
+    {{"velocity_spread_x", "m/s", [](const BubbleVector& b) { return b.velocity_spread[0]; }, nullptr}, "{:.6g}"},
+    {{"velocity_spread_y", "m/s", [](const BubbleVector& b) { return b.velocity_spread[1]; }, nullptr}, "{:.6g}"},
+    {{"velocity_spread_z", "m/s", [](const BubbleVector& b) { return b.velocity_spread[2]; }, nullptr}, "{:.6g}"},
+    {{"diameter_front", "m", [](const BubbleVector& b) { return b.diameter_front; }, nullptr}, "{:.9g}"},
+    {{"diameter_rear", "m", [](const BubbleVector& b) { return b.diameter_rear; }, nullptr}, "{:.9g}"},
+    {{"normal_front_x", "-", [](const BubbleVector& b) { return b.normal_front[0]; }, nullptr}, "{:.6f}"},
+    {{"normal_front_y", "-", [](const BubbleVector& b) { return b.normal_front[1]; }, nullptr}, "{:.6f}"},
+    {{"normal_front_z", "-", [](const BubbleVector& b) { return b.normal_front[2]; }, nullptr}, "{:.6f}"},
+    {{"area_share", "s/m", [](const BubbleVector& b) { return b.area_share; }, nullptr}, "{:.9g}"},
+    {{"weight", "s", [](const BubbleVector& b) { return b.weight; }, nullptr}, "{:.9g}"},
+    {{"combinations", "-", [](const BubbleVector& b) { return static_cast<double>(b.combinations); }, nullptr}, "{:.0f}"},
+    {{"combinations_skipped", "-", [](const BubbleVector& b) { return static_cast<double>(b.combinations_skipped); },
+      nullptr},
+     "{:.0f}"},
+    {{"fate", "", nullptr, [](const BubbleVector& b) { return to_string(b.fate); }}, "{}"},
+};
+
 // The columns of a table without their formats.
 template <class Format, std::size_t N>
 auto columns_of(const Format (&formats)[N]) {
@@ -115,6 +144,7 @@ constexpr AwccStatus kAwccStatuses[] = {AwccStatus::ok,           AwccStatus::to
                                         AwccStatus::delay_below_one_sample, AwccStatus::too_few_windows,
                                         AwccStatus::tips_swapped, AwccStatus::no_tip_separation};
 constexpr AwccQuality kAwccQualities[] = {AwccQuality::ok, AwccQuality::low, AwccQuality::insufficient};
+constexpr MultiTipStatus kMultiTipStatuses[] = {MultiTipStatus::ok, MultiTipStatus::too_few_bubbles};
 constexpr WindowFate kWindowFates[] = {WindowFate::accepted, WindowFate::correlation, WindowFate::lag,
                                        WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
                                        WindowFate::correction};
@@ -193,7 +223,8 @@ std::vector<std::string_view> written_values(std::string_view column) {
   namespace c = profile_column;
   if (column == c::fscc_status) return texts(kFsccStatuses);
   if (column == c::awcc_status) return texts(kAwccStatuses);
-  if (column == c::awcc_quality) return texts(kAwccQualities);
+  if (column == c::awcc_quality || column == c::events_quality) return texts(kAwccQualities);
+  if (column == c::multi_tip_status) return texts(kMultiTipStatuses);
   if (column == c::awcc_weighting) return texts(values::weighting);
   if (column == c::awcc_signal) return texts(values::signal);
   if (column == c::awcc_subsample) return texts(values::subsample);
@@ -216,6 +247,13 @@ std::span<const BubbleColumn> event_bubble_columns() {
 }
 
 std::string event_bubbles_csv(const EventResult& result) { return table_csv(kBubbleColumns, result.bubbles); }
+
+std::span<const VectorColumn> multi_tip_bubble_columns() {
+  static const auto columns = columns_of(kVectorColumns);
+  return columns;
+}
+
+std::string multi_tip_bubbles_csv(const MultiTipResult& result) { return table_csv(kVectorColumns, result.bubbles); }
 
 namespace {
 
@@ -254,6 +292,8 @@ json options_json(const ProcessOptions& o) {
   add_options(out, fscc_option_fields(), o.fscc_options);
   add_options(out, awcc_option_fields(), o.awcc_options);
   add_options(out, structure_option_fields(), o.structure);
+  add_options(out, event_option_fields(), o.event_options);
+  add_options(out, multi_tip_option_fields(), o.multi_tip_options);
   return out;
 }
 
@@ -426,33 +466,215 @@ json to_json(const SignalCheck& s) {
 
 }  // namespace
 
+namespace {
+
+json tip_json(const TipResult& t) {
+  const auto& p = t.phase;
+  json tip{
+      {"channel", t.channel},
+      {"name", t.name.empty() ? json(nullptr) : json(t.name)},
+      {process_key::status, to_string(p.status)},
+      {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
+      {process_key::void_fraction, p.void_fraction},
+      {"void_fraction_ci95", ci(p.void_fraction_ci95)},
+      {process_key::bubble_count_rate, p.bubble_count_rate},
+      {"bubble_count_rate_ci95", ci(p.bubble_count_rate_ci95)},
+      {"chord_time_mean", p.air_chord_time.mean},
+      {"chord_time_median", p.air_chord_time.median},
+      {"air_chord_time", summary(p.air_chord_time)},
+      {"water_chord_time", summary(p.water_chord_time)},
+      {"interarrival_time", summary(p.interarrival_time)},
+      {"air_chord_time_histogram", histogram(p.air_chord_histogram)},
+      {"water_chord_time_histogram", histogram(p.water_chord_histogram)},
+      {"chord_length", p.air_chord_length ? summary(*p.air_chord_length) : json(nullptr)},
+      {"sauter_diameter", optional(p.sauter_diameter)},
+  };
+  tip.update(to_json(t.threshold));
+  tip[process_key::signal] = to_json(t.signal);
+  return tip;
+}
+
+json fscc_json(const FsccResult& f) {
+  json out{
+      {process_key::status, to_string(f.status)},
+      {process_key::reason, f.ok() ? json(nullptr) : json(f.message)},
+      {process_key::velocity, f.ok() ? json(f.velocity) : json(nullptr)},
+      {"velocity_ci95", f.ok() && f.velocity_ci95 ? ci(*f.velocity_ci95) : json(nullptr)},
+      {"interval_segments", f.interval_segments},
+      {"lag", f.lag},
+      {"lag_samples", f.lag_samples},
+      {process_key::r12_max, f.r12_max},
+      {"t05", optional(f.t05)},
+      {"tau05", optional(f.tau05)},
+      {"txx", optional(f.txx)},
+      {"txy", optional(f.txy)},
+      {"turbulence_intensity_chanson", optional(f.turbulence_intensity_chanson)},
+      {"note", f.note.empty() ? json(nullptr) : json(f.note)},
+      {"warnings", f.warnings},
+      {process_key::signal, to_string(f.signal)},
+      {"segments_used", f.segments_used},
+      {"t_r11_zero", optional(f.t_r11_zero)},
+      {"t_r11_min", optional(f.t_r11_min)},
+      {"r11_min", optional(f.r11_min)},
+      {"t_half", optional(f.t_half)},
+      {"t_r12_zero", optional(f.t_r12_zero)},
+      {"t_r12_min", optional(f.t_r12_min)},
+      {"r12_min", optional(f.r12_min)},
+  };
+  json notes = json::object();
+  for (const auto& [name, why] : f.scale_notes) notes[name] = why;
+  out["scale_notes"] = notes;
+  return out;
+}
+
+json awcc_json(const AwccResult& a) {
+  auto value = [&](double v) { return a.ok() ? json(v) : json(nullptr); };
+  auto interval = [&](const Interval95& i) { return a.ok() ? ci(i) : json(nullptr); };
+  json out{
+      {process_key::status, to_string(a.status)},
+      {process_key::reason, a.ok() ? json(nullptr) : json(a.message)},
+      {process_key::np, a.np},
+      {process_key::options, to_json(a.options)},
+      {process_key::velocity, value(a.velocity)},
+      {"velocity_ci95", interval(a.velocity_ci95)},
+      {"velocity_rms", value(a.velocity_rms)},
+      {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
+      {process_key::turbulence_intensity, value(a.turbulence_intensity)},
+      {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
+      {process_key::windows_total, a.windows_total},
+      {"windows_lag_zero", a.lag_zero_windows},
+      {"roc_iterations", a.roc_iterations},
+      {"windows_negative_lag", a.negative_lag_windows},
+      {"quality", to_string(a.quality)},
+      {"quality_reason", a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
+      {process_key::probe_corrected, a.probe_corrected},
+      {"velocity_measured", a.probe_corrected ? value(a.velocity_measured) : json(nullptr)},
+      {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
+      {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
+      {"windows_not_bubbly", a.windows_not_bubbly},
+      {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
+                                            static_cast<double>(a.windows_total))
+                                      : json(nullptr)},
+  };
+  // From the counts by fate (nlohmann::json sorts an object's keys: the
+  // file reads as when they were listed by hand).
+  for (std::size_t i = 0; i < window_fate_count; ++i) {
+    const auto fate = static_cast<WindowFate>(i);
+    out[window_count_key(fate)] = a.count(fate);
+  }
+  return out;
+}
+
+json vec(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+json events_json(const EventResult& e) {
+  auto value = [&](double v) { return e.ok() ? json(v) : json(nullptr); };
+  auto interval = [&](const Interval95& i) { return e.ok() ? ci(i) : json(nullptr); };
+  json out{
+      {process_key::status, to_string(e.status)},
+      {process_key::reason, e.ok() ? json(nullptr) : json(e.message)},
+      {"quality", to_string(e.quality)},
+      {"quality_reason", e.quality_reason.empty() ? json(nullptr) : json(e.quality_reason)},
+      {"pairing", to_string(e.options.pairing)},
+      {"first_velocity", optional(e.first_velocity)},
+      {process_key::velocity, value(e.velocity)},
+      {"velocity_ci95", interval(e.velocity_ci95)},
+      {"velocity_rms", value(e.velocity_rms)},
+      {"velocity_rms_ci95", interval(e.velocity_rms_ci95)},
+      {process_key::turbulence_intensity, value(e.turbulence_intensity)},
+      {"turbulence_intensity_ci95", interval(e.turbulence_intensity_ci95)},
+      {"bubbles_total", e.bubbles_total},
+      {"bubbles_complete", e.bubbles_complete},
+      {"bubbles_paired", e.bubbles_paired},
+      {"yield", e.bubbles_complete > 0 ? json(static_cast<double>(e.bubbles_paired) /
+                                              static_cast<double>(e.bubbles_complete))
+                                        : json(nullptr)},
+      {"roc_iterations", e.roc_iterations},
+      {"chord_length", e.ok() ? summary(e.chord_length) : json(nullptr)},
+      {"sauter_diameter", value(e.sauter_diameter)},
+  };
+  json fates = json::object();
+  for (std::size_t i = 0; i < bubble_fate_count; ++i) fates[std::string(bubble_fate_names[i])] = e.bubbles_by_fate[i];
+  out["bubbles_by_fate"] = fates;
+  return out;
+}
+
+json multi_tip_json(const ProbeResult& p) {
+  const MultiTipResult& v = p.vectors;
+  const bool ok = v.ok();
+  json tips = json::array();
+  for (std::size_t k = 0; k < p.geometry.tip_count(); ++k) {
+    tips.push_back(json{{"tip", k},
+                        {"channel", k < p.channels.size() ? json(p.channels[k]) : json(nullptr)},
+                        {"position", vec(p.geometry.positions()[k])},
+                        {"leading", k == p.geometry.leading()}});
+  }
+  json trailing = json::array();
+  const auto& order = p.geometry.trailing_tips();
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    json fates = json::object();
+    if (k < p.pairing.fates.size()) {
+      for (std::size_t i = 0; i < bubble_fate_count; ++i) fates[std::string(bubble_fate_names[i])] = p.pairing.fates[k][i];
+    }
+    trailing.push_back(json{{"tip", order[k]}, {"bubbles_by_fate", fates}});
+  }
+  json intervals = json::array(), rms_intervals = json::array(), tu_intervals = json::array(), stress = json::array();
+  for (std::size_t i = 0; i < 3; ++i) {
+    intervals.push_back(ci(v.velocity_ci95[i]));
+    rms_intervals.push_back(ci(v.velocity_rms_ci95[i]));
+    tu_intervals.push_back(ci(v.turbulence_intensity_ci95[i]));
+    stress.push_back(vec(v.reynolds_stress[i]));
+  }
+  auto when_ok = [&](json value) { return ok ? value : json(nullptr); };
+  json out{
+      {process_key::status, to_string(v.status)},
+      {process_key::reason, ok ? json(nullptr) : json(v.message)},
+      {"pairing_status", to_string(p.pairing.status)},
+      {"velocity_algorithm", to_string(v.options.algorithm)},
+      {"record_length", v.record_length},
+      {"tips", tips},
+      {"trailing_tips", trailing},
+      {process_key::velocity, when_ok(vec(v.velocity))},
+      {"velocity_ci95", when_ok(intervals)},
+      {"speed", when_ok(json(v.speed))},
+      {"velocity_rms", when_ok(vec(v.velocity_rms))},
+      {"velocity_rms_ci95", when_ok(rms_intervals)},
+      {"reynolds_stress", when_ok(stress)},
+      {process_key::turbulence_intensity, when_ok(vec(v.turbulence_intensity))},
+      {"turbulence_intensity_ci95", when_ok(tu_intervals)},
+      {"diameter_front", optional(v.diameter_front)},
+      {"diameter_rear", optional(v.diameter_rear)},
+      {"interfacial_area", optional(v.interfacial_area)},
+      {"bubbles_total", v.bubbles_total},
+      {"bubbles_accepted", v.bubbles_accepted},
+      {"partners_censored", v.partners_censored},
+      {"combinations_solved", v.combinations_solved},
+      {"combinations_ill_conditioned", v.combinations_ill_conditioned},
+      {"combinations_degenerate", v.combinations_degenerate},
+      {"roc_passes", v.roc_passes},
+  };
+  json fates = json::object();
+  for (std::size_t i = 0; i < vector_fate_count; ++i) fates[std::string(vector_fate_names[i])] = v.bubbles_by_fate[i];
+  out["bubbles_by_fate"] = fates;
+  json further = json::array();
+  for (const auto& t : p.further_tips) further.push_back(tip_json(t));
+  out["further_tips"] = further;
+  json pairs = json::array();
+  for (const auto& pair : p.pairs) {
+    json j{{"tip", pair.tip}, {"channel", pair.channel}, {process_key::dx, pair.dx}, {process_key::dy, pair.dy}};
+    if (pair.fscc) j[process_key::fscc] = fscc_json(*pair.fscc);
+    if (pair.awcc) j[process_key::awcc] = awcc_json(*pair.awcc);
+    pairs.push_back(j);
+  }
+  out["pairs"] = pairs;
+  return out;
+}
+
+}  // namespace
+
 json to_json(const ProcessResult& r) {
   json tips = json::array();
-  for (const auto& t : r.tips) {
-    const auto& p = t.phase;
-    json tip{
-        {"channel", t.channel},
-        {"name", t.name.empty() ? json(nullptr) : json(t.name)},
-        {process_key::status, to_string(p.status)},
-        {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
-        {process_key::void_fraction, p.void_fraction},
-        {"void_fraction_ci95", ci(p.void_fraction_ci95)},
-        {process_key::bubble_count_rate, p.bubble_count_rate},
-        {"bubble_count_rate_ci95", ci(p.bubble_count_rate_ci95)},
-        {"chord_time_mean", p.air_chord_time.mean},
-        {"chord_time_median", p.air_chord_time.median},
-        {"air_chord_time", summary(p.air_chord_time)},
-        {"water_chord_time", summary(p.water_chord_time)},
-        {"interarrival_time", summary(p.interarrival_time)},
-        {"air_chord_time_histogram", histogram(p.air_chord_histogram)},
-        {"water_chord_time_histogram", histogram(p.water_chord_histogram)},
-        {"chord_length", p.air_chord_length ? summary(*p.air_chord_length) : json(nullptr)},
-        {"sauter_diameter", optional(p.sauter_diameter)},
-    };
-    tip.update(to_json(t.threshold));
-    tip[process_key::signal] = to_json(t.signal);
-    tips.push_back(tip);
-  }
+  for (const auto& t : r.tips) tips.push_back(tip_json(t));
   json out{
       {"file", r.info.path.string()},
       {"format", r.info.description},
@@ -467,38 +689,7 @@ json to_json(const ProcessResult& r) {
       {"chord_velocity_source", to_string(r.velocity_source())},
       {"chord_velocity", optional(r.velocity())},
   };
-  if (r.fscc) {
-    const auto& f = *r.fscc;
-    out[process_key::fscc] = json{
-        {process_key::status, to_string(f.status)},
-        {process_key::reason, f.ok() ? json(nullptr) : json(f.message)},
-        {process_key::velocity, f.ok() ? json(f.velocity) : json(nullptr)},
-        {"velocity_ci95", f.ok() && f.velocity_ci95 ? ci(*f.velocity_ci95) : json(nullptr)},
-        {"interval_segments", f.interval_segments},
-        {"lag", f.lag},
-        {"lag_samples", f.lag_samples},
-        {process_key::r12_max, f.r12_max},
-        {"t05", optional(f.t05)},
-        {"tau05", optional(f.tau05)},
-        {"txx", optional(f.txx)},
-        {"txy", optional(f.txy)},
-        {"turbulence_intensity_chanson", optional(f.turbulence_intensity_chanson)},
-        {"note", f.note.empty() ? json(nullptr) : json(f.note)},
-        {"warnings", f.warnings},
-        {process_key::signal, to_string(f.signal)},
-        {"segments_used", f.segments_used},
-        {"t_r11_zero", optional(f.t_r11_zero)},
-        {"t_r11_min", optional(f.t_r11_min)},
-        {"r11_min", optional(f.r11_min)},
-        {"t_half", optional(f.t_half)},
-        {"t_r12_zero", optional(f.t_r12_zero)},
-        {"t_r12_min", optional(f.t_r12_min)},
-        {"r12_min", optional(f.r12_min)},
-    };
-    json notes = json::object();
-    for (const auto& [name, why] : f.scale_notes) notes[name] = why;
-    out[process_key::fscc]["scale_notes"] = notes;
-  }
+  if (r.fscc) out[process_key::fscc] = fscc_json(*r.fscc);
   if (r.structure) out["structure"] = to_json(*r.structure);
   if (r.spectrum) {
     const auto& v = *r.spectrum;
@@ -514,43 +705,9 @@ json to_json(const ProcessResult& r) {
                                     {"time_scale_ratio", optional(v.time_scale_ratio)},
                                     {"warning", v.warning.empty() ? json(nullptr) : json(v.warning)}};
   }
-  if (r.awcc) {
-    const auto& a = *r.awcc;
-    auto value = [&](double v) { return a.ok() ? json(v) : json(nullptr); };
-    auto interval = [&](const Interval95& i) { return a.ok() ? ci(i) : json(nullptr); };
-    out[process_key::awcc] = json{
-        {process_key::status, to_string(a.status)},
-        {process_key::reason, a.ok() ? json(nullptr) : json(a.message)},
-        {process_key::np, a.np},
-        {process_key::options, to_json(a.options)},
-        {process_key::velocity, value(a.velocity)},
-        {"velocity_ci95", interval(a.velocity_ci95)},
-        {"velocity_rms", value(a.velocity_rms)},
-        {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
-        {process_key::turbulence_intensity, value(a.turbulence_intensity)},
-        {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
-        {process_key::windows_total, a.windows_total},
-        {"windows_lag_zero", a.lag_zero_windows},
-        {"roc_iterations", a.roc_iterations},
-        {"windows_negative_lag", a.negative_lag_windows},
-        {"quality", to_string(a.quality)},
-        {"quality_reason", a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
-        {process_key::probe_corrected, a.probe_corrected},
-        {"velocity_measured", a.probe_corrected ? value(a.velocity_measured) : json(nullptr)},
-        {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
-        {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
-        {"windows_not_bubbly", a.windows_not_bubbly},
-        {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
-                                              static_cast<double>(a.windows_total))
-                                        : json(nullptr)},
-    };
-    // From the counts by fate (nlohmann::json sorts an object's keys: the
-    // file reads as when they were listed by hand).
-    for (std::size_t i = 0; i < window_fate_count; ++i) {
-      const auto fate = static_cast<WindowFate>(i);
-      out[process_key::awcc][window_count_key(fate)] = a.count(fate);
-    }
-  }
+  if (r.awcc) out[process_key::awcc] = awcc_json(*r.awcc);
+  if (r.events) out[process_key::events] = events_json(*r.events);
+  if (r.probe) out[process_key::multi_tip] = multi_tip_json(*r.probe);
   return out;
 }
 
@@ -615,6 +772,22 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"awcc_turbulence_intensity_measured", "-", "/awcc/turbulence_intensity_measured", "Tu before the probe correction"},
       {"velocity_integral_time_scale", "s", "/velocity_spectrum/integral_time_scale", "integral time scale T_u of AWCC's velocity series"},
       {"velocity_time_scale_ratio", "-", "/velocity_spectrum/time_scale_ratio", "T_u / T_W (below 2: AWCC's Tu underestimated)"},
+      {profile_column::events_velocity, "m/s", "/events/velocity", "event detection's mean velocity (method events)"},
+      {"events_velocity_ci95_lower", "m/s", "/events/velocity_ci95/0", "event detection velocity, 95 % interval, lower"},
+      {"events_velocity_ci95_upper", "m/s", "/events/velocity_ci95/1", "event detection velocity, 95 % interval, upper"},
+      {"events_turbulence_intensity", "-", "/events/turbulence_intensity", "event detection's Tu"},
+      {profile_column::events_quality, "", "/events/quality", "event detection's quality: ok, low or insufficient"},
+      {"events_bubbles_paired", "-", "/events/bubbles_paired", "bubbles paired by event detection"},
+      {profile_column::multi_tip_status, "", "/multi_tip/status", "multi-tip statistics: ok or too_few_bubbles"},
+      {"multi_tip_velocity_x", "m/s", "/multi_tip/velocity/0", "multi-tip mean velocity vector, x (streamwise)"},
+      {"multi_tip_velocity_y", "m/s", "/multi_tip/velocity/1", "multi-tip mean velocity vector, y"},
+      {"multi_tip_velocity_z", "m/s", "/multi_tip/velocity/2", "multi-tip mean velocity vector, z"},
+      {"multi_tip_turbulence_intensity_x", "-", "/multi_tip/turbulence_intensity/0", "multi-tip Tu_x"},
+      {"multi_tip_turbulence_intensity_y", "-", "/multi_tip/turbulence_intensity/1", "multi-tip Tu_y"},
+      {"multi_tip_turbulence_intensity_z", "-", "/multi_tip/turbulence_intensity/2", "multi-tip Tu_z"},
+      {"multi_tip_diameter", "m", "/multi_tip/diameter_front", "multi-tip mean bubble diameter (front interfaces)"},
+      {"multi_tip_interfacial_area", "1/m", "/multi_tip/interfacial_area", "multi-tip interfacial area concentration"},
+      {"multi_tip_bubbles_accepted", "-", "/multi_tip/bubbles_accepted", "bubbles with an accepted velocity vector"},
   };
   return columns;
 }
@@ -680,6 +853,23 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   const bool series = r.spectrum && r.spectrum->status == SpectrumStatus::ok;
   out += fmt::format(",{},{}", csv_number(series ? r.spectrum->integral_time_scale : std::nullopt),
                      csv_number(series ? r.spectrum->time_scale_ratio : std::nullopt));
+  const auto& e = r.events;
+  const bool events_ok = e && e->ok();
+  auto if_events = [&](double v) { return csv_number(events_ok ? std::optional(v) : std::nullopt); };
+  out += fmt::format(",{},{},{},{},{},{}", if_events(e ? e->velocity : 0.0),
+                     if_events(e ? e->velocity_ci95.lower : 0.0), if_events(e ? e->velocity_ci95.upper : 0.0),
+                     if_events(e ? e->turbulence_intensity : 0.0), e ? to_string(e->quality) : "",
+                     e ? std::to_string(e->bubbles_paired) : std::string());
+  if (r.probe) {
+    const auto& v = r.probe->vectors;
+    auto if_ok = [&](double x) { return csv_number(v.ok() ? std::optional(x) : std::nullopt); };
+    out += fmt::format(",{},{},{},{},{},{},{},{},{},{}", to_string(v.status), if_ok(v.velocity[0]),
+                       if_ok(v.velocity[1]), if_ok(v.velocity[2]), if_ok(v.turbulence_intensity[0]),
+                       if_ok(v.turbulence_intensity[1]), if_ok(v.turbulence_intensity[2]), csv_number(v.diameter_front),
+                       csv_number(v.interfacial_area), v.bubbles_accepted);
+  } else {
+    out += ",,,,,,,,,,";
+  }
   return out;
 }
 
@@ -888,6 +1078,52 @@ std::string ProcessResult::report() const {
                      a.count(WindowFate::lag), a.count(WindowFate::roc), a.count(WindowFate::constant),
                      a.count(WindowFate::too_short) ? fmt::format(", {} too short", a.count(WindowFate::too_short))
                                                     : std::string()));
+  }
+  if (events) {
+    const auto& e = *events;
+    if (e.ok()) {
+      line(fmt::format("  events ({} pairing): velocity {:.4f} m/s (95 % sampling interval {:.4f} - {:.4f}), u_rms "
+                       "{:.4f} m/s, Tu {:.4f} ({:.4f} - {:.4f}); d32 {:.3f} mm from each bubble's own velocity",
+                       to_string(e.options.pairing), e.velocity, e.velocity_ci95.lower, e.velocity_ci95.upper,
+                       e.velocity_rms, e.turbulence_intensity, e.turbulence_intensity_ci95.lower,
+                       e.turbulence_intensity_ci95.upper, e.sauter_diameter * 1e3));
+    } else {
+      line(fmt::format("  events ({} pairing): no velocity: {}", to_string(e.options.pairing), e.message));
+    }
+    std::string fates;
+    for (std::size_t i = 1; i < bubble_fate_count; ++i) {
+      if (e.bubbles_by_fate[i] > 0) fates += fmt::format(", {} {}", e.bubbles_by_fate[i], bubble_fate_names[i]);
+    }
+    line(fmt::format("        quality {}{}", to_string(e.quality),
+                     e.quality_reason.empty() ? std::string() : ": " + e.quality_reason));
+    line(fmt::format("        bubbles {} paired of {} complete ({} in all{})", e.bubbles_paired, e.bubbles_complete,
+                     e.bubbles_total, fates));
+  }
+  if (probe) {
+    const auto& p = *probe;
+    std::string tips_text;
+    for (std::size_t k = 0; k < p.geometry.tip_count(); ++k) {
+      tips_text += fmt::format("{}{} (channel {})", k == 0 ? "" : ", ", p.geometry.tip_name(k),
+                               k < p.channels.size() ? p.channels[k] : -1);
+    }
+    line("  multi-tip probe: " + tips_text);
+    for (const auto& t : p.further_tips) {
+      line(fmt::format("    tip of channel {}: void fraction {:.5f}, bubble count rate {:.3f} /s", t.channel,
+                       t.phase.void_fraction, t.phase.bubble_count_rate));
+    }
+    std::string text = p.vectors.report();
+    for (std::size_t from = 0; from < text.size();) {
+      const auto end = std::min(text.find('\n', from), text.size());
+      line("    " + text.substr(from, end - from));
+      from = end + 1;
+    }
+    for (const auto& pair : p.pairs) {
+      line(fmt::format("    leading tip with tip {} (dx {:.3f} mm): FSCC {}, AWCC {}", pair.tip, pair.dx * 1e3,
+                       pair.fscc && pair.fscc->ok() ? fmt::format("{:.4f} m/s", pair.fscc->velocity)
+                                                    : std::string("no velocity"),
+                       pair.awcc && pair.awcc->ok() ? fmt::format("{:.4f} m/s", pair.awcc->velocity)
+                                                    : std::string("no velocity")));
+    }
   }
   if ((fscc && fscc->ok() && fscc->velocity_ci95) || (awcc && awcc->ok())) line("  " + std::string(sampling_intervals_only));
   if (structure) {

@@ -224,6 +224,8 @@ py::list options() {
   describe(out, "fscc", awcc::fscc_option_fields(), p.fscc_options);
   describe(out, "awcc", awcc::awcc_option_fields(), p.awcc_options);
   describe(out, "structure", awcc::structure_option_fields(), p.structure);
+  describe(out, "event detection", awcc::event_option_fields(), p.event_options);
+  describe(out, "multi-tip", awcc::multi_tip_option_fields(), p.multi_tip_options);
   const synth::Scene scene;
   for (const auto& f : synth::scene_fields()) {
     py::dict d;
@@ -418,7 +420,8 @@ bool declared(std::string_view name) {
   };
   return in(awcc::process_option_fields()) || in(awcc::reader_option_fields()) ||
          in(awcc::binarisation_option_fields()) || in(awcc::fscc_option_fields()) ||
-         in(awcc::awcc_option_fields()) || in(awcc::structure_option_fields()) || in(synth::scene_fields());
+         in(awcc::awcc_option_fields()) || in(awcc::structure_option_fields()) || in(awcc::event_option_fields()) ||
+         in(awcc::multi_tip_option_fields()) || in(synth::scene_fields());
 }
 
 // Library errors as Python exceptions with the library's message, the

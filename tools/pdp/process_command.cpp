@@ -30,6 +30,8 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   o.library.add(cmd, awcc::fscc_option_fields(), defaults.fscc_options, "FSCC");
   o.library.add(cmd, awcc::awcc_option_fields(), defaults.awcc_options, "AWCC");
   o.library.add(cmd, awcc::structure_option_fields(), defaults.structure, "Structure (PDFs, clusters, arrivals)");
+  o.library.add(cmd, awcc::event_option_fields(), defaults.event_options, "Event detection (method events)");
+  o.library.add(cmd, awcc::multi_tip_option_fields(), defaults.multi_tip_options, "Multi-tip probes");
   cmd->add_option("--preset", o.preset,
                   "felder: Felder's program (his threshold rule, 15 segments of raw voltages, his lags, scale rules, "
                   "bins and defects; FSCC only); options given as well override it")
@@ -38,6 +40,10 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"))->group(out);
   path_option(cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)"))->group(out);
   path_option(cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)"))->group(out);
+  path_option(cmd->add_option("--bubbles", o.bubbles,
+                              "per-bubble table as CSV (one recording): the multi-tip vectors, or event detection's "
+                              "pairs (method events); with both, event detection's goes to FILE.events.csv"))
+      ->group(out);
   path_option(
       cmd->add_option("--spectrum", o.spectrum,
                       "AWCC's velocity series as CSV: Welch spectrum and autocorrelation (sample-and-hold resampling)"))

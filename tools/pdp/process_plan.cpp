@@ -23,6 +23,13 @@ awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
     throw std::invalid_argument("--windows writes the window table of one recording; give one file");
   }
   if (!o.windows.empty() && !p.awcc) throw std::invalid_argument("--windows needs --method awcc or both");
+  if (!o.bubbles.empty() && o.files.size() != 1) {
+    throw std::invalid_argument("--bubbles writes the bubble table of one recording; give one file");
+  }
+  if (!o.bubbles.empty() && !p.events && p.multi_tip == awcc::MultiTipChoice::off) {
+    throw std::invalid_argument("--bubbles writes a per-bubble table: use --method events (a tip pair) or multi-tip "
+                                "(a probe of four or more tips)");
+  }
   if (!o.spectrum.empty() && (!p.awcc || !p.velocity_spectrum)) {
     throw std::invalid_argument("--spectrum writes AWCC's velocity spectrum: use --method awcc or both, and "
                                 "--velocity-spectrum on");
@@ -111,7 +118,7 @@ std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o)
 void check_output_names(const ProcessCommandOptions& o) {
   const std::vector<std::pair<const char*, const std::string*>> named = {
       {"--json", &o.json},       {"--csv", &o.csv},
-      {"--windows", &o.windows}, {"--correlation-functions", &o.correlation_functions},
+      {"--windows", &o.windows}, {"--bubbles", &o.bubbles}, {"--correlation-functions", &o.correlation_functions},
       {"--spectrum", &o.spectrum}, {"--report", &o.report}};
   for (std::size_t a = 0; a < named.size(); ++a) {
     for (std::size_t b = a + 1; b < named.size(); ++b) {
@@ -125,7 +132,7 @@ void check_output_names(const ProcessCommandOptions& o) {
       }
     }
   }
-  for (const auto& output : {o.json, o.csv, o.windows, o.correlation_functions, o.spectrum, o.report}) {
+  for (const auto& output : {o.json, o.csv, o.windows, o.bubbles, o.correlation_functions, o.spectrum, o.report}) {
     if (output.empty() || !std::filesystem::exists(output)) continue;
     for (const auto& input : o.files) {
       if (std::filesystem::equivalent(output, input)) {

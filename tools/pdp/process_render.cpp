@@ -96,6 +96,22 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
     else out.json_for_report = awcc::json_text(j);
   }
   if (!o.windows.empty() && results[0].awcc) out.outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
+  if (!o.bubbles.empty()) {
+    const auto& r = results[0];
+    if (!r.probe && !r.events) {
+      throw std::invalid_argument(fmt::format("--bubbles: {} was processed as a tip pair (it has fewer than four tips "
+                                              "declared or stated) without event detection: use --method events",
+                                              r.info.path.string()));
+    }
+    if (r.probe) out.outputs.emplace_back(o.bubbles, awcc::multi_tip_bubbles_csv(r.probe->vectors));
+    if (r.events) {
+      const std::filesystem::path base(o.bubbles);
+      const std::string file =
+          r.probe ? (base.parent_path() / (base.stem().string() + ".events" + base.extension().string())).string()
+                  : o.bubbles;
+      out.outputs.emplace_back(file, awcc::event_bubbles_csv(*r.events));
+    }
+  }
   std::vector<const awcc::ProcessResult*> all;
   for (const auto& r : results) all.push_back(&r);
   if (!o.correlation_functions.empty()) {

@@ -16,7 +16,8 @@
 // scatter). It compares whenever both give a velocity: AWCC of quality low
 // is compared (its interval is wide when its windows are few), AWCC of
 // quality insufficient gives no velocity and is not. FSCC without an interval
-// (too few segments hold a peak) is not compared.
+// (too few segments hold a peak) is not compared. Event detection's velocity
+// is compared with FSCC's (or AWCC's) by the same rule (events_disagree).
 
 #include <cmath>
 #include <optional>
@@ -40,6 +41,25 @@ struct MethodsComparison {
 /// Both velocities and their intervals; empty unless both methods gave a
 /// velocity and FSCC an interval.
 std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const AwccResult& awcc);
+
+/// Event detection's velocity against a correlation method's, by the same
+/// rule (m/s): FSCC's where it has an interval, else AWCC's of quality ok.
+/// Event detection's Kramer pairing takes an unrelated later bubble as the
+/// partner of one that passed beside the trailing tip; where bubbles are
+/// sparse those lags are long and the mean is biased low (30-60 % on the
+/// spillway recordings), inside the outlier band, with hundreds of bubbles:
+/// its own interval cannot show it, the comparison does.
+struct EventsComparison {
+  std::string_view reference;      ///< "FSCC" or "AWCC"
+  double events = 0.0, reference_velocity = 0.0;
+  Interval95 events_ci95, reference_ci95;
+  double difference = 0.0;  ///< events - reference
+  double allowed = 0.0;     ///< the 95 % half-width of the difference
+  double relative = 0.0;    ///< |difference| / reference
+  [[nodiscard]] bool disagree() const { return std::abs(difference) > allowed; }
+};
+/// Empty unless event detection gave a velocity and a reference exists.
+std::optional<EventsComparison> compare_events(const EventResult& events, const ProcessResult& result);
 
 /// Every warning of a processed recording, in the order of the list above.
 std::vector<Warning> assess(const ProcessResult& result);

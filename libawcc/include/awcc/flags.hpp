@@ -22,6 +22,7 @@ enum class Flag {
   integral_scale_short,      ///< the velocity's integral time scale is under 2 window durations (error E4)
   integral_scale_undefined,  ///< the velocity's autocorrelation does not reach zero: no time scale
   methods_disagree,          ///< FSCC and AWCC differ by more than their sampling intervals allow
+  events_disagree,           ///< event detection's velocity differs from FSCC's (AWCC's) beyond their intervals
 };
 
 struct FlagName {
@@ -32,7 +33,7 @@ struct FlagName {
 
 /// Every flag in the enum's order: to_string, parse_flag and the lists of
 /// codes read this one table.
-inline constexpr std::array<FlagName, 7> flag_names{{
+inline constexpr std::array<FlagName, 8> flag_names{{
     {Flag::reader_note, "reader_note", "the reader accepted the file but notes something about it"},
     {Flag::signal_check, "signal_check",
      "a tip's voltage is not a clean two-level signal of the stated polarity, or its air level is the continuous one"},
@@ -44,12 +45,14 @@ inline constexpr std::array<FlagName, 7> flag_names{{
      "the velocity's autocorrelation does not reach zero: no integral time scale"},
     {Flag::methods_disagree, "methods_disagree",
      "FSCC and AWCC differ by more than their 95 % sampling intervals allow together"},
+    {Flag::events_disagree, "events_disagree",
+     "event detection's velocity differs from FSCC's (else AWCC's) by more than their 95 % sampling intervals allow"},
 }};
 constexpr bool flag_names_in_enum_order() {
   for (std::size_t i = 0; i < flag_names.size(); ++i) {
     if (static_cast<std::size_t>(flag_names[i].flag) != i) return false;
   }
-  return static_cast<std::size_t>(Flag::methods_disagree) + 1 == flag_names.size();
+  return static_cast<std::size_t>(Flag::events_disagree) + 1 == flag_names.size();
 }
 static_assert(flag_names_in_enum_order(), "a flag added to Flag needs its row in flag_names, in the enum's order");
 

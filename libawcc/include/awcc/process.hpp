@@ -11,9 +11,11 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/binarisation.hpp"
+#include "awcc/event_detection.hpp"
 #include "awcc/fft.hpp"
 #include "awcc/flags.hpp"
 #include "awcc/fscc.hpp"
+#include "awcc/multi_tip.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/probe_tips.hpp"
 #include "awcc/recording.hpp"
@@ -22,6 +24,14 @@
 #include "awcc/velocity_series.hpp"
 
 namespace awcc {
+
+/// Whether a recording is processed bubble by bubble as a multi-tip probe
+/// (METHOD 11.3-11.6).
+enum class MultiTipChoice {
+  automatic,  ///< for a probe of four or more tips (declared, or stated by the recording)
+  off,        ///< never: the tip pair alone
+  on,         ///< always: a probe of fewer than four tips is refused
+};
 
 struct ProcessOptions {
   ReaderOptions reader;
@@ -47,6 +57,18 @@ struct ProcessOptions {
   /// AWCC settings; signal = raw makes FSCC and AWCC correlate the voltages
   /// (one more pass over the file for each).
   AwccOptions awcc_options;
+  /// Event detection on the tip pair (METHOD 11.1-11.2): a velocity per
+  /// bubble. Off by default: its Kramer pairing is biased where bubbles are
+  /// sparse (awcc/event_detection.hpp), so it runs beside FSCC and AWCC,
+  /// against which every output checks it (awcc/assess.hpp).
+  bool events = false;
+  /// Its pairing and quality; its `roc` and `weighting` are taken from
+  /// awcc_options when processing (one switch for both methods).
+  EventOptions event_options;
+  /// The probe bubble by bubble: 3-D velocity, sizes, interfacial area, with
+  /// FSCC and AWCC on every tip pair alongside.
+  MultiTipChoice multi_tip = MultiTipChoice::automatic;
+  MultiTipOptions multi_tip_options;
   int histogram_bins = 50;            ///< chord-time histogram bins
   /// Chord and voltage PDFs, clusters, inter-particle arrivals (and Felder's conventions).
   StructureOptions structure;
@@ -67,6 +89,8 @@ struct ProcessOptions {
 
   /// The tips' channels: leading, trailing, then further_channels.
   [[nodiscard]] std::vector<int> tip_channels() const;
+  /// event_options with AWCC's roc and weighting: what event detection runs with.
+  [[nodiscard]] EventOptions effective_event_options() const;
   /// Every part's validate(), then implausible() unless allow_unusual.
   [[nodiscard]] Validation validate() const;
   /// Ok when every stated value is plausible for a phase-detection probe:
@@ -85,10 +109,13 @@ struct ProcessOptions {
 /// channels theirs. A declared probe of two tips processes exactly as dx and
 /// dy of the same separation. With only dx (and dy) given, a recording
 /// stating its tips must agree on the pair's separation (a zero dx or dy
-/// takes the file's). The result has no declared tips (it is its own
-/// tip_pair_options()). Throws InputError naming the file, the tips and the
-/// fix (probe_of(), no tip downstream of the leading one, a dx that
-/// disagrees with the file's).
+/// takes the file's). Processed as a multi-tip probe (multi_tip on, or
+/// automatic with four or more tips), the other tips' channels become
+/// further_channels in the order of the tips. The result has no declared
+/// tips (it is its own tip_pair_options()). Throws InputError naming the
+/// file, the tips and the fix (probe_of(), no tip downstream of the leading
+/// one, a dx that disagrees with the file's, multi-tip asked of a probe of
+/// fewer than four tips).
 [[nodiscard]] ProcessOptions tip_pair_options(const ProcessOptions& options, const RecordingInfo& info);
 
 /// The plausible sampling rates of a probe recording, Hz (a file's own rate is checked too).
@@ -126,6 +153,37 @@ struct BinarisedRecording {
   /// The signal check of each tip's histogram (unchecked without one).
   SignalCheck leading_signal, trailing_signal;
   std::vector<BinarisedTip> further_tips;   ///< tips 2, 3, ... in the order of further_channels
+  /// Every binarised tip's position, m, in the same order (leading,
+  /// trailing, further tips), where the probe's tips are declared or stated
+  /// by the recording; else empty.
+  std::vector<Vec3> tip_positions;
+};
+
+/// FSCC and AWCC of the leading tip with one more trailing tip of a
+/// multi-tip probe, as labs compare them with the bubble-by-bubble vector.
+struct TipPairResult {
+  std::size_t tip = 0;   ///< the trailing tip, an index into ProbeResult::geometry
+  int channel = 0;
+  double dx = 0.0, dy = 0.0;  ///< the pair's streamwise and cross-stream separation, m
+  std::optional<FsccResult> fscc;
+  std::optional<AwccResult> awcc;
+};
+
+/// A probe of four or more tips processed bubble by bubble (METHOD 11.3-11.6).
+struct ProbeResult {
+  /// The tips in processing order: leading (0), trailing (1), further tips.
+  ProbeGeometry geometry;
+  std::vector<int> channels;          ///< each tip's channel, same order
+  std::vector<TipResult> further_tips;  ///< the phase statistics of tips 2, 3, ...
+  /// Event detection's pairing of the leading tip with each trailing tip:
+  /// the bubbles with their partners and each trailing tip's fate counts.
+  ProbePairing pairing;
+  /// The per-bubble vectors and their statistics; status too_few_bubbles
+  /// with the pairing's message when the pairing was refused.
+  MultiTipResult vectors;
+  /// FSCC and AWCC of the leading tip with every trailing tip other than
+  /// the pair's (ProcessResult::fscc and awcc), where it lies downstream.
+  std::vector<TipPairResult> pairs;
 };
 
 struct ProcessResult {
@@ -136,6 +194,8 @@ struct ProcessResult {
   std::optional<AwccResult> awcc;
   std::optional<StructureResult> structure;
   std::optional<VelocitySpectrum> spectrum;  ///< of AWCC's series, when AWCC ran
+  std::optional<EventResult> events;  ///< event detection on the tip pair (options.events)
+  std::optional<ProbeResult> probe;   ///< a multi-tip probe bubble by bubble (options.multi_tip)
   /// Every warning of the recording with its flag, in one list (awcc/assess.hpp
   /// assembles it; every output writes it).
   std::vector<Warning> warnings;

@@ -64,6 +64,22 @@ std::span<const BubbleColumn> event_bubble_columns();
 /// empty cell where the bubble has no value (no candidate, no velocity).
 std::string event_bubbles_csv(const EventResult& result);
 
+/// A column of the multi-tip bubble table (awcc/multi_tip.hpp, BubbleVector).
+struct VectorColumn {
+  std::string_view name;
+  std::string_view unit;
+  double (*value)(const BubbleVector&);           ///< numeric columns (NaN: the bubble has no value)
+  std::string_view (*text)(const BubbleVector&);  ///< the text column (fate); null for numeric ones
+};
+/// The columns of the multi-tip bubble table, in order: the leading-tip
+/// time, the vector and its speed, its spread over the tip combinations,
+/// diameters, the front normal, the interfacial-area share, the weight,
+/// the combinations solved and skipped, the fate.
+std::span<const VectorColumn> multi_tip_bubble_columns();
+/// The multi-tip per-bubble table as CSV, one row per leading bubble; an
+/// empty cell where the bubble has no value (no vector, Tian's sizes).
+std::string multi_tip_bubbles_csv(const MultiTipResult& result);
+
 /// A profile CSV column: its name, its unit ("" for text, "-" for a
 /// dimensionless number), where the same value is in the recording's JSON
 /// object (an RFC 6901 pointer; "" when it is not: the version lives in the
