@@ -100,9 +100,9 @@
 //    partners are from another bubble (Kramer pairing), the outlier cutoff
 //    cannot remove them at that share, and m is 5 times the true mean
 //    1 / |v| (the mean vector 1.9 m/s against 5): a is 5 times 6 c / d_b.
-//    Where the partners are right (the same scene with Tu = 0.05 and 0.1:
-//    the cutoff removes the mis-paired vectors) a is within its interval
-//    of 6 c_tip / d_b. `caution` (below) flags the first case.
+//    Where the cutoff removes the mis-paired vectors (the same scene with
+//    Tu = 0.05 and 0.1, seeds 6 to 8) the interval holds 6 c_tip / d_b in
+//    all six records. `caution` (below) flags the first case.
 //    95 % interval: with the complete bubbles a Poisson process (count N_0,
 //    variance N_0) and the accepted speeds a sample of n independent ones of
 //    sample variance s^2 (variance of m: s^2 / n), chosen independently of
@@ -113,9 +113,9 @@
 //    make it wide; speeds correlated over an integral time scale T_u
 //    longer than the bubbles' spacing make the s^2 / n term narrow by
 //    about 2 T_u N_0 / T (the intervals of METHOD 4 item 8 take the same
-//    independence). On the clean scene (T_u = 1 s, 19 bubbles a second)
-//    the Poisson term dominates: half-width 1.9 %, measured spread over 12
-//    seeds 0.9 % (1 sd).
+//    independence). On the clean scene (T_u = 1 s, 19 bubbles a second,
+//    600 s) the Poisson term dominates: half-width 1.9 %, i.e. sd 0.95 %;
+//    measured over 12 seeds, sd 0.9 % against 6 c / d_b.
 //
 // caution (empty when no check fails): a status ok with vectors that are
 // likely wrong. Two checks on the accepted vectors, both tripped by
@@ -127,7 +127,9 @@
 //    partners, 4.5 and 5.1 on the four-tip sample;
 //  - the outlier cutoff rejected more than half the solved vectors: the
 //    accepted ones may be a cluster of mis-paired ones (on the four-tip
-//    sample with another seed it kept 20 of 411, all wrong).
+//    sample with another seed it kept 20 of 411, all wrong). A caution, not
+//    a verdict: at Tu = 0.05 and 0.1 it fires on 2 of 6 records whose
+//    cutoff removed the mis-paired half correctly.
 // Neither sees a population of mis-paired vectors consistent among
 // themselves: the four-tip geometry in the base case (3 mm spheres,
 // c = 0.25) pairs 72 % of its partners wrongly and passes both. Validate
