@@ -89,6 +89,8 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
       wrong += right ? 0 : 1;
     }
   }
+  std::printf("pairing: %lld of %lld partners wrong (%.2f %%)\n", static_cast<long long>(wrong),
+              static_cast<long long>(partners), 100.0 * static_cast<double>(wrong) / static_cast<double>(partners));
   ASSERT_GT(partners, 1000);
   EXPECT_LT(static_cast<double>(wrong), 0.01 * static_cast<double>(partners)) << wrong << " of " << partners;
 
@@ -108,6 +110,9 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
   }
   ASSERT_GT(errors.size(), 500u);
   std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2), errors.end());
+  std::printf("%lld of %lld leading bubbles accepted; median speed error %.3f %% over %zu matched to the truth\n",
+              static_cast<long long>(result.bubbles_accepted), static_cast<long long>(result.bubbles_total),
+              100.0 * errors[errors.size() / 2], errors.size());
   EXPECT_LT(errors[errors.size() / 2], 0.02);
 
   // The mean vector against the realised fluid mean (the bubbles sample the
@@ -115,6 +120,8 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
   // fast bubbles).
   const auto& realised = p.synthesis.truth.realised.mean_velocity;
   const double realised_speed = std::hypot(realised[0], realised[1], realised[2]);
+  std::printf("mean vector (%.4f, %.4f, %.4f) m/s, realised (%.4f, %.4f, %.4f) m/s\n", result.velocity[0],
+              result.velocity[1], result.velocity[2], realised[0], realised[1], realised[2]);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(result.velocity[static_cast<std::size_t>(i)], realised[static_cast<std::size_t>(i)],
                 0.02 * realised_speed)
