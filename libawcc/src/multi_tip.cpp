@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/detail/multi_tip_steps.hpp"
@@ -204,7 +206,10 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
   result.reynolds_stress = {};
   result.speed = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
-  result.diameter_front = result.diameter_rear = result.interfacial_area = std::nullopt;
+  result.diameter_front = result.diameter_rear = result.interfacial_area = result.interfacial_area_paired = std::nullopt;
+  result.interfacial_area_ci95 = std::nullopt;
+  result.caution.clear();
+  result.bubbles_complete = result.bubbles_total - result.count(VectorFate::censored);
   if (result.bubbles_accepted < options.vectors_reported) {
     result.status = MultiTipStatus::too_few_bubbles;
     result.message = fmt::format("{} of {} leading bubbles have an accepted velocity vector ({}): too few for "
@@ -224,8 +229,19 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
   for (std::size_t j = 0; j < 3; ++j) result.velocity[j] = sum[j] / weights;
   std::array<Vec3, 3> stress{};
   double diameter_front = 0.0, diameter_rear = 0.0, shares = 0.0;
+  // 1 / |v| of the accepted bubbles: Welford's running mean and sum of
+  // squared deviations.
+  double slowness = 0.0, slowness_m2 = 0.0;
+  std::int64_t slow_count = 0;
+  std::vector<double> speeds;
+  speeds.reserve(static_cast<std::size_t>(result.bubbles_accepted));
   for (const auto& b : bubbles) {
     if (b.fate != VectorFate::solved) continue;
+    speeds.push_back(std::sqrt(dot(b.velocity, b.velocity)));
+    const double u = 1.0 / speeds.back();
+    const double du = u - slowness;
+    slowness += du / static_cast<double>(++slow_count);
+    slowness_m2 += du * (u - slowness);
     Vec3 d{};
     for (std::size_t j = 0; j < 3; ++j) d[j] = b.velocity[j] - result.velocity[j];
     for (std::size_t j = 0; j < 3; ++j)
@@ -250,10 +266,42 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
     result.velocity_rms_ci95[j] = {rms - hr, rms + hr};
     result.turbulence_intensity_ci95[j] = {tu - ht, tu + ht};
   }
+  {
+    // a = 4 N_0 m / T and its interval (multi_tip.hpp).
+    const double n0 = static_cast<double>(result.bubbles_complete);
+    const double a = 4.0 * n0 * slowness / result.record_length;
+    const double sample_variance = slowness_m2 / (n - 1.0);
+    const double relative = std::sqrt(1.0 / n0 + sample_variance / (n * slowness * slowness));
+    result.interfacial_area = a;
+    result.interfacial_area_ci95 = Interval95{a * (1.0 - 1.96 * relative), a * (1.0 + 1.96 * relative)};
+  }
+  {
+    // The checks of `caution` (multi_tip.hpp).
+    const auto middle = speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2);
+    std::nth_element(speeds.begin(), middle, speeds.end());
+    const double tail = slowness * *middle;
+    const std::int64_t cut = result.count(VectorFate::roc);
+    std::vector<std::string> reasons;
+    if (tail > 1.25) {
+      reasons.push_back(fmt::format("the mean of 1/|v| is {:.3g} times 1/(median speed), above 1.25: a tail of slow "
+                                    "vectors, as mis-paired partners give, rules it",
+                                    tail));
+    }
+    if (2 * cut > cut + result.bubbles_accepted) {
+      reasons.push_back(fmt::format("the outlier cutoff rejected {} of {} solved vectors: the accepted ones may be a "
+                                    "cluster of mis-paired ones",
+                                    cut, cut + result.bubbles_accepted));
+    }
+    for (const auto& r : reasons) result.caution += (result.caution.empty() ? "" : "; ") + r;
+    if (!result.caution.empty()) {
+      result.caution += "; the vectors and the interfacial area are likely wrong: check the pairing against the truth "
+                        "for this geometry (pdp validate)";
+    }
+  }
   if (options.algorithm == VelocityAlgorithm::shen_nakamura) {
     result.diameter_front = diameter_front / n;
     result.diameter_rear = diameter_rear / n;
-    result.interfacial_area = 2.0 * shares / result.record_length;
+    result.interfacial_area_paired = 2.0 * shares / result.record_length;
   }
   result.status = MultiTipStatus::ok;
   result.message.clear();
@@ -347,6 +395,7 @@ std::string MultiTipResult::report() const {
                      combinations_solved, combinations_ill_conditioned, options.conditioning_min,
                      combinations_degenerate, partners_censored);
   if (!ok()) return out + "no statistics: " + message + "\n";
+  if (!caution.empty()) out += "caution: " + caution + "\n";
   static constexpr const char* axis = "xyz";
   out += fmt::format("mean velocity ({:.4g}, {:.4g}, {:.4g}) m/s, |V| = {:.4g} m/s\n", velocity[0], velocity[1],
                      velocity[2], speed);
@@ -361,19 +410,22 @@ std::string MultiTipResult::report() const {
     out += fmt::format("  {:11.4g} {:11.4g} {:11.4g}\n", reynolds_stress[j][0], reynolds_stress[j][1],
                        reynolds_stress[j][2]);
   }
-  if (interfacial_area) {
-    out += fmt::format("mean diameter {:.4g} mm (front interfaces), {:.4g} mm (rear); interfacial area {:.4g} 1/m "
-                       "(of the bubbles with a vector)\n",
-                       1e3 * *diameter_front, 1e3 * *diameter_rear, *interfacial_area);
-    if (const auto missed = count(VectorFate::too_few_tips); missed > 0) {
-      // Spheres pierced off-centre miss the trailing tips first, and those
-      // are the ones with the largest 1 / |V . n|: the sum under-counts.
-      out += fmt::format("  {} of {} leading bubbles ({:.0f} %) pierce fewer than three trailing tips and add no "
-                         "area: the interfacial area is low by more than that share\n",
-                         missed, bubbles_total, 100.0 * static_cast<double>(missed) / static_cast<double>(bubbles_total));
-    }
+  if (interfacial_area && interfacial_area_ci95) {
+    out += fmt::format("interfacial area {:.4g} 1/m [{:.4g}, {:.4g}] (4 N_0 <1/|v|> / T, N_0 = {} complete leading "
+                       "bubbles)\n",
+                       *interfacial_area, interfacial_area_ci95->lower, interfacial_area_ci95->upper,
+                       bubbles_complete);
+  }
+  if (interfacial_area_paired && diameter_front && diameter_rear) {
+    out += fmt::format("mean diameter {:.4g} mm (front interfaces), {:.4g} mm (rear); interfacial area of the bubbles "
+                       "with a vector {:.4g} 1/m (Shen & Nakamura Eq. 54: a lower bound, ",
+                       1e3 * *diameter_front, 1e3 * *diameter_rear, *interfacial_area_paired);
+    // Spheres pierced off-centre miss the trailing tips first, and those are
+    // the ones with the largest 1 / |V . n|: the sum under-counts.
+    out += fmt::format("{} of {} complete leading bubbles add nothing to it)\n", bubbles_complete - bubbles_accepted,
+                       bubbles_complete);
   } else {
-    out += "no sizes or interfacial area: Tian et al. 2015 gives velocities only\n";
+    out += "no sizes or normals: Tian et al. 2015 gives velocities only\n";
   }
   return out;
 }

@@ -5,16 +5,20 @@
 // vector statistics (multi_tip). The scene is clean (METHOD 11.7: large
 // spheres, weak turbulence with a long time scale), where the issue asks for
 // pairing errors under 1 %, a median per-bubble speed error under 2 % and a
-// mean vector within 2 % of the realised one.
+// mean vector within 2 % of the realised one, and the interfacial area
+// within 5 % of 6 c / d_b. Then pdp's four-tip sample, where the pairing
+// gives wrong partners and the result must say so.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "awcc/interface_times.hpp"
 #include "awcc/multi_tip.hpp"
 #include "synth/synthesiser.hpp"
+#include "test_paths.hpp"
 
 namespace {
 
@@ -85,6 +89,8 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
       wrong += right ? 0 : 1;
     }
   }
+  std::printf("pairing: %lld of %lld partners wrong (%.2f %%)\n", static_cast<long long>(wrong),
+              static_cast<long long>(partners), 100.0 * static_cast<double>(wrong) / static_cast<double>(partners));
   ASSERT_GT(partners, 1000);
   EXPECT_LT(static_cast<double>(wrong), 0.01 * static_cast<double>(partners)) << wrong << " of " << partners;
 
@@ -104,6 +110,9 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
   }
   ASSERT_GT(errors.size(), 500u);
   std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2), errors.end());
+  std::printf("%lld of %lld leading bubbles accepted; median speed error %.3f %% over %zu matched to the truth\n",
+              static_cast<long long>(result.bubbles_accepted), static_cast<long long>(result.bubbles_total),
+              100.0 * errors[errors.size() / 2], errors.size());
   EXPECT_LT(errors[errors.size() / 2], 0.02);
 
   // The mean vector against the realised fluid mean (the bubbles sample the
@@ -111,11 +120,103 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
   // fast bubbles).
   const auto& realised = p.synthesis.truth.realised.mean_velocity;
   const double realised_speed = std::hypot(realised[0], realised[1], realised[2]);
+  std::printf("mean vector (%.4f, %.4f, %.4f) m/s, realised (%.4f, %.4f, %.4f) m/s\n", result.velocity[0],
+              result.velocity[1], result.velocity[2], realised[0], realised[1], realised[2]);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(result.velocity[static_cast<std::size_t>(i)], realised[static_cast<std::size_t>(i)],
                 0.02 * realised_speed)
         << "component " << i;
   }
+}
+
+// The interfacial area of every complete bubble (multi_tip.hpp) on the clean
+// scene, against 6 c / d_b and against the realised one at the leading tip.
+// 1200 s give N_0 = 22,500 complete leading bubbles (19 a second), so:
+//  - against 6 c / d_b the Poisson count error is 1 / sqrt(N_0) = 0.67 %;
+//    the mean 1 / |v| adds at most 0.2 % (Tu_x = 0.05 over about T / 2T_x =
+//    600 independent speeds); sd 0.7 %, and 5 % is 7 sd.
+//  - The realised value (synth::TipTruth) is (1 / T) sum over the
+//    interfaces that crossed the tip of 1 / |u . n|: N_0 is common to both,
+//    what differs is its 1 / cos theta, of mean 2 and infinite variance
+//    (P(1 / cos > x) = 1 / x^2). One pierce at cos theta < 1 / (2 N_0 d),
+//    d = 5 %, adds 5 % on its own: probability 1 / (4 N_0 d^2) = 0.4 % a
+//    record, and seed 11's first 600 s hold two at cos theta = 0.0012 (7 %
+//    of that half's sum). Those pierces last less than a sample
+//    (d_b cos theta / |u| < 1 / fs) and no probe sees them, so the
+//    comparison is with the realised sum over the pierces that last a
+//    sample or more: its 1 / cos theta is capped at G = fs d_b / |u| = 800,
+//    one pierce adds at most G / (2 N_0) = 1.8 %, the variance of 1 / cos
+//    is 2 ln G - 4 = 9.4 and the relative sd sqrt(9.4 / N_0) / 2 = 1.0 %:
+//    5 % is 5 sd. TipTruth's value is printed beside it.
+// The paired sum must stay below the realised one: it is a lower bound.
+TEST(MultiTipSynthetic, InterfacialAreaOfTheCleanSceneIsSixCOverDWithinFivePercent) {
+  const double duration = 1200.0;
+  const CleanProbe p = clean_four_tip(duration);
+  const auto pairing = awcc::pair_probe(p.geometry, p.crossings, awcc::EventOptions{});
+  ASSERT_TRUE(pairing.ok()) << pairing.message;
+  const double expected = p.synthesis.truth.expected_interfacial_area;
+  const auto& leading_tip = p.synthesis.truth.tips[p.geometry.leading()];
+  ASSERT_TRUE(leading_tip.interfacial_area);
+  const auto& truth = *p.synthesis.bubbles;
+  const double fs = p.synthesis.signals[0].fs;
+  double shares = 0.0;
+  for (std::size_t r = 0; r < truth.size(); ++r) {
+    const auto& pierce = truth.pierce(r, p.geometry.leading());
+    if (!pierce.pierced() || pierce.censored() || pierce.rear - pierce.front < 1.0 / fs) continue;
+    const auto& v = truth.velocity[r];
+    for (const auto& n : {pierce.front_normal, pierce.rear_normal}) {
+      shares += 1.0 / std::fabs(v.x * n[0] + v.y * n[1] + v.z * n[2]);
+    }
+  }
+  const double realised = shares / duration;
+  std::printf("realised at the leading tip %.3f 1/m over the pierces of a sample or more (TipTruth: %.3f 1/m over "
+              "all)\n",
+              realised, *leading_tip.interfacial_area);
+  for (auto algorithm : awcc::velocity_algorithms) {
+    const auto r = awcc::multi_tip(p.geometry, pairing.bubbles, duration, awcc::MultiTipOptions{.algorithm = algorithm});
+    ASSERT_TRUE(r.ok()) << r.message;
+    ASSERT_TRUE(r.interfacial_area && r.interfacial_area_ci95);
+    const double a = *r.interfacial_area;
+    std::printf("%s: N_0 = %lld, %lld accepted; a = %.3f 1/m [%.3f, %.3f], 6c/d_b = %.3f, realised %.3f: %.4f and "
+                "%.4f of them",
+                std::string(to_string(algorithm)).c_str(), static_cast<long long>(r.bubbles_complete),
+                static_cast<long long>(r.bubbles_accepted), a, r.interfacial_area_ci95->lower,
+                r.interfacial_area_ci95->upper, expected, realised, a / expected, a / realised);
+    if (r.interfacial_area_paired) {
+      std::printf("; paired %.3f 1/m (%.4f)", *r.interfacial_area_paired, *r.interfacial_area_paired / expected);
+      EXPECT_LT(*r.interfacial_area_paired, realised) << "a lower bound";
+    }
+    std::printf("\n");
+    EXPECT_GT(r.bubbles_complete, 20000);
+    EXPECT_NEAR(a / expected, 1.0, 0.05);
+    EXPECT_NEAR(a / realised, 1.0, 0.05);
+    EXPECT_TRUE(r.caution.empty()) << r.caution;
+  }
+}
+
+// pdp's four-tip sample (samples/four-tip.toml: 4 mm spheres, c = 0.1,
+// Tu = 0.2, tips 5 mm behind and 1.5 mm apart, 10 s) is where the estimator
+// breaks (multi_tip.hpp): a quarter of the partners come from other bubbles,
+// their slow vectors rule the mean of 1 / |v|, and a is several times
+// 6 c / d_b. The result is ok (enough vectors), so it must carry a caution.
+TEST(MultiTipSynthetic, TheFourTipSampleIsMisPairedAndSaysSo) {
+  synth::Scene s;
+  synth::load_scene_toml(pdp_test::source_dir() / "samples" / "four-tip.toml", s);
+  const auto synthesis = synth::synthesise(s);
+  std::vector<awcc::Vec3> tips;
+  for (const auto& t : s.probe_tips()) tips.push_back({t.x, t.y, t.z});
+  const awcc::ProbeGeometry geometry(tips);
+  std::vector<std::vector<awcc::Crossing>> crossings;
+  for (const auto& signal : synthesis.signals) crossings.push_back(awcc::crossings(signal));
+  const auto pairing = awcc::pair_probe(geometry, crossings, awcc::EventOptions{});
+  ASSERT_TRUE(pairing.ok()) << pairing.message;
+  const auto r = awcc::multi_tip(geometry, pairing.bubbles, s.duration);
+  ASSERT_TRUE(r.ok()) << r.message;
+  const double expected = synthesis.truth.expected_interfacial_area;
+  std::printf("four-tip sample: |V| = %.3f m/s (scene %.3f), a = %.1f 1/m, 6c/d_b = %.1f 1/m; caution: %s\n", r.speed,
+              s.velocity, *r.interfacial_area, expected, r.caution.c_str());
+  EXPECT_GT(*r.interfacial_area, 2.0 * expected) << "the breakage this test documents";
+  EXPECT_FALSE(r.caution.empty());
 }
 
 }  // namespace

@@ -1,0 +1,83 @@
+// Benchmark of multi-tip processing on the four-tip base case
+// (docs/performance.md, issue 30).
+//
+//   multi_tip_bench [--duration SECONDS] [--repeat N]
+//
+// Synthesises the base case (synth::Scene's defaults: 10 m/s, c = 0.25,
+// 3 mm spheres, 500 kHz) with the four tips of samples/four-tip.toml into
+// memory once, then times on one thread the chain a record goes through:
+// the crossings of every tip, pair_probe (Kramer's pairing of the leading
+// tip with each trailing tip), and multi_tip with each velocity algorithm.
+// Median of N runs of each step and of the whole chain, and the cost per
+// leading bubble.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "awcc/interface_times.hpp"
+#include "awcc/multi_tip.hpp"
+#include "bench_util.hpp"
+#include "synth/synthesiser.hpp"
+
+using bench::now;
+
+namespace {
+
+template <class Run>
+double median_seconds(int repeat, Run run) {
+  std::vector<double> times;
+  for (int k = 0; k < repeat; ++k) {
+    const double t0 = now();
+    run();
+    times.push_back(now() - t0);
+  }
+  return bench::median(times);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const auto args = bench::base_case_args(argc, argv);
+  synth::Scene scene;
+  scene.duration = args.duration;
+  scene.tips = {{0, 0, 0}, {5e-3, 0, 0}, {5e-3, 1.5e-3, 0}, {5e-3, 0, 1.5e-3}};  // samples/four-tip.toml
+  const double t_synth = now();
+  const auto syn = synth::synthesise(scene);
+  std::printf("four-tip base case %.0f s at %.0f kHz (synthesised in %.1f s): air intervals per tip", args.duration,
+              scene.fs / 1e3, now() - t_synth);
+  for (const auto& s : syn.signals) std::printf(" %zu", s.intervals.size());
+  std::printf("\n");
+  std::vector<awcc::Vec3> positions;
+  for (const auto& t : scene.probe_tips()) positions.push_back({t.x, t.y, t.z});
+  const awcc::ProbeGeometry geometry(positions);
+
+  std::vector<std::vector<awcc::Crossing>> tips;
+  const double t_cross = median_seconds(args.repeat, [&] {
+    tips.clear();
+    for (const auto& s : syn.signals) tips.push_back(awcc::crossings(s));
+  });
+  awcc::ProbePairing pairing;
+  const double t_pair = median_seconds(args.repeat, [&] { pairing = awcc::pair_probe(geometry, tips, {}); });
+  const double bubbles = static_cast<double>(pairing.bubbles.size());
+  const auto per = [&](double seconds) { return seconds / bubbles * 1e9; };
+  std::printf("crossings of 4 tips: %.3f s; pair_probe: %.3f s (%.0f ns a leading bubble, %zu of them)\n", t_cross,
+              t_pair, per(t_pair), pairing.bubbles.size());
+  for (auto algorithm : awcc::velocity_algorithms) {
+    awcc::MultiTipResult r;
+    const awcc::MultiTipOptions o{.algorithm = algorithm};
+    const double t_solve =
+        median_seconds(args.repeat, [&] { r = awcc::multi_tip(geometry, pairing.bubbles, args.duration, o); });
+    // The whole chain once more end to end, as a record meets it.
+    const double t_chain = median_seconds(args.repeat, [&] {
+      std::vector<std::vector<awcc::Crossing>> c;
+      for (const auto& s : syn.signals) c.push_back(awcc::crossings(s));
+      const auto p = awcc::pair_probe(geometry, c, {});
+      r = awcc::multi_tip(geometry, p.bubbles, args.duration, o);
+    });
+    std::printf("multi_tip %s: %.3f s (%.0f ns a bubble); chain %.3f s (%.0f ns a bubble), %lld accepted; peak %.0f MB\n",
+                std::string(awcc::to_string(algorithm)).c_str(), t_solve, per(t_solve), t_chain, per(t_chain),
+                static_cast<long long>(r.bubbles_accepted), bench::peak_mb());
+    if (!r.caution.empty()) std::printf("  caution: %s\n", r.caution.c_str());
+  }
+  return 0;
+}
