@@ -34,11 +34,13 @@ std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const A
   return c;
 }
 
-std::optional<EventsComparison> compare_events(const EventResult& events, const ProcessResult& r) {
-  if (!events.ok()) return std::nullopt;
+namespace {
+
+std::optional<EventsComparison> against_reference(double velocity, const Interval95& velocity_ci95,
+                                                  const ProcessResult& r) {
   EventsComparison c;
-  c.events = events.velocity;
-  c.events_ci95 = events.velocity_ci95;
+  c.events = velocity;
+  c.events_ci95 = velocity_ci95;
   if (r.fscc && r.fscc->ok() && r.fscc->velocity_ci95) {
     c.reference = "FSCC";
     c.reference_velocity = r.fscc->velocity;
@@ -54,6 +56,18 @@ std::optional<EventsComparison> compare_events(const EventResult& events, const 
   c.allowed = allowed_difference(c.events, c.events_ci95, c.reference_velocity, c.reference_ci95);
   c.relative = std::abs(c.difference) / c.reference_velocity;
   return c;
+}
+
+}  // namespace
+
+std::optional<EventsComparison> compare_events(const EventResult& events, const ProcessResult& r) {
+  if (!events.ok()) return std::nullopt;
+  return against_reference(events.velocity, events.velocity_ci95, r);
+}
+
+std::optional<EventsComparison> compare_multi_tip(const MultiTipResult& vectors, const ProcessResult& r) {
+  if (!vectors.ok()) return std::nullopt;
+  return against_reference(vectors.velocity[0], vectors.velocity_ci95[0], r);
 }
 
 namespace {
@@ -143,6 +157,17 @@ std::optional<Warning> events_disagree(const ProcessResult& r) {
                   to_string(e.options.pairing), c->reference)};
 }
 
+std::optional<Warning> multi_tip_doubtful(const ProcessResult& r) {
+  if (!r.probe || r.probe->quality != AwccQuality::low) return std::nullopt;
+  const auto& v = r.probe->vectors;
+  return Warning{Flag::multi_tip_doubtful,
+                 fmt::format("the multi-tip mean vector ({:.3f}, {:.3f}, {:.3f}) m/s from {} of {} leading bubbles is "
+                             "doubtful: {}; use FSCC's or AWCC's velocity of the tip pairs, and the bubble table only "
+                             "to see the fates",
+                             v.velocity[0], v.velocity[1], v.velocity[2], v.bubbles_accepted, v.bubbles_complete,
+                             r.probe->quality_reason)};
+}
+
 }  // namespace
 
 std::vector<Warning> assess(const ProcessResult& r) {
@@ -162,6 +187,7 @@ std::vector<Warning> assess(const ProcessResult& r) {
   }
   if (auto w = methods_disagree(r)) out.push_back(std::move(*w));
   if (auto w = events_disagree(r)) out.push_back(std::move(*w));
+  if (auto w = multi_tip_doubtful(r)) out.push_back(std::move(*w));
   return out;
 }
 

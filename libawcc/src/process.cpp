@@ -722,6 +722,27 @@ void check_events(EventResult& e, const ProcessResult& out) {
   e.quality_reason = e.quality_reason.empty() ? why : e.quality_reason + "; " + why;
 }
 
+// The multi-tip vectors' quality (ProbeResult::quality).
+void check_vectors(ProbeResult& probe, const ProcessResult& out) {
+  const MultiTipResult& v = probe.vectors;
+  if (!v.ok()) {
+    probe.quality = AwccQuality::insufficient;
+    probe.quality_reason = v.message;
+    return;
+  }
+  std::vector<std::string> why;
+  if (!v.caution.empty()) why.push_back(v.caution);
+  if (const auto c = compare_multi_tip(v, out); c && c->disagree()) {
+    why.push_back(fmt::format("its streamwise component {:.3f} m/s ({:.3f}-{:.3f}) and {}'s velocity of the tip pair "
+                              "{:.3f} m/s ({:.3f}-{:.3f}) differ by {:.0f} %, more than their sampling intervals allow",
+                              c->events, c->events_ci95.lower, c->events_ci95.upper, c->reference,
+                              c->reference_velocity, c->reference_ci95.lower, c->reference_ci95.upper,
+                              100.0 * c->relative));
+  }
+  probe.quality = why.empty() ? AwccQuality::ok : AwccQuality::low;
+  for (const auto& w : why) probe.quality_reason += (probe.quality_reason.empty() ? "" : "; ") + w;
+}
+
 // The bubble-by-bubble methods on the binarised tips: event detection on
 // the pair, the multi-tip vectors with FSCC and AWCC on every further pair.
 void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const ProcessOptions& options) {
@@ -769,6 +790,7 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
     probe.vectors.record_length = record_length;
     probe.vectors.message = probe.pairing.message;
   }
+  check_vectors(probe, out);
   const bool binary = options.awcc_options.signal == CorrelationSignal::binary;
   for (std::size_t k = 2; binary && k < tips; ++k) {
     const Vec3& a = r.tip_positions[0];

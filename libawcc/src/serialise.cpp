@@ -223,7 +223,9 @@ std::vector<std::string_view> written_values(std::string_view column) {
   namespace c = profile_column;
   if (column == c::fscc_status) return texts(kFsccStatuses);
   if (column == c::awcc_status) return texts(kAwccStatuses);
-  if (column == c::awcc_quality || column == c::events_quality) return texts(kAwccQualities);
+  if (column == c::awcc_quality || column == c::events_quality || column == c::multi_tip_quality) {
+    return texts(kAwccQualities);
+  }
   if (column == c::multi_tip_status) return texts(kMultiTipStatuses);
   if (column == c::awcc_weighting) return texts(values::weighting);
   if (column == c::awcc_signal) return texts(values::signal);
@@ -645,7 +647,13 @@ json multi_tip_json(const ProbeResult& p) {
       {"diameter_front", optional(v.diameter_front)},
       {"diameter_rear", optional(v.diameter_rear)},
       {"interfacial_area", optional(v.interfacial_area)},
+      {"interfacial_area_ci95", v.interfacial_area_ci95 ? ci(*v.interfacial_area_ci95) : json(nullptr)},
+      {"interfacial_area_paired", optional(v.interfacial_area_paired)},
+      {"caution", v.caution.empty() ? json(nullptr) : json(v.caution)},
+      {"quality", to_string(p.quality)},
+      {"quality_reason", p.quality_reason.empty() ? json(nullptr) : json(p.quality_reason)},
       {"bubbles_total", v.bubbles_total},
+      {"bubbles_complete", v.bubbles_complete},
       {"bubbles_accepted", v.bubbles_accepted},
       {"partners_censored", v.partners_censored},
       {"combinations_solved", v.combinations_solved},
@@ -779,6 +787,7 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {profile_column::events_quality, "", "/events/quality", "event detection's quality: ok, low or insufficient"},
       {"events_bubbles_paired", "-", "/events/bubbles_paired", "bubbles paired by event detection"},
       {profile_column::multi_tip_status, "", "/multi_tip/status", "multi-tip statistics: ok or too_few_bubbles"},
+      {profile_column::multi_tip_quality, "", "/multi_tip/quality", "multi-tip quality: ok, low or insufficient"},
       {"multi_tip_velocity_x", "m/s", "/multi_tip/velocity/0", "multi-tip mean velocity vector, x (streamwise)"},
       {"multi_tip_velocity_y", "m/s", "/multi_tip/velocity/1", "multi-tip mean velocity vector, y"},
       {"multi_tip_velocity_z", "m/s", "/multi_tip/velocity/2", "multi-tip mean velocity vector, z"},
@@ -863,12 +872,13 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   if (r.probe) {
     const auto& v = r.probe->vectors;
     auto if_ok = [&](double x) { return csv_number(v.ok() ? std::optional(x) : std::nullopt); };
-    out += fmt::format(",{},{},{},{},{},{},{},{},{},{}", to_string(v.status), if_ok(v.velocity[0]),
+    out += fmt::format(",{},{},{},{},{},{},{},{},{},{},{}", to_string(v.status), to_string(r.probe->quality),
+                       if_ok(v.velocity[0]),
                        if_ok(v.velocity[1]), if_ok(v.velocity[2]), if_ok(v.turbulence_intensity[0]),
                        if_ok(v.turbulence_intensity[1]), if_ok(v.turbulence_intensity[2]), csv_number(v.diameter_front),
                        csv_number(v.interfacial_area), v.bubbles_accepted);
   } else {
-    out += ",,,,,,,,,,";
+    out += ",,,,,,,,,,,";
   }
   return out;
 }
@@ -1107,6 +1117,8 @@ std::string ProcessResult::report() const {
                                k < p.channels.size() ? p.channels[k] : -1);
     }
     line("  multi-tip probe: " + tips_text);
+    line(fmt::format("    quality {}{}", to_string(p.quality),
+                     p.quality_reason.empty() ? std::string() : ": " + p.quality_reason));
     for (const auto& t : p.further_tips) {
       line(fmt::format("    tip of channel {}: void fraction {:.5f}, bubble count rate {:.3f} /s", t.channel,
                        t.phase.void_fraction, t.phase.bubble_count_rate));

@@ -60,6 +60,10 @@ struct EventsComparison {
 };
 /// Empty unless event detection gave a velocity and a reference exists.
 std::optional<EventsComparison> compare_events(const EventResult& events, const ProcessResult& result);
+/// The same for the multi-tip mean vector's streamwise component (its
+/// interval: mean +/- 1.96 rms / sqrt(N), awcc/multi_tip.hpp) against FSCC's
+/// velocity of the tip pair; empty unless both exist.
+std::optional<EventsComparison> compare_multi_tip(const MultiTipResult& vectors, const ProcessResult& result);
 
 /// Every warning of a processed recording, in the order of the list above.
 std::vector<Warning> assess(const ProcessResult& result);

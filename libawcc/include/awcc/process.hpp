@@ -184,6 +184,15 @@ struct ProbeResult {
   /// FSCC and AWCC of the leading tip with every trailing tip other than
   /// the pair's (ProcessResult::fscc and awcc), where it lies downstream.
   std::vector<TipPairResult> pairs;
+  /// Whether the vectors can be trusted, by AWCC's levels: insufficient
+  /// without statistics; low when the solver's caution is raised
+  /// (MultiTipResult::caution), or when the mean vector's streamwise
+  /// component and FSCC's velocity of the tip pair differ by more than their
+  /// 95 % intervals allow together (the rule of awcc/assess.hpp): a bubble
+  /// that misses a trailing tip is paired with an unrelated one, and the
+  /// vectors of such pairs are wild but not all beyond the outlier cutoff.
+  AwccQuality quality = AwccQuality::insufficient;
+  std::string quality_reason;  ///< why not ok
 };
 
 struct ProcessResult {

@@ -121,6 +121,7 @@ inline constexpr std::string_view fscc_velocity = "fscc_velocity";
 inline constexpr std::string_view events_velocity = "events_velocity";
 inline constexpr std::string_view events_quality = "events_quality";
 inline constexpr std::string_view multi_tip_status = "multi_tip_status";
+inline constexpr std::string_view multi_tip_quality = "multi_tip_quality";
 inline constexpr std::string_view fscc_r12_max = "fscc_r12_max";
 inline constexpr std::string_view awcc_velocity = "awcc_velocity";
 inline constexpr std::string_view awcc_turbulence_intensity = "awcc_turbulence_intensity";
