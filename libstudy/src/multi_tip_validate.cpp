@@ -209,6 +209,8 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
   // The probe's pairing holds every leading crossing in order (pair_probe):
   // the rows of its leading bubbles are the crossings' rows.
   const auto& trailing = v.geometry.trailing_tips();
+  // A leading bubble with a wrong partner at any trailing tip (score_partners' rule).
+  std::vector<bool> mispaired(leading.size(), false);
   if (pairing.ok()) {
     if (leading.size() != lead_crossings.size()) {
       throw std::logic_error("validate_multi_tip: the pairing's leading bubbles are not the leading tip's crossings");
@@ -218,6 +220,9 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
       for (std::size_t h = 0; h < leading.size(); ++h) {
         const auto& p = pairing.bubbles.partner(h, k);
         fronts[h] = p ? std::optional(p->front) : std::nullopt;
+        if (!p) continue;
+        const auto* at_tip = rows[h] ? &table.pierce(*rows[h], trailing[k]) : nullptr;
+        if (!at_tip || !at_tip->pierced() || std::fabs(at_tip->front - p->front) > tolerance) mispaired[h] = true;
       }
       v.pairing.push_back(score_partners(table, rows, trailing[k], fronts, tolerance));
       v.pairing_total += v.pairing.back();
@@ -227,10 +232,20 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
   for (auto& result : processed.vectors) {
     VectorValidation a;
     std::vector<double> speed, vector, diameter;
+    awcc::Vec3 selected{};
+    double selected_weight = 0.0, weight = 0.0, mispaired_weight = 0.0;
     for (std::size_t h = 0; h < result.bubbles.size(); ++h) {
       const auto& b = result.bubbles[h];
-      if (b.fate != awcc::VectorFate::solved || !rows[h]) continue;
+      if (b.fate != awcc::VectorFate::solved) continue;
+      weight += b.weight;
+      if (h < mispaired.size() && (mispaired[h] || !rows[h])) {
+        ++a.accepted_mispaired;
+        mispaired_weight += b.weight;
+      }
+      if (!rows[h]) continue;
       const auto truth_v = to_vec(table.velocity[*rows[h]]);
+      for (std::size_t i = 0; i < 3; ++i) selected[i] += b.weight * truth_v[i];
+      selected_weight += b.weight;
       const double true_speed = norm(truth_v);
       if (!(true_speed > 0.0)) continue;
       speed.push_back(std::fabs(norm(b.velocity) - true_speed) / true_speed);
@@ -241,12 +256,17 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
         diameter.push_back(std::fabs(b.diameter_front - true_d) / true_d);
       }
     }
+    a.mispaired_weight_share = weight > 0.0 ? mispaired_weight / weight : kNaN;
     a.speed_error = awcc::summarise(std::move(speed));
     a.vector_error = awcc::summarise(std::move(vector));
     a.diameter_error = awcc::summarise(std::move(diameter));
     for (std::size_t i = 0; i < 3; ++i) {
       a.mean_velocity[i] = {result.ok() ? std::optional(result.velocity[i]) : std::nullopt, v.realised_velocity[i],
                             realised_speed};
+      a.selected_velocity[i] = {result.ok() && selected_weight > 0.0
+                                    ? std::optional(selected[i] / selected_weight)
+                                    : std::nullopt,
+                                v.realised_velocity[i], realised_speed};
       a.turbulence_intensity[i] = {result.ok() ? std::optional(result.turbulence_intensity[i]) : std::nullopt,
                                    v.realised_turbulence_intensity[i], v.realised_turbulence_intensity[i]};
     }
@@ -267,9 +287,13 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
     std::vector<std::optional<double>> fronts(ed.size());
     std::vector<double> errors;
     for (std::size_t h = 0; h < ed.size(); ++h) {
-      if (ed[h].fate != awcc::BubbleFate::paired) continue;
-      fronts[h] = ed[h].trailing_front;
-      if (!ed_rows[h]) continue;
+      // The pairing's partners are the paired bubbles and those the outlier
+      // cutoff removed after pairing (the probe's pairing has no cutoff);
+      // the velocities are of the paired ones.
+      if (ed[h].fate == awcc::BubbleFate::paired || ed[h].fate == awcc::BubbleFate::roc) {
+        fronts[h] = ed[h].trailing_front;
+      }
+      if (ed[h].fate != awcc::BubbleFate::paired || !ed_rows[h]) continue;
       const double vx = table.velocity[*ed_rows[h]].x;
       if (vx != 0.0) errors.push_back(std::fabs(ed[h].velocity - vx) / std::fabs(vx));
     }
@@ -339,6 +363,8 @@ std::string multi_tip_report(const MultiTipValidation& v) {
                        r.bubbles_total, r.bubbles_accepted, r.count(awcc::VectorFate::censored),
                        r.count(awcc::VectorFate::too_few_tips), r.count(awcc::VectorFate::ill_conditioned),
                        r.count(awcc::VectorFate::degenerate), r.count(awcc::VectorFate::roc));
+    out += fmt::format("  accepted with a wrong partner: {} of {}, carrying {:.1f} % of the weights\n",
+                       a.accepted_mispaired, r.bubbles_accepted, 100.0 * a.mispaired_weight_share);
     out += fmt::format("  per bubble: speed error {}\n", quantiles(a.speed_error));
     out += fmt::format("  per bubble: vector error |v - v_true| / |v_true| {}\n", quantiles(a.vector_error));
     if (a.diameter_error.count) out += fmt::format("  per bubble: diameter error {}\n", quantiles(a.diameter_error));
@@ -347,6 +373,7 @@ std::string multi_tip_report(const MultiTipValidation& v) {
     for (std::size_t i = 0; i < 3; ++i) {
       compared_row(out, fmt::format("mean u_{} (m/s, error / |U|)", axes[i]), a.mean_velocity[i]);
     }
+    compared_row(out, "same mean of their true u_x", a.selected_velocity[0]);
     for (std::size_t i = 0; i < 3; ++i) compared_row(out, fmt::format("Tu_{}", axes[i]), a.turbulence_intensity[i]);
     if (a.interfacial_area.value) {
       compared_row(out, "IAC vs 6 c / d_b (1/m)", a.interfacial_area, 1.0, "{:.2f}");
@@ -360,7 +387,8 @@ std::string multi_tip_report(const MultiTipValidation& v) {
                      g.tip_name(d.trailing_tip), d.dx * 1e3, d.dy * 1e3);
   out += fmt::format("  event detection: status {}{}\n", awcc::to_string(d.events.status),
                      d.events.ok() ? std::string() : ": " + d.events.message);
-  out += fmt::format("  ED pairing: {}\n", partner_line(d.pairing));
+  out += fmt::format("  ED pairing (before its outlier cutoff, which removed {}): {}\n", d.events.count(awcc::BubbleFate::roc),
+                     partner_line(d.pairing));
   out += fmt::format("  ED per bubble: |u_h - v_x| / |v_x| {}\n", quantiles(d.velocity_error));
   if (d.processed.awcc) out += "  " + awcc_status_line(*d.processed.awcc);
   out += fmt::format("  {:<30}{:>12}{:>12}{:>12}\n", "quantity", "truth", "estimate", "error");
@@ -431,9 +459,10 @@ json multi_tip_to_json(const MultiTipValidation& v) {
     const auto& r = a.result;
     json fates;
     for (std::size_t f = 0; f < awcc::vector_fate_count; ++f) fates[std::string(awcc::vector_fate_names[f])] = r.bubbles_by_fate[f];
-    json mean = json::array(), tu = json::array();
+    json mean = json::array(), tu = json::array(), selected = json::array();
     for (std::size_t i = 0; i < 3; ++i) {
       mean.push_back(compared_json(a.mean_velocity[i]));
+      selected.push_back(compared_json(a.selected_velocity[i]));
       tu.push_back(compared_json(a.turbulence_intensity[i]));
     }
     algorithms[std::string(awcc::to_string(r.options.algorithm))] = {
@@ -445,6 +474,9 @@ json multi_tip_to_json(const MultiTipValidation& v) {
         {"vector_error", quantiles_json(a.vector_error)},
         {"diameter_error", quantiles_json(a.diameter_error)},
         {"mean_velocity", mean},
+        {"selected_velocity", selected},
+        {"accepted_mispaired", a.accepted_mispaired},
+        {"mispaired_weight_share", finite(a.mispaired_weight_share)},
         {"turbulence_intensity", tu},
         {"interfacial_area", compared_json(a.interfacial_area)},
         {"interfacial_area_vs_realised", compared_json(a.interfacial_area_realised)}};

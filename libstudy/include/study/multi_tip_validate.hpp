@@ -122,6 +122,17 @@ struct VectorValidation {
   awcc::Summary vector_error;   ///< per bubble, |v - v_true| / |v_true|
   awcc::Summary diameter_error; ///< per bubble, |D_front - d| / d (Shen & Nakamura; count 0 with Tian)
   std::array<Compared, 3> mean_velocity;         ///< m/s, error over the realised speed
+  /// The same weighted mean of the accepted bubbles' true vectors (those
+  /// matched to a truth row) against the realised mean, error over the
+  /// realised speed: the part of the mean's error that is which bubbles were
+  /// accepted (selection, mis-pairing's bubbles excluded), not how well each
+  /// was measured.
+  std::array<Compared, 3> selected_velocity;
+  /// Accepted bubbles with at least one wrong partner (or no truth row), and
+  /// their share of the weights of the mean vector: mis-paired lags are long,
+  /// so such a bubble has a small speed and a long interaction span.
+  std::int64_t accepted_mispaired = 0;
+  double mispaired_weight_share = 0.0;
   std::array<Compared, 3> turbulence_intensity;  ///< relative
   Compared interfacial_area;           ///< 1/m, against 6 c / d_b (relative)
   Compared interfacial_area_realised;  ///< 1/m, against the leading tip's realised IAC (relative)
@@ -132,8 +143,10 @@ struct DualTipValidation {
   std::size_t leading_tip = 0, trailing_tip = 1;
   double dx = 0.0, dy = 0.0;    ///< streamwise and transverse separation, m
   awcc::EventResult events;     ///< event detection on the pair
-  PartnerScore pairing;         ///< ED's partners against the truth
-  awcc::Summary velocity_error; ///< per paired bubble, |u_h - v_x| / |v_x|
+  /// ED's partners against the truth: those of its pairing, before its
+  /// outlier cutoff (as the probe's pairing, which has none).
+  PartnerScore pairing;
+  awcc::Summary velocity_error; ///< per paired bubble (after the cutoff), |u_h - v_x| / |v_x|
   Compared ed_velocity, ed_turbulence_intensity;      ///< against the realised u_x and Tu_x (relative)
   Compared awcc_velocity, awcc_turbulence_intensity;  ///< same, AWCC (value only when quality is ok or low)
   awcc::ProcessResult processed;  ///< pdp process's dual-tip processing (FSCC, AWCC)
