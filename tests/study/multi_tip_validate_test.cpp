@@ -199,6 +199,16 @@ TEST(ValidateMultiTip, ACleanFourTipSceneMeetsItsDerivedBounds) {
     ASSERT_TRUE(sn.turbulence_intensity[i].error());
     EXPECT_LT(std::fabs(*sn.turbulence_intensity[i].error()), 4.0 / std::sqrt(2.0 * n)) << "component " << i;
   }
+  // The accepted bubbles' true vectors average to the realised mean within
+  // the same sampling bound, and a mis-paired accepted bubble has a wrong
+  // partner: no more of them than wrong partners.
+  const double sigma_x = v.realised_turbulence_intensity[0] * speed;
+  ASSERT_TRUE(sn.selected_velocity[0].error());
+  EXPECT_LT(std::fabs(*sn.selected_velocity[0].error()), 4.0 * sigma_x / std::sqrt(n) / speed);
+  EXPECT_LE(sn.accepted_mispaired, v.pairing_total.wrong);
+  EXPECT_GE(sn.mispaired_weight_share, 0.0);
+  EXPECT_LE(sn.mispaired_weight_share, 1.0);
+
   // Tian et al. solve the same linear system as Shen & Nakamura
   // (awcc/multi_tip.hpp): the same vector per bubble, to rounding, and no
   // interfacial area.
