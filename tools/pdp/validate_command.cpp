@@ -4,6 +4,7 @@
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/json_text.hpp"
+#include "study/multi_tip_validate.hpp"
 #include "study/validate.hpp"
 #include "terminal.hpp"
 
@@ -20,12 +21,53 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"));
 }
 
+namespace {
+
+// A probe of four or more tips: validated bubble by bubble
+// (study/multi_tip_validate.hpp), the dual tip's FSCC and AWCC with the
+// method options.
+int run_multi_tip_validate(const synth::Scene& scene, const ValidateOptions& o) {
+  study::MultiTipValidateOptions options;
+  std::vector<study::MultiTipValidation> runs;
+  try {
+    apply_method_options(o.methods, options.dual);
+    Progress progress("validating");
+    runs = study::validate_multi_tip_repeats(scene, options, o.repeat, [&](double fraction) { progress(fraction); });
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  nlohmann::json j;
+  if (runs.size() == 1) {
+    fmt::print("{}", study::multi_tip_report(runs[0]));
+    j = study::multi_tip_to_json(runs[0]);
+  } else {
+    const auto summary = study::summarise_multi_tip(runs);
+    fmt::print("{}", study::multi_tip_repeats_report(runs, summary, scene.seed));
+    j = study::multi_tip_repeats_to_json(runs, summary);
+  }
+  if (!o.json.empty()) {
+    try {
+      awcc::write_text_atomically(o.json, awcc::json_text(j));
+    } catch (const std::exception& e) {
+      return report_error(e);
+    }
+  }
+  return exit_ok;
+}
+
+}  // namespace
+
 int run_validate(const ValidateOptions& o) {
   synth::Scene scene;
+  try {
+    scene = build_scene(o.scene);
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  if (scene.probe_tips().size() >= 4) return run_multi_tip_validate(scene, o);
   study::RunOptions options;
   std::vector<study::RunResult> runs;
   try {
-    scene = build_scene(o.scene);
     apply_method_options(o.methods, options);
     Progress progress("validating");
     runs = study::run_repeats(scene, options, o.repeat, [&](double fraction) { progress(fraction); });
