@@ -283,8 +283,8 @@ TEST(ChannelsIgnored, AFourChannelRecordingNamesTheChannelsNotProcessed) {
   ASSERT_EQ(kept.size(), 1u);
   EXPECT_EQ(kept[0].flag, awcc::Flag::channels_ignored);
   EXPECT_EQ(kept[0].text,
-            "channels 2 and 3 of 4 are not processed (a 4-tip probe?): this version processes one tip pair, channels "
-            "0 and 1 (leading-channel, trailing-channel)");
+            "channels 2 and 3 of 4 are not processed (a 4-tip probe?): the tip pair alone was processed, channels 0 "
+            "and 1; to process every tip as a probe of four or more, declare their positions (tips, tip-channels)");
   o.trailing_channel = 3;
   const auto other = awcc::process_recording(*recording, o);
   const auto ignored = std::find_if(other.warnings.begin(), other.warnings.end(),

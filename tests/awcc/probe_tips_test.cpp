@@ -133,19 +133,37 @@ TEST(ProbeTips, ATwoTipDeclarationProcessesExactlyAsDxAndDy) {
 TEST(ProbeTips, AFourTipDeclarationProcessesItsFirstPairOnTheChannelsMapped) {
   const auto flac = written("four.flac", four_tips());
   // Tip 1 of the declaration is channel 2 (5 mm downstream, 1.5 mm across): the pair is channels 0 and 2.
-  const auto declared = awcc::process_recording(
-      flac, options({{"tips", "0,0,0;5mm,1.5mm,0;5mm,0,0;5mm,0,1.5mm", ""}, {"tip-channels", "0,2,1,3", ""}}));
+  // Method both: the tip pair alone, the other channels flagged as not processed.
+  const auto declared = awcc::process_recording(flac, options({{"tips", "0,0,0;5mm,1.5mm,0;5mm,0,0;5mm,0,1.5mm", ""},
+                                                               {"tip-channels", "0,2,1,3", ""},
+                                                               {"method", "both", ""}}));
   const auto pair = awcc::process_recording(
-      flac, options({{"dx", "5mm", ""}, {"dy", "1.5mm", ""}, {"trailing-channel", "2", ""}}));
+      flac, options({{"dx", "5mm", ""}, {"dy", "1.5mm", ""}, {"trailing-channel", "2", ""}, {"method", "both", ""}}));
   ASSERT_EQ(declared.tips.size(), 2u);
   EXPECT_EQ(declared.tips[1].channel, 2);
   auto a = awcc::to_json(declared), b = awcc::to_json(pair);
   a.erase("seconds");
   b.erase("seconds");
   EXPECT_EQ(a, b);
-  // The other tips are flagged as not processed (until the multi-tip method is wired).
   EXPECT_TRUE(std::any_of(declared.warnings.begin(), declared.warnings.end(),
                           [](const awcc::Warning& w) { return w.flag == awcc::Flag::channels_ignored; }));
+  // By default (method auto) a probe of four tips is processed bubble by
+  // bubble: the same pair first, every other tip in the order declared, each
+  // on its channel, none ignored; the pair's own results unchanged.
+  const auto multi = awcc::process_recording(
+      flac, options({{"tips", "0,0,0;5mm,1.5mm,0;5mm,0,0;5mm,0,1.5mm", ""}, {"tip-channels", "0,2,1,3", ""}}));
+  ASSERT_TRUE(multi.probe);
+  EXPECT_EQ(multi.probe->channels, (std::vector<int>{0, 2, 1, 3}));
+  EXPECT_EQ(multi.probe->geometry.positions()[1], (awcc::Vec3{5e-3, 1.5e-3, 0.0}));
+  EXPECT_EQ(multi.probe->geometry.positions()[2], (awcc::Vec3{5e-3, 0.0, 0.0}));
+  ASSERT_EQ(multi.probe->further_tips.size(), 2u);
+  EXPECT_EQ(multi.probe->further_tips[0].channel, 1);
+  EXPECT_EQ(multi.probe->pairs.size(), 2u);
+  EXPECT_TRUE(std::none_of(multi.warnings.begin(), multi.warnings.end(),
+                           [](const awcc::Warning& w) { return w.flag == awcc::Flag::channels_ignored; }));
+  ASSERT_TRUE(multi.fscc && declared.fscc);
+  EXPECT_EQ(multi.fscc->velocity, declared.fscc->velocity);
+  EXPECT_EQ(multi.tips[1].phase.void_fraction, declared.tips[1].phase.void_fraction);
 }
 
 TEST(ProbeTips, AFourTipH5FromPdpSynthCarriesItsTipsBack) {

@@ -27,8 +27,9 @@ cat >"$dir/probe.toml" <<'TOML'
 tips = [["0mm", "0mm", "0mm"], ["5mm", "1.5mm", "0mm"], ["5mm", "0mm", "0mm"], ["5mm", "0mm", "1.5mm"]]
 tip-channels = [0, 2, 1, 3]
 TOML
-"$pdp" --log-level error process "$dir/four.flac" --config "$dir/probe.toml" --json "$dir/table.json" >/dev/null || fail "[probe]"
-"$pdp" --log-level error process "$dir/four.flac" --dx 5mm --dy 1.5mm --trailing-channel 2 --json "$dir/pair.json" >/dev/null ||
+"$pdp" --log-level error process "$dir/four.flac" --config "$dir/probe.toml" --method both --json "$dir/table.json" >/dev/null ||
+  fail "[probe]"
+"$pdp" --log-level error process "$dir/four.flac" --dx 5mm --dy 1.5mm --trailing-channel 2 --method both --json "$dir/pair.json" >/dev/null ||
   fail "pair"
 [[ "$(result "$dir/table.json")" == "$(result "$dir/pair.json")" ]] || fail "[probe] with tip-channels differs from its pair"
 printf '[probe]\ntips = [["0mm", "0mm", "0mm"], ["5mm", "0mm", "0mm"]]\nnp = 10\n' >"$dir/stray.toml"

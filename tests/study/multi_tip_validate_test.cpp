@@ -221,8 +221,9 @@ TEST(ValidateMultiTip, ACleanFourTipSceneMeetsItsDerivedBounds) {
     for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(a.velocity[i], b.velocity[i], 1e-9 * speed) << "bubble " << h;
   }
   EXPECT_EQ(tian.diameter_error.count, 0);
-  EXPECT_FALSE(tian.interfacial_area.value);
-  EXPECT_TRUE(sn.interfacial_area.value);
+  // The interfacial area needs the speeds only (awcc/multi_tip.hpp): both algorithms give the same.
+  ASSERT_TRUE(tian.interfacial_area.value && sn.interfacial_area.value);
+  EXPECT_NEAR(*tian.interfacial_area.value, *sn.interfacial_area.value, 1e-9 * *sn.interfacial_area.value);
 
   // Event detection on the aligned pair: u_h = |v|^2 / v_x, above v_x by
   // (v_y^2 + v_z^2) / v_x, on average U (Tu_y^2 + Tu_z^2) = 0.125 % of U;
