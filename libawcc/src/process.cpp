@@ -731,6 +731,18 @@ void check_vectors(ProbeResult& probe, const ProcessResult& out) {
     return;
   }
   std::vector<std::string> why;
+  // A leading tip's signal that arrives after a trailing tip's is a channel
+  // mapped to the wrong tip: the vectors are then of a different probe.
+  auto order = [&](const std::optional<FsccResult>& f, std::size_t tip, double dx) {
+    if (!f || (f->status != FsccStatus::tips_swapped && f->status != FsccStatus::non_positive_lag)) return;
+    why.push_back(fmt::format("FSCC of the leading tip (channel {}) with tip {} (channel {}, {:.3g} mm downstream) "
+                              "finds {}: is the channel of one of them swapped with another tip's? (tip-channels)",
+                              probe.channels[0], tip, probe.channels[tip], dx * 1e3,
+                              f->status == FsccStatus::tips_swapped ? "the trailing tip's signal first"
+                                                                    : "no delay between them"));
+  };
+  order(out.fscc, 1, out.dx);
+  for (const auto& pair : probe.pairs) order(pair.fscc, pair.tip, pair.dx);
   if (!v.caution.empty()) why.push_back(v.caution);
   if (const auto c = compare_multi_tip(v, out); c && c->disagree()) {
     why.push_back(fmt::format("its streamwise component {:.3f} m/s ({:.3f}-{:.3f}) and {}'s velocity of the tip pair "
@@ -790,7 +802,6 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
     probe.vectors.record_length = record_length;
     probe.vectors.message = probe.pairing.message;
   }
-  check_vectors(probe, out);
   const bool binary = options.awcc_options.signal == CorrelationSignal::binary;
   for (std::size_t k = 2; binary && k < tips; ++k) {
     const Vec3& a = r.tip_positions[0];
@@ -806,6 +817,7 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
     if (options.awcc) pair.awcc = awcc::awcc(r.leading, trailing, pair.dx, options.awcc_options);
     probe.pairs.push_back(std::move(pair));
   }
+  check_vectors(probe, out);
   out.probe = std::move(probe);
 }
 

@@ -185,7 +185,9 @@ struct ProbeResult {
   /// the pair's (ProcessResult::fscc and awcc), where it lies downstream.
   std::vector<TipPairResult> pairs;
   /// Whether the vectors can be trusted, by AWCC's levels: insufficient
-  /// without statistics; low when the solver's caution is raised
+  /// without statistics; low when FSCC of the leading tip with a trailing
+  /// tip finds the trailing signal first or no delay (a channel mapped to
+  /// the wrong tip), when the solver's caution is raised
   /// (MultiTipResult::caution), or when the mean vector's streamwise
   /// component and FSCC's velocity of the tip pair differ by more than their
   /// 95 % intervals allow together (the rule of awcc/assess.hpp): a bubble
