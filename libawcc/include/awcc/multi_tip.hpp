@@ -322,7 +322,7 @@ MultiTipResult multi_tip(const ProbeGeometry& geometry, const PiercedBubbles& bu
 ///  2. One candidate or none. None: no_partner. Two or more: ambiguous,
 ///     refused at that tip; never the closer one (that selects the faster
 ///     velocity, and a wrong first one is what mis-pairs). Measured: taking
-///     the first candidate accepted 35 % more bubbles on the sample but
+///     the first candidate accepted 20-40 % more bubbles on the sample but
 ///     biased their true mean speed 1.6 % high (slow bubbles lose their
 ///     partner to an earlier unrelated one); refusing left the accepted
 ///     bubbles' true mean within 0.5 % of all leading bubbles'. (Refusal is
