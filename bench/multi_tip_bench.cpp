@@ -6,14 +6,16 @@
 // Synthesises the base case (synth::Scene's defaults: 10 m/s, c = 0.25,
 // 3 mm spheres, 500 kHz) with the four tips of samples/four-tip.toml into
 // memory once, then times on one thread the chain a record goes through:
-// the crossings of every tip, pair_probe (Kramer's pairing of the leading
-// tip with each trailing tip), and multi_tip with each velocity algorithm.
+// the crossings of every tip, FSCC of the tip pair (pair_probe's first
+// velocity), pair_probe (the joint pairing of the trailing tips), and
+// multi_tip with each velocity algorithm.
 // Median of N runs of each step and of the whole chain, and the cost per
 // leading bubble.
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "awcc/fscc.hpp"
 #include "awcc/interface_times.hpp"
 #include "awcc/multi_tip.hpp"
 #include "bench_util.hpp"
@@ -56,8 +58,14 @@ int main(int argc, char** argv) {
     tips.clear();
     for (const auto& s : syn.signals) tips.push_back(awcc::crossings(s));
   });
+  const double dx = scene.tips[1].x - scene.tips[0].x;
+  awcc::FsccResult first;
+  const double t_fscc =
+      median_seconds(args.repeat, [&] { first = awcc::fscc(syn.signals[0], syn.signals[1], dx); });
+  std::printf("FSCC of the tip pair: %.3f s, %.3f m/s\n", t_fscc, first.velocity);
   awcc::ProbePairing pairing;
-  const double t_pair = median_seconds(args.repeat, [&] { pairing = awcc::pair_probe(geometry, tips, {}); });
+  const double t_pair =
+      median_seconds(args.repeat, [&] { pairing = awcc::pair_probe(geometry, tips, {}, first.velocity); });
   const double bubbles = static_cast<double>(pairing.bubbles.size());
   const auto per = [&](double seconds) { return seconds / bubbles * 1e9; };
   std::printf("crossings of 4 tips: %.3f s; pair_probe: %.3f s (%.0f ns a leading bubble, %zu of them)\n", t_cross,
@@ -71,7 +79,8 @@ int main(int argc, char** argv) {
     const double t_chain = median_seconds(args.repeat, [&] {
       std::vector<std::vector<awcc::Crossing>> c;
       for (const auto& s : syn.signals) c.push_back(awcc::crossings(s));
-      const auto p = awcc::pair_probe(geometry, c, {});
+      const auto f = awcc::fscc(syn.signals[0], syn.signals[1], dx);
+      const auto p = awcc::pair_probe(geometry, c, {}, f.velocity);
       r = awcc::multi_tip(geometry, p.bubbles, args.duration, o);
     });
     std::printf("multi_tip %s: %.3f s (%.0f ns a bubble); chain %.3f s (%.0f ns a bubble), %lld accepted; peak %.0f MB\n",

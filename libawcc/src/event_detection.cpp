@@ -42,6 +42,30 @@ Validation EventOptions::validate() const {
                                            "first velocity)",
                                            shen_lag_factor));
   }
+  if (!(probe_speed_min > 0.0 && probe_speed_min < 1.0)) {
+    return Validation::invalid("probe-speed-min",
+                               fmt::format("probe-speed-min = {} must lie in (0, 1): the slowest bubble paired, as a "
+                                           "fraction of the first velocity",
+                                           probe_speed_min));
+  }
+  if (!(probe_speed_max > 1.0) || !std::isfinite(probe_speed_max)) {
+    return Validation::invalid("probe-speed-max",
+                               fmt::format("probe-speed-max = {} must be above 1: the fastest bubble paired, as a "
+                                           "multiple of the first velocity",
+                                           probe_speed_max));
+  }
+  if (!(probe_angle_max > 0.0 && probe_angle_max < 90.0)) {
+    return Validation::invalid("probe-angle-max",
+                               fmt::format("probe-angle-max = {} degrees must lie in (0, 90): the largest angle "
+                                           "between a bubble's velocity and the streamwise axis",
+                                           probe_angle_max));
+  }
+  if (!(probe_diameter_mismatch > 0.0)) {
+    return Validation::invalid("probe-diameter-mismatch",
+                               fmt::format("probe-diameter-mismatch = {} must be positive (a large value turns the "
+                                           "check off)",
+                                           probe_diameter_mismatch));
+  }
   if (bubbles_reported < 2) {
     return Validation::invalid("bubbles-reported",
                                fmt::format("bubbles reported {}: moments need at least 2 bubbles", bubbles_reported));

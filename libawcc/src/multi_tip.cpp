@@ -292,6 +292,12 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
                                     "cluster of mis-paired ones",
                                     cut, cut + result.bubbles_accepted));
     }
+    if (20 * result.bubbles_accepted < result.bubbles_complete) {
+      reasons.push_back(fmt::format("only {} of {} complete leading bubbles have an accepted vector (below 5 %): where "
+                                    "bubbles are this dense the pairing refuses most (ambiguous lag windows) and the "
+                                    "few accepted are a selection, some of them mis-paired",
+                                    result.bubbles_accepted, result.bubbles_complete));
+    }
     for (const auto& r : reasons) result.caution += (result.caution.empty() ? "" : "; ") + r;
     if (!result.caution.empty()) {
       result.caution += "; the vectors and the interfacial area are likely wrong: check the pairing against the truth "
@@ -430,39 +436,201 @@ std::string MultiTipResult::report() const {
   return out;
 }
 
+namespace {
+
+// The least conditioning |det A_0| of a combination the pairing's diameter
+// check solves through: MultiTipOptions' default (pair_probe does not see
+// the solver's options; a combination below it gives no trustworthy D).
+constexpr double kPairingConditioning = MultiTipOptions{}.conditioning_min;
+
+// Window of the centre lag to trailing tip k (multi_tip.hpp, pairing).
+struct LagWindow {
+  double earliest = 0.0, latest = 0.0;  // s, relative to the leading centre
+};
+
+LagWindow lag_window(const Vec3& s, double v_ref, const EventOptions& o) {
+  constexpr double pi = 3.14159265358979323846;
+  const double length = std::sqrt(dot(s, s));
+  const double beta = o.probe_angle_max * pi / 180.0;
+  const double theta = std::acos(std::clamp(s[0] / length, -1.0, 1.0));  // S_0k against x
+  // lag = |S| cos(angle between S and v) / |v|, the angle within theta +/- beta.
+  const double near = std::cos(std::max(theta - beta, 0.0));
+  const double far = std::cos(std::min(theta + beta, pi));
+  LagWindow w;
+  w.latest = length * near / ((near > 0.0 ? o.probe_speed_min : o.probe_speed_max) * v_ref);
+  w.earliest = length * far / ((far > 0.0 ? o.probe_speed_max : o.probe_speed_min) * v_ref);
+  return w;
+}
+
+// Whether the slowness w = v / |v|^2 lies in the cone and speed band.
+bool in_band(const Vec3& w, double v_ref, double tan_max, const EventOptions& o) {
+  const double w2 = dot(w, w);
+  if (!(w[0] > 0.0) || !std::isfinite(w2)) return false;
+  if (std::hypot(w[1], w[2]) > tan_max * w[0]) return false;
+  const double speed = 1.0 / std::sqrt(w2);
+  return speed >= o.probe_speed_min * v_ref && speed <= o.probe_speed_max * v_ref;
+}
+
+// The joint test of one bubble's unique candidates at the tips in `use`
+// (multi_tip.hpp, pairing): the least-squares slowness of their centre lags
+// in the band and cone, and every well-conditioned combination's Shen &
+// Nakamura diameters alike. False also when no combination of them is well
+// conditioned (nothing to test against).
+bool one_bubble(const ProbeGeometry& g, const Crossing& lead, const std::vector<const Crossing*>& at,
+                const std::vector<bool>& use, double v_ref, double tan_max, const EventOptions& o) {
+  // Normal equations (sum S S^T) w = sum S lag; exact for three tips.
+  std::array<Vec3, 3> m{};
+  Vec3 b{};
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    if (!use[k]) continue;
+    const Vec3 s = g.offset(k);
+    const double lag = at[k]->centre() - lead.centre();
+    for (std::size_t i = 0; i < 3; ++i) {
+      b[i] += s[i] * lag;
+      for (std::size_t j = 0; j < 3; ++j) m[i][j] += s[i] * s[j];
+    }
+  }
+  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  int tested = 0;
+  for (const auto& c : g.combinations()) {
+    if (!use[c.trailing[0]] || !use[c.trailing[1]] || !use[c.trailing[2]]) continue;
+    if (c.conditioning() < kPairingConditioning) continue;
+    ++tested;
+    detail::CombinationSolution s;
+    const std::array<const Crossing*, 3> three{at[c.trailing[0]], at[c.trailing[1]], at[c.trailing[2]]};
+    if (!detail::solve_combination(c, lead, three, VelocityAlgorithm::shen_nakamura, s)) return false;
+    const double mean = 0.5 * (s.diameter_front + s.diameter_rear);
+    if (std::fabs(s.diameter_front - s.diameter_rear) > o.probe_diameter_mismatch * mean) return false;
+  }
+  if (tested == 0 || !(det != 0.0)) return false;
+  Vec3 w{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::array<Vec3, 3> mi = m;
+    for (std::size_t r = 0; r < 3; ++r) mi[r][i] = b[r];
+    w[i] = (mi[0][0] * (mi[1][1] * mi[2][2] - mi[1][2] * mi[2][1]) - mi[0][1] * (mi[1][0] * mi[2][2] - mi[1][2] * mi[2][0]) +
+            mi[0][2] * (mi[1][0] * mi[2][1] - mi[1][1] * mi[2][0])) /
+           det;
+  }
+  return in_band(w, v_ref, tan_max, o);
+}
+
+}  // namespace
+
 ProbePairing pair_probe(const ProbeGeometry& geometry, std::span<const std::vector<Crossing>> tips,
                         const EventOptions& options, std::optional<double> first_velocity) {
   if (tips.size() != geometry.tip_count()) {
     throw std::invalid_argument(fmt::format("pair_probe: {} tips' crossings for a probe of {} tips", tips.size(),
                                             geometry.tip_count()));
   }
+  options.validate().throw_if_failed();
   const std::vector<Crossing>& leading = tips[geometry.leading()];
   const std::vector<std::size_t>& trailing = geometry.trailing_tips();
+  const std::size_t k_tips = trailing.size();
   ProbePairing out;
-  out.bubbles = PiercedBubbles(trailing.size());
-  std::vector<PairingResult> pairings;
-  pairings.reserve(trailing.size());
-  for (std::size_t k = 0; k < trailing.size(); ++k) {
-    PairingResult pairing = pair_bubbles(leading, tips[trailing[k]], geometry.distance(k), options, first_velocity);
-    if (!pairing.ok()) {
-      out.status = pairing.status;
-      out.message = fmt::format("{} with {}: {}", geometry.tip_name(geometry.leading()),
-                                geometry.tip_name(trailing[k]), pairing.message);
-      out.fates.clear();
-      return out;
-    }
-    auto& fates = out.fates.emplace_back();
-    fates.fill(0);
-    for (const BubblePairing& b : pairing.bubbles) ++fates[static_cast<std::size_t>(b.fate)];
-    pairings.push_back(std::move(pairing));
+  out.bubbles = PiercedBubbles(k_tips);
+  if (!first_velocity || !(*first_velocity > 0.0) || !std::isfinite(*first_velocity)) {
+    out.status = EventStatus::no_first_velocity;
+    out.message = first_velocity
+                      ? fmt::format("multi-tip pairing needs a positive first velocity; {} m/s was given",
+                                    *first_velocity)
+                      : std::string("multi-tip pairing needs a first velocity (FSCC's of the tip pair) for its lag "
+                                    "windows, and none was given: the leading tip paired with each trailing tip "
+                                    "alone takes unrelated bubbles as partners");
+    return out;
   }
-  out.bubbles.reserve(leading.size());
-  std::vector<std::optional<Crossing>> partners(trailing.size());
+  const double v_ref = *first_velocity;
+  constexpr double pi = 3.14159265358979323846;
+  const double tan_max = std::tan(options.probe_angle_max * pi / 180.0);
+  std::vector<LagWindow> windows;
+  for (std::size_t k = 0; k < k_tips; ++k) windows.push_back(lag_window(geometry.offset(k), v_ref, options));
+
+  // Per bubble and tip: the chosen candidate (an index) and the fate.
+  constexpr std::size_t none = static_cast<std::size_t>(-1);
+  std::vector<std::size_t> chosen(leading.size() * k_tips, none);
+  std::vector<BubbleFate> fate(leading.size() * k_tips, BubbleFate::no_partner);
+  std::vector<std::size_t> first(k_tips, 0);  // first crossing not before the window, per tip
+  std::vector<const Crossing*> at(k_tips);
+  std::vector<bool> use(k_tips);
   for (std::size_t h = 0; h < leading.size(); ++h) {
-    for (std::size_t k = 0; k < trailing.size(); ++k) {
-      const BubblePairing& b = pairings[k].bubbles[h];
+    const Crossing& a = leading[h];
+    std::size_t present = 0;
+    for (std::size_t k = 0; k < k_tips; ++k) {
+      const std::vector<Crossing>& c = tips[trailing[k]];
+      // Window starts increase with h (leading centres do): one pass a tip.
+      std::size_t& j = first[k];
+      while (j < c.size() && c[j].centre() < a.centre() + windows[k].earliest) ++j;
+      std::size_t n = 0;
+      while (j + n < c.size() && n < 2 && c[j + n].centre() <= a.centre() + windows[k].latest) ++n;
+      const std::size_t i = h * k_tips + k;
+      at[k] = nullptr;
+      use[k] = false;
+      if (a.censored) {
+        fate[i] = BubbleFate::censored;
+      } else if (n == 0) {
+        fate[i] = BubbleFate::no_partner;
+      } else if (n > 1) {
+        fate[i] = BubbleFate::ambiguous;
+      } else if (c[j].censored) {
+        fate[i] = BubbleFate::censored;
+      } else {
+        fate[i] = BubbleFate::paired;
+        chosen[i] = j;
+        at[k] = &c[j];
+        use[k] = true;
+        ++present;
+      }
+    }
+    // Fewer than three: no vector, nothing to test them against; listed.
+    if (present < 3 || one_bubble(geometry, a, at, use, v_ref, tan_max, options)) continue;
+    // More than three: the one tip whose removal leaves one bubble, if
+    // exactly one does.
+    std::optional<std::size_t> drop;
+    int drops = 0;
+    for (std::size_t k = 0; present > 3 && k < k_tips; ++k) {
+      if (!use[k]) continue;
+      use[k] = false;
+      if (one_bubble(geometry, a, at, use, v_ref, tan_max, options)) {
+        drop = k;
+        ++drops;
+      }
+      use[k] = true;
+    }
+    for (std::size_t k = 0; k < k_tips; ++k) {
+      const std::size_t i = h * k_tips + k;
+      if (!use[k] || (drops == 1 && k != *drop)) continue;
+      fate[i] = BubbleFate::inconsistent;
+      chosen[i] = none;
+    }
+  }
+  // A trailing crossing chosen by two leading bubbles: neither keeps it (at
+  // most one is its bubble, and the times do not say which). Choices never
+  // decrease with h, so the claims on one crossing are consecutive.
+  for (std::size_t k = 0; k < k_tips; ++k) {
+    std::size_t previous = none;
+    for (std::size_t h = 0; h < leading.size(); ++h) {
+      const std::size_t i = h * k_tips + k;
+      if (chosen[i] == none) continue;
+      if (previous != none && chosen[previous * k_tips + k] == chosen[i]) {
+        fate[previous * k_tips + k] = fate[i] = BubbleFate::claimed_twice;
+      }
+      previous = h;
+    }
+    for (std::size_t h = 0; h < leading.size(); ++h) {
+      const std::size_t i = h * k_tips + k;
+      if (fate[i] == BubbleFate::claimed_twice) chosen[i] = none;
+    }
+  }
+  out.fates.assign(k_tips, {});
+  out.bubbles.reserve(leading.size());
+  std::vector<std::optional<Crossing>> partners(k_tips);
+  for (std::size_t h = 0; h < leading.size(); ++h) {
+    for (std::size_t k = 0; k < k_tips; ++k) {
+      const std::size_t i = h * k_tips + k;
+      ++out.fates[k][static_cast<std::size_t>(fate[i])];
       partners[k].reset();
-      if (b.fate == BubbleFate::paired && b.candidate) partners[k] = tips[trailing[k]][*b.candidate];
+      if (chosen[i] != none) partners[k] = tips[trailing[k]][chosen[i]];
     }
     out.bubbles.add(leading[h], partners);
   }

@@ -430,6 +430,26 @@ const OptionField<E> kEvents[] = {
      "Shen pairing: f in the lag limit |S| / (f V_gas); 0.3 pairs bubbles down to 30 % of the mean velocity",
      [](E& o, std::string_view t) { o.shen_lag_factor = quantity(t, Dimension::dimensionless); },
      [](const E& o) { return fmt::format("{:g}", o.shen_lag_factor); }},
+    {"probe-speed-min", "-",
+     "multi-tip pairing: slowest bubble paired, as a fraction of the first velocity (FSCC's); sets the long end of "
+     "each trailing tip's lag window",
+     [](E& o, std::string_view t) { o.probe_speed_min = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}", o.probe_speed_min); }},
+    {"probe-speed-max", "-",
+     "multi-tip pairing: fastest bubble paired, as a multiple of the first velocity; sets the short end of each "
+     "lag window",
+     [](E& o, std::string_view t) { o.probe_speed_max = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}", o.probe_speed_max); }},
+    {"probe-angle-max", "deg",
+     "multi-tip pairing: largest angle between a bubble's velocity and the streamwise axis (raise it for strongly "
+     "3-D flows)",
+     [](E& o, std::string_view t) { o.probe_angle_max = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}", o.probe_angle_max); }},
+    {"probe-diameter-mismatch", "-",
+     "multi-tip pairing: largest |D_front - D_rear| / D of a bubble's Shen & Nakamura diameters (0 for a sphere "
+     "paired right); raise it for bubbles far from spheres",
+     [](E& o, std::string_view t) { o.probe_diameter_mismatch = quantity(t, Dimension::dimensionless); },
+     [](const E& o) { return fmt::format("{:g}", o.probe_diameter_mismatch); }},
     {"bubbles-reported", "-",
      "event detection quality: fewest paired bubbles whose velocity and Tu are reported (insufficient below)",
      [](E& o, std::string_view t) { o.bubbles_reported = static_cast<int>(whole(t, 2, 1000000000)); },

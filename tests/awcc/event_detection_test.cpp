@@ -467,9 +467,13 @@ TEST(EventDetection, PairingEqualsABruteForcePairingOnRandomTips) {
       }
     }
   }
-  // The random tips exercise every fate the pairing gives.
-  for (std::size_t f = 0; f + 1 < awcc::bubble_fate_count; ++f)
+  // The random tips exercise every fate the pairing gives (ambiguous and
+  // inconsistent are the multi-tip pairing's, roc the statistics').
+  for (std::size_t f = 0; f < awcc::bubble_fate_count; ++f) {
+    const auto fate = static_cast<BubbleFate>(f);
+    if (fate == BubbleFate::ambiguous || fate == BubbleFate::inconsistent || fate == BubbleFate::roc) continue;
     EXPECT_GT(seen[f], 0) << awcc::bubble_fate_names[f];
+  }
 }
 
 TEST(EventDetection, FateCountsSumToTheLeadingBubbles) {

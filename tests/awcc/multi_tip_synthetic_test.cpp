@@ -6,8 +6,9 @@
 // spheres, weak turbulence with a long time scale), where the issue asks for
 // pairing errors under 1 %, a median per-bubble speed error under 2 % and a
 // mean vector within 2 % of the realised one, and the interfacial area
-// within 5 % of 6 c / d_b. Then pdp's four-tip sample, where the pairing
-// gives wrong partners and the result must say so.
+// within 5 % of 6 c / d_b. Then pdp's four-tip sample, where pairing each
+// trailing tip alone took a quarter of the partners from other bubbles and
+// the joint pairing must not (pair_probe's header, measured).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "awcc/fscc.hpp"
 #include "awcc/interface_times.hpp"
 #include "awcc/multi_tip.hpp"
 #include "synth/synthesiser.hpp"
@@ -52,6 +54,14 @@ CleanProbe clean_four_tip(double duration) {
   return p;
 }
 
+// pair_probe's first velocity, as pdp process gives it: FSCC's of the
+// leading tip and the first trailing one.
+double first_velocity(const synth::Synthesis& syn, const awcc::ProbeGeometry& g) {
+  const auto f = awcc::fscc(syn.signals[g.leading()], syn.signals[g.trailing_tips()[0]], g.offset(0)[0]);
+  EXPECT_TRUE(f.ok()) << f.message;
+  return f.velocity;
+}
+
 // The truth row whose leading-tip front lies within one sample of `front`.
 std::optional<std::size_t> truth_row(const synth::BubbleTruth& truth, std::size_t leading, double front, double fs) {
   std::optional<std::size_t> best;
@@ -69,7 +79,8 @@ std::optional<std::size_t> truth_row(const synth::BubbleTruth& truth, std::size_
 TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVelocity) {
   const CleanProbe p = clean_four_tip(120.0);
   ASSERT_TRUE(p.geometry.check(0.05).ok()) << p.geometry.check(0.05).message;
-  const auto pairing = awcc::pair_probe(p.geometry, p.crossings, awcc::EventOptions{});
+  const auto pairing =
+      awcc::pair_probe(p.geometry, p.crossings, awcc::EventOptions{}, first_velocity(p.synthesis, p.geometry));
   ASSERT_TRUE(pairing.ok()) << pairing.message;
   const auto& truth = *p.synthesis.bubbles;
   const double fs = p.synthesis.signals[0].fs;
@@ -152,7 +163,8 @@ TEST(MultiTipSynthetic, ACleanFourTipSceneGivesEachBubbleItsOwnPartnersAndVeloci
 TEST(MultiTipSynthetic, InterfacialAreaOfTheCleanSceneIsSixCOverDWithinFivePercent) {
   const double duration = 1200.0;
   const CleanProbe p = clean_four_tip(duration);
-  const auto pairing = awcc::pair_probe(p.geometry, p.crossings, awcc::EventOptions{});
+  const auto pairing =
+      awcc::pair_probe(p.geometry, p.crossings, awcc::EventOptions{}, first_velocity(p.synthesis, p.geometry));
   ASSERT_TRUE(pairing.ok()) << pairing.message;
   const double expected = p.synthesis.truth.expected_interfacial_area;
   const auto& leading_tip = p.synthesis.truth.tips[p.geometry.leading()];
@@ -195,28 +207,87 @@ TEST(MultiTipSynthetic, InterfacialAreaOfTheCleanSceneIsSixCOverDWithinFivePerce
 }
 
 // pdp's four-tip sample (samples/four-tip.toml: 4 mm spheres, c = 0.1,
-// Tu = 0.2, tips 5 mm behind and 1.5 mm apart, 10 s) is where the estimator
-// breaks (multi_tip.hpp): a quarter of the partners come from other bubbles,
-// their slow vectors rule the mean of 1 / |v|, and a is several times
-// 6 c / d_b. The result is ok (enough vectors), so it must carry a caution.
-TEST(MultiTipSynthetic, TheFourTipSampleIsMisPairedAndSaysSo) {
+// 5 m/s, Tu = 0.2, trailing tips 5 mm behind, two offset 1.5 mm; 10 s),
+// where each trailing tip paired alone took 26 % of its partners from other
+// bubbles (41 % of the accepted bubbles, mean vector 1.7 m/s). The joint
+// pairing, against libsynth's truth:
+//  - pairing errors (accepted bubbles with any partner from another bubble)
+//    below 2 % of the accepted: the target; measured 1 of 360 (0.28 %).
+//  - the mean vector against the truth of the same accepted bubbles with the
+//    same weights, within 2 % of |V|: it then differs only by each bubble's
+//    timing error (one sample, 5 us, on 1 ms lags: 0.5 % a bubble, averaged
+//    down over 360) and by the mis-paired ones (2 % of them at most, their
+//    speeds off by at most 60 %: 1.2 %).
+//  - the same against the duration-weighted truth of every complete
+//    leading bubble matched to the truth: the accepted are a subset chosen
+//    by where they pierce, not by their speed (pair_probe's header), so the
+//    difference is a sampling one: rms 0.94 m/s over 360 bubbles, sd
+//    0.05 m/s (1 %) as if independent; 3 % is 3 sd.
+//  - the realised time mean is not the comparison: the synthesiser's
+//    arrivals are uniform in time, and the duration weighting (right for
+//    arrivals in proportion to the speed) is biased by about -Tu_x^2 = -4 %
+//    here; printed beside.
+//  - no caution, and the interfacial area within 10 % of 6 c_tip / d_b,
+//    c_tip = c (1 + Tu_x^2) the tip's void fraction under equal-time
+//    arrivals (N_0 = 1856: Poisson sd 2.3 %, plus the mean 1 / |v| of 360
+//    speeds at Tu 0.2: 1.1 %; 10 % is 4 sd).
+TEST(MultiTipSynthetic, TheFourTipSamplePairsEachBubbleWithItsOwnPartners) {
   synth::Scene s;
   synth::load_scene_toml(pdp_test::source_dir() / "samples" / "four-tip.toml", s);
-  const auto synthesis = synth::synthesise(s);
+  synth::SynthesisOptions so;
+  so.bubble_truth = true;
+  const auto synthesis = synth::synthesise(s, so);
   std::vector<awcc::Vec3> tips;
   for (const auto& t : s.probe_tips()) tips.push_back({t.x, t.y, t.z});
   const awcc::ProbeGeometry geometry(tips);
   std::vector<std::vector<awcc::Crossing>> crossings;
   for (const auto& signal : synthesis.signals) crossings.push_back(awcc::crossings(signal));
-  const auto pairing = awcc::pair_probe(geometry, crossings, awcc::EventOptions{});
+  const auto pairing = awcc::pair_probe(geometry, crossings, awcc::EventOptions{}, first_velocity(synthesis, geometry));
   ASSERT_TRUE(pairing.ok()) << pairing.message;
   const auto r = awcc::multi_tip(geometry, pairing.bubbles, s.duration);
   ASSERT_TRUE(r.ok()) << r.message;
-  const double expected = synthesis.truth.expected_interfacial_area;
-  std::printf("four-tip sample: |V| = %.3f m/s (scene %.3f), a = %.1f 1/m, 6c/d_b = %.1f 1/m; caution: %s\n", r.speed,
-              s.velocity, *r.interfacial_area, expected, r.caution.c_str());
-  EXPECT_GT(*r.interfacial_area, 2.0 * expected) << "the breakage this test documents";
-  EXPECT_FALSE(r.caution.empty());
+  const auto& truth = *synthesis.bubbles;
+  const double fs = synthesis.signals[0].fs;
+  const auto& trailing = geometry.trailing_tips();
+  std::int64_t wrong = 0;
+  double w_accepted = 0.0, w_all = 0.0;
+  awcc::Vec3 accepted{}, all{};
+  for (std::size_t h = 0; h < pairing.bubbles.size(); ++h) {
+    const auto& lead = pairing.bubbles.leading[h];
+    const auto row = truth_row(truth, geometry.leading(), lead.front, fs);
+    if (lead.censored || !row) continue;
+    const auto& v = truth.velocity[*row];
+    const double span = truth.interaction_end[*row] - truth.interaction_start[*row];
+    w_all += span;
+    all = {all[0] + span * v.x, all[1] + span * v.y, all[2] + span * v.z};
+    const auto& b = r.bubbles[h];
+    if (b.fate != awcc::VectorFate::solved) continue;
+    w_accepted += b.weight;
+    accepted = {accepted[0] + b.weight * v.x, accepted[1] + b.weight * v.y, accepted[2] + b.weight * v.z};
+    bool right = true;
+    for (std::size_t k = 0; k < trailing.size(); ++k) {
+      const auto& partner = pairing.bubbles.partner(h, k);
+      const auto& pierce = truth.pierce(*row, trailing[k]);
+      right = right && partner && pierce.pierced() && std::fabs(pierce.front - partner->front) <= 1.0 / fs;
+    }
+    wrong += right ? 0 : 1;
+  }
+  const auto& realised = synthesis.truth.realised.mean_velocity;
+  std::printf("four-tip sample: %lld of %lld accepted bubbles mis-paired; mean vector (%.3f, %.3f, %.3f) m/s, truth of "
+              "the accepted (%.3f, %.3f, %.3f), of all leading bubbles (%.3f, %.3f, %.3f), realised (%.3f, %.3f, "
+              "%.3f); a = %.1f 1/m, 6 c_tip / d_b = %.1f 1/m\n",
+              static_cast<long long>(wrong), static_cast<long long>(r.bubbles_accepted), r.velocity[0], r.velocity[1],
+              r.velocity[2], accepted[0] / w_accepted, accepted[1] / w_accepted, accepted[2] / w_accepted,
+              all[0] / w_all, all[1] / w_all, all[2] / w_all, realised[0], realised[1], realised[2],
+              *r.interfacial_area, synthesis.truth.expected_interfacial_area * (1.0 + s.tu * s.tu));
+  ASSERT_GT(r.bubbles_accepted, 200);
+  EXPECT_LT(static_cast<double>(wrong), 0.02 * static_cast<double>(r.bubbles_accepted));
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_NEAR(r.velocity[j], accepted[j] / w_accepted, 0.02 * r.speed) << "component " << j;
+    EXPECT_NEAR(r.velocity[j], all[j] / w_all, 0.03 * r.speed) << "component " << j;
+  }
+  EXPECT_TRUE(r.caution.empty()) << r.caution;
+  EXPECT_NEAR(*r.interfacial_area / (synthesis.truth.expected_interfacial_area * (1.0 + s.tu * s.tu)), 1.0, 0.10);
 }
 
 }  // namespace

@@ -715,3 +715,209 @@ TEST(MultiTip, OptionsAreDeclaredOnceAndValidated) {
 }
 
 }  // namespace
+
+// The joint pairing (pair_probe) on constructed crossings whose answer is
+// known: a sphere's exact crossings of pdp's four-tip sample geometry, with
+// V_ref = 5 m/s, at and around each decision limit (window, speed band,
+// cone, one candidate, one bubble, diameters, claims).
+namespace pairing {
+
+using awcc::BubbleFate;
+using awcc::EventOptions;
+
+const std::vector<Vec3> kSample{{0, 0, 0}, {5e-3, 0, 0}, {5e-3, 1.5e-3, 0}, {5e-3, 0, 1.5e-3}};
+constexpr double kRef = 5.0;
+
+// Every tip's crossings of the spheres (a missed tip has none), plus extras.
+std::vector<std::vector<Crossing>> crossings_of(const ProbeGeometry& g, const std::vector<Sphere>& spheres,
+                                                const std::vector<std::pair<std::size_t, Crossing>>& extra = {}) {
+  std::vector<std::vector<Crossing>> tips(g.tip_count());
+  for (const auto& s : spheres)
+    for (std::size_t t = 0; t < g.tip_count(); ++t)
+      if (const auto c = s.at(g.positions()[t])) tips[t].push_back(*c);
+  for (const auto& [t, c] : extra) tips[t].push_back(c);
+  for (auto& t : tips) std::sort(t.begin(), t.end(), [](const Crossing& a, const Crossing& b) { return a.front < b.front; });
+  return tips;
+}
+
+BubbleFate fate(const awcc::ProbePairing& p, std::size_t k) {
+  for (std::size_t f = 0; f < awcc::bubble_fate_count; ++f)
+    if (p.fates[k][f] > 0) return static_cast<BubbleFate>(f);
+  return BubbleFate::roc;  // none: cannot happen with one leading bubble
+}
+
+// A 4 mm sphere along x at `speed`, its line 0.5 mm off the leading tip in y
+// and z: it pierces all four tips.
+Sphere along_x(double speed, double t0 = 0.01) { return sphere_through({speed, 0, 0}, 4e-3, {0, 0.5e-3, 0.5e-3}, t0); }
+
+awcc::ProbePairing pair(const std::vector<std::vector<Crossing>>& tips, const EventOptions& o = {},
+                        std::optional<double> v_ref = kRef) {
+  return awcc::pair_probe(ProbeGeometry(kSample), tips, o, v_ref);
+}
+
+}  // namespace pairing
+
+TEST(PairProbe, TheSlowEndOfTheWindowIsProbeSpeedMinOfTheFirstVelocity) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  // Tip 1 straight behind: latest lag |S| / (0.5 V_ref) = 2 ms, i.e. 2.5 m/s.
+  // Tips 2 and 3 (16.7 degrees off x, within the 30 degree cone): 2.09 ms.
+  const auto inside = pair(crossings_of(g, {along_x(2.53)}));
+  ASSERT_TRUE(inside.ok()) << inside.message;
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(inside, k), BubbleFate::paired) << k;
+  const auto outside = pair(crossings_of(g, {along_x(2.47)}));
+  EXPECT_EQ(fate(outside, 0), BubbleFate::no_partner);
+  EXPECT_EQ(fate(outside, 1), BubbleFate::paired) << "2.02 ms is inside tip 2's window";
+  EXPECT_EQ(fate(outside, 2), BubbleFate::paired);
+  // Two partners cannot be tested: listed, and no vector from them.
+  EXPECT_FALSE(outside.bubbles.partner(0, 0));
+  EXPECT_EQ(awcc::multi_tip(g, outside.bubbles, 1.0, no_statistics()).count(VectorFate::too_few_tips), 1);
+  // The same bubble with a looser band pairs at every tip.
+  EventOptions slower;
+  slower.probe_speed_min = 0.45;
+  const auto loose = pair(crossings_of(g, {along_x(2.47)}), slower);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(loose, k), BubbleFate::paired) << k;
+}
+
+TEST(PairProbe, TheFastEndIsTheSpeedBandOfTheSolvedVector) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  // The window's short end is |S| cos(30 deg) / (2.5 V_ref) = 0.35 ms for tip
+  // 1: a bubble at 12.6 m/s (0.40 ms) is in every window, but its vector is
+  // above 2.5 V_ref = 12.5 m/s: not taken for one bubble.
+  const auto fast = pair(crossings_of(g, {along_x(12.6)}));
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(fast, k), BubbleFate::inconsistent) << k;
+  const auto below = pair(crossings_of(g, {along_x(12.4)}));
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(below, k), BubbleFate::paired) << k;
+  const auto r = awcc::multi_tip(g, below.bubbles, 1.0, no_statistics());
+  ASSERT_EQ(r.count(VectorFate::solved), 1);
+  EXPECT_LT(relative(r.bubbles[0].velocity, {12.4, 0, 0}), 1e-9);
+}
+
+TEST(PairProbe, TheConeRefusesAVelocityTiltedBeyondProbeAngleMax) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  // A 20 mm sphere through the probe's middle, 5 m/s tilted towards +y: it
+  // pierces every tip at 29 and 31 degrees, and its lags lie in every
+  // window; only the angle of its vector decides.
+  for (const double degrees : {29.0, 31.0}) {
+    const double a = degrees * std::numbers::pi / 180.0;
+    const Vec3 v{5.0 * std::cos(a), 5.0 * std::sin(a), 0.0};
+    const auto p = pair(crossings_of(g, {sphere_through(v, 20e-3, {0, 0, 0}, 0.01)}));
+    ASSERT_TRUE(p.ok());
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(fate(p, k), degrees < 30.0 ? BubbleFate::paired : BubbleFate::inconsistent) << degrees << " " << k;
+  }
+}
+
+TEST(PairProbe, TwoCandidatesInAWindowAreRefusedNeverTheCloserTaken) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  const Sphere s = along_x(5.0);
+  const Crossing own = *s.at(kSample[2]);
+  // A second crossing at tip 2 after the bubble's own, both in the window
+  // (1.0 ms and 1.6 ms against 2.09 ms).
+  const Crossing other{own.front + 0.6e-3, own.rear + 0.6e-3, false};
+  const auto p = pair(crossings_of(g, {s}, {{2, other}}));
+  EXPECT_EQ(fate(p, 1), BubbleFate::ambiguous);
+  EXPECT_FALSE(p.bubbles.partner(0, 1));
+  EXPECT_EQ(fate(p, 0), BubbleFate::paired);
+  EXPECT_EQ(fate(p, 2), BubbleFate::paired);
+  // Beyond the window (2.2 ms) it is no candidate: the bubble pairs.
+  const Crossing late{own.front + 1.2e-3, own.rear + 1.2e-3, false};
+  const auto q = pair(crossings_of(g, {s}, {{2, late}}));
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(q, k), BubbleFate::paired) << k;
+}
+
+TEST(PairProbe, PartnersThatAreNotOneBubbleAreRefusedAtEveryTip) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  // The bubble misses tip 2; another crossing there 0.4 ms after it would
+  // have come: in the window, but the vector through it is tilted 53 degrees.
+  const Sphere s = along_x(5.0);
+  const Crossing own = *s.at(kSample[2]);
+  auto tips = crossings_of(g, {s});
+  tips[2] = {Crossing{own.front + 0.4e-3, own.rear + 0.4e-3, false}};
+  const auto p = pair(tips);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(p, k), BubbleFate::inconsistent) << k;
+  EXPECT_EQ(awcc::multi_tip(g, p.bubbles, 1.0, no_statistics()).count(VectorFate::solved), 0);
+}
+
+TEST(PairProbe, DiametersThatDisagreeRefuseThePartnersAtTheMismatchLimit) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  // Tip 2's front 0.05 ms early: the vector moves little (in band and cone,
+  // as the pairing at 1.01 times the mismatch shows), the diameters disagree.
+  // (A chord lengthened about its centre changes both diameters alike.)
+  const Sphere s = along_x(5.0);
+  auto tips = crossings_of(g, {s});
+  tips[2][0].front -= 0.05e-3;
+  const auto& c = g.combinations()[0];
+  awcc::detail::CombinationSolution sol;
+  const std::array<const Crossing*, 3> at{&tips[1][0], &tips[2][0], &tips[3][0]};
+  ASSERT_TRUE(awcc::detail::solve_combination(c, tips[0][0], at, VelocityAlgorithm::shen_nakamura, sol));
+  const double mismatch =
+      std::fabs(sol.diameter_front - sol.diameter_rear) / (0.5 * (sol.diameter_front + sol.diameter_rear));
+  ASSERT_GT(mismatch, 0.01);
+  for (const double limit : {0.99 * mismatch, 1.01 * mismatch}) {
+    EventOptions o;
+    o.probe_diameter_mismatch = limit;
+    const auto p = pair(tips, o);
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(fate(p, k), limit < mismatch ? BubbleFate::inconsistent : BubbleFate::paired) << limit << " " << k;
+  }
+}
+
+TEST(PairProbe, ATrailingCrossingChosenByTwoLeadingBubblesIsRefusedToBoth) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  // A second leading crossing ending 0.1 ms before the bubble's own, of the
+  // same chord: its lags to the bubble's partners (1.85 ms) lie in its
+  // windows too, and with the diameter check off they are one bubble for
+  // it as well: both choose them.
+  const Sphere s = along_x(5.0);
+  const Crossing lead = *s.at(kSample[0]);
+  const Crossing before{2.0 * lead.front - lead.rear - 0.1e-3, lead.front - 0.1e-3, false};
+  EventOptions o;
+  o.probe_diameter_mismatch = 1e9;
+  const auto p = pair(crossings_of(g, {s}, {{0, before}}), o);
+  ASSERT_EQ(p.bubbles.size(), 2u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(p.fates[k][static_cast<std::size_t>(BubbleFate::claimed_twice)], 2) << k;
+    EXPECT_FALSE(p.bubbles.partner(0, k));
+    EXPECT_FALSE(p.bubbles.partner(1, k));
+  }
+}
+
+TEST(PairProbe, OfFiveTipsTheOneTipThatIsNotTheBubblesIsDropped) {
+  using namespace pairing;
+  std::vector<Vec3> five = kSample;
+  five.push_back({5e-3, -1e-3, 0});
+  const ProbeGeometry g(five);
+  const Sphere s = along_x(5.0);
+  auto tips = crossings_of(g, {s});
+  ASSERT_EQ(tips[4].size(), 1u);
+  tips[4][0].front += 0.4e-3;
+  tips[4][0].rear += 0.4e-3;
+  const auto p = awcc::pair_probe(g, tips, EventOptions{}, kRef);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(fate(p, k), BubbleFate::paired) << k;
+  EXPECT_EQ(fate(p, 3), BubbleFate::inconsistent);
+  const auto r = awcc::multi_tip(g, p.bubbles, 1.0, no_statistics());
+  ASSERT_EQ(r.count(VectorFate::solved), 1);
+  EXPECT_LT(relative(r.bubbles[0].velocity, {5, 0, 0}), 1e-9);
+}
+
+TEST(PairProbe, WithoutAFirstVelocityThePairingIsRefused) {
+  using namespace pairing;
+  const ProbeGeometry g(kSample);
+  const auto tips = crossings_of(g, {along_x(5.0)});
+  for (const std::optional<double> v : {std::optional<double>{}, std::optional<double>{0.0}}) {
+    const auto p = pair(tips, {}, v);
+    EXPECT_EQ(p.status, awcc::EventStatus::no_first_velocity);
+    EXPECT_FALSE(p.message.empty());
+    EXPECT_EQ(p.bubbles.size(), 0u);
+  }
+  EventOptions bad;
+  bad.probe_angle_max = 90.0;
+  EXPECT_THROW((void)pair(tips, bad), awcc::OptionError);
+}

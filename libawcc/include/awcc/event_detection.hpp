@@ -115,13 +115,15 @@ enum class BubbleFate {
   shen_lag,          ///< Shen: a front or rear lag above |S| / (f V_gas)
   non_positive_lag,  ///< the centre lag is not positive: no velocity
   claimed_twice,     ///< its candidate is also another leading bubble's
+  ambiguous,         ///< multi-tip pairing: two or more candidates in the tip's lag window
+  inconsistent,      ///< multi-tip pairing: its partners at the trailing tips are not one bubble's
   roc,               ///< paired, rejected by the robust outlier cutoff
 };
 /// The fates' names in the enum's order: the bubble table's fate column and
 /// the result's counts are written from this one table.
-inline constexpr std::array<std::string_view, 9> bubble_fate_names{
-    "paired", "censored", "no_partner", "beyond_next", "disparity", "shen_lag", "non_positive_lag", "claimed_twice",
-    "roc"};
+inline constexpr std::array<std::string_view, 11> bubble_fate_names{
+    "paired",        "censored",  "no_partner",   "beyond_next", "disparity", "shen_lag", "non_positive_lag",
+    "claimed_twice", "ambiguous", "inconsistent", "roc"};
 inline constexpr std::size_t bubble_fate_count = bubble_fate_names.size();
 static_assert(static_cast<std::size_t>(BubbleFate::roc) + 1 == bubble_fate_count,
               "a fate added to BubbleFate needs its name in bubble_fate_names");
@@ -145,6 +147,34 @@ struct EventOptions {
   /// Moments weighted by each bubble's interaction time span (item 6) or not
   /// at all. pdp's front ends set it from AWCC's declared `weighting`.
   Weighting weighting = Weighting::duration;
+  /// Multi-tip pairing (pair_probe, awcc/multi_tip.hpp), from the first
+  /// velocity V_ref (FSCC's of the tip pair) along x. A bubble's velocity is
+  /// taken to lie within a speed band and a cone around x; its centre lag to
+  /// each trailing tip then lies in a window, and its partners' vector must
+  /// lie in the band and cone too.
+  /// Slowest and fastest bubble paired, as fractions of V_ref, -. 0.5 keeps
+  /// bubbles 2.5 standard deviations below the mean at Tu_x = 0.2 (the
+  /// slowest 0.1-0.3 % of pdp's four-tip sample fall below); every 0.5 of
+  /// V_ref / slowest adds a window a quarter of the mean lag wide in which an
+  /// unrelated bubble passes (measured: 0.5 against Shen's 0.3 halves the
+  /// mis-paired bubbles). 2.5 costs little: the window's short end is
+  /// where few wrong partners fall (their lags are uniform, their speeds
+  /// dense at the slow end).
+  double probe_speed_min = 0.5;
+  double probe_speed_max = 2.5;
+  /// Largest angle between a bubble's velocity and x, degrees. 30 keeps a
+  /// lateral component 4.6 standard deviations out at Tu_y = 0.125 (the
+  /// sample's); the wrong partners it refuses give vectors tilted 55-85
+  /// degrees (measured median tan 2.4). Raise it for strongly 3-D flows.
+  double probe_angle_max = 30.0;
+  /// Largest |D_front - D_rear| / D of a bubble's Shen & Nakamura diameters
+  /// over every combination of its paired tips, -. Exact (0) for a sphere
+  /// pierced by the right partners; measured 99 % below 0.066-0.084 on the
+  /// four-tip sample, while a partner from another bubble gives a median
+  /// 0.04-0.05 with a long tail: 0.1 refuses a quarter to a third of the
+  /// wrong ones that pass the window and cone. Bubbles far from spheres
+  /// need more (it is refused, counted, as inconsistent).
+  double probe_diameter_mismatch = 0.1;
   /// Fewest paired bubbles whose moments are reported (quality insufficient below).
   int bubbles_reported = 10;
   /// Fewest paired bubbles of quality ok (low below).
