@@ -5,6 +5,8 @@ Numpy in, numpy and dicts out, no file needed:
     rec = pdp.read("dc157_05.dat", fs=20e3)             # channels, fs, metadata
     r = pdp.process(rec, dx="7.15mm")                   # as `pdp process --json`
     r.tips[0].void_fraction, r.awcc.velocity, r.windows # attribute or key access
+    r = pdp.process("four-tip.h5")                      # a multi-tip probe: r.multi_tip, r.vectors
+    r.bubbles                                           # method="events": a velocity per bubble
     a = pdp.awcc(lead, trail, fs=20e3, dx=7.15e-3, np=10)
     s = pdp.synth(duration=10, fs=100e3)                # signals and their truth
     c = pdp.correct(r, model="awcc.qrf")                # bias-corrected quantiles
@@ -55,15 +57,17 @@ class Result(dict):
 
 
 # What pdp.process keeps of a recording beside its JSON, as attributes of its
-# Result: the window table, R11 and R12, the velocity spectrum.
-_DETAIL = ("windows", "correlation", "spectrum")
+# Result: the window table, R11 and R12, the velocity spectrum, event
+# detection's bubble table and the multi-tip vector table.
+_DETAIL = ("windows", "correlation", "spectrum", "bubbles", "vectors")
 
 
 class Profile(Result):
     """A profile: ``{"profile": [...], "provenance": ...}`` as ``pdp process
     --json`` writes it, one Result per position in ``profile``. Processed by
     pdp.process, each position keeps its detail: ``profile[i].windows`` (the
-    AWCC window table), ``.correlation`` and ``.spectrum``."""
+    AWCC window table), ``.correlation``, ``.spectrum``, ``.bubbles`` (event
+    detection's bubble table) and ``.vectors`` (the multi-tip vector table)."""
 
     def __getattr__(self, name):
         if name in _DETAIL and name not in self:
@@ -105,15 +109,22 @@ def _wrap(value):
     return value
 
 
-def _table(columns):
-    """A dict of arrays as a pandas DataFrame when pandas is importable."""
+_TABLE_UNITS = {table: dict(columns) for table, columns in _pdp.table_units().items()}
+
+
+def _table(columns, name="windows"):
+    """A dict of arrays (one per declared column of table ``name``: windows,
+    bubbles, vectors) as a pandas DataFrame when pandas is importable, its
+    columns' SI units in ``attrs["units"]`` ("" for text)."""
     if columns is None:
         return None
     try:
         import pandas
     except ImportError:
         return columns
-    return pandas.DataFrame(columns)
+    frame = pandas.DataFrame(columns)
+    frame.attrs["units"] = dict(_TABLE_UNITS[name])
+    return frame
 
 
 class Recording:
@@ -144,7 +155,7 @@ def options(group=None):
     """Every option with its group, name, unit, help and default (the
     declarations the command line reads); only ``group``'s when given
     ("probe and methods", "input", "binarisation", "fscc", "awcc",
-    "structure", "scene")."""
+    "structure", "event detection", "multi-tip", "scene")."""
     return [Result(o) for o in _OPTIONS if group is None or o["group"] == group]
 
 
@@ -174,7 +185,8 @@ _UNITS = {o["name"]: o["unit"] for o in _OPTIONS if o["group"] != "scene"}
 
 def _text(value, unit=""):
     """An option's value as a user types it; a number gets its SI unit (the
-    library refuses a quantity without one)."""
+    library refuses a quantity without one); a list of points (tips) is
+    written x,y,z;x,y,z."""
     if isinstance(value, bool) or isinstance(value, _np.bool_):
         return "on" if value else "off"
     suffix = "" if unit in ("", "-", "bytes") else unit
@@ -182,7 +194,9 @@ def _text(value, unit=""):
         return f"{int(value)}{suffix}"
     if isinstance(value, (float, _np.floating)):
         return f"{float(value)!r}{suffix}"
-    if isinstance(value, (list, tuple)):
+    if isinstance(value, (list, tuple, _np.ndarray)):
+        if any(isinstance(v, (list, tuple, _np.ndarray)) for v in value):
+            return ";".join(_text(v, unit) for v in value)
         return ",".join(_text(v, unit) for v in value)
     if isinstance(value, (str, _os.PathLike)):
         return _os.fspath(value)
@@ -332,9 +346,16 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     AWCC window table, ``result.correlation`` R11 and R12 (``lag`` in s,
     ``r11``, ``r12``; NaN outside a function's lags) and ``result.spectrum``
     Welch's PSD of AWCC's velocity series (``frequency`` Hz, ``density``
-    (m/s)^2/Hz, ``resolvable_frequency``), or None. A profile is a Profile:
-    each position ``result.profile[i]`` has them, and ``result.to_dataframe()``
-    is the profile CSV's table."""
+    (m/s)^2/Hz, ``resolvable_frequency``), or None. Bubble by bubble (the
+    tables ``pdp process --bubbles`` writes, one row per leading bubble, NaN
+    where a bubble has no value, the fate of each): ``result.bubbles`` is
+    event detection's table when it ran (``method="events"``; the JSON's
+    ``events``), ``result.vectors`` the multi-tip vector table when the probe
+    was processed bubble by bubble (``method="multi-tip"``, or ``"auto"``
+    with four or more tips; the JSON's ``multi_tip``), else None. A probe's
+    tips: ``tips=[[0, 0, 0], [5e-3, 0, 0], ...]`` (m) or the command line's
+    text. A profile is a Profile: each position ``result.profile[i]`` has
+    them, and ``result.to_dataframe()`` is the profile CSV's table."""
     settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
     if isinstance(source, (str, _os.PathLike)):
@@ -372,8 +393,10 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
 
 def _detail(windows, detail):
     """A recording's detail (_DETAIL) from the compiled core's answer."""
-    return {"windows": _table(windows), "correlation": None if detail is None else detail["correlation"],
-            "spectrum": None if detail is None else detail["spectrum"]}
+    detail = detail or {}
+    return {"windows": _table(windows), "correlation": detail.get("correlation"),
+            "spectrum": detail.get("spectrum"), "bubbles": _table(detail.get("bubbles"), "bubbles"),
+            "vectors": _table(detail.get("vectors"), "vectors")}
 
 
 def synth(scene=None, *, signal="binary", **fields):
@@ -422,7 +445,7 @@ def correct(results, model, *, dx=None, dy=None, np=None):
     loaded as a dict. Returns the results with a ``correction`` object per
     recording (median, 80 % and 95 % quantiles of u and Tu, or why not
     corrected), as ``pdp correct`` writes them, each recording's windows,
-    correlation and spectrum kept. ``dx``, ``dy`` (m) and ``np``
+    correlation, spectrum, bubbles and vectors kept. ``dx``, ``dy`` (m) and ``np``
     fill values the results lack."""
     out, warnings = _pdp.correct(_json.dumps(results), _os.fspath(model), dx, dy, np)
     for w in warnings:
@@ -445,7 +468,8 @@ _GROUPS = {
     phase_statistics: ["binarisation"],
     fscc: ["probe and methods", "binarisation", "fscc"],
     awcc: ["probe and methods", "binarisation", "awcc"],
-    process: ["probe and methods", "input", "binarisation", "fscc", "awcc", "structure"],
+    process: ["probe and methods", "input", "binarisation", "fscc", "awcc", "structure", "event detection",
+              "multi-tip"],
     synth: ["scene"],
 }
 

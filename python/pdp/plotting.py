@@ -326,9 +326,10 @@ def legend(ax, fontsize=None):
 
 def _floor_beneath(ax, extent, renderer):
     """The highest display y that a legend beneath ax must stay above: the
-    tops of the axes below it (with room for a title, which a panel drawn
-    later may still get) and the figure's own texts (a footer) under it,
-    else the figure's bottom edge."""
+    tops of the axes below it (with room for a one-line title, which a panel
+    drawn later may still get, or above the title it has: the bubble panels'
+    are two lines) and the figure's own texts (a footer) under it, else the
+    figure's bottom edge."""
     title = renderer.get_text_width_height_descent("Ag", FontProperties(size=matplotlib.rcParams["axes.titlesize"]),
                                                    ismath=False)[1]
     title += renderer.points_to_pixels(matplotlib.rcParams["axes.titlepad"])
@@ -337,6 +338,8 @@ def _floor_beneath(ax, extent, renderer):
         b = other.bbox
         if other is not ax and b.y1 <= ax.bbox.y0 and b.x0 < extent.x1 and b.x1 > extent.x0:
             floor = max(floor, b.y1 + title)
+            if other.title.get_text():
+                floor = max(floor, other.title.get_window_extent(renderer).y1)
     for text in ax.figure.texts:
         b = text.get_window_extent(renderer)
         if b.y1 <= ax.bbox.y0 and b.x0 < extent.x1 and b.x1 > extent.x0:
@@ -716,6 +719,217 @@ def velocity_spectrum(ax, spectrum, series):
     _finish(ax, "PSD ((m/s)^2/Hz)", "frequency (Hz)", "Velocity spectrum")
 
 
+# --- bubble by bubble: event detection and the multi-tip probe ------------------
+# Panels of a recording processed bubble by bubble (the JSON's "events" and
+# "multi_tip"; the per-bubble columns from pdp.process's ``bubbles`` and
+# ``vectors``). Each title states the method's quality and flag, and a result
+# that is not of quality ok is drawn hollow in grey, never as if trusted.
+
+BUBBLE_FLAGS = {"events": "events_disagree", "multi_tip": "multi_tip_doubtful"}
+
+
+def verdict(row, key):
+    """(quality, text for a title): the quality level and, when raised, the flag."""
+    result = row.get(key) or {}
+    quality = result.get("quality")
+    flag = BUBBLE_FLAGS[key] if BUBBLE_FLAGS[key] in (row.get("flags") or []) else None
+    text = f"quality {quality or 'not stated'}" + (f", flag {flag}" if flag else "")
+    return quality, flag, text
+
+
+def _trusted_style(trusted, colour, marker):
+    if trusted:
+        return dict(color=colour, marker=marker, ls="none", ms=7)
+    return dict(color=GREY, marker=marker, ls="none", ms=8, mfc="none", mew=1.5)
+
+
+def _interval_point(ax, x, value, interval, label, **style):
+    v = number(value)
+    if v is None:
+        return False
+    lo, hi = (number(b) for b in (interval or (None, None)))
+    err = [[max(0.0, v - lo) if lo is not None else 0.0], [max(0.0, hi - v) if hi is not None else 0.0]]
+    err = err if interval else None
+    ax.errorbar([x], [v], yerr=err, capsize=4, label=label, **style)
+    return True
+
+
+def vector_components(ax, row):
+    """The multi-tip mean vector's components with their 95 % intervals;
+    the tip pair's FSCC and AWCC velocities beside u_x, as labs compare them."""
+    m = row.get("multi_tip") or {}
+    quality, flag, text = verdict(row, "multi_tip")
+    if m.get("status") != "ok" or m.get("velocity") is None:
+        note(ax, f"multi-tip mean vector: {m.get('reason') or m.get('status') or 'not computed'}")
+        return
+    trusted = quality == "ok" and flag is None
+    style = _trusted_style(trusted, BLUE, "o")
+    what = "mean vector, 95 % interval" + ("" if trusted else " (doubtful)")
+    for k, name in enumerate(("u_x", "u_y", "u_z")):
+        _interval_point(ax, k, m["velocity"][k], get(m, "velocity_ci95", k), what if k == 0 else None, **style)
+    for dx, key, colour, marker, name in ((-0.25, "fscc", BLACK, "D", "FSCC"), (0.25, "awcc", VERMILION, "^", "AWCC")):
+        result = row.get(key) or {}
+        _interval_point(ax, dx, result.get("velocity"), result.get("velocity_ci95"), f"{name} of the tip pair",
+                        color=colour, marker=marker, ls="none", mfc="none", ms=6)
+    ax.axhline(0, color=BLACK, lw=0.6)
+    ax.set_xticks([0, 1, 2], ["u_x", "u_y", "u_z"])
+    ax.set_xlim(-0.6, 2.6)
+    _finish(ax, "velocity (m/s)", f"component ({m.get('bubbles_accepted')} bubbles accepted)",
+            f"Multi-tip mean vector\n{text}")
+
+
+def events_velocity(ax, row):
+    """Event detection's mean velocity with its interval beside FSCC's and AWCC's."""
+    e = row.get("events") or {}
+    quality, flag, text = verdict(row, "events")
+    trusted = e.get("status") == "ok" and quality == "ok" and flag is None
+    shown = _interval_point(ax, 0, e.get("velocity"), e.get("velocity_ci95"),
+                            "ED, 95 % interval" + ("" if trusted else " (doubtful)"),
+                            **_trusted_style(trusted, BLUE, "o"))
+    for x, key, colour, marker, name in ((1, "fscc", BLACK, "D", "FSCC"), (2, "awcc", VERMILION, "^", "AWCC")):
+        result = row.get(key) or {}
+        shown |= _interval_point(ax, x, result.get("velocity"), result.get("velocity_ci95"),
+                                 name + (", 95 % interval" if result.get("velocity_ci95") else ""),
+                                 color=colour, marker=marker, ls="none", ms=6)
+    if not shown:
+        note(ax, f"event detection: {e.get('reason') or e.get('status') or 'not run'}")
+        return
+    ax.set_xticks([0, 1, 2], ["events", "FSCC", "AWCC"])
+    ax.set_xlim(-0.6, 2.6)
+    _finish(ax, "mean velocity (m/s)", f"method ({e.get('bubbles_paired')} bubbles paired)",
+            f"Event detection against FSCC, AWCC\n{text}")
+
+
+def _column(table, name):
+    return np.asarray([np.nan if v is None else v for v in table[name]], dtype=float)
+
+
+def _kept(table, fate):
+    """Indices of the rows of one fate; None, said by the caller, without a table."""
+    if table is None:
+        return None
+    return np.flatnonzero(np.asarray(table["fate"]) == fate)
+
+
+def _references(ax, row, mean, mean_label, trusted, vertical=True):
+    line = ax.axvline if vertical else ax.axhline
+    if number(mean) is not None:
+        line(mean, color=BLUE if trusted else GREY, lw=1.6, ls="-" if trusted else "-.",
+             label=f"{mean_label} {mean:.3g} m/s" + ("" if trusted else " (doubtful)"))
+    for key, colour, ls, name in (("fscc", BLACK, "--", "FSCC"), ("awcc", VERMILION, ":", "AWCC")):
+        v = number(get(row, key, "velocity"))
+        if v is not None:
+            line(v, color=colour, ls=ls, lw=1.4, label=f"{name} {v:.3g} m/s")
+
+
+def bubble_histogram(ax, row, table, key):
+    """Per-bubble velocities (events: the paired bubbles' u_h; multi-tip: the
+    solved bubbles' u_x), the method's mean, FSCC's and AWCC's marked."""
+    what = "paired" if key == "events" else "solved"
+    column = "velocity" if key == "events" else "velocity_x"
+    quality, flag, text = verdict(row, key)
+    trusted = quality == "ok" and flag is None
+    rows = _kept(table, what)
+    if rows is None:
+        note(ax, "per-bubble table not available: see this position's note")
+        return
+    values = _column(table, column)[rows]
+    values = values[np.isfinite(values)]
+    if not len(values):
+        note(ax, f"no {what} bubble")
+        return
+    lo, hi = np.percentile(values, [0.5, 99.5])
+    pad = 0.05 * (hi - lo) or 0.1 * abs(hi) or 1.0
+    edges = np.linspace(lo - pad, hi + pad, max(10, min(60, int(2 * math.sqrt(len(values))))) + 1)
+    outside = int(((values < edges[0]) | (values > edges[-1])).sum())
+    ax.hist(values, bins=edges, color=SKY, label=f"{len(values)} {what} bubbles"
+            + (f" ({outside} outside not shown)" if outside else ""))
+    mean = get(row, key, "velocity", 0) if key == "multi_tip" else get(row, key, "velocity")
+    _references(ax, row, mean, "mean u_x" if key == "multi_tip" else "ED mean", trusted)
+    name = "u_x" if key == "multi_tip" else "u_h = dx / lag"
+    _finish(ax, "bubbles", f"per-bubble velocity {name} (m/s)",
+            f"{'Multi-tip' if key == 'multi_tip' else 'Events'}: bubble velocities\n{text}")
+
+
+def bubble_size_velocity(ax, row, table, key):
+    """Size against velocity: multi-tip diameter_front against speed of the
+    solved bubbles; events chord length against velocity of the paired ones."""
+    what = "paired" if key == "events" else "solved"
+    size, velocity = ("chord_length", "velocity") if key == "events" else ("diameter_front", "speed")
+    _, _, text = verdict(row, key)
+    rows = _kept(table, what)
+    if rows is None:
+        note(ax, "per-bubble table not available: see this position's note")
+        return
+    x, y = _column(table, velocity)[rows], 1e3 * _column(table, size)[rows]
+    finite = np.isfinite(x) & np.isfinite(y)
+    if not finite.any():
+        note(ax, f"no {what} bubble with a size (Tian's vectors have none)" if key == "multi_tip"
+             else f"no {what} bubble")
+        return
+    x, y = x[finite], y[finite]
+    ax.plot(x, y, ls="none", marker=".", ms=3, color=BLUE, alpha=0.6, rasterized=len(x) > 2000,
+            label=f"{len(x)} {what} bubbles")
+    xl, xh = np.percentile(x, [0.5, 99.5])
+    yl, yh = np.percentile(y, [0.5, 99.5])
+    ax.set_xlim(xl - 0.05 * (xh - xl or 1), xh + 0.05 * (xh - xl or 1))
+    ax.set_ylim(max(0.0, yl - 0.05 * (yh - yl or 1)), yh + 0.05 * (yh - yl or 1))
+    outside = int(((x < ax.get_xlim()[0]) | (x > ax.get_xlim()[1]) | (y > ax.get_ylim()[1])).sum())
+    if outside:
+        ax.plot([], [], ls="none", label=f"{outside} outside not shown")
+    xlabel = "speed |V| (m/s)" if key == "multi_tip" else "velocity u_h (m/s)"
+    ylabel = "front diameter (mm)" if key == "multi_tip" else "chord length (mm)"
+    _finish(ax, ylabel, xlabel, f"{'Multi-tip' if key == 'multi_tip' else 'Events'}: size against "
+            f"velocity\n{text}")
+
+
+# The bubble-by-bubble rows of the per-position figure, for the JSON key of
+# each method: (SVG group key, title) of its three panels.
+BUBBLE_PANELS = {
+    "multi_tip": [("multi-tip-vector", "multi-tip mean vector components"),
+                  ("multi-tip-histogram", "multi-tip bubble velocity histogram"),
+                  ("multi-tip-size-velocity", "multi-tip size against velocity")],
+    "events": [("events-velocity", "event detection against FSCC and AWCC"),
+               ("events-histogram", "event detection bubble velocity histogram"),
+               ("events-size-velocity", "event detection chord length against velocity")],
+}
+
+
+def bubble_rows(row):
+    """The JSON keys of the bubble-by-bubble methods a recording holds, in BUBBLE_PANELS' order."""
+    return [key for key in BUBBLE_PANELS if row.get(key) is not None]
+
+
+def profile_vector(rows, ax=None):
+    """The multi-tip mean vector's components with their 95 % intervals
+    against position; a doubtful row's points hollow and grey."""
+    fig, ax = _profile_axes(ax)
+    y, ylabel = positions_mm(rows)
+
+    def trusted(r):
+        quality, flag, _ = verdict(r, "multi_tip")
+        return quality == "ok" and flag is None
+
+    doubtful = [r for r in rows if r.get("multi_tip") is not None and not trusted(r)]
+    for k, (name, colour, marker, ls) in enumerate((("u_x", BLUE, "o", "-"), ("u_y", ORANGE, "s", "--"),
+                                                    ("u_z", GREEN, "^", ":"))):
+        def value(r, k=k, want=True):
+            return get(r, "multi_tip", "velocity", k) if trusted(r) == want else None
+        _series(ax, y, rows, value, lambda r, k=k: get(r, "multi_tip", "velocity_ci95", k), color=colour,
+                marker=marker, ls=ls, label=f"{name}, 95 % interval")
+        if doubtful:
+            _series(ax, y, rows, lambda r, k=k: value(r, k, False),
+                    lambda r, k=k: get(r, "multi_tip", "velocity_ci95", k), color=GREY, marker=marker, ls="none",
+                    mfc="none", label="quality not ok (doubtful): hollow, grey" if k == 0 else None)
+    ax.axvline(0, color=BLACK, lw=0.6)
+    _finish(ax, ylabel, "mean velocity component (m/s)", "Multi-tip mean vector")
+    return fig
+
+
+# Profile figures drawn only when a row holds their method's results.
+BUBBLE_PROFILE_FIGURES = [("multi-tip-vector", "Multi-tip mean vector", profile_vector, "multi_tip")]
+
+
 # The per-position figure is printed at about half its size: its text is
 # drawn larger, to stay legible (about 6.5 pt on A4).
 POSITION_FONTS = {"font.size": 13, "axes.titlesize": 14, "axes.labelsize": 13, "legend.fontsize": 11,
@@ -730,11 +944,27 @@ def position_svg(row, detail, salt):
 
 
 def position_figure(row, detail, gid_prefix=""):
-    """Every per-position panel of one recording in one figure (3 x 3); each
-    panel's SVG group is named gid_prefix + its POSITION_PANELS key. ``detail``
-    holds what the JSON does not (windows, correlation, spectrum); a key that
-    is None is said missing in its panel."""
-    fig, axes = figure(width=13.5, height=10.5, rows=3, cols=3, margins=(0.8, 0.6, 0.12, 0.4))
+    """Every per-position panel of one recording in one figure (3 x 3, and a
+    row of three for each bubble-by-bubble method it holds: BUBBLE_PANELS);
+    each panel's SVG group is named gid_prefix + its POSITION_PANELS (or
+    BUBBLE_PANELS) key. ``detail`` holds what the JSON does not (windows,
+    correlation, spectrum, the per-bubble tables bubbles and vectors); a key
+    that is None or missing is said missing in its panel."""
+    methods = bubble_rows(row)
+    # Each panel keeps the height of the 3 x 3 layout (2.375 in, gaps half of it).
+    n = 3 + len(methods)
+    fig, axes = figure(width=13.5, height=1.0 + 2.375 * (n + 0.5 * (n - 1)), rows=n, cols=3,
+                       margins=(0.8, 0.6, 0.12, 0.4))
+    # The bubble rows first: their two-line titles are then there for the
+    # legends placed beneath the panels above them to keep clear of (_floor_beneath).
+    panels = list(POSITION_PANELS)
+    for k, key in enumerate(methods):
+        ax = axes[3 + k]
+        table = detail.get("vectors" if key == "multi_tip" else "bubbles")
+        (vector_components if key == "multi_tip" else events_velocity)(ax[0], row)
+        bubble_histogram(ax[1], row, table, key)
+        bubble_size_velocity(ax[2], row, table, key)
+        panels += BUBBLE_PANELS[key]
     s = row.get("structure") or {}
     chord_pdf(axes[0][0], s.get("chord_time_pdf"), "time")
     chord_pdf(axes[0][1], s.get("chord_length_pdf"), "length")
@@ -748,7 +978,7 @@ def position_figure(row, detail, gid_prefix=""):
     cluster_sizes(axes[2][0], clusters)
     arrival_pdf(axes[2][1], get(s, "arrivals", "time"))
     velocity_spectrum(axes[2][2], detail.get("spectrum"), row.get("velocity_spectrum"))
-    for ax, (key, _) in zip((a for r in axes for a in r), POSITION_PANELS):
+    for ax, (key, _) in zip((a for r in axes for a in r), panels):
         ax.set_gid(gid_prefix + key)
     return fig
 

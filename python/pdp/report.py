@@ -10,11 +10,12 @@ and reasons with every gap explained, and the provenance of the profile and
 of the report. Figures are inline SVG: no network, no external file.
 
 The per-position figures need what the JSON does not keep (the AWCC window
-table, R11/R12, the velocity spectrum): each recording named in the
+table, R11/R12, the velocity spectrum, the per-bubble tables of event
+detection and of a multi-tip probe): each recording named in the
 provenance is found (as written, then beside the JSON), its SHA-256 checked,
 and processed again with the provenance's options through the Python module;
-the report uses it only when the re-processed FSCC and AWCC velocities equal
-the JSON's. Otherwise the position says why its detail is missing.
+the report uses it only when the re-processed velocities (FSCC, AWCC, event
+detection, the multi-tip mean vector) equal the JSON's. Otherwise the position says why its detail is missing.
 
 Exit status as pdp's (README, "Exit status"): 1 bad input, 2 bad usage,
 3 output not written, 4 internal error, 5 a package is missing.
@@ -60,7 +61,7 @@ def load(path):
                            "process result; give the file pdp process --json wrote")
     where = "profile[{}]" if "profile" in data else "the recording{}"
     for i, row in enumerate(rows):
-        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum"):
+        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum", "events", "multi_tip"):
             if row.get(key) is not None and not isinstance(row[key], dict):
                 raise InputProblem(f"{path}: field '{key}' of {where.format(f'[{i}]' if 'profile' in data else '')} "
                                    "is not an object: not what pdp process writes; give the file pdp process "
@@ -220,9 +221,10 @@ def detail_for(index, row, data, json_dir, pdp, options):
         r = pdp.process(path, **options)
     except pdp.PdpError as e:
         return None, f"{path} could not be processed again: {e}"
-    for section in ("fscc", "awcc"):
+    for section, name in (("fscc", "FSCC"), ("awcc", "AWCC"), ("events", "event detection"),
+                          ("multi_tip", "multi-tip")):
         if not _same((row.get(section) or {}).get("velocity"), (r.get(section) or {}).get("velocity")):
-            return None, (f"processed again, {path} gives a different {section.upper()} velocity than the JSON "
+            return None, (f"processed again, {path} gives a different {name} velocity than the JSON "
                           f"(pdp {provenance.get('pdp_version')} wrote it, this is pdp {pdp.__version__})")
     windows = None if r.windows is None else {k: list(r.windows[k]) for k in
                                               ("start_time", "velocity", "fate")}
@@ -232,7 +234,13 @@ def detail_for(index, row, data, json_dir, pdp, options):
         "frequency": [float(x) for x in r.spectrum["frequency"]],
         "density": [float(x) for x in r.spectrum["density"]],
         "resolvable_frequency": r.spectrum.get("resolvable_frequency")}
-    return {"windows": windows, "correlation": correlation, "spectrum": spectrum}, None
+    # The per-bubble columns the panels draw (plotting.bubble_histogram, bubble_size_velocity).
+    bubbles = None if r.bubbles is None else {k: list(r.bubbles[k]) for k in
+                                              ("velocity", "chord_length", "fate")}
+    vectors = None if r.vectors is None else {k: list(r.vectors[k]) for k in
+                                              ("velocity_x", "speed", "diameter_front", "fate")}
+    return {"windows": windows, "correlation": correlation, "spectrum": spectrum, "bubbles": bubbles,
+            "vectors": vectors}, None
 
 
 # --- figures ------------------------------------------------------------------------
@@ -240,14 +248,17 @@ def detail_for(index, row, data, json_dir, pdp, options):
 
 def _profile_svgs(rows):
     from pdp import plotting
-    return [(key, title, plotting.svg(make(rows), salt=key)) for key, title, make in plotting.PROFILE_FIGURES]
+    figures = list(plotting.PROFILE_FIGURES) + [(key, title, make) for key, title, make, method in
+                                                 plotting.BUBBLE_PROFILE_FIGURES
+                                                 if any(r.get(method) is not None for r in rows)]
+    return [(key, title, plotting.svg(make(rows), salt=key)) for key, title, make in figures]
 
 
 def _position_svg(args):
     from pdp import plotting
     index, row, detail = args
     if detail is None:  # not recomputed: each panel that needs it says so
-        detail = {"windows": None, "correlation": None, "spectrum": None}
+        detail = {"windows": None, "correlation": None, "spectrum": None, "bubbles": None, "vectors": None}
     return plotting.position_svg(row, detail, salt=f"p{index}")
 
 
@@ -352,8 +363,12 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
                           "corrected value (the figures draw its median apart, hollow)", None))
         for text in correction.get("notes") or []:
             notes.append(("correction.notes", text, None))
+        # The bubble-by-bubble methods' quality and flag beside AWCC's, in the position's summary.
+        bubble = [(name, *plotting.verdict(row, key)[:2]) for key, name in (("multi_tip", "multi-tip"),
+                                                                             ("events", "event detection"))
+                  if row.get(key) is not None]
         positions.append({"index": i, "label": labels[i], "file": row.get("file"), "svg": position_svgs[i],
-                          "quality": (row.get("awcc") or {}).get("quality"), "notes": notes,
+                          "quality": (row.get("awcc") or {}).get("quality"), "bubble": bubble, "notes": notes,
                           "detail_note": detail_notes[i]})
 
     made = {"pdp_version": pdp.__version__, "utc_time": datetime.datetime.now(datetime.timezone.utc)
@@ -365,7 +380,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     return env.get_template("report.html.j2").render(
         title=input_name or os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
         positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
-        provenance=provenance, made=made, panels=plotting.POSITION_PANELS, single="profile" not in data,
+        provenance=provenance, made=made, panels=plotting.POSITION_PANELS, bubble_panels=plotting.BUBBLE_PANELS,
+        single="profile" not in data,
         sampling_intervals_only=pdp._pdp.sampling_intervals_only)
 
 

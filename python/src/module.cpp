@@ -137,23 +137,38 @@ py::array_t<std::int64_t> intervals_array(const awcc::AirIntervals& s) {
   return out;
 }
 
-// The window table (awcc::awcc_window_columns) as a dict of arrays.
-py::dict windows_of(const awcc::AwccResult& r) {
+// A table of one row per window or bubble as a dict of arrays, one per
+// declared column (awcc/serialise.hpp: the CSV's columns): a float64 array
+// for a numeric column (NaN where a row has no value), an array of str for
+// the text one. The declarations are the one owner of names and order.
+template <class Columns, class Rows>
+py::dict table_of(const Columns& columns, const Rows& rows) {
   py::dict out;
-  for (const auto& column : awcc::awcc_window_columns()) {
+  for (const auto& column : columns) {
     if (column.text) {
       py::list cells;
-      for (const auto& w : r.windows) cells.append(py::str(std::string(column.text(w))));
-      out[py::str(std::string(column.name))] = py::module_::import("numpy").attr("array")(cells);
+      for (const auto& row : rows) cells.append(py::str(std::string(column.text(row))));
+      out[py::str(std::string(column.name))] = py::module_::import("numpy").attr("array")(cells, "U");
     } else {
-      py::array_t<double> values(static_cast<py::ssize_t>(r.windows.size()));
+      py::array_t<double> values(static_cast<py::ssize_t>(rows.size()));
       auto m = values.mutable_unchecked<1>();
-      for (std::size_t i = 0; i < r.windows.size(); ++i) m(static_cast<py::ssize_t>(i)) = column.value(r.windows[i]);
+      for (std::size_t i = 0; i < rows.size(); ++i) m(static_cast<py::ssize_t>(i)) = column.value(rows[i]);
       out[py::str(std::string(column.name))] = values;
     }
   }
   return out;
 }
+
+// Each table's columns with their units ("" for text), for the DataFrames' attrs.
+template <class Columns>
+py::list units_of(const Columns& columns) {
+  py::list out;
+  for (const auto& column : columns) out.append(py::make_tuple(std::string(column.name), std::string(column.unit)));
+  return out;
+}
+
+// The window table (awcc::awcc_window_columns) as a dict of arrays.
+py::dict windows_of(const awcc::AwccResult& r) { return table_of(awcc::awcc_window_columns(), r.windows); }
 
 py::array_t<double> array_of(const std::vector<double>& v) {
   py::array_t<double> out(static_cast<py::ssize_t>(v.size()));
@@ -161,9 +176,10 @@ py::array_t<double> array_of(const std::vector<double>& v) {
   return out;
 }
 
-// The functions behind the JSON's scales, as --correlation-functions and
-// --spectrum write them: R11 and R12 against the lag (s; NaN where a
-// function has no value) and Welch's PSD of AWCC's velocity series.
+// What the JSON does not hold: the functions behind its scales, as
+// --correlation-functions and --spectrum write them (R11 and R12 against the
+// lag, s, NaN where a function has no value; Welch's PSD of AWCC's velocity
+// series), and the per-bubble tables, as --bubbles writes them.
 py::dict detail_of(const awcc::ProcessResult& r) {
   py::dict out;
   out["correlation"] = py::none();
@@ -190,6 +206,11 @@ py::dict detail_of(const awcc::ProcessResult& r) {
                                py::arg("density") = array_of(v.psd.density),
                                py::arg("resolvable_frequency") = v.resolvable_frequency);
   }
+  // The per-bubble tables, where their method ran: event detection's one row
+  // per leading bubble, the multi-tip probe's one vector row per leading bubble.
+  out["bubbles"] = r.events ? py::object(table_of(awcc::event_bubble_columns(), r.events->bubbles)) : py::none();
+  out["vectors"] =
+      r.probe ? py::object(table_of(awcc::multi_tip_bubble_columns(), r.probe->vectors.bubbles)) : py::none();
   return out;
 }
 
@@ -471,6 +492,12 @@ PYBIND11_MODULE(_pdp, m) {
     if (correction) add(correction::correction_csv_columns());
     return out;
   }, py::arg("correction"));
+  m.def("table_units", [] {
+    // (name, unit) of each column of the windows, bubbles and vectors tables.
+    return py::dict(py::arg("windows") = units_of(awcc::awcc_window_columns()),
+                    py::arg("bubbles") = units_of(awcc::event_bubble_columns()),
+                    py::arg("vectors") = units_of(awcc::multi_tip_bubble_columns()));
+  });
   m.def("flags", [] {
     // The codes a result's "flags" may hold, with their meanings (awcc/flags.hpp).
     py::list out;
