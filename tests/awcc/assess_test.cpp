@@ -304,3 +304,86 @@ TEST(ChannelsIgnored, AFourChannelRecordingNamesTheChannelsNotProcessed) {
 }
 
 }  // namespace
+
+awcc::EventResult events_at(double velocity, awcc::Interval95 ci) {
+  awcc::EventResult e;
+  e.status = awcc::EventStatus::ok;
+  e.quality = awcc::AwccQuality::ok;
+  e.velocity = velocity;
+  e.velocity_ci95 = ci;
+  e.bubbles_paired = 500;
+  e.bubbles_complete = 900;
+  return e;
+}
+
+TEST(EventsDisagree, AgainstFsccAtTheLimitElseAwccOfQualityOkElseNotCompared) {
+  // Binary-exact: FSCC 2 m/s [1.5, 2.5], event detection 1.375 [1.0, 1.75]:
+  // half-widths 0.5 and 0.375 facing each other combine to 0.625, the
+  // difference exactly: not beyond; a step further is.
+  auto f = fscc_at_2();
+  f.velocity_ci95 = awcc::Interval95{1.5, 2.5};
+  const auto r = row(f, awcc_at(2.0));
+  const auto at_limit = awcc::compare_events(events_at(1.375, {1.0, 1.75}), r);
+  ASSERT_TRUE(at_limit);
+  EXPECT_EQ(at_limit->reference, "FSCC");
+  EXPECT_EQ(at_limit->allowed, 0.625);
+  EXPECT_FALSE(at_limit->disagree());
+  EXPECT_TRUE(awcc::compare_events(events_at(std::nextafter(1.375, 0.0), {1.0, 1.75}), r)->disagree());
+  // Above FSCC: its upper half-width faces event detection's lower one.
+  const auto above = awcc::compare_events(events_at(3.0, {2.875, 3.25}), r);
+  EXPECT_EQ(above->allowed, std::hypot(0.5, 0.125));
+  EXPECT_TRUE(above->disagree());
+  // Without FSCC's interval: AWCC of quality ok is the reference; of quality low, none.
+  auto no_interval = f;
+  no_interval.velocity_ci95.reset();
+  auto a = awcc_at(2.0);
+  EXPECT_EQ(awcc::compare_events(events_at(1.0, {0.9, 1.1}), row(no_interval, a))->reference, "AWCC");
+  a.quality = awcc::AwccQuality::low;
+  EXPECT_FALSE(awcc::compare_events(events_at(1.0, {0.9, 1.1}), row(no_interval, a)));
+  // Event detection without a velocity is not compared.
+  auto none = events_at(1.0, {0.9, 1.1});
+  none.status = awcc::EventStatus::too_few_bubbles;
+  EXPECT_FALSE(awcc::compare_events(none, r));
+}
+
+TEST(EventsDisagree, TheWarningIsInTheRowsListWithItsFlag) {
+  auto r = row(fscc_at_2(), awcc_at(2.0));
+  r.events = events_at(1.0, {0.95, 1.05});
+  const auto w = awcc::assess(r);
+  const auto it = std::find_if(w.begin(), w.end(), [](const awcc::Warning& x) { return x.flag == awcc::Flag::events_disagree; });
+  ASSERT_NE(it, w.end());
+  EXPECT_NE(it->text.find("event detection's velocity 1.000 m/s"), std::string::npos) << it->text;
+  EXPECT_NE(it->text.find("use FSCC's velocity"), std::string::npos) << it->text;
+  r.events = events_at(2.0, {1.9, 2.1});
+  const auto agree = awcc::assess(r);
+  EXPECT_TRUE(std::none_of(agree.begin(), agree.end(), [](const awcc::Warning& x) { return x.flag == awcc::Flag::events_disagree; }));
+}
+
+TEST(MultiTipDoubtful, TheStreamwiseComponentAgainstFsccAndTheQualityInTheRowsList) {
+  awcc::MultiTipResult v;
+  v.status = awcc::MultiTipStatus::ok;
+  v.velocity = {1.375, 0.0, 0.0};
+  v.velocity_ci95[0] = {1.0, 1.75};
+  auto f = fscc_at_2();
+  f.velocity_ci95 = awcc::Interval95{1.5, 2.5};
+  auto r = row(f, awcc_at(2.0));
+  const auto at_limit = awcc::compare_multi_tip(v, r);
+  ASSERT_TRUE(at_limit);
+  EXPECT_EQ(at_limit->allowed, 0.625);
+  EXPECT_FALSE(at_limit->disagree());
+  v.velocity[0] = std::nextafter(1.375, 0.0);
+  EXPECT_TRUE(awcc::compare_multi_tip(v, r)->disagree());
+  // Only a low quality reaches the row's warnings.
+  awcc::ProbeResult probe;
+  probe.vectors = v;
+  probe.quality = awcc::AwccQuality::ok;
+  r.probe = probe;
+  auto w = awcc::assess(r);
+  EXPECT_TRUE(std::none_of(w.begin(), w.end(), [](const awcc::Warning& x) { return x.flag == awcc::Flag::multi_tip_doubtful; }));
+  r.probe->quality = awcc::AwccQuality::low;
+  r.probe->quality_reason = "because";
+  w = awcc::assess(r);
+  const auto it = std::find_if(w.begin(), w.end(), [](const awcc::Warning& x) { return x.flag == awcc::Flag::multi_tip_doubtful; });
+  ASSERT_NE(it, w.end());
+  EXPECT_NE(it->text.find("is doubtful: because"), std::string::npos) << it->text;
+}
