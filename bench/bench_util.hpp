@@ -27,6 +27,18 @@ inline double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+/// The median wall time of `repeat` calls of run(), s.
+template <class Run>
+double median_seconds(int repeat, Run run) {
+  std::vector<double> times;
+  for (int k = 0; k < repeat; ++k) {
+    const double t0 = now();
+    run();
+    times.push_back(now() - t0);
+  }
+  return median(times);
+}
+
 /// The base-case benchmarks' arguments: --duration SECONDS (300) and --repeat N (3).
 struct BaseCaseArgs {
   double duration = 300.0;

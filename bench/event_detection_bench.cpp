@@ -18,21 +18,6 @@
 
 using bench::now;
 
-namespace {
-
-template <class Run>
-double median_seconds(int repeat, Run run) {
-  std::vector<double> times;
-  for (int k = 0; k < repeat; ++k) {
-    const double t0 = now();
-    run();
-    times.push_back(now() - t0);
-  }
-  return bench::median(times);
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
   const auto args = bench::base_case_args(argc, argv);
   const double duration = args.duration;
@@ -46,7 +31,7 @@ int main(int argc, char** argv) {
     awcc::EventOptions o;
     o.pairing = pairing;
     awcc::EventResult r;
-    const double t = median_seconds(repeat, [&] {
+    const double t = bench::median_seconds(repeat, [&] {
       r = awcc::event_detection(syn.signals[0], syn.signals[1], scene.dx, o, scene.velocity);
     });
     std::printf("%s: %.3f s median of %d, %lld leading bubbles (%.2f million/s, %.0f ns each), %lld paired, u = %.3f "
@@ -57,7 +42,7 @@ int main(int argc, char** argv) {
   }
   const auto leading = awcc::crossings(syn.signals[0]);
   const auto trailing = awcc::crossings(syn.signals[1]);
-  const double t = median_seconds(repeat, [&] { (void)awcc::pair_bubbles(leading, trailing, scene.dx, {}); });
+  const double t = bench::median_seconds(repeat, [&] { (void)awcc::pair_bubbles(leading, trailing, scene.dx, {}); });
   std::printf("Kramer pairing alone: %.3f s (%.0f ns per leading bubble)\n", t,
               t / static_cast<double>(leading.size()) * 1e9);
   return 0;

@@ -23,21 +23,6 @@
 
 using bench::now;
 
-namespace {
-
-template <class Run>
-double median_seconds(int repeat, Run run) {
-  std::vector<double> times;
-  for (int k = 0; k < repeat; ++k) {
-    const double t0 = now();
-    run();
-    times.push_back(now() - t0);
-  }
-  return bench::median(times);
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
   const auto args = bench::base_case_args(argc, argv);
   synth::Scene scene;
@@ -54,18 +39,18 @@ int main(int argc, char** argv) {
   const awcc::ProbeGeometry geometry(positions);
 
   std::vector<std::vector<awcc::Crossing>> tips;
-  const double t_cross = median_seconds(args.repeat, [&] {
+  const double t_cross = bench::median_seconds(args.repeat, [&] {
     tips.clear();
     for (const auto& s : syn.signals) tips.push_back(awcc::crossings(s));
   });
   const double dx = scene.tips[1].x - scene.tips[0].x;
   awcc::FsccResult first;
   const double t_fscc =
-      median_seconds(args.repeat, [&] { first = awcc::fscc(syn.signals[0], syn.signals[1], dx); });
+      bench::median_seconds(args.repeat, [&] { first = awcc::fscc(syn.signals[0], syn.signals[1], dx); });
   std::printf("FSCC of the tip pair: %.3f s, %.3f m/s\n", t_fscc, first.velocity);
   awcc::ProbePairing pairing;
   const double t_pair =
-      median_seconds(args.repeat, [&] { pairing = awcc::pair_probe(geometry, tips, {}, first.velocity); });
+      bench::median_seconds(args.repeat, [&] { pairing = awcc::pair_probe(geometry, tips, {}, first.velocity); });
   const double bubbles = static_cast<double>(pairing.bubbles.size());
   const auto per = [&](double seconds) { return seconds / bubbles * 1e9; };
   std::printf("crossings of 4 tips: %.3f s; pair_probe: %.3f s (%.0f ns a leading bubble, %zu of them)\n", t_cross,
@@ -74,9 +59,9 @@ int main(int argc, char** argv) {
     awcc::MultiTipResult r;
     const awcc::MultiTipOptions o{.algorithm = algorithm};
     const double t_solve =
-        median_seconds(args.repeat, [&] { r = awcc::multi_tip(geometry, pairing.bubbles, args.duration, o); });
+        bench::median_seconds(args.repeat, [&] { r = awcc::multi_tip(geometry, pairing.bubbles, args.duration, o); });
     // The whole chain once more end to end, as a record meets it.
-    const double t_chain = median_seconds(args.repeat, [&] {
+    const double t_chain = bench::median_seconds(args.repeat, [&] {
       std::vector<std::vector<awcc::Crossing>> c;
       for (const auto& s : syn.signals) c.push_back(awcc::crossings(s));
       const auto f = awcc::fscc(syn.signals[0], syn.signals[1], dx);
