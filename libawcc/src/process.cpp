@@ -778,7 +778,9 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
   if (const auto v = probe.geometry.check(options.multi_tip_options.conditioning_min); !v.ok()) {
     throw InputError(fmt::format("{}: {} (or process the tip pair alone: method both)", file, v.message), v.quantity);
   }
-  probe.channels = options.tip_channels();
+  // The binarised tips' own channels (a recording built in memory need not name them in the options).
+  probe.channels = {options.leading_channel, options.trailing_channel};
+  for (const auto& t : r.further_tips) probe.channels.push_back(t.channel);
   PhaseStatisticsOptions po;
   po.histogram_bins = options.histogram_bins;
   po.velocity = out.velocity();

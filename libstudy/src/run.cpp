@@ -58,6 +58,28 @@ awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::A
   return out;
 }
 
+awcc::BinarisedRecording binarised_probe(std::vector<awcc::AirIntervals> signals,
+                                         const std::vector<awcc::Vec3>& positions,
+                                         const awcc::BinarisationOptions& binarisation) {
+  if (signals.size() < 2 || signals.size() != positions.size()) {
+    throw std::invalid_argument(fmt::format("a probe of {} signals and {} tip positions: give one position per tip",
+                                            signals.size(), positions.size()));
+  }
+  std::vector<awcc::AirIntervals> further(std::make_move_iterator(signals.begin() + 2),
+                                          std::make_move_iterator(signals.end()));
+  awcc::BinarisedRecording out = binarised_recording(std::move(signals[0]), std::move(signals[1]), binarisation);
+  out.info.channels = static_cast<int>(positions.size());
+  for (std::size_t k = 0; k < further.size(); ++k) {
+    awcc::BinarisedTip& tip = out.further_tips.emplace_back();
+    tip.channel = static_cast<int>(k + 2);
+    tip.histogram = two_levels(further[k]);
+    tip.threshold = awcc::choose_threshold(*tip.histogram, binarisation.for_trailing_tip());
+    tip.signal = std::move(further[k]);
+  }
+  out.tip_positions = positions;
+  return out;
+}
+
 awcc::ProcessResult process_synthesis(awcc::AirIntervals leading, awcc::AirIntervals trailing,
                                       const awcc::ProcessOptions& options) {
   if (options.awcc_options.signal != awcc::CorrelationSignal::binary) {
@@ -102,9 +124,34 @@ RunResult run_scene(const synth::Scene& scene, const RunOptions& options) {
   r.dy = scene.lateral_separation();
 
   start = std::chrono::steady_clock::now();
-  r.processed = process_synthesis(std::move(syn.signals[0]), std::move(syn.signals[1]),
-                                  processing_options(options, r.dx, r.dy));
+  const auto processing = processing_options(options, r.dx, r.dy);
+  const auto tips = scene.probe_tips();
+  if (tips.size() >= 4) {
+    // Every tip, as pdp process reads a recording that states its tips.
+    if (processing.awcc_options.signal != awcc::CorrelationSignal::binary) {
+      throw std::invalid_argument("signal = raw: a synthesised record in memory holds binary signals only");
+    }
+    std::vector<awcc::Vec3> positions;
+    for (const auto& t : tips) positions.push_back({t.x, t.y, t.z});
+    r.processed = awcc::process_binarised(
+        binarised_probe(std::move(syn.signals), positions, processing.binarisation), processing);
+  } else {
+    r.processed = process_synthesis(std::move(syn.signals[0]), std::move(syn.signals[1]), processing);
+  }
   r.seconds_process = seconds_since(start);
+  for (std::size_t i = 0; i < 3; ++i) {
+    r.multi_tip_velocity[i].truth = truth.realised.mean_velocity[i];
+    r.multi_tip_turbulence_intensity[i].truth = truth.realised.turbulence_intensity[i];
+  }
+  r.multi_tip_interfacial_area.truth = truth.expected_interfacial_area;
+  if (r.processed.probe && r.processed.probe->vectors.ok()) {
+    const auto& v = r.processed.probe->vectors;
+    for (std::size_t i = 0; i < 3; ++i) {
+      r.multi_tip_velocity[i].value = v.velocity[i];
+      r.multi_tip_turbulence_intensity[i].value = v.turbulence_intensity[i];
+    }
+    r.multi_tip_interfacial_area.value = v.interfacial_area;
+  }
   r.measurement = correction::measurement_of(r.processed);
 
   const auto& p = r.processed;

@@ -336,6 +336,25 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
   cell(SweepColumn::window_rms) = num(r->window_rms);
   // FSCC and AWCC run together, as in pdp process: their own seconds are not
   // measured (seconds_fscc and seconds_awcc stay empty).
+  cell(SweepColumn::truth_velocity_y) = num(r->multi_tip_velocity[1].truth);
+  cell(SweepColumn::truth_velocity_z) = num(r->multi_tip_velocity[2].truth);
+  cell(SweepColumn::truth_turbulence_intensity_y) = num(r->multi_tip_turbulence_intensity[1].truth);
+  cell(SweepColumn::truth_turbulence_intensity_z) = num(r->multi_tip_turbulence_intensity[2].truth);
+  cell(SweepColumn::truth_interfacial_area) = num(r->multi_tip_interfacial_area.truth);
+  if (const auto& probe = r->processed.probe) {
+    constexpr SweepColumn velocity[] = {SweepColumn::multi_tip_velocity_x, SweepColumn::multi_tip_velocity_y,
+                                        SweepColumn::multi_tip_velocity_z};
+    constexpr SweepColumn tu[] = {SweepColumn::multi_tip_turbulence_intensity_x,
+                                  SweepColumn::multi_tip_turbulence_intensity_y,
+                                  SweepColumn::multi_tip_turbulence_intensity_z};
+    for (std::size_t i = 0; i < 3; ++i) {
+      cell(velocity[i]) = num(r->multi_tip_velocity[i].value);
+      cell(tu[i]) = num(r->multi_tip_turbulence_intensity[i].value);
+    }
+    cell(SweepColumn::multi_tip_interfacial_area) = num(r->multi_tip_interfacial_area.value);
+    cell(SweepColumn::multi_tip_quality) = std::string(awcc::to_string(probe->quality));
+    cell(SweepColumn::multi_tip_bubbles_accepted) = count(probe->vectors.bubbles_accepted);
+  }
   cell(SweepColumn::seconds_synth) = fmt::format("{:.4f}", r->seconds_synth);
   cell(SweepColumn::seconds_process) = fmt::format("{:.4f}", r->seconds_process);
   cell(SweepColumn::reason) = clean(reason);

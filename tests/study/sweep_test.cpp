@@ -79,6 +79,56 @@ TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
   EXPECT_EQ(cell(row, "seconds_awcc"), "");
 }
 
+// A four-tip scene (the clean one of METHOD 11.7: 8 mm spheres, Tu 0.05,
+// tips 2 mm apart) is processed bubble by bubble in a sweep, as pdp process
+// processes a recording stating its tips: the row carries the mean vector,
+// Tu per component and the interfacial area beside their truths; a dual-tip
+// run leaves those cells empty and still gives the lateral truths.
+TEST(SweepRows, AFourTipSceneCarriesTheMultiTipVectorBesideItsTruth) {
+  study::SweepRun run;
+  run.np = 10;
+  run.scene.velocity = 2.0;
+  run.scene.tu = 0.05;
+  run.scene.tu_y = run.scene.tu_z = 0.025;
+  run.scene.time_scale = 1.0;
+  run.scene.void_fraction = 0.05;
+  run.scene.bubble_diameter = 8e-3;
+  run.scene.tips = {{0, 0, 0}, {2e-3, 0, 0}, {2e-3, 1e-3, 0}, {2e-3, 0, 1e-3}};
+  run.scene.fs = 200e3;
+  run.scene.duration = 30.0;
+  study::RunOptions options;
+  options.awcc.np = run.np;
+  const auto r = study::run_scene(run.scene, options);
+  ASSERT_TRUE(r.processed.probe);
+  const auto& v = r.processed.probe->vectors;
+  ASSERT_TRUE(v.ok()) << v.message;
+  EXPECT_EQ(r.processed.probe->channels, (std::vector<int>{0, 1, 2, 3}));
+  const auto row = study::sweep_row(run, &r, "", 1, options.awcc);
+  EXPECT_EQ(cell(row, "multi_tip_velocity_x"), fmt::format("{:.10g}", v.velocity[0]));
+  EXPECT_EQ(cell(row, "multi_tip_turbulence_intensity_z"), fmt::format("{:.10g}", v.turbulence_intensity[2]));
+  EXPECT_EQ(cell(row, "multi_tip_interfacial_area"), fmt::format("{:.10g}", *v.interfacial_area));
+  EXPECT_EQ(cell(row, "multi_tip_bubbles_accepted"), std::to_string(v.bubbles_accepted));
+  EXPECT_EQ(cell(row, "multi_tip_quality"), std::string(awcc::to_string(r.processed.probe->quality)));
+  EXPECT_EQ(cell(row, "truth_interfacial_area"), fmt::format("{:.10g}", 6 * 0.05 / 8e-3));
+  EXPECT_EQ(cell(row, "truth_velocity_y"), fmt::format("{:.10g}", r.multi_tip_velocity[1].truth));
+  // The estimate against its truth: some 300 accepted bubbles of speed
+  // spread Tu = 0.05 give the mean's sampling sd 0.05 / sqrt(300) = 0.3 %;
+  // the per-bubble timing error (one 5 us sample in a 1 ms lag, 0.5 %) adds
+  // 0.5 % / sqrt(300). 2 % is beyond 5 sd of both.
+  ASSERT_TRUE(r.multi_tip_velocity[0].error());
+  EXPECT_LT(std::fabs(*r.multi_tip_velocity[0].error()), 0.02);
+  // The interfacial area (4/T) N_0 <1/|v|>: N_0 of about 500 complete
+  // bubbles, a Poisson sd of 4.5 %; 20 % is beyond 4 sd.
+  ASSERT_TRUE(r.multi_tip_interfacial_area.error());
+  EXPECT_LT(std::fabs(*r.multi_tip_interfacial_area.error()), 0.2);
+  // A dual-tip run: no multi-tip cells.
+  const auto pair = short_run();
+  const auto rp = study::run_scene(pair.scene, options);
+  const auto pair_row = study::sweep_row(pair, &rp, "", 1, options.awcc);
+  EXPECT_EQ(cell(pair_row, "multi_tip_velocity_x"), "");
+  EXPECT_EQ(cell(pair_row, "multi_tip_quality"), "");
+}
+
 // The writer's header is the declaration (key columns, the scene's fields,
 // the result columns in order); what the writer puts in a row, training reads
 // back: the correction's features and the processing, every value of them.

@@ -52,6 +52,11 @@ enum class SweepColumn : std::size_t {
   reason,
   probe_dx, probe_dy,
   awcc_filter_a, awcc_roc, awcc_weighting, awcc_signal, awcc_subsample,
+  truth_velocity_y, truth_velocity_z, truth_turbulence_intensity_y, truth_turbulence_intensity_z,
+  truth_interfacial_area,
+  multi_tip_velocity_x, multi_tip_velocity_y, multi_tip_velocity_z,
+  multi_tip_turbulence_intensity_x, multi_tip_turbulence_intensity_y, multi_tip_turbulence_intensity_z,
+  multi_tip_interfacial_area, multi_tip_quality, multi_tip_bubbles_accepted,
   count
 };
 
@@ -93,6 +98,20 @@ inline constexpr std::array<SweepColumnInfo, sweep_result_column_count> sweep_re
     {"awcc_weighting", "text", "AWCC's window weighting (awcc::to_string(Weighting))"},
     {"awcc_signal", "text", "the signals correlated (awcc::to_string(CorrelationSignal))"},
     {"awcc_subsample", "text", "the peak refinement (awcc::to_string(Subsample))"},
+    {"truth_velocity_y", "m/s", "the scene's realised mean lateral velocity"},
+    {"truth_velocity_z", "m/s", "the scene's realised mean vertical velocity"},
+    {"truth_turbulence_intensity_y", "-", "the scene's realised Tu_y (rms v_y / |mean vector|)"},
+    {"truth_turbulence_intensity_z", "-", "the scene's realised Tu_z"},
+    {"truth_interfacial_area", "1/m", "the scene's expected interfacial area concentration, 6 c / d_b"},
+    {"multi_tip_velocity_x", "m/s", "a probe of four or more tips: the mean vector's x component (empty otherwise)"},
+    {"multi_tip_velocity_y", "m/s", "the mean vector's y component"},
+    {"multi_tip_velocity_z", "m/s", "the mean vector's z component"},
+    {"multi_tip_turbulence_intensity_x", "-", "multi-tip Tu_x"},
+    {"multi_tip_turbulence_intensity_y", "-", "multi-tip Tu_y"},
+    {"multi_tip_turbulence_intensity_z", "-", "multi-tip Tu_z"},
+    {"multi_tip_interfacial_area", "1/m", "multi-tip interfacial area concentration"},
+    {"multi_tip_quality", "text", "multi-tip quality: ok, low or insufficient"},
+    {"multi_tip_bubbles_accepted", "-", "bubbles with an accepted velocity vector"},
 }};
 
 [[nodiscard]] constexpr std::string_view column_name(SweepColumn c) {

@@ -7,6 +7,7 @@
 // the bench are loops around process_synthesis; sweeps and validate around
 // run_scene.
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +45,13 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
 awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
                                              const awcc::BinarisationOptions& binarisation = {});
 
+/// The same for every tip of a probe of four or more tips (signals in the
+/// scene's tip order, the first two the pair): the further tips on channels
+/// 2, 3, ... and every tip's position (m), so that processing treats the
+/// record as a multi-tip probe.
+awcc::BinarisedRecording binarised_probe(std::vector<awcc::AirIntervals> signals,
+                                         const std::vector<awcc::Vec3>& positions,
+                                         const awcc::BinarisationOptions& binarisation = {});
 /// Synthesises a scene for a study: it needs two tips, the first two being
 /// the pair processed (throws std::invalid_argument naming the tips otherwise).
 synth::Synthesis synthesise_pair(const synth::Scene& scene, const synth::SynthesisOptions& options = {});
@@ -85,6 +93,13 @@ struct RunResult {
   // Window level (AWCC): accepted window velocity minus window-averaged truth.
   std::optional<double> window_bias, window_rms;   ///< m/s
   awcc::Summary accepted_truth, rejected_truth;    ///< true window velocities, m/s
+  // A probe of four or more tips, processed bubble by bubble
+  // (ProcessResult::probe): the mean vector and Tu per component against the
+  // realised flow's, the interfacial area against 6 c / d_b (the scene's
+  // expected value, synth::Truth::expected_interfacial_area). No value where
+  // the scene has fewer tips or the statistics are not ok.
+  std::array<Score, 3> multi_tip_velocity, multi_tip_turbulence_intensity;
+  Score multi_tip_interfacial_area;
   double seconds_synth = 0.0;           ///< wall seconds of the synthesis
   double seconds_process = 0.0;         ///< wall seconds of the processing (FSCC and AWCC together, as pdp process)
 };
