@@ -5,12 +5,13 @@
 //
 // The definition is a sweep file (study/sweep.hpp: [sweep], [base], [grid];
 // the tips as a grid of `tips` strings, anisotropy as Tu_y/Tu_x). Each run is
-// validated bubble by bubble (study/multi_tip_validate.hpp): both velocity
-// algorithms on the probe's pairing, event detection and AWCC on the dual
-// tip, every estimate against the realised truth. One CSV row a run; bias
-// and spread over the seeds are the figure script's
-// (docs/figures/multi_tip_geometry.py). One thread: the study is sized to
-// run in a few minutes on one core, so it is not resumable.
+// validated bubble by bubble (study/multi_tip_validate.hpp): pdp process's
+// processing of the probe, both velocity algorithms on its pairing with
+// pdp's quality of each, event detection, FSCC and AWCC on the dual tip,
+// every estimate against the realised truth. One CSV row a run; bias and
+// spread over the seeds are the figure script's (scripts/multi-tip-geometry).
+// One thread: the study is sized to run in about a minute on one core, so it
+// is not resumable.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
