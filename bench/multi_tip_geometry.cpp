@@ -5,12 +5,13 @@
 //
 // The definition is a sweep file (study/sweep.hpp: [sweep], [base], [grid];
 // the tips as a grid of `tips` strings, anisotropy as Tu_y/Tu_x). Each run is
-// validated bubble by bubble (study/multi_tip_validate.hpp): both velocity
-// algorithms on the probe's pairing, event detection and AWCC on the dual
-// tip, every estimate against the realised truth. One CSV row a run; bias
-// and spread over the seeds are the figure script's
-// (docs/figures/multi_tip_geometry.py). One thread: the study is sized to
-// run in a few minutes on one core, so it is not resumable.
+// validated bubble by bubble (study/multi_tip_validate.hpp): pdp process's
+// processing of the probe, both velocity algorithms on its pairing with
+// pdp's quality of each, event detection, FSCC and AWCC on the dual tip,
+// every estimate against the realised truth. One CSV row a run; bias and
+// spread over the seeds are the figure script's (scripts/multi-tip-geometry).
+// One thread: the study is sized to run in about a minute on one core, so it
+// is not resumable.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -45,12 +46,20 @@ std::pair<double, double> spacing_of(const awcc::ProbeGeometry& g) {
 const char* kHeader =
     "index,seed,velocity,bubble_diameter,void_fraction,tu,tu_y,tu_z,anisotropy,spacing,lateral,spacing_ratio,"
     "conditioning,leading_bubbles,pairing_error,pairing_yield,"
-    "sn_status,sn_accepted,sn_mispaired,sn_mispaired_weight,sn_selected_ux,sn_ux,sn_uy,sn_uz,sn_tux,sn_tuy,sn_tuz,sn_iac,sn_iac_realised,sn_speed_median,"
-    "sn_speed_p90,sn_vector_median,sn_diameter_median,"
-    "tian_status,tian_accepted,tian_ux,tian_uy,tian_uz,tian_tux,tian_tuy,tian_tuz,tian_speed_median,tian_speed_p90,"
-    "tian_vector_median,sn_tian_max_difference,"
-    "ed_status,ed_paired,ed_pairing_error,ed_u,ed_tu,ed_velocity_median,awcc_quality,awcc_u,awcc_tu,"
+    "sn_status,sn_quality,sn_quality_reason,sn_accepted,sn_mispaired,sn_mispaired_weight,sn_selected_ux,sn_ux,sn_uy,"
+    "sn_uz,sn_tux,sn_tuy,sn_tuz,sn_iac,sn_iac_realised,sn_iac_paired,sn_speed_median,sn_speed_p90,sn_vector_median,"
+    "sn_diameter_median,"
+    "tian_status,tian_quality,tian_quality_reason,tian_accepted,tian_ux,tian_uy,tian_uz,tian_tux,tian_tuy,tian_tuz,"
+    "tian_speed_median,tian_speed_p90,tian_vector_median,sn_tian_max_difference,"
+    "ed_status,ed_paired,ed_pairing_error,ed_u,ed_tu,ed_velocity_median,awcc_quality,awcc_u,awcc_tu,fscc_u,"
     "seconds_synth,seconds_process,error\n";
+
+// A free text as one CSV field: the separators and quotes blanked.
+std::string field(std::string text) {
+  for (auto& c : text)
+    if (c == '"' || c == '\n' || c == ',') c = ' ';
+  return text;
+}
 
 std::string row(const study::SweepRun& run, const study::MultiTipValidation* v, const std::string& error) {
   const auto& s = run.scene;
@@ -61,10 +70,7 @@ std::string row(const study::SweepRun& run, const study::MultiTipValidation* v, 
     const std::string header(kHeader);
     const auto empty = std::count(header.begin(), header.end(), ',') - 9;
     for (std::ptrdiff_t i = 0; i < empty; ++i) out += ',';
-    std::string quoted = error;
-    for (auto& c : quoted)
-      if (c == '"' || c == '\n' || c == ',') c = ' ';
-    return out + quoted + "\n";
+    return out + field(error) + "\n";
   }
   const auto [spacing, lateral] = spacing_of(v->geometry);
   out += fmt::format("{},{},{},{},{},{},{},", num(spacing), num(lateral), num(spacing / s.bubble_diameter),
@@ -78,15 +84,21 @@ std::string row(const study::SweepRun& run, const study::MultiTipValidation* v, 
   }
   auto algorithm = [&](const study::VectorValidation* a, bool sn_columns) {
     std::string o;
-    if (!a) return std::string(sn_columns ? 17 : 11, ',');
-    o += fmt::format("{},{},", awcc::to_string(a->result.status), a->result.bubbles_accepted);
+    if (!a) return std::string(sn_columns ? 20 : 13, ',');
+    // pdp's verdict: a large error with quality ok is the one a user cannot see.
+    o += fmt::format("{},{},{},{},", awcc::to_string(a->result.status), awcc::to_string(a->quality),
+                     a->quality == awcc::AwccQuality::ok ? std::string() : field(a->quality_reason),
+                     a->result.bubbles_accepted);
     if (sn_columns) {
       o += fmt::format("{},{},{},", a->accepted_mispaired, num(a->mispaired_weight_share),
                        num(a->selected_velocity[0].error()));
     }
     for (const auto& c : a->mean_velocity) o += num(c.error()) + ",";
     for (const auto& c : a->turbulence_intensity) o += num(c.error()) + ",";
-    if (sn_columns) o += num(a->interfacial_area.error()) + "," + num(a->interfacial_area_realised.error()) + ",";
+    if (sn_columns) {
+      o += num(a->interfacial_area.error()) + "," + num(a->interfacial_area_realised.error()) + "," +
+           num(a->interfacial_area_paired.error()) + ",";
+    }
     auto q = [](const awcc::Summary& x, bool p90) {
       return x.count ? num(p90 ? x.percentiles[5] : x.median) : std::string();
     };
@@ -118,6 +130,11 @@ std::string row(const study::SweepRun& run, const study::MultiTipValidation* v, 
                      d.velocity_error.count ? num(d.velocity_error.median) : std::string());
   out += fmt::format("{},{},{},", d.processed.awcc ? std::string(awcc::to_string(d.processed.awcc->quality)) : "",
                      num(d.awcc_velocity.error()), num(d.awcc_turbulence_intensity.error()));
+  // FSCC's velocity of the pair against the realised u_x: the reference the
+  // probe's quality compares the mean vector with (ProbeResult::quality).
+  const auto& f = d.processed.fscc;
+  const double ux = v->realised_velocity[0];
+  out += (f && f->ok() ? num((f->velocity - ux) / ux) : std::string()) + ",";
   out += fmt::format("{:.3f},{:.3f},\n", v->seconds_synth, v->seconds_process);
   return out;
 }

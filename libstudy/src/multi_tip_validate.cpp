@@ -102,35 +102,74 @@ std::optional<double> Compared::error() const {
 
 namespace {
 
-// What the scene's processing gave: pdp process's dual-tip processing (FSCC,
-// AWCC), event detection on the same pair, the probe's pairing and one
-// vector result per algorithm. The one place the processing is called.
+// The probe as pdp process takes it from a user: every tip declared (tip k
+// on channel k), the leading tip the most upstream one, multi-tip
+// processing and event detection on.
+awcc::ProcessOptions probe_options(const awcc::ProbeGeometry& geometry, const MultiTipValidateOptions& options) {
+  awcc::ProcessOptions p = processing_options(options.dual, 0.0, 0.0);
+  for (const auto& t : geometry.positions()) p.probe.positions.push_back(t);
+  p.probe.leading = static_cast<int>(geometry.leading());
+  p.events = true;
+  p.event_options = options.events;
+  p.multi_tip = awcc::MultiTipChoice::on;
+  p.multi_tip_options = options.multi_tip;
+  return p;
+}
+
+awcc::RecordingInfo synthetic_info(const synth::Scene& scene, std::size_t tips) {
+  awcc::RecordingInfo info;
+  info.description = "synthesised binary signals";
+  info.channels = static_cast<int>(tips);
+  info.fs = scene.fs;
+  info.frames = static_cast<std::int64_t>(std::llround(scene.duration * scene.fs));
+  info.quantum = 1.0;
+  return info;
+}
+
+// The synthetic signals as process_binarised takes a probe's recording:
+// the tip pair first, then the further tips, in the channel order pdp
+// process chose (`resolved`, from tip_pair_options), each binarised as a
+// binary channel is (the further tips like the trailing one), with every
+// tip's position.
+awcc::BinarisedRecording probe_recording(const synth::Synthesis& syn, const awcc::ProcessOptions& resolved,
+                                         const awcc::ProbeGeometry& geometry) {
+  const auto channels = resolved.tip_channels();
+  const auto signal = [&](int c) -> const awcc::AirIntervals& { return syn.signals.at(static_cast<std::size_t>(c)); };
+  auto r = binarised_recording(signal(channels[0]), signal(channels[1]), resolved.binarisation);
+  r.info.channels = static_cast<int>(syn.signals.size());
+  for (std::size_t j = 2; j < channels.size(); ++j) {
+    // A pair of the tip with itself: its trailing half is the tip binarised
+    // as a trailing tip, what BinarisedTip holds.
+    auto alone = binarised_recording(signal(channels[j]), signal(channels[j]), resolved.binarisation);
+    auto& t = r.further_tips.emplace_back();
+    t.channel = channels[j];
+    t.threshold = alone.trailing_threshold;
+    t.signal = std::move(alone.trailing);
+    t.histogram = std::move(alone.trailing_histogram);
+  }
+  for (const int c : channels) r.tip_positions.push_back(geometry.positions().at(static_cast<std::size_t>(c)));
+  return r;
+}
+
+// What the scene's processing gave: pdp process's result of the first
+// algorithm (FSCC, AWCC and event detection of the tip pair, the probe) and
+// each algorithm's probe result. The one place the processing is called.
 struct Processed {
-  awcc::ProcessResult dual;
-  awcc::EventResult events;
-  awcc::ProbePairing pairing;
-  std::vector<awcc::MultiTipResult> vectors;
+  awcc::ProcessResult result;
+  std::vector<awcc::ProbeResult> probes;  ///< in the options' order of algorithms
 };
 
-Processed process_probe(const synth::Synthesis& syn, const awcc::ProbeGeometry& geometry, const DualTipValidation& pair,
-                        const MultiTipValidateOptions& options, double record_length) {
+Processed process_probe(const awcc::BinarisedRecording& recording, const awcc::ProcessOptions& given,
+                        const MultiTipValidateOptions& options) {
   Processed out;
-  const auto& lead = syn.signals.at(pair.leading_tip);
-  const auto& trail = syn.signals.at(pair.trailing_tip);
-  out.dual = process_synthesis(lead, trail, processing_options(options.dual, pair.dx, pair.dy));
-  out.events = awcc::event_detection(lead, trail, pair.dx, options.events);
-  std::vector<std::vector<awcc::Crossing>> tips;
-  tips.reserve(syn.signals.size());
-  for (const auto& signal : syn.signals) tips.push_back(awcc::crossings(signal));
-  // Shen's pairing needs a first velocity: FSCC's of the dual tip, as pdp process gives it.
-  std::optional<double> first;
-  if (out.dual.fscc && out.dual.fscc->ok()) first = out.dual.fscc->velocity;
-  out.pairing = awcc::pair_probe(geometry, tips, options.events, first);
-  if (!out.pairing.ok()) return out;
   for (const auto algorithm : options.algorithms) {
-    auto o = options.multi_tip;
-    o.algorithm = algorithm;
-    out.vectors.push_back(awcc::multi_tip(geometry, out.pairing.bubbles, record_length, o));
+    auto o = given;
+    o.multi_tip_options.algorithm = algorithm;
+    o.events = out.probes.empty();  // one event detection: it does not depend on the algorithm
+    auto r = awcc::process_binarised(recording, o);
+    if (!r.probe) throw std::logic_error("validate_multi_tip: process_binarised gave no multi-tip result");
+    out.probes.push_back(*r.probe);
+    if (out.probes.size() == 1) out.result = std::move(r);
   }
   return out;
 }
@@ -157,25 +196,21 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
   }
   for (const auto& c : v.geometry.combinations()) v.conditioning = std::max(v.conditioning, c.conditioning());
 
-  // The dual tip: the leading tip and the first tip after it in the tips'
-  // order that lies downstream of it (pdp process's choice).
+  // The tip pair and the further tips' order: pdp process's choice
+  // (tip_pair_options: the leading tip and the first tip after it, in the
+  // tips' order, downstream of it), made before the synthesis so that a
+  // probe pdp refuses costs nothing.
+  const auto given = probe_options(v.geometry, options);
+  const auto resolved = awcc::tip_pair_options(given, synthetic_info(scene, tips.size()));
+  const auto channels = resolved.tip_channels();
   auto& d = v.dual;
-  d.leading_tip = v.geometry.leading();
-  const auto& lead_at = positions[d.leading_tip];
-  bool found = false;
-  for (const auto k : v.geometry.trailing_tips()) {
-    if (positions[k][0] > lead_at[0]) {
-      d.trailing_tip = k;
-      found = true;
-      break;
-    }
+  d.leading_tip = static_cast<std::size_t>(channels.at(0));
+  d.trailing_tip = static_cast<std::size_t>(channels.at(1));
+  d.dx = resolved.dx;
+  d.dy = resolved.dy;
+  if (d.leading_tip != v.geometry.leading() || channels.size() != tips.size()) {
+    throw std::logic_error("validate_multi_tip: pdp process chose another leading tip or dropped a tip");
   }
-  if (!found) {
-    throw std::invalid_argument(fmt::format("tips: no tip lies downstream of the leading {}",
-                                            v.geometry.tip_name(d.leading_tip)));
-  }
-  d.dx = positions[d.trailing_tip][0] - lead_at[0];
-  d.dy = std::hypot(positions[d.trailing_tip][1] - lead_at[1], positions[d.trailing_tip][2] - lead_at[2]);
 
   synth::SynthesisOptions so;
   so.bubble_truth = true;
@@ -192,12 +227,29 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
   const double realised_speed = norm(v.realised_velocity);
 
   start = std::chrono::steady_clock::now();
-  auto processed = process_probe(syn, v.geometry, d, options, scene.duration);
+  auto processed = process_probe(probe_recording(syn, resolved, v.geometry), given, options);
   v.seconds_process = seconds_since(start);
 
   const double tolerance = options.match_tolerance_samples / syn.signals.at(d.leading_tip).fs;
-  const auto& pairing = processed.pairing;
-  v.pairing_fates = pairing.fates;
+  const auto& probe = processed.probes.front();
+  if (probe.channels != channels) {
+    throw std::logic_error("validate_multi_tip: process_binarised ordered the tips otherwise than tip_pair_options");
+  }
+  const auto& pairing = probe.pairing;
+  v.pairing_status = pairing.status;
+  v.pairing_message = pairing.message;
+  // The processing's trailing tips are its tips 1, 2, ... (channels[1],
+  // channels[2], ...); the study's are the scene's tips in their order.
+  // processed_at[k]: the processing's position of the study's trailing tip k.
+  const auto& trailing = v.geometry.trailing_tips();
+  std::vector<std::size_t> processed_at(trailing.size());
+  for (std::size_t k = 0; k < trailing.size(); ++k) {
+    const auto it = std::find(channels.begin() + 1, channels.end(), static_cast<int>(trailing[k]));
+    processed_at[k] = static_cast<std::size_t>(it - channels.begin()) - 1;
+  }
+  for (std::size_t k = 0; k < trailing.size() && pairing.fates.size() == trailing.size(); ++k) {
+    v.pairing_fates.push_back(pairing.fates[processed_at[k]]);
+  }
   const auto& leading = pairing.bubbles.leading;
   // Without a pairing (Shen's without a first velocity) there are no
   // bubbles to score; the leading tip's crossings still count.
@@ -208,7 +260,6 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
 
   // The probe's pairing holds every leading crossing in order (pair_probe):
   // the rows of its leading bubbles are the crossings' rows.
-  const auto& trailing = v.geometry.trailing_tips();
   // A leading bubble with a wrong partner at any trailing tip (score_partners' rule).
   std::vector<bool> mispaired(leading.size(), false);
   if (pairing.ok()) {
@@ -218,7 +269,7 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
     std::vector<std::optional<double>> fronts(leading.size());
     for (std::size_t k = 0; k < trailing.size(); ++k) {
       for (std::size_t h = 0; h < leading.size(); ++h) {
-        const auto& p = pairing.bubbles.partner(h, k);
+        const auto& p = pairing.bubbles.partner(h, processed_at[k]);
         fronts[h] = p ? std::optional(p->front) : std::nullopt;
         if (!p) continue;
         const auto* at_tip = rows[h] ? &table.pierce(*rows[h], trailing[k]) : nullptr;
@@ -229,8 +280,11 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
     }
   }
 
-  for (auto& result : processed.vectors) {
+  for (auto& processed_probe : processed.probes) {
+    auto& result = processed_probe.vectors;
     VectorValidation a;
+    a.quality = processed_probe.quality;
+    a.quality_reason = processed_probe.quality_reason;
     std::vector<double> speed, vector, diameter;
     awcc::Vec3 selected{};
     double selected_weight = 0.0, weight = 0.0, mispaired_weight = 0.0;
@@ -273,14 +327,17 @@ MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipV
     a.interfacial_area = {result.interfacial_area, v.expected_interfacial_area, v.expected_interfacial_area};
     a.interfacial_area_realised = {result.interfacial_area, v.realised_interfacial_area.value_or(0.0),
                                    v.realised_interfacial_area.value_or(0.0)};
+    a.interfacial_area_paired = {result.interfacial_area_paired, v.expected_interfacial_area,
+                                 v.expected_interfacial_area};
     a.result = std::move(result);
     v.algorithms.push_back(std::move(a));
   }
 
   // The dual tip: ED's partners and per-bubble velocities against the truth,
   // ED's and AWCC's moments against the realised streamwise ones.
-  d.events = std::move(processed.events);
-  d.processed = std::move(processed.dual);
+  if (!processed.result.events) throw std::logic_error("validate_multi_tip: process_binarised ran no event detection");
+  d.events = *processed.result.events;
+  d.processed = std::move(processed.result);
   {
     const auto& ed = d.events.bubbles;
     const auto ed_rows = ed.size() == lead_crossings.size() ? rows : std::vector<std::optional<std::size_t>>(ed.size());
@@ -349,7 +406,8 @@ std::string multi_tip_report(const MultiTipValidation& v) {
   out += fmt::format("truth: {} bubbles pierced a tip; {} leading bubbles, {} matched to their truth row\n",
                      v.truth_bubbles, v.leading_bubbles, v.leading_matched);
   out += fmt::format("pairing (leading tip with each trailing tip, {}):\n",
-                     v.pairing.empty() ? "refused" : "against the truth");
+                     v.pairing_status == awcc::EventStatus::ok ? std::string("against the truth")
+                                                               : "refused: " + v.pairing_message);
   for (std::size_t k = 0; k < v.pairing.size(); ++k) {
     out += fmt::format("  {}: {}\n", g.tip_name(g.trailing_tips()[k]), partner_line(v.pairing[k]));
   }
@@ -358,6 +416,8 @@ std::string multi_tip_report(const MultiTipValidation& v) {
     const auto& r = a.result;
     out += fmt::format("{}: status {}{}\n", awcc::to_string(r.options.algorithm), awcc::to_string(r.status),
                        r.ok() ? std::string() : ": " + r.message);
+    out += fmt::format("  pdp's quality: {}{}\n", awcc::to_string(a.quality),
+                       a.quality == awcc::AwccQuality::ok ? std::string() : " (" + a.quality_reason + ")");
     out += fmt::format("  bubbles: {} leading, {} solved, {} censored, {} too few tips, {} ill-conditioned, {} "
                        "degenerate, {} outlier cutoff\n",
                        r.bubbles_total, r.bubbles_accepted, r.count(awcc::VectorFate::censored),
@@ -380,6 +440,9 @@ std::string multi_tip_report(const MultiTipValidation& v) {
       if (v.realised_interfacial_area) {
         compared_row(out, "IAC vs realised (1/m)", a.interfacial_area_realised, 1.0, "{:.2f}");
       }
+    }
+    if (a.interfacial_area_paired.value) {
+      compared_row(out, "IAC of the paired (1/m)", a.interfacial_area_paired, 1.0, "{:.2f}");
     }
   }
   const auto& d = v.dual;
@@ -450,7 +513,9 @@ json multi_tip_to_json(const MultiTipValidation& v) {
     }
     per_tip.push_back(p);
   }
-  out["pairing"] = {{"leading_bubbles", v.leading_bubbles},
+  out["pairing"] = {{"status", awcc::to_string(v.pairing_status)},
+                    {"reason", v.pairing_status == awcc::EventStatus::ok ? json(nullptr) : json(v.pairing_message)},
+                    {"leading_bubbles", v.leading_bubbles},
                     {"leading_matched", v.leading_matched},
                     {"tips", per_tip},
                     {"all", partner_json(v.pairing_total)}};
@@ -479,7 +544,10 @@ json multi_tip_to_json(const MultiTipValidation& v) {
         {"mispaired_weight_share", finite(a.mispaired_weight_share)},
         {"turbulence_intensity", tu},
         {"interfacial_area", compared_json(a.interfacial_area)},
-        {"interfacial_area_vs_realised", compared_json(a.interfacial_area_realised)}};
+        {"interfacial_area_vs_realised", compared_json(a.interfacial_area_realised)},
+        {"interfacial_area_paired", compared_json(a.interfacial_area_paired)},
+        {"quality", awcc::to_string(a.quality)},
+        {"quality_reason", a.quality == awcc::AwccQuality::ok ? json(nullptr) : json(a.quality_reason)}};
   }
   out["algorithms"] = algorithms;
   const auto& d = v.dual;
@@ -583,6 +651,17 @@ std::string multi_tip_repeats_report(const std::vector<MultiTipValidation>& runs
     }
     out += fmt::format("{:<36}{:>8}{:>10.3f} %{:>14.3f} % to {:.3f} %\n", e.name, m.count, 100.0 * m.mean,
                        100.0 * m.lower, 100.0 * m.upper);
+  }
+  // pdp's verdict per algorithm: an error above is only unflagged where the runs were ok.
+  const std::size_t algorithms = runs.empty() ? 0 : runs.front().algorithms.size();
+  for (std::size_t a = 0; a < algorithms; ++a) {
+    std::array<int, 3> levels{};
+    for (const auto& r : runs) {
+      if (a < r.algorithms.size()) ++levels.at(static_cast<std::size_t>(r.algorithms[a].quality));
+    }
+    out += fmt::format("{} quality: {} ok, {} low, {} insufficient\n",
+                       awcc::to_string(runs.front().algorithms[a].result.options.algorithm), levels[0], levels[1],
+                       levels[2]);
   }
   return out;
 }

@@ -37,8 +37,15 @@
 //    Tu_x. For a sphere in uniform motion the centre lag is S . v / |v|^2, so
 //    u_h = |v|^2 / v_x: the per-bubble error of ED holds the transverse
 //    velocity as well as timing and mis-pairing.
-// Both velocity algorithms are run on the one pairing (Tian et al. 2015 gives
-// no size, normal or interfacial area).
+//  - pdp's own verdict on each algorithm's vectors (ProbeResult::quality and
+//    quality_reason): a wrong result is only a bug of pdp when it is not
+//    flagged, so a validation reports both.
+// The processing is pdp process's: the synthetic signals become a
+// BinarisedRecording of the declared probe (its tips' positions, the leading
+// tip the most upstream one), processed by awcc::process_binarised with
+// multi-tip processing and event detection on, once per velocity algorithm
+// (the pairing does not depend on it, so both are scored on one pairing;
+// Tian et al. 2015 gives no size or normals).
 
 #include <array>
 #include <cstddef>
@@ -61,9 +68,9 @@
 namespace study {
 
 struct MultiTipValidateOptions {
-  /// The pairing of the leading tip with every trailing tip and the dual
-  /// tip's event detection: one pairing rule for both, so that ED and the
-  /// vectors are compared on the same bubbles' partners.
+  /// The pairing's options (the probe's joint pairing and the dual tip's
+  /// event detection both read them, as in pdp process; their roc and
+  /// weighting are `dual.awcc`'s, ProcessOptions::effective_event_options).
   awcc::EventOptions events;
   /// The solvers' options; run once per algorithm in `algorithms` (its own
   /// `algorithm` is overridden).
@@ -134,8 +141,15 @@ struct VectorValidation {
   std::int64_t accepted_mispaired = 0;
   double mispaired_weight_share = 0.0;
   std::array<Compared, 3> turbulence_intensity;  ///< relative
-  Compared interfacial_area;           ///< 1/m, against 6 c / d_b (relative)
-  Compared interfacial_area_realised;  ///< 1/m, against the leading tip's realised IAC (relative)
+  Compared interfacial_area;           ///< 1/m, all bubbles' estimator, against 6 c / d_b (relative)
+  Compared interfacial_area_realised;  ///< 1/m, the same against the leading tip's realised IAC (relative)
+  /// 1/m, the sum over the accepted bubbles (Shen & Nakamura only), against 6 c / d_b.
+  Compared interfacial_area_paired;
+  /// pdp's verdict on these vectors (ProbeResult::quality): low or
+  /// insufficient says a user is warned; a large error with quality ok is
+  /// what the validation exists to find.
+  awcc::AwccQuality quality = awcc::AwccQuality::insufficient;
+  std::string quality_reason;  ///< why not ok
 };
 
 /// The dual tip: event detection and AWCC on one tip pair.
@@ -149,7 +163,9 @@ struct DualTipValidation {
   awcc::Summary velocity_error; ///< per paired bubble (after the cutoff), |u_h - v_x| / |v_x|
   Compared ed_velocity, ed_turbulence_intensity;      ///< against the realised u_x and Tu_x (relative)
   Compared awcc_velocity, awcc_turbulence_intensity;  ///< same, AWCC (value only when quality is ok or low)
-  awcc::ProcessResult processed;  ///< pdp process's dual-tip processing (FSCC, AWCC)
+  /// pdp process's processing of the probe (the first algorithm's): FSCC,
+  /// AWCC and event detection of the pair, `probe` the multi-tip result.
+  awcc::ProcessResult processed;
 };
 
 struct MultiTipValidation {
@@ -168,8 +184,11 @@ struct MultiTipValidation {
   /// The probe's pairing, per trailing tip (order of trailing_tips()), and over all.
   std::vector<PartnerScore> pairing;
   PartnerScore pairing_total;
-  /// Event detection's fate counts per trailing tip (ProbePairing::fates).
+  /// The pairing's fate counts per trailing tip (ProbePairing::fates), and
+  /// its status and message (refused without a first velocity).
   std::vector<std::array<std::int64_t, awcc::bubble_fate_count>> pairing_fates;
+  awcc::EventStatus pairing_status = awcc::EventStatus::ok;
+  std::string pairing_message;
   std::vector<VectorValidation> algorithms;  ///< in the options' order
   DualTipValidation dual;
   double seconds_synth = 0.0, seconds_process = 0.0;
@@ -177,7 +196,9 @@ struct MultiTipValidation {
 
 /// Synthesises `scene` (four or more tips; throws std::invalid_argument
 /// naming the tips otherwise, awcc::OptionError when the geometry is
-/// refused) with the truth per bubble, processes it and scores it.
+/// refused, awcc::InputError when pdp process refuses the probe, e.g. no tip
+/// downstream of the leading one) with the truth per bubble, processes it
+/// and scores it.
 MultiTipValidation validate_multi_tip(const synth::Scene& scene, const MultiTipValidateOptions& options = {});
 
 /// The readable report: geometry, pairing, per-bubble errors, the statistics
@@ -192,7 +213,8 @@ std::string multi_tip_report(const MultiTipValidation& v);
 /// tip's fates); algorithms (by name: status, reason, fates, speed_error,
 /// vector_error and diameter_error as count/median/p90, mean_velocity and
 /// turbulence_intensity as [x, y, z] of value/truth/error,
-/// interfacial_area and interfacial_area_vs_realised); dual_tip (tips, dx,
+/// interfacial_area, interfacial_area_vs_realised and interfacial_area_paired,
+/// quality and quality_reason); dual_tip (tips, dx,
 /// dy, ED's status, pairing and per-bubble velocity_error, ED's and AWCC's
 /// velocity and turbulence_intensity as value/truth/error); run times.
 /// Errors are null where the method gave no value.
@@ -208,6 +230,7 @@ std::vector<MultiTipValidation> validate_multi_tip_repeats(const synth::Scene& s
 /// error fraction, each algorithm's median per-bubble speed error, mean
 /// components (over the realised speed), Tu_x, Tu_y, Tu_z and IAC (against
 /// 6 c / d_b), and ED's and AWCC's u_x and Tu_x. Relative, as fractions.
+/// Each algorithm's quality is counted in the report (runs of quality ok).
 std::vector<ErrorSummary> summarise_multi_tip(const std::vector<MultiTipValidation>& runs);
 std::string multi_tip_repeats_report(const std::vector<MultiTipValidation>& runs,
                                      const std::vector<ErrorSummary>& summary, std::uint64_t seed);
