@@ -7,6 +7,10 @@
 
 namespace awcc {
 
+double correlation_peak_velocity(double mean, double turbulence_intensity) {
+  return mean * (1.0 + std::sqrt(1.0 + 8.0 * turbulence_intensity * turbulence_intensity)) / 2.0;
+}
+
 namespace {
 
 // The 95 % half-width of estimate - reference: the half-widths of the two
@@ -37,23 +41,33 @@ std::optional<MethodsComparison> compare_methods(const FsccResult& fscc, const A
 namespace {
 
 std::optional<EventsComparison> against_reference(double velocity, const Interval95& velocity_ci95,
-                                                  const ProcessResult& r) {
+                                                  double turbulence_intensity, const ProcessResult& r) {
   EventsComparison c;
+  c.tolerance = peak_model_tolerance;
   c.events = velocity;
   c.events_ci95 = velocity_ci95;
   if (r.fscc && r.fscc->ok() && r.fscc->velocity_ci95) {
     c.reference = "FSCC";
     c.reference_velocity = r.fscc->velocity;
     c.reference_ci95 = *r.fscc->velocity_ci95;
+    const double tu = std::clamp(turbulence_intensity, 0.0, peak_model_tu_max);
+    c.band_lower = c.reference_velocity / correlation_peak_velocity(1.0, tu);
   } else if (r.awcc && r.awcc->ok() && r.awcc->quality == AwccQuality::ok) {
     c.reference = "AWCC";
     c.reference_velocity = r.awcc->velocity;
     c.reference_ci95 = r.awcc->velocity_ci95;
+    c.band_lower = c.reference_velocity;
   } else {
     return std::nullopt;
   }
-  c.difference = c.events - c.reference_velocity;
-  c.allowed = allowed_difference(c.events, c.events_ci95, c.reference_velocity, c.reference_ci95);
+  c.band_upper = c.reference_velocity;
+  // The reference's interval carried to the band's end the mean faces.
+  const bool below = velocity < c.band_lower;
+  const double end = below ? c.band_lower : c.band_upper;
+  const double scale = end / c.reference_velocity;
+  const Interval95 end_ci{c.reference_ci95.lower * scale, c.reference_ci95.upper * scale};
+  c.difference = below ? velocity - c.band_lower : (velocity > c.band_upper ? velocity - c.band_upper : 0.0);
+  c.allowed = c.difference == 0.0 ? 0.0 : allowed_difference(velocity, velocity_ci95, end, end_ci);
   c.relative = std::abs(c.difference) / c.reference_velocity;
   return c;
 }
@@ -62,12 +76,12 @@ std::optional<EventsComparison> against_reference(double velocity, const Interva
 
 std::optional<EventsComparison> compare_events(const EventResult& events, const ProcessResult& r) {
   if (!events.ok()) return std::nullopt;
-  return against_reference(events.velocity, events.velocity_ci95, r);
+  return against_reference(events.velocity, events.velocity_ci95, events.turbulence_intensity, r);
 }
 
 std::optional<EventsComparison> compare_multi_tip(const MultiTipResult& vectors, const ProcessResult& r) {
   if (!vectors.ok()) return std::nullopt;
-  return against_reference(vectors.velocity[0], vectors.velocity_ci95[0], r);
+  return against_reference(vectors.velocity[0], vectors.velocity_ci95[0], vectors.turbulence_intensity[0], r);
 }
 
 namespace {
@@ -147,13 +161,15 @@ std::optional<Warning> events_disagree(const ProcessResult& r) {
   return Warning{
       Flag::events_disagree,
       fmt::format("event detection's velocity {:.3f} m/s (95 % sampling interval {:.3f}-{:.3f}, {} paired bubbles of "
-                  "{}) and {}'s {:.3f} m/s ({:.3f}-{:.3f}) differ by {:.0f} % ({} {}), more than their sampling "
-                  "intervals allow together ({:.3f} m/s): the pairing ({}) is biased here (partners taken from later, "
-                  "unrelated bubbles where bubbles are sparse or the tips offset); use {}'s velocity, and event "
-                  "detection's per-bubble table only to see the pairing's fates",
-                  c->events, c->events_ci95.lower, c->events_ci95.upper, e.bubbles_paired, e.bubbles_complete,
-                  c->reference, c->reference_velocity, c->reference_ci95.lower, c->reference_ci95.upper,
-                  100.0 * c->relative, c->difference < 0.0 ? "below" : "above", c->reference, c->allowed,
+                  "{}; Tu {:.2f}) lies {:.0f} % of {}'s {:.3f} m/s ({:.3f}-{:.3f}) {} the band its peak allows "
+                  "({:.3f}-{:.3f}), more than their sampling intervals allow together ({:.3f} m/s) and {:.0f} %: the "
+                  "pairing ({}) is biased here (partners taken from later, unrelated bubbles where bubbles are sparse "
+                  "or the tips offset); use {}'s velocity, and event detection's per-bubble table only to see the "
+                  "pairing's fates",
+                  e.velocity, e.velocity_ci95.lower, e.velocity_ci95.upper, e.bubbles_paired, e.bubbles_complete,
+                  e.turbulence_intensity, 100.0 * c->relative, c->reference, c->reference_velocity,
+                  c->reference_ci95.lower, c->reference_ci95.upper, c->difference < 0.0 ? "below" : "above",
+                  c->band_lower, c->band_upper, c->allowed, 100.0 * c->tolerance,
                   to_string(e.options.pairing), c->reference)};
 }
 

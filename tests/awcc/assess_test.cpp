@@ -359,6 +359,47 @@ TEST(EventsDisagree, TheWarningIsInTheRowsListWithItsFlag) {
   EXPECT_TRUE(std::none_of(agree.begin(), agree.end(), [](const awcc::Warning& x) { return x.flag == awcc::Flag::events_disagree; }));
 }
 
+TEST(EventsDisagree, TheMeanIsCarriedToFsccsPeakAndADifferenceWithinTheModelsToleranceCounts) {
+  // The peak of the lag density for u ~ N(U, (Tu U)^2): U (1 + sqrt(1 + 8 Tu^2)) / 2.
+  EXPECT_DOUBLE_EQ(awcc::correlation_peak_velocity(2.0, 0.0), 2.0);
+  EXPECT_DOUBLE_EQ(awcc::correlation_peak_velocity(1.0, 0.3), (1.0 + std::sqrt(1.72)) / 2.0);
+  // Brute force: the density's maximum over a fine lag grid (dx = 1, U = 1, Tu = 0.3).
+  double best_tau = 0.0, best = -1.0;
+  for (int k = 1; k < 200000; ++k) {
+    const double tau = 0.5 + k * 1e-5;
+    const double z = (1.0 / tau - 1.0) / 0.3;
+    const double p = std::exp(-0.5 * z * z) / (tau * tau);
+    if (p > best) best = p, best_tau = tau;
+  }
+  EXPECT_NEAR(1.0 / best_tau, awcc::correlation_peak_velocity(1.0, 0.3), 1e-4);
+  // A mean of 2 m/s at Tu 0.3 (narrow intervals) is expected in [u_F / g,
+  // u_F], g = 1.1557: inside it at either end; above it by 11 % of u_F
+  // (u_F = 1.8) a disagreement, by 8 % (u_F = 1.85) within the tolerance;
+  // below it by 7 % (band from 2.18) not, by 17 % (band from 2.5) it is.
+  const double g = awcc::correlation_peak_velocity(1.0, 0.3);
+  auto narrow_fscc = [](double v) {
+    auto f = fscc_at_2();
+    f.velocity = v;
+    f.velocity_ci95 = awcc::Interval95{v - 1e-3, v + 1e-3};
+    return f;
+  };
+  auto e = events_at(2.0, {1.999, 2.001});
+  e.turbulence_intensity = 0.3;
+  auto against = [&](double fscc) { return *awcc::compare_events(e, row(narrow_fscc(fscc), awcc_at(2.0))); };
+  EXPECT_EQ(against(2.0).difference, 0.0);
+  EXPECT_FALSE(against(2.0).disagree());
+  EXPECT_NEAR(against(2.0 * g).band_lower, 2.0, 1e-12);
+  EXPECT_FALSE(against(2.0 * g).disagree());
+  EXPECT_TRUE(against(1.8).disagree());
+  EXPECT_FALSE(against(1.85).disagree());
+  EXPECT_FALSE(against(2.18 * g).disagree());
+  EXPECT_TRUE(against(2.5 * g).disagree());
+  // A Tu beyond 0.3 (a mis-paired record's) does not widen the band.
+  e.turbulence_intensity = 1.5;
+  EXPECT_NEAR(against(2.5 * g).band_lower, 2.5, 1e-12);
+  EXPECT_TRUE(against(2.5 * g).disagree());
+}
+
 TEST(MultiTipDoubtful, TheStreamwiseComponentAgainstFsccAndTheQualityInTheRowsList) {
   awcc::MultiTipResult v;
   v.status = awcc::MultiTipStatus::ok;
