@@ -4,6 +4,7 @@
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/json_text.hpp"
+#include "awcc/options.hpp"
 #include "study/multi_tip_validate.hpp"
 #include "study/validate.hpp"
 #include "terminal.hpp"
@@ -16,6 +17,8 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
   add_config_option(command);
   add_scene_options(cmd, o.scene);
   add_method_options(cmd, o.methods);
+  o.bubbles.add(cmd, awcc::event_option_fields(), awcc::EventOptions{}, "Event detection (a probe of four or more tips)");
+  o.bubbles.add(cmd, awcc::multi_tip_option_fields(), awcc::MultiTipOptions{}, "Multi-tip probes");
   cmd->add_option("--repeat", o.repeat, "runs with different seeds; means and 95 % intervals of every error")
       ->check(CLI::Range(1, 100000))->capture_default_str();
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"));
@@ -31,6 +34,14 @@ int run_multi_tip_validate(const synth::Scene& scene, const ValidateOptions& o) 
   std::vector<study::MultiTipValidation> runs;
   try {
     apply_method_options(o.methods, options.dual);
+    const auto settings = o.bubbles.settings();
+    std::vector<bool> used(settings.size(), false);
+    awcc::apply_settings(awcc::event_option_fields(), std::span<const awcc::OptionSetting>(settings), options.events,
+                         used);
+    awcc::apply_settings(awcc::multi_tip_option_fields(), std::span<const awcc::OptionSetting>(settings),
+                         options.multi_tip, used);
+    options.events.validate().throw_if_failed();
+    options.multi_tip.validate().throw_if_failed();
     Progress progress("validating");
     runs = study::validate_multi_tip_repeats(scene, options, o.repeat, [&](double fraction) { progress(fraction); });
   } catch (const std::exception& e) {
@@ -65,6 +76,13 @@ int run_validate(const ValidateOptions& o) {
     return report_error(e);
   }
   if (scene.probe_tips().size() >= 4) return run_multi_tip_validate(scene, o);
+  if (!o.bubbles.settings().empty()) {
+    return report_error(awcc::OptionError(
+        fmt::format("--{}: event detection's and the multi-tip options apply to a scene of four or more tips; this "
+                    "scene has {}",
+                    o.bubbles.settings().front().name, scene.probe_tips().size()),
+        o.bubbles.settings().front().name));
+  }
   study::RunOptions options;
   std::vector<study::RunResult> runs;
   try {

@@ -12,6 +12,7 @@ namespace pdp {
 struct ValidateOptions {
   SceneCli scene;
   OptionSet methods;
+  OptionSet bubbles;        ///< event detection's and the multi-tip solvers' options (a probe of four or more tips)
   int repeat = 1;           ///< seeds (run i uses a seed derived from the scene seed and i)
   std::string json;         ///< JSON output file
 };
