@@ -394,6 +394,46 @@ const OptionField<A> kAwcc[] = {
      [](const A& o) { return name_of(o.path, kPaths); }},
 };
 
+using PF = ProfileFlowOptions;
+const OptionField<PF> kFlow[] = {
+    {"discharge", "m2/s",
+     "profile: the discharge per unit width the lab set (e.g. 0.2m2/s, 150l/s/m), for the continuity error "
+     "(q_w - q) / q; none: no check",
+     [](PF& o, std::string_view t) {
+       if (t == "none") {
+         o.discharge.reset();
+       } else {
+         o.discharge = quantity(t, Dimension::discharge_per_width);
+       }
+     },
+     [](const PF& o) {
+       return o.discharge ? format_quantity(*o.discharge, Dimension::discharge_per_width) : std::string("none");
+     }},
+    {"invert", "",
+     "profile: the void fraction from the invert to the first position, which no probe reaches: held (the first "
+     "reading) | zero | left-out",
+     [](PF& o, std::string_view t) { o.invert = choice(t, invert_rules); },
+     [](const PF& o) { return name_of(o.invert); }},
+    {"depth-levels", "-", "profile: void fractions of the characteristic depths reported besides Y90, e.g. 0.5,0.95",
+     [](PF& o, std::string_view t) {
+       o.levels.clear();
+       if (t == "none") return;
+       for (const auto& cell : split_cells(t)) o.levels.push_back(quantity(cell, Dimension::dimensionless));
+     },
+     [](const PF& o) {
+       if (o.levels.empty()) return std::string("none");
+       std::string out;
+       for (double l : o.levels) out += fmt::format("{}{:g}", out.empty() ? "" : ",", l);
+       return out;
+     }},
+    {"flow-draws", "-", "profile: Monte Carlo draws of the profile quantities' 95 % intervals",
+     [](PF& o, std::string_view t) { o.draws = static_cast<int>(whole(t, 100, 10000000)); },
+     [](const PF& o) { return std::to_string(o.draws); }},
+    {"flow-seed", "-", "profile: the Monte Carlo seed (the same seed, the same intervals)",
+     [](PF& o, std::string_view t) { o.seed = static_cast<std::uint64_t>(whole(t, 0, 9007199254740991LL)); },
+     [](const PF& o) { return std::to_string(o.seed); }},
+};
+
 using M = MultiTipOptions;
 const OptionField<M> kMultiTip[] = {
     {"velocity-algorithm", "",
@@ -576,6 +616,8 @@ std::span<const OptionField<ProcessOptions>> probe_option_fields() {
 std::span<const OptionField<StructureOptions>> structure_option_fields() { return kStructure; }
 std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields() { return kMultiTip; }
 std::span<const OptionField<EventOptions>> event_option_fields() { return kEvents; }
+std::span<const OptionField<ProfileFlowOptions>> profile_flow_option_fields() { return kFlow; }
+
 
 std::span<const PresetSetting> preset_settings(std::string_view name) {
   if (name == "felder") return kFelder;
@@ -648,6 +690,15 @@ ProcessOptions process_options(std::span<const OptionSetting> given) {
   if (!p.allow_unusual) p.implausible().throw_if_failed();
   p.validate().throw_if_failed();
   return p;
+}
+
+ProfileFlowOptions profile_flow_options(std::span<const OptionSetting> settings) {
+  std::vector<bool> used(settings.size(), false);
+  ProfileFlowOptions out;
+  apply_settings(profile_flow_option_fields(), settings, out, used);
+  refuse_unknown(settings, used, "a profile's flow quantities");
+  out.validate().throw_if_failed();
+  return out;
 }
 
 }  // namespace awcc

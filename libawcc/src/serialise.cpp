@@ -680,6 +680,69 @@ json multi_tip_json(const ProbeResult& p) {
 
 }  // namespace
 
+namespace {
+
+json quantity_json(const FlowQuantity& q) {
+  return json{{"value", optional(q.value)},
+              {"ci95", q.ci95 ? ci(*q.ci95) : json(nullptr)},
+              {"reason", q.reason.empty() ? json(nullptr) : json(q.reason)},
+              {"draws_defined", q.draws_defined}};
+}
+
+json depth_json(const CharacteristicDepth& point, const FlowQuantity& depth) {
+  json out = quantity_json(depth);
+  out["level"] = point.level;
+  out["status"] = to_string(point.status);
+  out["position"] = optional(point.y);
+  if (!point.message.empty()) out["reason"] = point.message;
+  return out;
+}
+
+json fit_json(const ConcentrationFit& f) {
+  json out = quantity_json(f.diffusivity);
+  out["residual"] = optional(f.residual);
+  out["points"] = f.points;
+  out["k_prime"] = f.curve ? json(f.curve->k_prime()) : json(nullptr);
+  return out;
+}
+
+}  // namespace
+
+json to_json(const ProfileFlowResult& f) {
+  json levels = json::array();
+  for (const auto& l : f.levels) levels.push_back(depth_json(l.point, l.depth));
+  json rows = json::array();
+  for (const auto& r : f.rows) {
+    rows.push_back(json{{"name", r.name},
+                        {"position", r.y},
+                        {"void_fraction", r.c},
+                        {"velocity", optional(r.u)},
+                        {"velocity_source", r.u ? json(to_string(r.u_source)) : json(nullptr)}});
+  }
+  json power{{"n", quantity_json(f.power_law.n)},
+             {"u90", quantity_json(f.power_law.u90)},
+             {"residual", optional(f.power_law.residual)},
+             {"points", f.power_law.points}};
+  return json{{process_key::status, to_string(f.status)},
+              {process_key::reason, f.message.empty() ? json(nullptr) : json(f.message)},
+              {"notes", f.notes},
+              {"invert", to_string(f.options.invert)},
+              {"discharge", optional(f.options.discharge)},
+              {"draws", f.draws},
+              {"seed", f.options.seed},
+              {"y90", depth_json(f.y90_point, f.y90)},
+              {"levels", levels},
+              {"c_mean", quantity_json(f.c_mean)},
+              {"clear_water_depth", quantity_json(f.clear_water_depth)},
+              {"power_law", power},
+              {"water_discharge", quantity_json(f.water_discharge)},
+              {"air_discharge", quantity_json(f.air_discharge)},
+              {"continuity_error", quantity_json(f.continuity_error)},
+              {"smooth_chute", fit_json(f.smooth_chute)},
+              {"stepped_chute", fit_json(f.stepped_chute)},
+              {"rows", rows}};
+}
+
 json to_json(const ProcessResult& r) {
   json tips = json::array();
   for (const auto& t : r.tips) tips.push_back(tip_json(t));

@@ -41,6 +41,8 @@ std::vector<Unit> units_of(Dimension dimension) {
       return {{"m2/s", 1.0}, {"mm2/s", 1e-6}};
     case Dimension::surface_tension:
       return {{"N/m", 1.0}, {"mN/m", 1e-3}};
+    case Dimension::discharge_per_width:
+      return {{"m2/s", 1.0}, {"m3/s/m", 1.0}, {"l/s/m", 1e-3}, {"L/s/m", 1e-3}};
   }
   return {};
 }
@@ -57,6 +59,7 @@ std::string_view dimension_name(Dimension dimension) {
     case Dimension::density: return "a density";
     case Dimension::kinematic_viscosity: return "a kinematic viscosity";
     case Dimension::surface_tension: return "a surface tension";
+    case Dimension::discharge_per_width: return "a discharge per unit width";
   }
   return "a quantity";
 }
@@ -73,6 +76,7 @@ std::pair<std::string_view, std::string_view> usual_units(Dimension dimension) {
     case Dimension::density: return {"kg/m3", "g/cm3"};
     case Dimension::kinematic_viscosity: return {"m2/s", "mm2/s"};
     case Dimension::surface_tension: return {"N/m", "mN/m"};
+    case Dimension::discharge_per_width: return {"m2/s", "l/s/m"};
     case Dimension::dimensionless: break;
   }
   return {"", ""};

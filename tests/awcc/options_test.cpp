@@ -358,3 +358,60 @@ TEST(ProcessOptions, ASwitchIsWrittenOnOrOffAndTakesItsAliases) {
   const std::vector<OptionSetting> bad{{"roc", "maybe", ""}};
   EXPECT_EQ(std::string(error_of(bad).what()), "roc: 'maybe' is not on or off");
 }
+
+TEST(ProcessOptions, TheMethodNamesEachCombinationAndReadsItBack) {
+  // Every combination of the fields is written so that it reads back the same.
+  for (const bool fscc : {false, true}) {
+    for (const bool awcc : {false, true}) {
+      for (const bool events : {false, true}) {
+        for (const auto multi : {awcc::MultiTipChoice::automatic, awcc::MultiTipChoice::off, awcc::MultiTipChoice::on}) {
+          awcc::ProcessOptions o;
+          o.fscc = fscc;
+          o.awcc = awcc;
+          o.events = events;
+          o.multi_tip = multi;
+          const auto fields = awcc::process_option_fields();
+          const auto field = std::find_if(fields.begin(), fields.end(),
+                                           [](const auto& f) { return f.name == "method"; });
+          const std::string text = field->format(o);
+          awcc::ProcessOptions back;
+          field->parse(back, text);
+          EXPECT_EQ(back.fscc, fscc) << text;
+          EXPECT_EQ(back.awcc, awcc) << text;
+          EXPECT_EQ(back.events, events) << text;
+          EXPECT_EQ(back.multi_tip, multi) << text;
+        }
+      }
+    }
+  }
+  // The names a user types: auto is the default; events and multi-tip run FSCC and AWCC beside them.
+  EXPECT_EQ(awcc::process_options({}).multi_tip, awcc::MultiTipChoice::automatic);
+  const auto events = awcc::process_options(std::vector<awcc::OptionSetting>{{"method", "events", ""}});
+  EXPECT_TRUE(events.events && events.fscc && events.awcc);
+  EXPECT_EQ(events.multi_tip, awcc::MultiTipChoice::off);
+  const auto fewer = awcc::process_options(std::vector<awcc::OptionSetting>{{"method", "fscc+multi-tip", ""}});
+  EXPECT_TRUE(fewer.fscc && !fewer.awcc && fewer.multi_tip == awcc::MultiTipChoice::on);
+  EXPECT_THROW((void)awcc::process_options(std::vector<awcc::OptionSetting>{{"method", "fscc+awcc", ""}}),
+               awcc::OptionError);
+}
+
+TEST(ProfileFlowOptions, EachDeclaredDefaultReadsBackAndADischargeNeedsItsUnit) {
+  const awcc::ProfileFlowOptions defaults;
+  for (const auto& f : awcc::profile_flow_option_fields()) {
+    awcc::ProfileFlowOptions o;
+    f.parse(o, f.format(defaults));
+    EXPECT_EQ(f.format(o), f.format(defaults)) << f.name;
+  }
+  const auto o = awcc::profile_flow_options(std::vector<awcc::OptionSetting>{
+      {"discharge", "150l/s/m", ""}, {"invert", "zero", ""}, {"depth-levels", "0.5,0.8", ""}});
+  ASSERT_TRUE(o.discharge);
+  EXPECT_DOUBLE_EQ(*o.discharge, 0.15);
+  EXPECT_EQ(o.invert, awcc::InvertRule::zero);
+  EXPECT_EQ(o.levels, (std::vector<double>{0.5, 0.8}));
+  try {
+    (void)awcc::profile_flow_options(std::vector<awcc::OptionSetting>{{"discharge", "0.2", ""}});
+    ADD_FAILURE() << "a discharge without a unit was accepted";
+  } catch (const awcc::OptionError& e) {
+    EXPECT_EQ(e.quantity(), "discharge");
+  }
+}

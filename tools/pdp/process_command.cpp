@@ -32,6 +32,8 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   o.library.add(cmd, awcc::structure_option_fields(), defaults.structure, "Structure (PDFs, clusters, arrivals)");
   o.library.add(cmd, awcc::event_option_fields(), defaults.event_options, "Event detection (method events)");
   o.library.add(cmd, awcc::multi_tip_option_fields(), defaults.multi_tip_options, "Multi-tip probes");
+  o.flow.add(cmd, awcc::profile_flow_option_fields(), awcc::ProfileFlowOptions{},
+             "Profile quantities (several recordings with positions: Y90, C_mean, discharge, models)");
   cmd->add_option("--preset", o.preset,
                   "felder: Felder's program (his threshold rule, 15 segments of raw voltages, his lags, scale rules, "
                   "bins and defects; FSCC only); options given as well override it")

@@ -14,6 +14,7 @@ namespace pdp {
 struct ProcessCommandOptions {
   std::vector<std::string> files;
   OptionSet library;                                 // the libraries' options (awcc/options.hpp)
+  OptionSet flow;                                    // a profile's flow quantities (awcc/profile_flow.hpp)
   std::string json, csv, windows, bubbles, correlation_functions, spectrum, report;  // output files
   std::string preset;                                // named option values (awcc::preset_settings)
   std::string positions, manifest;                   // profile positions

@@ -1,11 +1,13 @@
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <vector>
 
 #include "awcc/csv.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/options.hpp"
 #include "awcc/sha256.hpp"
 #include "awcc/units.hpp"
@@ -204,6 +206,17 @@ Plan plan_of(const ProcessCommandOptions& o) {
   if (!o.correct.empty() && plan.options.awcc_options.probe_correction.enabled) {
     throw std::invalid_argument("--correct and --probe-correction both correct AWCC's velocity: the model was trained "
                                 "on synthetic records without bubble-probe interaction; use one of them");
+  }
+  plan.flow = awcc::profile_flow_options(o.flow.settings());
+  if (!o.flow.settings().empty()) {
+    const bool positioned = std::all_of(plan.positions.begin(), plan.positions.end(),
+                                        [](const std::optional<double>& p) { return p.has_value(); });
+    if (o.files.size() < 2 || !positioned) {
+      throw awcc::OptionError(fmt::format("--{}: a profile's flow quantities need two or more recordings with their "
+                                          "positions (--positions or --manifest)",
+                                          o.flow.settings().front().name),
+                              o.flow.settings().front().name);
+    }
   }
   check_output_names(o);
   // The model is read before any processing: a damaged one, or one trained

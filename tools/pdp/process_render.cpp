@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "awcc/errors.hpp"
 #include "awcc/json_text.hpp"
 #include "awcc/serialise.hpp"
+#include "correction/profile_rows.hpp"
 #include "command.hpp"
 #include "process_steps.hpp"
 #include "report_command.hpp"
@@ -75,6 +77,20 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
     return c;
   };
   Rendered out;
+  // A profile's flow quantities (METHOD 12): every recording kept has a position.
+  std::optional<awcc::ProfileFlowResult> flow;
+  std::vector<std::string> flow_notes;
+  if (results.size() >= 2 && std::all_of(positions.begin(), positions.end(),
+                                         [](const std::optional<double>& y) { return y.has_value(); })) {
+    std::vector<awcc::ProfileRow> rows;
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      auto r = correction::profile_row(results[i], *positions[i], corrected ? &corrections[i] : nullptr);
+      if (!r.note.empty()) flow_notes.push_back(std::move(r.note));
+      rows.push_back(std::move(r.row));
+    }
+    flow = awcc::profile_flow(std::move(rows), plan.flow);
+    flow->notes.insert(flow->notes.end(), flow_notes.begin(), flow_notes.end());
+  }
   if (!o.json.empty() || !o.report.empty()) {
     nlohmann::json j;
     if (results.size() == 1 && o.files.size() == 1) {
@@ -89,6 +105,7 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
         j["profile"].push_back(row);
       }
       if (!p.skipped.empty()) j["skipped"] = p.skipped;
+      if (flow) j["flow"] = awcc::to_json(*flow);
     }
     // Hashing the inputs costs a read of each: only for the JSON, which records it.
     j["provenance"] = awcc::provenance_json(plan.options, p.inputs, command_line());
@@ -135,8 +152,13 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
       table += awcc::profile_csv_row(results[i], positions[i]);
       table += corrected ? "," + correction::correction_csv_cells(corrections[i]) + "\n" : "\n";
     }
-    if (o.csv.empty()) out.stdout_text = table;
-    else out.outputs.emplace_back(o.csv, table);
+    if (o.csv.empty()) {
+      out.stdout_text = table;
+    } else {
+      out.outputs.emplace_back(o.csv, table);
+      // stdout holds no table: the profile's flow quantities are read there.
+      if (flow) out.stdout_text = flow->report();
+    }
   }
   return out;
 }

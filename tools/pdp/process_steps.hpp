@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "awcc/process.hpp"
+#include "awcc/profile_flow.hpp"
 #include "correction/model.hpp"
 #include "process_command.hpp"
 
@@ -20,6 +21,7 @@ struct Plan {
   awcc::ProcessOptions options;
   std::vector<std::optional<double>> positions;
   std::optional<correction::CorrectionModel> model;
+  awcc::ProfileFlowOptions flow;  ///< a profile's flow quantities
 };
 
 Plan plan_of(const ProcessCommandOptions& o);

@@ -16,6 +16,7 @@
 #include "awcc/multi_tip.hpp"
 #include "awcc/option_field.hpp"
 #include "awcc/process.hpp"
+#include "awcc/profile_flow.hpp"
 #include "awcc/recording.hpp"
 
 namespace awcc {
@@ -38,6 +39,12 @@ std::span<const OptionField<MultiTipOptions>> multi_tip_option_fields();
 /// their velocities compare like with like): a front end copies them from
 /// the AwccOptions it applied, as FSCC takes AWCC's `subsample`.
 std::span<const OptionField<EventOptions>> event_option_fields();
+/// A profile's flow quantities (awcc/profile_flow.hpp): discharge, invert,
+/// depth-levels, flow-draws, flow-seed.
+std::span<const OptionField<ProfileFlowOptions>> profile_flow_option_fields();
+/// ProfileFlowOptions from settings by their declared names, validated;
+/// throws OptionError as process_options does.
+ProfileFlowOptions profile_flow_options(std::span<const OptionSetting> settings);
 
 /// A named set of option values (the setting `preset = felder`): applied to
 /// the options the user does not give.

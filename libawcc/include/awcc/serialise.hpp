@@ -12,6 +12,7 @@
 
 #include "awcc/event_detection.hpp"
 #include "awcc/process.hpp"
+#include "awcc/profile_flow.hpp"
 
 namespace awcc {
 
@@ -21,6 +22,8 @@ inline constexpr std::string_view sampling_intervals_only =
     "method's bias, which the bias correction (pdp correct) estimates.";
 
 nlohmann::json to_json(const ProcessResult& result);
+/// A profile's flow quantities (awcc/profile_flow.hpp): the "flow" object of a profile's JSON.
+nlohmann::json to_json(const ProfileFlowResult& result);
 nlohmann::json to_json(const AwccOptions& options);
 nlohmann::json to_json(const StructureResult& result);
 /// A tip's threshold: the keys its entry of the process JSON's "tips" holds.

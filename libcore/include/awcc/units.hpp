@@ -24,6 +24,7 @@ enum class Dimension {
   density,              ///< kg/m3
   kinematic_viscosity,  ///< m2/s
   surface_tension,      ///< N/m
+  discharge_per_width,  ///< m2/s (l/s/m accepted): a flow's discharge per unit width
 };
 
 /// SI unit symbol of a dimension ("m", "s", "Hz", "m/s", "V", "").

@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# A profile's flow quantities from the command line (issue 31, METHOD 12):
+# twelve binary recordings of known void fraction (square waves: c exact)
+# processed with their positions give Y90, Y50, C_mean and d by the
+# trapezoid through the points and (Y90, 0.9), which this test computes
+# independently; the JSON's "flow" object; the real profile (c <= 0.21) gives
+# no Y90 and says why for every quantity that needs it; the mistakes
+# (a discharge without its unit, profile options for one recording) refused.
+# Usage: flow_cli_test.sh PDP SCRATCH_DIR SOURCE_DIR
+set -u
+pdp=$1
+dir=$2/flow_cli
+src=$3
+data=$src/../shared/data/felder-stepped-spillway
+rm -rf "$dir" && mkdir -p "$dir"
+source "$(dirname "$0")/lib.sh"
+
+# c_i = 0.08 i at y_i = 5 i mm (i = 1..12): a square wave of period 100
+# samples whose air run is 8 i samples; the trailing tip 5 samples later.
+/usr/bin/python3 - "$dir" <<'PY'
+import sys
+d = sys.argv[1]
+fs, n, period, lag = 10000, 20000, 100, 5
+for i in range(1, 13):
+    air = 8 * i
+    lead = [1 if (k % period) < air else 0 for k in range(n)]
+    trail = lead[-lag:] + lead[:-lag]
+    with open(f"{d}/r{i:02d}.csv", "w") as f:
+        f.write("time,lead,trail\n")
+        f.writelines(f"{k / fs:.5f},{lead[k]},{trail[k]}\n" for k in range(n))
+PY
+positions=$(/usr/bin/python3 -c "print(','.join(f'{5 * i}mm' for i in range(1, 13)))")
+"$pdp" --log-level error process "$dir"/r*.csv --dx 5mm --positions "$positions" --csv "$dir/p.csv" \
+  --json "$dir/p.json" --discharge 150l/s/m >"$dir/p.txt" || fail "process the synthetic profile"
+/usr/bin/python3 - "$dir/p.json" <<'PY' || fail "the synthetic profile's flow quantities"
+import json, sys
+f = json.load(open(sys.argv[1]))["flow"]
+# Y90: between y = 55 mm (c 0.88) and 60 mm (0.96): 55 + 5 (0.02 / 0.08) = 56.25 mm.
+y90 = 0.05625
+assert abs(f["y90"]["value"] - y90) < 1e-12, f["y90"]
+levels = {l["level"]: l for l in f["levels"]}
+assert abs(levels[0.5]["value"] - 0.03125) < 1e-12, levels[0.5]   # 30 + 5 (0.02 / 0.08) mm
+# C_mean: c held at 0.08 below 5 mm, the trapezoid of the linear c from 5 to
+# 55 mm (mean 0.48 over 50 mm), then (0.88 + 0.9) / 2 over 1.25 mm.
+integral = 0.08 * 0.005 + 0.48 * 0.050 + 0.89 * 0.00125
+assert abs(f["c_mean"]["value"] - integral / y90) < 1e-12, f["c_mean"]
+assert abs(f["clear_water_depth"]["value"] - (y90 - integral)) < 1e-12, f["clear_water_depth"]
+assert f["invert"] == "held" and abs(f["discharge"] - 0.15) < 1e-15
+# Every row's c is exact and its velocity the same (no power law, no
+# discharge): each quantity without a value says why.
+for key in ("water_discharge", "continuity_error"):
+    assert f[key]["value"] is None and f[key]["reason"], (key, f[key])
+assert f["power_law"]["n"]["value"] is None and "does not grow" in f["power_law"]["n"]["reason"]
+assert f["status"] == "incomplete"
+PY
+grep -q "Y90 = 56.25 mm" "$dir/p.txt" || fail "the summary lacks Y90: $(cat "$dir/p.txt")"
+
+# Mistakes.
+expect 2 "discharge" "$pdp" process "$dir"/r*.csv --dx 5mm --positions "$positions" --discharge 0.2 --json "$dir/x.json"
+expect 2 "a profile's flow quantities need two or more recordings with their positions" \
+  "$pdp" process "$dir/r01.csv" --dx 5mm --discharge 0.2m2/s --json "$dir/x.json"
+expect 2 "invert" "$pdp" process "$dir"/r*.csv --dx 5mm --positions "$positions" --invert below --json "$dir/x.json"
+[[ -e $dir/x.json ]] && fail "an output was written for a refused profile"
+
+# The real profile stops at c = 0.21: no Y90, and every quantity needing it says so.
+if [[ -d $data ]]; then
+  "$pdp" --log-level error process "$data"/dc157_*.dat --fs 20kHz --dx 7.15mm \
+    --positions 2mm,8mm,14mm,20mm,26mm,32mm,38mm,44mm,50mm,54mm --json "$dir/real.json" --csv "$dir/real.csv" \
+    >/dev/null || fail "process the real profile"
+  /usr/bin/python3 - "$dir/real.json" <<'PY' || fail "the real profile's flow quantities"
+import json, sys
+f = json.load(open(sys.argv[1]))["flow"]
+assert f["y90"]["value"] is None and "never reaches c = 0.9" in f["y90"]["reason"], f["y90"]
+for key in ("c_mean", "clear_water_depth", "water_discharge", "air_discharge"):
+    assert f[key]["value"] is None and "no Y90" in f[key]["reason"], (key, f[key])
+assert len(f["rows"]) == 10
+PY
+else
+  echo "skipped the real profile: $data is absent"
+fi
+
+exit $((failures > 0))
