@@ -18,6 +18,7 @@
 
 #include "awcc/fscc.hpp"
 #include "awcc/interface_times.hpp"
+#include "clean_scene.hpp"
 #include "awcc/multi_tip.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
@@ -31,19 +32,7 @@ struct CleanProbe {
 };
 
 CleanProbe clean_four_tip(double duration) {
-  synth::Scene s;
-  s.velocity = 2.0;
-  s.tu = 0.05;
-  s.tu_y = s.tu_z = 0.025;
-  s.time_scale = 1.0;
-  s.void_fraction = 0.05;
-  s.bubble_diameter = 8e-3;
-  // Three trailing tips 2 mm downstream, two of them offset by 1 mm: the
-  // combination's conditioning |det A_0| is 0.2 (probe_geometry.hpp).
-  s.tips = {{0, 0, 0}, {2e-3, 0, 0}, {2e-3, 1e-3, 0}, {2e-3, 0, 1e-3}};
-  s.fs = 200e3;
-  s.duration = duration;
-  s.seed = 11;
+  const synth::Scene s = pdp_test::clean_four_tip_scene(duration);
   synth::SynthesisOptions o;
   o.bubble_truth = true;
   CleanProbe p{synth::synthesise(s, o), {}, {}};

@@ -3,6 +3,8 @@
 // among them), and the validation of a short clean four-tip scene.
 #include <gtest/gtest.h>
 
+#include "awcc/clean_scene.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -127,23 +129,8 @@ TEST(ValidateMultiTip, RefusesAProbeOfFewerThanFourTipsAndTipsInOnePlane) {
 
 namespace {
 
-// The clean four-tip scene of tests/awcc/multi_tip_synthetic_test.cpp
-// (METHOD 11.7: large spheres, weak turbulence with a long time scale),
-// shorter.
-synth::Scene clean_four_tip(double duration) {
-  synth::Scene s;
-  s.velocity = 2.0;
-  s.tu = 0.05;
-  s.tu_y = s.tu_z = 0.025;
-  s.time_scale = 1.0;
-  s.void_fraction = 0.05;
-  s.bubble_diameter = 8e-3;
-  s.tips = {{0, 0, 0}, {2e-3, 0, 0}, {2e-3, 1e-3, 0}, {2e-3, 0, 1e-3}};
-  s.fs = 200e3;
-  s.duration = duration;
-  s.seed = 11;
-  return s;
-}
+// The clean four-tip scene (tests/awcc/clean_scene.hpp), shorter.
+synth::Scene clean_four_tip(double duration) { return pdp_test::clean_four_tip_scene(duration); }
 
 // Bounds derived for this scene (fs = 200 kHz, |S_0k| = 2-2.24 mm, U = 2 m/s):
 //  - timing: each interface is within half a sample of the truth, uniform, so

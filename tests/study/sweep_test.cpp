@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <sstream>
 
+#include "awcc/clean_scene.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "correction/sweep_columns.hpp"
@@ -87,15 +88,7 @@ TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
 TEST(SweepRows, AFourTipSceneCarriesTheMultiTipVectorBesideItsTruth) {
   study::SweepRun run;
   run.np = 10;
-  run.scene.velocity = 2.0;
-  run.scene.tu = 0.05;
-  run.scene.tu_y = run.scene.tu_z = 0.025;
-  run.scene.time_scale = 1.0;
-  run.scene.void_fraction = 0.05;
-  run.scene.bubble_diameter = 8e-3;
-  run.scene.tips = {{0, 0, 0}, {2e-3, 0, 0}, {2e-3, 1e-3, 0}, {2e-3, 0, 1e-3}};
-  run.scene.fs = 200e3;
-  run.scene.duration = 30.0;
+  run.scene = pdp_test::clean_four_tip_scene(30.0);
   study::RunOptions options;
   options.awcc.np = run.np;
   const auto r = study::run_scene(run.scene, options);
