@@ -446,9 +446,10 @@ TEST(ProfileFlow, UnsortedPositionsAreSortedSaidAndGiveTheSameNumbers) {
   std::vector<ProfileRow> rows;
   for (int i = 0; i < 8; ++i) {
     const double y = 0.01 * (i + 1);
-    rows.push_back(exact_row(y, std::min(0.05 + 0.12 * i, 1.0), 2.0 + 0.2 * std::sqrt(y)));
-    rows.back().c_ci95 = {rows.back().c - 0.02, rows.back().c + 0.02};
-    rows.back().u_ci95 = awcc::Interval95{*rows.back().u - 0.05, *rows.back().u + 0.05};
+    // c from 0.05 to 0.96: the profile crosses 0.9 between its last two rows.
+    rows.push_back(exact_row(y, 0.05 + 0.13 * i, 2.0 + 2.0 * std::sqrt(y)));
+    rows.back().c_ci95 = {rows.back().c - 0.02, std::min(rows.back().c + 0.02, 1.0)};
+    rows.back().u_ci95 = awcc::Interval95{*rows.back().u - 0.02, *rows.back().u + 0.02};
   }
   ProfileFlowOptions o;
   o.seed = 11;
@@ -464,6 +465,12 @@ TEST(ProfileFlow, UnsortedPositionsAreSortedSaidAndGiveTheSameNumbers) {
   ASSERT_EQ(r.input_index.size(), 8u);
   for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(shuffled[r.input_index[i]].y, rows[i].y);
   // The same numbers, intervals included, bit for bit.
+  ASSERT_TRUE(sorted.y90.value && sorted.y90.ci95 && sorted.c_mean.ci95 && sorted.water_discharge.ci95 &&
+              sorted.stepped_chute.diffusivity.ci95)
+      << sorted.report();
+  ASSERT_TRUE(r.y90.value && r.y90.ci95 && r.c_mean.ci95 && r.water_discharge.ci95 &&
+              r.stepped_chute.diffusivity.ci95)
+      << r.report();
   EXPECT_EQ(*r.y90.value, *sorted.y90.value);
   EXPECT_EQ(r.y90.ci95->lower, sorted.y90.ci95->lower);
   EXPECT_EQ(r.c_mean.ci95->upper, sorted.c_mean.ci95->upper);
