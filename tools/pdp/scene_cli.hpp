@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_options.hpp"
+#include "study/profile.hpp"
 #include "study/run.hpp"
 #include "synth/scene.hpp"
 
@@ -26,6 +27,12 @@ void add_scene_options(CLI::App* cmd, SceneCli& cli);
 /// validated. Throws std::invalid_argument naming the option, the field and
 /// the allowed range.
 synth::Scene build_scene(const SceneCli& cli);
+
+/// The synthetic profile of `path` (study/profile.hpp), its base scene's
+/// fields overridden by those given on the command line (the laws' fields
+/// refused there); validated. Throws InputError for the file, OptionError
+/// naming the option or field.
+study::ProfileSpec build_profile(const std::string& path, const SceneCli& cli);
 
 /// The AWCC and FSCC options of the studies (validate, compare, sweep, bench).
 void add_method_options(CLI::App* cmd, OptionSet& methods);

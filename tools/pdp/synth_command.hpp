@@ -19,6 +19,7 @@ struct SynthOptions {
   std::string format;                    ///< flac | wav | w64 | rf64; default from the extension
   double flac_compression = 0.0;         ///< 0 (fastest) to 1 (smallest)
   bool quiet = false;                    ///< no truth summary on stdout
+  std::string profile;                   ///< a synthetic profile's file (study/profile.hpp): a recording per position
 };
 
 void setup_synth(CLI::App& app, Command& command, SynthOptions& options);

@@ -6,6 +6,7 @@
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
 #include "study/multi_tip_validate.hpp"
+#include "study/profile.hpp"
 #include "study/validate.hpp"
 #include "terminal.hpp"
 
@@ -22,6 +23,15 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
   cmd->add_option("--repeat", o.repeat, "runs with different seeds; means and 95 % intervals of every error")
       ->check(CLI::Range(1, 100000))->capture_default_str();
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"));
+  path_option(cmd->add_option("--profile", o.profile,
+                              "a synthetic profile (samples/stepped-profile.toml): every position synthesised and "
+                              "processed, every profile quantity (Y90, C_mean, d, N, q_w, the model's D, ...) "
+                              "against the truth it was made from; scene options given override its [scene]"));
+  path_option(cmd->add_option("--correct", o.correct,
+                              "with --profile: correct every position with this model (pdp process --correct), so "
+                              "that each row contributes its corrected AWCC median"));
+  o.flow.add(cmd, awcc::profile_flow_option_fields(), awcc::ProfileFlowOptions{}, "Profile quantities (--profile)",
+             {"invert", "depth-levels", "flow-draws", "flow-seed"});
 }
 
 namespace {
@@ -66,9 +76,61 @@ int run_multi_tip_validate(const synth::Scene& scene, const ValidateOptions& o) 
   return exit_ok;
 }
 
+// A synthetic profile: every position processed, the profile quantities
+// against their truth (study/profile.hpp).
+int run_profile_validate(const ValidateOptions& o) {
+  study::ProfileValidation v;
+  try {
+    if (o.repeat != 1) throw awcc::OptionError("--repeat: a profile is validated once (its positions have their seeds)", "repeat");
+    if (!o.bubbles.settings().empty()) {
+      throw awcc::OptionError(fmt::format("--{}: a profile's positions are processed as tip pairs",
+                                          o.bubbles.settings().front().name),
+                              o.bubbles.settings().front().name);
+    }
+    const auto spec = build_profile(o.profile, o.scene);
+    study::ProfileValidateOptions options;
+    apply_method_options(o.methods, options.run);
+    options.flow = awcc::profile_flow_options(o.flow.settings());
+    std::optional<correction::CorrectionModel> model;
+    if (!o.correct.empty()) {
+      model = correction::CorrectionModel::load(o.correct);
+      if (const auto why = model->mismatch(correction::processing_of(options.run.awcc)); !why.empty()) {
+        throw awcc::OptionError(fmt::format("--correct {}: the model was trained on results processed otherwise ({})",
+                                            o.correct, why),
+                                "correct");
+      }
+      options.correction = &*model;
+    }
+    Progress progress("validating the profile");
+    v = study::validate_profile(spec, options, [&](double fraction) { progress(fraction); });
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  fmt::print("{}", v.report());
+  if (!o.json.empty()) {
+    try {
+      awcc::write_text_atomically(o.json, awcc::json_text(study::profile_validation_json(v)));
+    } catch (const std::exception& e) {
+      return report_error(e);
+    }
+  }
+  return exit_ok;
+}
+
 }  // namespace
 
 int run_validate(const ValidateOptions& o) {
+  if (!o.profile.empty()) return run_profile_validate(o);
+  if (!o.correct.empty()) {
+    return report_error(awcc::OptionError("--correct: pdp validate corrects a --profile's positions; a scene's run is "
+                                          "scored uncorrected (pdp sweep and pdp train study the correction)",
+                                          "correct"));
+  }
+  if (!o.flow.settings().empty()) {
+    return report_error(awcc::OptionError(
+        fmt::format("--{}: the profile quantities' options apply to --profile", o.flow.settings().front().name),
+        o.flow.settings().front().name));
+  }
   synth::Scene scene;
   try {
     scene = build_scene(o.scene);

@@ -15,6 +15,9 @@ struct ValidateOptions {
   OptionSet bubbles;        ///< event detection's and the multi-tip solvers' options (a probe of four or more tips)
   int repeat = 1;           ///< seeds (run i uses a seed derived from the scene seed and i)
   std::string json;         ///< JSON output file
+  std::string profile;      ///< a synthetic profile's file (study/profile.hpp): every profile quantity against its truth
+  std::string correct;      ///< with --profile: the correction model applied to every position
+  OptionSet flow;           ///< the profile quantities' options (but the discharge, which the truth gives)
 };
 
 void setup_validate(CLI::App& app, Command& command, ValidateOptions& options);
