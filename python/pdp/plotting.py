@@ -25,10 +25,13 @@ import numpy as np
 
 matplotlib.use("Agg")
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa: E402
+from matplotlib.cm import ScalarMappable  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
+from matplotlib.colors import Normalize  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.font_manager import FontProperties  # noqa: E402
 from matplotlib.path import Path  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 
 # Okabe & Ito (2008): distinguishable with every common colour-vision deficiency.
@@ -719,12 +722,12 @@ def flow_concentration(rows, flow, ax=None):
     _flow_y_limits(ax, ys)
     ax.set_xlabel("void fraction c (-)" + ("; bands: D at its 95 % ends, Y90 held" if curves else ""))
     ax.set_ylabel("y from the invert (mm)")
-    _flow_reasons(fig, ax, reasons)
+    _reasons_beneath(fig, ax, reasons)
     legend(ax)
     return fig
 
 
-def _flow_reasons(fig, ax, reasons):
+def _reasons_beneath(fig, ax, reasons):
     """The reasons beneath the axes (wrapped), the figure grown to hold them."""
     if not reasons:
         return
@@ -791,7 +794,7 @@ def flow_velocity(rows, flow, ax=None):
     _flow_y_limits(ax, ys)
     ax.set_xlabel("velocity u (m/s)" + ("; band: N and u90 at their 95 % ends" if curves else ""))
     ax.set_ylabel("y from the invert (mm)")
-    _flow_reasons(fig, ax, reasons)
+    _reasons_beneath(fig, ax, reasons)
     legend(ax)
     return fig
 
@@ -1208,8 +1211,102 @@ def profile_vector(rows, ax=None):
     return fig
 
 
+# --- bubble sizes: each row's "sizes" (docs/output.md; METHOD 12) ----------------
+
+SIZES_WITH_VALUES = ("ok", "not_converged")  # statuses whose distribution and diameters exist
+
+
+def _sizes_missing(rows, labels):
+    """Each position without a distribution (or whose EM did not converge): its status and reason."""
+    out = []
+    for label, r in zip(labels, rows):
+        s = r.get("sizes")
+        if s is None:
+            out.append(f"{label}: no size distribution (pdp process --sizes off, or a JSON without sizes)")
+        elif s.get("status") != "ok":
+            out.append(f"{label}: {s.get('status')}" + (f": {s['reason']}" if s.get("reason") else ""))
+    return out
+
+
+def _row_labels(rows):
+    y, ylabel = positions_mm(rows)
+    return [f"y = {v:g} mm" if ylabel.startswith("position") else f"row {v}" for v in y], y, ylabel
+
+
+def profile_size_distributions(rows, ax=None):
+    """The number distributions n(D) of the positions, one curve each
+    (colour by position, the colour bar its scale; a distribution whose EM
+    did not converge dotted), D on a log axis as the bins are equal in ln D;
+    the positions without one, with their status and reason, beneath."""
+    if ax is None:  # room on the right for the colour bar
+        left, bottom, _, top = PROFILE_MARGINS
+        fig, ((ax,),) = figure(width=5.0, margins=(left, bottom, 0.75, top))
+    fig = ax.figure
+    labels, y, _ = _row_labels(rows)
+    order = sorted(range(len(rows)), key=lambda i: y[i])
+    drawn = [i for i in order if get(rows[i], "sizes", "status") in SIZES_WITH_VALUES
+             and get(rows[i], "sizes", "bins") is not None]
+    cmap = matplotlib.colormaps["cividis"]
+    low, high = (min(y), max(y)) if y else (0, 1)
+    norm = Normalize(low, high if high > low else low + 1)
+    for i in drawn:
+        bins = rows[i]["sizes"]["bins"]
+        converged = rows[i]["sizes"]["status"] == "ok"
+        ax.plot(1e3 * np.asarray(bins["diameters"], dtype=float), 1e-3 * np.asarray(_gaps(bins["density"])),
+                color=cmap(norm(y[i])), lw=1.4 if converged else 1.1, ls="-" if converged else ":")
+    if drawn:
+        ax.set_xscale("log")
+        ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_ylim(bottom=0)
+        bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, pad=0.03, fraction=0.06)
+        bar.set_label("position (mm)" if labels[0].startswith("y") else "row", fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+        if any(rows[i]["sizes"]["status"] != "ok" for i in drawn):
+            ax.plot([], [], color=GREY, ls=":", label="EM not converged (last iterate)")
+        ax.set_xlabel("sphere diameter D (mm)")
+        ax.set_ylabel("number density n(D) (1/mm)")
+    else:
+        ax.set_axis_off()
+    ax.set_title("Bubble size distributions")
+    _reasons_beneath(fig, ax, _sizes_missing(rows, labels))
+    legend(ax)
+    return fig
+
+
+def profile_size_d32(rows, ax=None):
+    """d32 of the inverted distribution against 1.5 u c / F (the flux
+    estimate, METHOD 12) by position; a distribution whose EM did not
+    converge hollow and grey; positions without one say why beneath."""
+    fig, ax = _profile_axes(ax)
+    labels, y, ylabel = _row_labels(rows)
+
+    def distribution_d32(r, want_ok=True):
+        s = r.get("sizes") or {}
+        return s.get("d32") if s.get("status") in SIZES_WITH_VALUES and (s.get("status") == "ok") == want_ok \
+            else None
+
+    _series(ax, y, rows, distribution_d32, scale=1e3, color=GREEN, marker="o", ls="-",
+            label="d32 of the size distribution n(D)")
+    if any(get(r, "sizes", "status") == "not_converged" for r in rows):
+        _series(ax, y, rows, lambda r: distribution_d32(r, False), scale=1e3, color=GREY, marker="o", mfc="none",
+                ls="none", label="d32, EM not converged (doubtful)")
+    _series(ax, y, rows, lambda r: get(r, "sizes", "d32_flux"), scale=1e3, color=BLACK, marker="D", mfc="none",
+            ls=":", label="1.5 u c / F (flux, spheres)")
+    ax.set_xlim(left=0)
+    ax.set_ylabel(ylabel)
+    ax.set_xlabel("Sauter diameter d32 (mm)")
+    ax.set_title("Sauter diameter: distribution against flux")
+    _reasons_beneath(fig, ax, _sizes_missing(rows, labels))
+    legend(ax)
+    return fig
+
+
 # Profile figures drawn only when a row holds their method's results.
-BUBBLE_PROFILE_FIGURES = [("multi-tip-vector", "Multi-tip mean vector", profile_vector, "multi_tip")]
+BUBBLE_PROFILE_FIGURES = [("multi-tip-vector", "Multi-tip mean vector", profile_vector, "multi_tip"),
+                          ("size-distributions", "Bubble size distributions", profile_size_distributions, "sizes"),
+                          ("size-d32", "Sauter diameter: distribution against flux", profile_size_d32, "sizes")]
 
 
 # The per-position figure is printed at about half its size: its text is

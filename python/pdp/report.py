@@ -61,7 +61,7 @@ def load(path):
                            "process result; give the file pdp process --json wrote")
     where = "profile[{}]" if "profile" in data else "the recording{}"
     for i, row in enumerate(rows):
-        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum", "events", "multi_tip"):
+        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum", "events", "multi_tip", "sizes"):
             if row.get(key) is not None and not isinstance(row[key], dict):
                 raise InputProblem(f"{path}: field '{key}' of {where.format(f'[{i}]' if 'profile' in data else '')} "
                                    "is not an object: not what pdp process writes; give the file pdp process "
