@@ -601,7 +601,8 @@ def flow_rows(rows, flow):
         else:
             u_ci = None
         out.append({"y": y, "c": number(f.get("void_fraction")), "c_ci95": get(row, "tips", 0, "void_fraction_ci95"),
-                    "u": number(f.get("velocity")), "source": source, "u_ci95": u_ci, "name": f.get("name")})
+                    "u": number(f.get("velocity")), "source": source, "u_ci95": list(u_ci) if u_ci else None,
+                    "name": f.get("name")})
     return out
 
 

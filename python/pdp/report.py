@@ -3,7 +3,10 @@ measurement and how far to trust it.
 
     python3 -m pdp.report PROFILE.json -o report.html     (or: pdp report ...)
 
-The page holds the profile figures (pdp.plotting), one collapsible panel of
+The page holds the profile figures (pdp.plotting), the profile's flow
+quantities (the JSON's "flow", METHOD 12: the c(y) and u(y) figures with the
+fitted curves, a table of every quantity with its interval or the reason it
+has none), one collapsible panel of
 figures per position, a table of every profile-CSV column with its unit and
 meaning (pdp.profile_columns(), the libraries' one declaration), the warnings
 and reasons with every gap explained, and the provenance of the profile and

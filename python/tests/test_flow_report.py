@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from pdp import plotting, report
 
-from conftest import made
+from conftest import MODEL, made
 from test_legends import check_legends
 from test_report import Page
 
@@ -268,6 +268,32 @@ def test_the_real_profile_has_no_y90_and_says_why_on_figure_and_table(real_profi
     assert list(zip(x, y)) == pytest.approx([(r["void_fraction"], 1e3 * r["position"]) for r in flow["rows"]])
     for segment, row in zip(points.lines[2][0].get_segments(), data["profile"]):
         assert [segment[0][0], segment[1][0]] == pytest.approx(row["tips"][0]["void_fraction_ci95"])
+
+
+def test_each_velocity_has_the_interval_of_its_source(real_files, tmp_path):
+    """The corrected real profile: its rows' velocities are the corrected
+    AWCC medians (the FSCC forest's row, untrusted, FSCC's own); each point's
+    bar is its source's interval: the AWCC forest's 2.5 and 97.5 % quantiles,
+    FSCC's 95 % interval."""
+    positions = ",".join(f"{p}mm" for p in (2, 8, 14, 20, 26, 32, 38, 44, 50, 54))
+    made("process", *real_files, "--fs", "20kHz", "--dx", "7.15mm", "--positions", positions, "--correct", MODEL,
+         "--json", tmp_path / "profile.json")
+    data = json.loads((tmp_path / "profile.json").read_text())
+    flow, rows = data["flow"], data["profile"]
+    assert {r["velocity_source"] for r in flow["rows"]} == {"corrected awcc", "fscc"}
+    ax = plotting.flow_velocity(rows, flow).axes[0]
+    checked = 0
+    for container in ax.containers:
+        source = next((s for s, v in plotting.VELOCITY_SOURCES.items() if v[0] == container.get_label()), None)
+        if source is None:
+            continue
+        mine = [(r, f) for r, f in zip(rows, flow["rows"]) if f["velocity_source"] == source]
+        for segment, (row, f) in zip(container.lines[2][0].get_segments(), mine):
+            expected = [row["correction"]["velocity"]["quantiles"][p] for p in ("0.025", "0.975")] \
+                if source == "corrected awcc" else row[source]["velocity_ci95"]
+            assert row["position"] == f["position"] and [segment[0][0], segment[1][0]] == pytest.approx(expected)
+            checked += 1
+    assert checked == len(flow["rows"])
 
 
 def test_a_json_without_flow_says_why(tmp_path, real_files):
