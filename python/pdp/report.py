@@ -259,7 +259,7 @@ def flow_table(flow):
             "draws": flow.get("draws"), "seed": flow.get("seed"), "quantities": quantities, "rows": rows}
 
 
-def flow_absent_reason(data, rows):
+def flow_absent_reason(data):
     """Why a JSON has no flow object."""
     if "profile" not in data:
         return "one recording: the flow quantities are a profile's (pdp process with two or more recordings and " \
@@ -483,7 +483,7 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
         positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
         provenance=provenance, made=made, panels=plotting.POSITION_PANELS, bubble_panels=plotting.BUBBLE_PANELS,
         flow=flow_table(data["flow"]) if isinstance(data.get("flow"), dict) else None,
-        flow_absent=flow_absent_reason(data, rows),
+        flow_absent=flow_absent_reason(data),
         single="profile" not in data,
         sampling_intervals_only=pdp._pdp.sampling_intervals_only)
 
