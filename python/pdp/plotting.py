@@ -25,10 +25,13 @@ import numpy as np
 
 matplotlib.use("Agg")
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
+from matplotlib.cm import ScalarMappable  # noqa: E402
+from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
+from matplotlib.colors import Normalize  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.font_manager import FontProperties  # noqa: E402
 from matplotlib.path import Path  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 
 # Okabe & Ito (2008): distinguishable with every common colour-vision deficiency.
@@ -217,10 +220,10 @@ def _no_line(style):
 def _drawn(ax, renderer):
     """What the axes draw, in display pixels: (polylines as (n, 2) arrays,
     boxes clipped to the axes as an (n, 4) array x0 y0 x1 y1, boxes of text
-    and arrows, which are not clipped)."""
+    and arrows, which are not clipped, filled areas as closed paths)."""
     ax.get_xlim(), ax.get_ylim()  # autoscaling done: the transforms are final
     points = renderer.points_to_pixels(1.0)
-    lines, boxes, texts = [], [], []
+    lines, boxes, texts, areas = [], [], [], []
 
     def box(b):
         return [b.x0, b.y0, b.x1, b.y1]
@@ -241,6 +244,10 @@ def _drawn(ax, renderer):
         if isinstance(c, LineCollection):  # error bars
             transform = c.get_transform()
             lines.extend(transform.transform(np.asarray(v, dtype=float)) for v in c.get_segments() if len(v))
+        elif type(c) is PolyCollection and not np.any(c.get_offsets()):  # fill_between(x): a band, by its outline
+            # (its bounding box would keep a legend off a diagonal band's empty side)
+            transform = c.get_transform()
+            areas.extend(transform.transform_path(p) for p in c.get_paths() if len(p.vertices))
         else:
             boxes.append(box(c.get_window_extent(renderer)))
     for patch in ax.patches:
@@ -260,7 +267,8 @@ def _drawn(ax, renderer):
         if arrow is not None:
             text.update_positions(renderer)
             texts.append(box(arrow.get_window_extent(renderer)))
-    return lines, np.array(boxes, dtype=float).reshape(-1, 4), np.array(texts, dtype=float).reshape(-1, 4)
+    return (lines, np.array(boxes, dtype=float).reshape(-1, 4), np.array(texts, dtype=float).reshape(-1, 4),
+            areas)
 
 
 def _overlap(boxes, b):
@@ -269,13 +277,15 @@ def _overlap(boxes, b):
 
 def _covers(b, drawn, clip):
     """Whether box b covers anything drawn (data is clipped to the axes' box)."""
-    lines, boxes, texts = drawn
+    lines, boxes, texts, areas = drawn
     if _overlap(texts, b):
         return True
     inner = Bbox.intersection(b, clip)
     if inner is None:
         return False
     if _overlap(boxes, inner):
+        return True
+    if any(area.intersects_bbox(inner, filled=True) for area in areas):  # its edge, or the box inside it
         return True
     for xy in lines:
         finite = np.isfinite(xy).all(axis=1)
@@ -517,6 +527,282 @@ PROFILE_FIGURES = [
     ("sauter", "Sauter diameter", profile_sauter),
     ("yield", "Data yield and quality", profile_yield),
 ]
+
+
+# --- a profile as a flow: the profile JSON's "flow" (METHOD 12) --------------
+# Every quantity drawn or written is the one pdp process wrote; the curves are
+# the models' formulas (awcc/profile_flow.hpp, written here once) evaluated
+# with the D', D_0, N, u90 and Y90 of the JSON.
+
+_ATANH_SQRT_01 = math.atanh(math.sqrt(0.1))  # c(Y90) = 0.9: tanh^2 of it is 0.1
+
+
+def smooth_chute_c(y, diffusivity, y90):
+    """Chanson (1997): c = 1 - tanh^2(K' - y' / (2 D')), K' = atanh(sqrt(0.1))
+    + 1 / (2 D'), y' = y / Y90."""
+    yp = np.asarray(y, dtype=float) / y90
+    k = _ATANH_SQRT_01 + 1 / (2 * diffusivity)
+    return 1 - np.tanh(k - yp / (2 * diffusivity)) ** 2
+
+
+def stepped_chute_c(y, diffusivity, y90):
+    """Chanson & Toombes (2002): c = 1 - tanh^2(K' - y' / (2 D_0) + (y' -
+    1/3)^3 / (3 D_0)), K' = atanh(sqrt(0.1)) + 1 / (2 D_0) - 8 / (81 D_0)."""
+    yp = np.asarray(y, dtype=float) / y90
+    k = _ATANH_SQRT_01 + 1 / (2 * diffusivity) - 8 / (81 * diffusivity)
+    return 1 - np.tanh(k - yp / (2 * diffusivity) + (yp - 1 / 3) ** 3 / (3 * diffusivity)) ** 2
+
+
+def power_law_u(y, n, u90, y90):
+    """u = u90 (y / Y90)^(1/N)."""
+    return u90 * (np.asarray(y, dtype=float) / y90) ** (1 / n)
+
+
+# (JSON key, symbol, name, formula, colour, line style) of the air-concentration models.
+CONCENTRATION_MODELS = (("smooth_chute", "D'", "smooth chute (Chanson 1997)", smooth_chute_c, BLUE, "-"),
+                        ("stepped_chute", "D_0", "stepped chute (Chanson & Toombes 2002)", stepped_chute_c,
+                         VERMILION, "--"))
+
+# How each row's velocity source is drawn: (name, colour, marker, hollow).
+VELOCITY_SOURCES = {"corrected awcc": ("corrected AWCC (median, 95 % band)", VERMILION, "^", False),
+                    "awcc": ("AWCC, 95 % interval", BLUE, "o", False),
+                    "fscc": ("FSCC, 95 % interval", BLACK, "D", True)}
+
+# A figure's own reasons, beneath it: text of this size, wrapped to this many characters a line.
+_REASON_SIZE, _REASON_CHARS, _REASON_LINE = 7, 88, 7 * 1.25 / 72  # points, characters, inches a line
+
+
+def depth_name(level):
+    """Y90, Y50, Y95, Y92.5: the name papers give the depth where c = level."""
+    return f"Y{100 * level:.10g}"
+
+
+def flow_depths(flow):
+    """Y90 then the further levels: the JSON's depth objects, each with its name."""
+    return [(depth_name(d.get("level", 0.9)), d) for d in [flow.get("y90") or {}] + list(flow.get("levels") or [])]
+
+
+def flow_rows(rows, flow):
+    """The flow's rows (increasing y) with their intervals, which the flow
+    object does not repeat: c's from the leading tip, the velocity's from the
+    source the row names (the corrected quantiles, AWCC's or FSCC's
+    interval), each found in the profile row at the same position (a
+    position is one recording: pdp refuses it twice). Each: y (m), c,
+    c_ci95, u, source, u_ci95."""
+    by_position = {number(r.get("position")): r for r in rows}
+    out = []
+    for f in flow.get("rows") or []:
+        y, row = number(f.get("position")), by_position.get(number(f.get("position"))) or {}
+        source = f.get("velocity_source")
+        if source == "corrected awcc":
+            u_ci = _quantiles(row, "velocity", "0.025", "0.975")
+        elif source in ("awcc", "fscc"):
+            u_ci = get(row, source, "velocity_ci95")
+        else:
+            u_ci = None
+        out.append({"y": y, "c": number(f.get("void_fraction")), "c_ci95": get(row, "tips", 0, "void_fraction_ci95"),
+                    "u": number(f.get("velocity")), "source": source, "u_ci95": list(u_ci) if u_ci else None,
+                    "name": f.get("name")})
+    return out
+
+
+def interval_text(q, scale=1.0, digits=3):
+    """'value [lower, upper]' of a flow quantity, scaled."""
+    v = number(q.get("value"))
+    if v is None:
+        return "none"
+    lo, hi = (number(b) for b in (q.get("ci95") or (None, None)))
+    text = f"{scale * v:.{digits}g}"
+    return text + (f" [{scale * lo:.{digits}g}, {scale * hi:.{digits}g}]" if lo is not None and hi is not None
+                   else " (no interval)")
+
+
+def _flow_figure(title_lines=1):
+    """A profile figure with room for a title of title_lines lines."""
+    left, bottom, right, top = PROFILE_MARGINS
+    more = 0.14 * (title_lines - 1)
+    fig, ((ax,),) = figure(height=3.4 + more, margins=(left, bottom, right, top + more))
+    return fig, ax
+
+
+def _flow_refused(flow):
+    """The reason a profile has no flow quantities at all, or None."""
+    if flow is None:
+        return "no flow quantities: a profile needs two or more recordings with their positions (pdp process " \
+               "--positions)"
+    if flow.get("status") == "refused":
+        return f"the profile's flow quantities were refused: {flow.get('reason')}"
+    return None
+
+
+def _flow_y_limits(ax, ys):
+    """From the invert (the curves start there) to above the highest point or depth drawn."""
+    top = max([y for y in ys if y is not None] or [1.0])
+    ax.set_ylim(0, 1.06 * top)
+
+
+def _depth_markers(ax, flow, ys):
+    """Each characteristic depth with its 95 % interval at (its level, Yc); a
+    depth below the first position as its bound y_0, pointing down. Appends
+    the heights drawn to ys; returns the reasons of the depths without a
+    value."""
+    reasons = []
+    styles = [(GREEN, "s"), (PURPLE, "P"), (ORANGE, "X"), (SKY, "h"), (BLACK, "*")]
+    for k, (name, d) in enumerate(flow_depths(flow)):
+        colour, marker = styles[k % len(styles)]
+        v, x = number(d.get("value")), d.get("level", 0.9)
+        if v is not None:
+            lo, hi = (number(b) for b in (d.get("ci95") or (None, None)))
+            err = [[1e3 * (v - lo)], [1e3 * (hi - v)]] if lo is not None and hi is not None else None
+            ax.errorbar([x], [1e3 * v], yerr=err, color=colour, marker=marker, ms=7, ls="none", capsize=3,
+                        mec=BLACK, mew=0.6, label=f"{name} = {interval_text(d, 1e3, 4)} mm")
+            ys += [1e3 * (hi if hi is not None else v)]
+        elif d.get("status") == "below_first_position" and number(d.get("position")) is not None:
+            ax.plot([x], [1e3 * d["position"]], color=colour, marker="v", ms=7, ls="none", mec=BLACK, mew=0.6,
+                    label=f"{name} < {1e3 * d['position']:.3g} mm (below the first position)")
+            reasons.append(f"{name}: {d.get('reason')}")
+        else:
+            reasons.append(f"{name}: {d.get('reason') or d.get('status')}")
+    return reasons
+
+
+def flow_concentration(rows, flow, ax=None):
+    """c(y) as hydraulics papers draw a profile (y from the invert up): the
+    measured points with their 95 % intervals, both air-concentration models
+    fitted with c(Y90) = 0.9 (the curve at the written D and Y90, over
+    0 <= y <= Y90, where they were fitted) with their bands (the curve at D's
+    2.5 and 97.5 % values, Y90 held), the characteristic depths with their
+    intervals, C_mean and d in the title. Without Y90 no curve, and the
+    reasons beneath the axes."""
+    refused = _flow_refused(flow)
+    flow = flow or {}
+    c_mean, depth = flow.get("c_mean") or {}, flow.get("clear_water_depth") or {}
+    stated = number(c_mean.get("value")) is not None
+    reasons = [refused] if refused else []
+    fig, ax = _flow_figure(2 if stated else 1) if ax is None else (ax.figure, ax)
+    points = flow_rows(rows, flow)
+    ys = [1e3 * p["y"] for p in points if p["y"] is not None]
+    drawn = [p for p in points if p["y"] is not None and p["c"] is not None]
+    if drawn:
+        lo = [max(0.0, p["c"] - number(get(p, "c_ci95", 0))) if number(get(p, "c_ci95", 0)) is not None else 0.0
+              for p in drawn]
+        hi = [max(0.0, number(get(p, "c_ci95", 1)) - p["c"]) if number(get(p, "c_ci95", 1)) is not None else 0.0
+              for p in drawn]
+        ax.errorbar([p["c"] for p in drawn], [1e3 * p["y"] for p in drawn], xerr=[lo, hi], color=BLACK, marker="o",
+                    ms=5, mfc="white", ls="none", capsize=2.5, zorder=3, label="measured c, 95 % interval")
+    y90, curves = number((flow.get("y90") or {}).get("value")), False
+    if not refused:
+        reasons += _depth_markers(ax, flow, ys)
+        if y90 is None:  # the depth's own reason is above
+            reasons.append("No Y90: no fitted curves (D', D_0), no C_mean, no d.")
+        for key, symbol, name, model, colour, ls in CONCENTRATION_MODELS:
+            fit = flow.get(key) or {}
+            d = number(fit.get("value"))
+            if d is None or y90 is None:
+                if y90 is not None:
+                    reasons.append(f"{symbol}, {name}: no curve: {fit.get('reason') or 'not fitted'}")
+                continue
+            y = np.linspace(0.0, y90, 241)
+            lo, hi = (number(b) for b in (fit.get("ci95") or (None, None)))
+            if lo is not None and hi is not None:
+                ax.fill_betweenx(1e3 * y, model(y, lo, y90), model(y, hi, y90), color=colour, alpha=0.18, lw=0)
+            residual = number(fit.get("residual"))
+            curves = True
+            ax.plot(model(y, d, y90), 1e3 * y, color=colour, ls=ls, lw=1.5,
+                    label=f"{name}:\n{symbol} = {interval_text(fit)}"
+                    + (f", rms {residual:.2g}" if residual is not None else ""))
+    if stated:
+        ax.set_title(f"Air concentration\nC_mean = {interval_text(c_mean)}, d = {interval_text(depth, 1e3)} mm")
+    else:
+        ax.set_title("Air concentration")
+        if not refused and y90 is not None:
+            reasons.append(f"C_mean: {c_mean.get('reason')}")
+    if not drawn and not refused:
+        reasons.append("no row has a void fraction")
+    ax.set_xlim(0, 1)
+    _flow_y_limits(ax, ys)
+    ax.set_xlabel("void fraction c (-)" + ("; bands: D at its 95 % ends, Y90 held" if curves else ""))
+    ax.set_ylabel("y from the invert (mm)")
+    _reasons_beneath(fig, ax, reasons)
+    legend(ax)
+    return fig
+
+
+def _reasons_beneath(fig, ax, reasons):
+    """The reasons beneath the axes (wrapped), the figure grown to hold them."""
+    if not reasons:
+        return
+    import textwrap
+    lines = [line for r in reasons for line in textwrap.wrap(r, _REASON_CHARS, subsequent_indent="  ")]
+    _grow_beneath(fig, fig.bbox.y0 + 1.0, (_REASON_LINE * len(lines) + 0.1) * fig.dpi)
+    fig.text(0.06, 0.04, "\n".join(lines), fontsize=_REASON_SIZE, color=BLACK, va="bottom", ha="left",
+             linespacing=1.25, transform=fig.dpi_scale_trans)
+
+
+def flow_velocity(rows, flow, ax=None):
+    """u(y): each row's velocity with its 95 % interval, marked by the source
+    the row contributes (corrected AWCC, AWCC, FSCC); the power law u90
+    (y / Y90)^(1/N) with its band (u90 and N both at their interval's ends:
+    wider than a joint band, the draws' correlation not being written), N
+    and u90 in the legend. Without them, the reason beneath the axes."""
+    refused = _flow_refused(flow)
+    flow = flow or {}
+    reasons = [refused] if refused else []
+    fig, ax = _flow_figure() if ax is None else (ax.figure, ax)
+    points = flow_rows(rows, flow)
+    ys = [1e3 * p["y"] for p in points if p["y"] is not None]
+    for source, (name, colour, marker, hollow) in VELOCITY_SOURCES.items():
+        drawn = [p for p in points if p["source"] == source and p["u"] is not None and p["y"] is not None]
+        if not drawn:
+            continue
+        ci = [(number(get(p, "u_ci95", 0)), number(get(p, "u_ci95", 1))) for p in drawn]
+        lo = [max(0.0, p["u"] - a) if a is not None else 0.0 for p, (a, _) in zip(drawn, ci)]
+        hi = [max(0.0, b - p["u"]) if b is not None else 0.0 for p, (_, b) in zip(drawn, ci)]
+        ax.errorbar([p["u"] for p in drawn], [1e3 * p["y"] for p in drawn], xerr=[lo, hi], color=colour,
+                    marker=marker, ms=6, mfc="white" if hollow else colour, ls="none", capsize=2.5, zorder=3,
+                    label=name)
+    without = [p["name"] for p in points if p["u"] is None]
+    if without and not refused:
+        reasons.append(f"no velocity at {', '.join(map(str, without))} (the notes say why)")
+    # The axis spans the points with their intervals and u90's: the law below
+    # the first position, down to u = 0 at the invert, is clipped.
+    span = [x for p in points if p["u"] is not None for x in (p["u"], number(get(p, "u_ci95", 0)),
+                                                              number(get(p, "u_ci95", 1))) if x is not None]
+    power = flow.get("power_law") or {}
+    n, u90 = power.get("n") or {}, power.get("u90") or {}
+    span += [x for x in [number(u90.get("value"))] + [number(b) for b in (u90.get("ci95") or [])] if x is not None]
+    y90 = number((flow.get("y90") or {}).get("value"))
+    curves = not refused and None not in (number(n.get("value")), number(u90.get("value")), y90)
+    if not refused:
+        if curves:
+            y = np.linspace(0.0, y90, 241)
+            (n_lo, n_hi), (u_lo, u_hi) = (n.get("ci95") or (None, None)), (u90.get("ci95") or (None, None))
+            if None not in (n_lo, n_hi, u_lo, u_hi):  # (y/Y90)^(1/N) grows with N below Y90
+                ax.fill_betweenx(1e3 * y, power_law_u(y, n_lo, u_lo, y90), power_law_u(y, n_hi, u_hi, y90),
+                                 color=GREEN, alpha=0.2, lw=0)
+            ax.plot(power_law_u(y, n["value"], u90["value"], y90), 1e3 * y, color=GREEN, lw=1.5,
+                    label=f"u90 (y/Y90)^(1/N): N = {interval_text(n)},\nu90 = {interval_text(u90)} m/s")
+            ax.axhline(1e3 * y90, color=GREY, ls=":", lw=1.0, label=f"Y90 = {1e3 * y90:.4g} mm")
+            ys.append(1e3 * y90)
+        elif y90 is None:
+            reasons.append(f"No power law (N, u90): no Y90: {(flow.get('y90') or {}).get('reason')}")
+        else:
+            reasons.append(f"No power law: {n.get('reason') or u90.get('reason') or 'not fitted'}")
+    ax.set_title("Velocity and power law")
+    if span:
+        pad = 0.08 * (max(span) - min(span)) or 0.1 * abs(max(span)) or 1.0
+        ax.set_xlim(max(0.0, min(span) - pad), max(span) + pad)
+    _flow_y_limits(ax, ys)
+    ax.set_xlabel("velocity u (m/s)" + ("; band: N and u90 at their 95 % ends" if curves else ""))
+    ax.set_ylabel("y from the invert (mm)")
+    _reasons_beneath(fig, ax, reasons)
+    legend(ax)
+    return fig
+
+
+# The flow's figures (drawn when the JSON has a profile): (key, title, make(rows, flow)).
+FLOW_FIGURES = [("flow-concentration", "Air concentration with the fitted models", flow_concentration),
+                ("flow-velocity", "Velocity with the power law", flow_velocity)]
 
 
 # --- per-position figures --------------------------------------------------------
@@ -926,8 +1212,102 @@ def profile_vector(rows, ax=None):
     return fig
 
 
+# --- bubble sizes: each row's "sizes" (docs/output.md; METHOD 12) ----------------
+
+SIZES_WITH_VALUES = ("ok", "not_converged")  # statuses whose distribution and diameters exist
+
+
+def _sizes_missing(rows, labels):
+    """Each position without a distribution (or whose EM did not converge): its status and reason."""
+    out = []
+    for label, r in zip(labels, rows):
+        s = r.get("sizes")
+        if s is None:
+            out.append(f"{label}: no size distribution (pdp process --sizes off, or a JSON without sizes)")
+        elif s.get("status") != "ok":
+            out.append(f"{label}: {s.get('status')}" + (f": {s['reason']}" if s.get("reason") else ""))
+    return out
+
+
+def _row_labels(rows):
+    y, ylabel = positions_mm(rows)
+    return [f"y = {v:g} mm" if ylabel.startswith("position") else f"row {v}" for v in y], y, ylabel
+
+
+def profile_size_distributions(rows, ax=None):
+    """The number distributions n(D) of the positions, one curve each
+    (colour by position, the colour bar its scale; a distribution whose EM
+    did not converge dotted), D on a log axis as the bins are equal in ln D;
+    the positions without one, with their status and reason, beneath."""
+    if ax is None:  # room on the right for the colour bar
+        left, bottom, _, top = PROFILE_MARGINS
+        fig, ((ax,),) = figure(width=5.0, margins=(left, bottom, 0.75, top))
+    fig = ax.figure
+    labels, y, _ = _row_labels(rows)
+    order = sorted(range(len(rows)), key=lambda i: y[i])
+    drawn = [i for i in order if get(rows[i], "sizes", "status") in SIZES_WITH_VALUES
+             and get(rows[i], "sizes", "bins") is not None]
+    cmap = matplotlib.colormaps["cividis"]
+    low, high = (min(y), max(y)) if y else (0, 1)
+    norm = Normalize(low, high if high > low else low + 1)
+    for i in drawn:
+        bins = rows[i]["sizes"]["bins"]
+        converged = rows[i]["sizes"]["status"] == "ok"
+        ax.plot(1e3 * np.asarray(bins["diameters"], dtype=float), 1e-3 * np.asarray(_gaps(bins["density"])),
+                color=cmap(norm(y[i])), lw=1.4 if converged else 1.1, ls="-" if converged else ":")
+    if drawn:
+        ax.set_xscale("log")
+        ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_ylim(bottom=0)
+        bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, pad=0.03, fraction=0.06)
+        bar.set_label("position (mm)" if labels[0].startswith("y") else "row", fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+        if any(rows[i]["sizes"]["status"] != "ok" for i in drawn):
+            ax.plot([], [], color=GREY, ls=":", label="EM not converged (last iterate)")
+        ax.set_xlabel("sphere diameter D (mm)")
+        ax.set_ylabel("number density n(D) (1/mm)")
+    else:
+        ax.set_axis_off()
+    ax.set_title("Bubble size distributions")
+    _reasons_beneath(fig, ax, _sizes_missing(rows, labels))
+    legend(ax)
+    return fig
+
+
+def profile_size_d32(rows, ax=None):
+    """d32 of the inverted distribution against 1.5 u c / F (the flux
+    estimate, METHOD 12) by position; a distribution whose EM did not
+    converge hollow and grey; positions without one say why beneath."""
+    fig, ax = _profile_axes(ax)
+    labels, y, ylabel = _row_labels(rows)
+
+    def distribution_d32(r, want_ok=True):
+        s = r.get("sizes") or {}
+        return s.get("d32") if s.get("status") in SIZES_WITH_VALUES and (s.get("status") == "ok") == want_ok \
+            else None
+
+    _series(ax, y, rows, distribution_d32, scale=1e3, color=GREEN, marker="o", ls="-",
+            label="d32 of the size distribution n(D)")
+    if any(get(r, "sizes", "status") == "not_converged" for r in rows):
+        _series(ax, y, rows, lambda r: distribution_d32(r, False), scale=1e3, color=GREY, marker="o", mfc="none",
+                ls="none", label="d32, EM not converged (doubtful)")
+    _series(ax, y, rows, lambda r: get(r, "sizes", "d32_flux"), scale=1e3, color=BLACK, marker="D", mfc="none",
+            ls=":", label="1.5 u c / F (flux, spheres)")
+    ax.set_xlim(left=0)
+    ax.set_ylabel(ylabel)
+    ax.set_xlabel("Sauter diameter d32 (mm)")
+    ax.set_title("Sauter diameter: distribution against flux")
+    _reasons_beneath(fig, ax, _sizes_missing(rows, labels))
+    legend(ax)
+    return fig
+
+
 # Profile figures drawn only when a row holds their method's results.
-BUBBLE_PROFILE_FIGURES = [("multi-tip-vector", "Multi-tip mean vector", profile_vector, "multi_tip")]
+BUBBLE_PROFILE_FIGURES = [("multi-tip-vector", "Multi-tip mean vector", profile_vector, "multi_tip"),
+                          ("size-distributions", "Bubble size distributions", profile_size_distributions, "sizes"),
+                          ("size-d32", "Sauter diameter: distribution against flux", profile_size_d32, "sizes")]
 
 
 # The per-position figure is printed at about half its size: its text is

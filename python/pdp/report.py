@@ -3,7 +3,10 @@ measurement and how far to trust it.
 
     python3 -m pdp.report PROFILE.json -o report.html     (or: pdp report ...)
 
-The page holds the profile figures (pdp.plotting), one collapsible panel of
+The page holds the profile figures (pdp.plotting), the profile's flow
+quantities (the JSON's "flow", METHOD 12: the c(y) and u(y) figures with the
+fitted curves, a table of every quantity with its interval or the reason it
+has none), one collapsible panel of
 figures per position, a table of every profile-CSV column with its unit and
 meaning (pdp.profile_columns(), the libraries' one declaration), the warnings
 and reasons with every gap explained, and the provenance of the profile and
@@ -61,7 +64,7 @@ def load(path):
                            "process result; give the file pdp process --json wrote")
     where = "profile[{}]" if "profile" in data else "the recording{}"
     for i, row in enumerate(rows):
-        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum", "events", "multi_tip"):
+        for key in ("fscc", "awcc", "structure", "correction", "velocity_spectrum", "events", "multi_tip", "sizes"):
             if row.get(key) is not None and not isinstance(row[key], dict):
                 raise InputProblem(f"{path}: field '{key}' of {where.format(f'[{i}]' if 'profile' in data else '')} "
                                    "is not an object: not what pdp process writes; give the file pdp process "
@@ -69,6 +72,8 @@ def load(path):
         if not all(isinstance(t, dict) for t in row["tips"]):
             raise InputProblem(f"{path}: field 'tips' of {where.format(f'[{i}]' if 'profile' in data else '')} "
                                "holds something other than objects: not what pdp process writes")
+    if not isinstance(data.get("flow", {}), dict):
+        raise InputProblem(f"{path}: field 'flow' is not an object: not what pdp process writes")
     if not isinstance(data.get("provenance", {}), dict):
         raise InputProblem(f"{path}: field 'provenance' is not an object: not what pdp process writes")
     return data, rows, hashlib.sha256(raw).hexdigest()
@@ -172,6 +177,97 @@ def gap_reason(row, pointer, have_positions):
     return "not defined for this recording"
 
 
+# --- the profile's flow quantities (the JSON's "flow"; METHOD 12) ------------------
+
+# (JSON pointer in "flow", quantity, symbol, unit shown, scale from the JSON's unit to it), in a paper's order;
+# the characteristic depths come first (flow_table).
+FLOW_QUANTITIES = [
+    ("/c_mean", "depth-averaged void fraction", "C_mean", "-", 1.0),
+    ("/clear_water_depth", "equivalent clear-water depth (1 - C_mean) Y90", "d", "mm", 1e3),
+    ("/power_law/n", "exponent of the power law u / u90 = (y / Y90)^(1/N)", "N", "-", 1.0),
+    ("/power_law/u90", "velocity at Y90 of the power law", "u90", "m/s", 1.0),
+    ("/water_discharge", "water discharge per unit width", "q_w", "m\u00b2/s", 1.0),
+    ("/air_discharge", "air discharge per unit width", "q_a", "m\u00b2/s", 1.0),
+    ("/continuity_error", "continuity error (q_w - q) / q", "", "%", 100.0),
+    ("/smooth_chute", "diffusivity, smooth chute (Chanson 1997)", "D'", "-", 1.0),
+    ("/stepped_chute", "diffusivity, stepped chute (Chanson & Toombes 2002)", "D_0", "-", 1.0),
+]
+
+# What each rule does below the lowest position (awcc/profile_flow.hpp, InvertRule).
+INVERT_RULES = {
+    "held": "c is held at the lowest position's value from the invert up to it (the probe's lowest reading is the "
+            "best guess of the layer it cannot reach)",
+    "zero": "c = 0 from the invert to the lowest position (clear water at the invert)",
+    "left-out": "the integrals start at the lowest position: C_mean is the mean over [y_0, Y90], and d takes the "
+                "layer below y_0 at that mean",
+}
+
+
+def _number_text(value, scale):
+    v = None if value is None else scale * value
+    return "" if v is None else f"{v:.4g}"
+
+
+def flow_table(flow):
+    """The page's table of the flow quantities: each with its value, unit, 95 %
+    interval or the reason it has none (the JSON's, never recomputed), and
+    the fits' residuals; with the rule below the lowest position, the notes
+    and each row's velocity source."""
+    from pdp import plotting
+    quantities = []
+
+    def add(pointer, name, symbol, unit, scale, q, residual=None):
+        value, ci = plotting.number(q.get("value")), q.get("ci95")
+        lower, upper = (plotting.number(b) for b in (ci or (None, None)))
+        reason = q.get("reason") or ""
+        if value is not None and (lower is None or upper is None) and not reason:
+            reason = "no interval"
+        quantities.append({
+            "pointer": pointer, "name": name, "symbol": symbol, "unit": unit, "scale": scale,
+            "value": value, "lower": lower, "upper": upper, "residual": residual,
+            "text": _number_text(value, scale), "interval": f"[{_number_text(lower, scale)}, "
+                                                            f"{_number_text(upper, scale)}]"
+            if lower is not None and upper is not None else "",
+            "residual_text": "" if residual is None else f"{residual:.3g}",
+            "reason": reason, "draws": q.get("draws_defined"),
+            "data": {k: json.dumps(v) for k, v in (("value", value), ("lower", lower), ("upper", upper),
+                                                   ("residual", residual))}})
+
+    for k, (name, depth) in enumerate(plotting.flow_depths(flow)):
+        level = depth.get("level", 0.9)
+        add("/y90" if k == 0 else f"/levels/{k - 1}", f"characteristic depth: the first y where c = {level:g}",
+            name, "mm", 1e3, depth)
+    discharge = plotting.number(flow.get("discharge"))
+    for pointer, name, symbol, unit, scale in FLOW_QUANTITIES:
+        if pointer == "/continuity_error" and discharge is None:
+            continue  # no check asked for: the page says so beside the table
+        q = plotting.get(flow, *pointer.split("/")[1:]) or {}
+        residual = None
+        if pointer in ("/smooth_chute", "/stepped_chute"):
+            residual = plotting.number(q.get("residual"))
+        elif pointer == "/power_law/n":
+            residual = plotting.number(plotting.get(flow, "power_law", "residual"))
+        add(pointer, name, symbol or "(q_w - q) / q", unit, scale, q, residual)
+    rows = [{"name": r.get("name"), "position": r.get("position"), "void_fraction": r.get("void_fraction"),
+             "velocity": r.get("velocity"), "source": r.get("velocity_source"),
+             "y_text": _number_text(plotting.number(r.get("position")), 1e3),
+             "c_text": _number_text(plotting.number(r.get("void_fraction")), 1.0),
+             "u_text": _number_text(plotting.number(r.get("velocity")), 1.0)} for r in flow.get("rows") or []]
+    return {"status": flow.get("status"), "reason": flow.get("reason"), "notes": flow.get("notes") or [],
+            "invert": flow.get("invert"), "invert_text": INVERT_RULES.get(flow.get("invert"), ""),
+            "discharge": discharge, "discharge_text": None if discharge is None else f"{discharge:.4g} m\u00b2/s",
+            "draws": flow.get("draws"), "seed": flow.get("seed"), "quantities": quantities, "rows": rows}
+
+
+def flow_absent_reason(data):
+    """Why a JSON has no flow object."""
+    if "profile" not in data:
+        return "one recording: the flow quantities are a profile's (pdp process with two or more recordings and " \
+               "--positions)"
+    return "no flow quantities: they need two or more recordings with their positions (pdp process --positions " \
+           "or --manifest)"
+
+
 # --- per-position detail: the recording processed again ---------------------------
 
 
@@ -246,12 +342,16 @@ def detail_for(index, row, data, json_dir, pdp, options):
 # --- figures ------------------------------------------------------------------------
 
 
-def _profile_svgs(rows):
+def _profile_svgs(rows, flow):
+    """The profile figures; the flow's (plotting.FLOW_FIGURES) when the JSON has a flow object."""
     from pdp import plotting
     figures = list(plotting.PROFILE_FIGURES) + [(key, title, make) for key, title, make, method in
                                                  plotting.BUBBLE_PROFILE_FIGURES
                                                  if any(r.get(method) is not None for r in rows)]
-    return [(key, title, plotting.svg(make(rows), salt=key)) for key, title, make in figures]
+    svgs = [(key, title, plotting.svg(make(rows), salt=key)) for key, title, make in figures]
+    if flow is not None:
+        svgs += [(key, title, plotting.svg(make(rows, flow), salt=key)) for key, title, make in plotting.FLOW_FIGURES]
+    return svgs
 
 
 def _position_svg(args):
@@ -276,7 +376,7 @@ class _Serial:
         return self._Done(function(*args))
 
 
-def figures(rows, detail_of, jobs, per_position=True):
+def figures(rows, detail_of, jobs, per_position=True, flow=None):
     """(profile SVGs, per-position SVGs, per-position notes). Workers draw
     while this process reads and processes the recordings again (detail_of(i)
     -> (detail, note)); they are forked before any processing, so no thread
@@ -287,7 +387,7 @@ def figures(rows, detail_of, jobs, per_position=True):
         pool = multiprocessing.get_context("fork").Pool(min(jobs, len(rows) + 1))
     try:
         runner = pool or _Serial()
-        profile = runner.apply_async(_profile_svgs, (rows,))
+        profile = runner.apply_async(_profile_svgs, (rows, flow))
         positions, notes = [], []
         for i, row in enumerate(rows):
             detail, note = detail_of(i)
@@ -326,7 +426,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     else:
         def detail_of(i):
             return None, None
-    profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs, per_position=detail)
+    profile_svgs, position_svgs, detail_notes = figures(rows, detail_of, jobs, per_position=detail,
+                                                        flow=data.get("flow"))
 
     text_columns = [c for c in columns if c["name"].endswith("reason") or c["name"] == "warnings"]
     # A row's flags are codes, each with its text among the warnings: an empty list is no gap.
@@ -381,6 +482,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
         title=input_name or os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
         positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
         provenance=provenance, made=made, panels=plotting.POSITION_PANELS, bubble_panels=plotting.BUBBLE_PANELS,
+        flow=flow_table(data["flow"]) if isinstance(data.get("flow"), dict) else None,
+        flow_absent=flow_absent_reason(data),
         single="profile" not in data,
         sampling_intervals_only=pdp._pdp.sampling_intervals_only)
 

@@ -96,10 +96,15 @@ def check_legends(fig, name):
     return len(legends)
 
 
-def check_report_figures(rows, detail_of, name):
+def check_report_figures(rows, detail_of, name, flow=None):
     checked = 0
     for key, _, make in plotting.PROFILE_FIGURES:
         checked += check_legends(make(rows), f"{name} {key}")
+    for key, _, make, method in plotting.BUBBLE_PROFILE_FIGURES:
+        if any(r.get(method) is not None for r in rows):
+            checked += check_legends(make(rows), f"{name} {key}")
+    for key, _, make in plotting.FLOW_FIGURES if flow is not None else []:
+        checked += check_legends(make(rows, flow), f"{name} {key}")
     for i, row in enumerate(rows):
         detail = detail_of(i)
         with matplotlib.rc_context(plotting.POSITION_FONTS):  # as plotting.position_svg draws it
@@ -117,7 +122,7 @@ def details(path):
         detail, why = report.detail_for(i, rows[i], data, str(path.parent), pdp, options)
         assert detail is not None, why
         return detail
-    return rows, detail_of
+    return rows, detail_of, data.get("flow")
 
 
 def test_no_legend_of_the_real_report_covers_data(real_files, tmp_path):
@@ -125,9 +130,10 @@ def test_no_legend_of_the_real_report_covers_data(real_files, tmp_path):
     positions = ",".join(f"{p}mm" for p in (2, 8, 14, 20, 26, 32, 38, 44, 50, 54))
     made("process", *real_files, "--fs", "20kHz", "--dx", "7.15mm", "--positions", positions, "--correct", MODEL,
          "--json", tmp_path / "profile.json")
-    rows, detail_of = details(tmp_path / "profile.json")
-    # Seven profile figures and nine panels a position, most of them with a legend.
-    assert check_report_figures(rows, detail_of, "real") >= 7 + 10 * 7
+    rows, detail_of, flow = details(tmp_path / "profile.json")
+    # Seven profile figures, the two of the flow and nine panels a position, most of them with a legend.
+    assert flow is not None
+    assert check_report_figures(rows, detail_of, "real", flow) >= 7 + 2 + 10 * 7
 
 
 def test_no_legend_of_a_synthetic_report_covers_data(tmp_path):
@@ -138,5 +144,6 @@ def test_no_legend_of_a_synthetic_report_covers_data(tmp_path):
         made("synth", "-o", tmp_path / files[-1], "--velocity", f"{u}m/s", "--void-fraction", str(c), "--duration",
              "6s", "--fs", "50kHz", "--seed", str(11 + i), "-q")
     made("process", *files, "--dx", "5mm", "--positions", "10mm,20mm,30mm", "--json", "profile.json", cwd=tmp_path)
-    rows, detail_of = details(tmp_path / "profile.json")
-    assert check_report_figures(rows, detail_of, "synthetic") >= 7 + 3 * 6
+    rows, detail_of, flow = details(tmp_path / "profile.json")
+    assert flow is not None
+    assert check_report_figures(rows, detail_of, "synthetic", flow) >= 7 + 2 + 3 * 6

@@ -128,8 +128,13 @@ def csv_rows(path):
         return list(csv.DictReader(f))
 
 
-def check_figures(page, rows):
-    assert page.figures == [key for key, _, _ in plotting.PROFILE_FIGURES]
+def check_figures(page, rows, flow=False):
+    """The profile figures (the bubble methods' where a row holds one, the
+    flow's for a JSON with a flow object), then each position's panels."""
+    assert page.figures == [key for key, _, _ in plotting.PROFILE_FIGURES] + \
+        [key for key, _, _, method in plotting.BUBBLE_PROFILE_FIGURES
+         if any(isinstance(r, dict) and r.get(method) is not None for r in rows)] + \
+        ([key for key, _, _ in plotting.FLOW_FIGURES] if flow else [])
     assert page.positions == list(range(len(rows)))
     for i in range(len(rows)):
         for key, _ in plotting.POSITION_PANELS:
@@ -211,7 +216,8 @@ def check_report(folder):
     """Every figure, panel and table cell of folder/report.html, nothing external."""
     text = (folder / "report.html").read_text()
     page = Page(text)
-    check_figures(page, load(folder / "profile.json")["profile"])
+    data = load(folder / "profile.json")
+    check_figures(page, data["profile"], flow="flow" in data)
     check_table(page, folder)
     check_self_contained(page, text)
     return text
