@@ -543,6 +543,20 @@ CharacteristicDepth characteristic_depth(std::span<const double> y, std::span<co
   return out;
 }
 
+std::string repeated_position(std::span<const double> y, std::span<const std::string> names) {
+  if (y.size() != names.size()) throw std::invalid_argument("repeated_position: as many names as positions");
+  std::vector<std::size_t> order(y.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return y[a] < y[b]; });
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    if (y[order[i - 1]] == y[order[i]]) {
+      return fmt::format("position y = {:.6g} m given twice ({} and {}): one recording a position", y[order[i]],
+                         names[order[i - 1]], names[order[i]]);
+    }
+  }
+  return {};
+}
+
 ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOptions& options) {
   options.validate().throw_if_failed();
   ProfileFlowResult result;
@@ -562,11 +576,15 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
   std::vector<std::size_t> order(rows.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return rows[a].y < rows[b].y; });
-  for (std::size_t i = 1; i < order.size(); ++i) {
-    const auto &a = rows[order[i - 1]], &b = rows[order[i]];
-    if (a.y == b.y) {
-      result.message = fmt::format("position y = {:.6g} m given twice ({} and {}): one recording a position",
-                                   a.y, row_name(a, order[i - 1]), row_name(b, order[i]));
+  {
+    std::vector<double> y;
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      y.push_back(rows[i].y);
+      names.push_back(row_name(rows[i], i));
+    }
+    if (auto why = repeated_position(y, names); !why.empty()) {
+      result.message = std::move(why);
       return result;
     }
   }
@@ -575,6 +593,7 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
     for (std::size_t i : order) numbers.push_back(i + 1);
     result.notes.push_back(fmt::format("positions did not come in increasing y: sorted by y (input rows {})",
                                        fmt::join(numbers, ", ")));
+    result.alerts.push_back(result.notes.back());
   }
   for (std::size_t i : order) result.rows.push_back(std::move(rows[i]));
   result.input_index = order;
@@ -696,6 +715,19 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
   }
   result.notes.push_back(rule + " (C_mean, d, q_w, q_a)");
   return result;
+}
+
+std::vector<std::string> ProfileFlowResult::warnings() const {
+  std::vector<std::string> out;
+  if (status == ProfileFlowStatus::refused) out.push_back("profile's flow quantities refused: " + message);
+  out.insert(out.end(), alerts.begin(), alerts.end());
+  if (y90_point.status == DepthStatus::below_first_position) out.push_back("Y90 flagged: " + y90_point.message);
+  for (const auto& l : levels) {
+    if (l.point.status == DepthStatus::below_first_position) {
+      out.push_back(fmt::format("Y{:g} flagged: {}", 100 * l.point.level, l.point.message));
+    }
+  }
+  return out;
 }
 
 std::string ProfileFlowResult::report() const {

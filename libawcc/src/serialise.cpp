@@ -478,9 +478,9 @@ json tip_json(const TipResult& t) {
       {process_key::status, to_string(p.status)},
       {"status_message", p.message.empty() ? json(nullptr) : json(p.message)},
       {process_key::void_fraction, p.void_fraction},
-      {"void_fraction_ci95", ci(p.void_fraction_ci95)},
+      {process_key::void_fraction_ci95, ci(p.void_fraction_ci95)},
       {process_key::bubble_count_rate, p.bubble_count_rate},
-      {"bubble_count_rate_ci95", ci(p.bubble_count_rate_ci95)},
+      {process_key::bubble_count_rate_ci95, ci(p.bubble_count_rate_ci95)},
       {"chord_time_mean", p.air_chord_time.mean},
       {"chord_time_median", p.air_chord_time.median},
       {"air_chord_time", summary(p.air_chord_time)},
@@ -501,7 +501,7 @@ json fscc_json(const FsccResult& f) {
       {process_key::status, to_string(f.status)},
       {process_key::reason, f.ok() ? json(nullptr) : json(f.message)},
       {process_key::velocity, f.ok() ? json(f.velocity) : json(nullptr)},
-      {"velocity_ci95", f.ok() && f.velocity_ci95 ? ci(*f.velocity_ci95) : json(nullptr)},
+      {process_key::velocity_ci95, f.ok() && f.velocity_ci95 ? ci(*f.velocity_ci95) : json(nullptr)},
       {"interval_segments", f.interval_segments},
       {"lag", f.lag},
       {"lag_samples", f.lag_samples},
@@ -538,7 +538,7 @@ json awcc_json(const AwccResult& a) {
       {process_key::np, a.np},
       {process_key::options, to_json(a.options)},
       {process_key::velocity, value(a.velocity)},
-      {"velocity_ci95", interval(a.velocity_ci95)},
+      {process_key::velocity_ci95, interval(a.velocity_ci95)},
       {"velocity_rms", value(a.velocity_rms)},
       {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
       {process_key::turbulence_intensity, value(a.turbulence_intensity)},
@@ -738,8 +738,8 @@ json to_json(const ProfileFlowResult& f) {
               {"water_discharge", quantity_json(f.water_discharge)},
               {"air_discharge", quantity_json(f.air_discharge)},
               {"continuity_error", quantity_json(f.continuity_error)},
-              {"smooth_chute", fit_json(f.smooth_chute)},
-              {"stepped_chute", fit_json(f.stepped_chute)},
+              {process_key::smooth_chute, fit_json(f.smooth_chute)},
+              {process_key::stepped_chute, fit_json(f.stepped_chute)},
               {"rows", rows}};
 }
 
@@ -747,7 +747,7 @@ json to_json(const ProcessResult& r) {
   json tips = json::array();
   for (const auto& t : r.tips) tips.push_back(tip_json(t));
   json out{
-      {"file", r.info.path.string()},
+      {process_key::file, r.info.path.string()},
       {"format", r.info.description},
       {process_key::fs, r.info.fs},
       {process_key::samples, r.info.frames},
@@ -757,7 +757,7 @@ json to_json(const ProcessResult& r) {
       {process_key::tips, tips},
       {process_key::warnings, warning_texts(r)},
       {process_key::flags, flag_codes(r)},
-      {"chord_velocity_source", to_string(r.velocity_source())},
+      {process_key::chord_velocity_source, to_string(r.velocity_source())},
       {"chord_velocity", optional(r.velocity())},
   };
   if (r.fscc) out[process_key::fscc] = fscc_json(*r.fscc);
@@ -784,8 +784,8 @@ json to_json(const ProcessResult& r) {
 
 std::span<const ProfileColumn> profile_csv_columns() {
   static constexpr ProfileColumn columns[] = {
-      {"file", "", "/file", "the recording's file name"},
-      {"position", "m", "/position", "position of the probe in the profile"},
+      {profile_column::file, "", "/file", "the recording's file name"},
+      {profile_column::position, "m", "/position", "position of the probe in the profile"},
       {profile_column::void_fraction, "-", "/tips/0/void_fraction", "void fraction c, leading tip"},
       {profile_column::bubble_count_rate, "1/s", "/tips/0/bubble_count_rate", "bubble count rate F, leading tip"},
       {"chord_time_mean", "s", "/tips/0/chord_time_mean", "mean air chord time, leading tip"},
@@ -821,14 +821,14 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {profile_column::duration, "s", "/duration", "record duration"},
       {profile_column::awcc_quality, "", "/awcc/quality", "AWCC quality level: ok, low or insufficient"},
       {"awcc_quality_reason", "", "/awcc/quality_reason", "why the quality is not ok"},
-      {"void_fraction_ci95_lower", "-", "/tips/0/void_fraction_ci95/0", "void fraction, 95 % interval, lower"},
-      {"void_fraction_ci95_upper", "-", "/tips/0/void_fraction_ci95/1", "void fraction, 95 % interval, upper"},
-      {"bubble_count_rate_ci95_lower", "1/s", "/tips/0/bubble_count_rate_ci95/0", "bubble count rate, 95 % interval, lower"},
-      {"bubble_count_rate_ci95_upper", "1/s", "/tips/0/bubble_count_rate_ci95/1", "bubble count rate, 95 % interval, upper"},
-      {"fscc_velocity_ci95_lower", "m/s", "/fscc/velocity_ci95/0", "FSCC velocity, 95 % sampling interval, lower"},
-      {"fscc_velocity_ci95_upper", "m/s", "/fscc/velocity_ci95/1", "FSCC velocity, 95 % sampling interval, upper"},
-      {"awcc_velocity_ci95_lower", "m/s", "/awcc/velocity_ci95/0", "AWCC velocity, 95 % interval, lower"},
-      {"awcc_velocity_ci95_upper", "m/s", "/awcc/velocity_ci95/1", "AWCC velocity, 95 % interval, upper"},
+      {profile_column::void_fraction_ci95_lower, "-", "/tips/0/void_fraction_ci95/0", "void fraction, 95 % interval, lower"},
+      {profile_column::void_fraction_ci95_upper, "-", "/tips/0/void_fraction_ci95/1", "void fraction, 95 % interval, upper"},
+      {profile_column::bubble_count_rate_ci95_lower, "1/s", "/tips/0/bubble_count_rate_ci95/0", "bubble count rate, 95 % interval, lower"},
+      {profile_column::bubble_count_rate_ci95_upper, "1/s", "/tips/0/bubble_count_rate_ci95/1", "bubble count rate, 95 % interval, upper"},
+      {profile_column::fscc_velocity_ci95_lower, "m/s", "/fscc/velocity_ci95/0", "FSCC velocity, 95 % sampling interval, lower"},
+      {profile_column::fscc_velocity_ci95_upper, "m/s", "/fscc/velocity_ci95/1", "FSCC velocity, 95 % sampling interval, upper"},
+      {profile_column::awcc_velocity_ci95_lower, "m/s", "/awcc/velocity_ci95/0", "AWCC velocity, 95 % interval, lower"},
+      {profile_column::awcc_velocity_ci95_upper, "m/s", "/awcc/velocity_ci95/1", "AWCC velocity, 95 % interval, upper"},
       {"awcc_velocity_rms_ci95_lower", "m/s", "/awcc/velocity_rms_ci95/0", "u_rms, 95 % interval, lower"},
       {"awcc_velocity_rms_ci95_upper", "m/s", "/awcc/velocity_rms_ci95/1", "u_rms, 95 % interval, upper"},
       {"awcc_turbulence_intensity_ci95_lower", "-", "/awcc/turbulence_intensity_ci95/0", "AWCC Tu, 95 % interval, lower"},

@@ -917,7 +917,7 @@ std::span<const awcc::ProfileColumn> correction_csv_columns() {
         {"correction_in_range", "", "/correction/in_range", "1 when the row was corrected"},
         {"correction_reason", "", "/correction/reason",
          "why the row was not corrected (untrusted: which trust rule its quantiles break, with the numbers)"},
-        {"correction_forest", "", "/correction/forest",
+        {correction_column::forest, "", "/correction/forest",
          "the forest that gave the quantiles: awcc, or fscc (velocity only)"}};
     for (const char* q : {"velocity", "turbulence_intensity"}) {
       const bool u = std::string_view(q) == "velocity";
@@ -934,7 +934,7 @@ std::span<const awcc::ProfileColumn> correction_csv_columns() {
                                         l, what))});
       }
     }
-    out.push_back({"correction_status", "", "/correction/status", "corrected, untrusted, or why not"});
+    out.push_back({correction_column::status, "", "/correction/status", "corrected, untrusted, or why not"});
     out.push_back({"correction_notes", "", "/correction/notes",
                    "what to know of the correction (a record longer than the training records, held at their "
                    "length), joined by '; '"});
@@ -982,14 +982,14 @@ nlohmann::json to_json(const Correction& c) {
     json levels = json::object();
     for (std::size_t k = 0; k < correction_levels.size(); ++k) levels[correction_level_names[k]] = q->quantiles[k];
     return json{{"measured", q->measured}, {"median", c.corrected() ? json(q->median()) : json(nullptr)},
-                {"quantiles", levels}};
+                {correction_key::quantiles, levels}};
   };
-  return json{{"status", to_string(c.status)},
+  return json{{correction_key::status, to_string(c.status)},
               {"in_range", c.corrected()},
-              {"forest", c.forest.empty() ? json(nullptr) : json(c.forest)},
+              {correction_key::forest, c.forest.empty() ? json(nullptr) : json(c.forest)},
               {"reason", c.corrected() ? json(nullptr) : json(c.message)},
               {"notes", c.notes},
-              {"velocity", quantity(c.velocity)},
+              {correction_key::velocity, quantity(c.velocity)},
               {"turbulence_intensity", quantity(c.turbulence_intensity)}};
 }
 

@@ -12,6 +12,8 @@ Numpy in, numpy and dicts out, no file needed:
     c = pdp.correct(r, model="awcc.qrf")                # bias-corrected quantiles
     p = pdp.process(files, fs=20e3, dx="7.15mm", positions=ys)  # a Profile
     p.to_dataframe(), p.profile[1].windows              # the profile CSV's table; a position's windows
+    p.flow.y90.value, p.flow.report()                   # the profile as a flow (Y90, C_mean, q_w, fits)
+    f = pdp.flow("profile.json", discharge="0.2m2/s")   # the same of a profile JSON or CSV read back
 
 Options are the command line's, by the same declarations (``pdp process
 --help``): write ``filter_a=0.5`` for ``--filter-a 0.5``. A number is in SI
@@ -32,8 +34,8 @@ from ._errors import InputError, OptionError, OutputError, PdpError
 
 __version__ = _pdp.version
 __all__ = ["read", "binarise", "phase_statistics", "fscc", "awcc", "process", "synth", "correct", "options",
-           "profile_columns",
-           "Result", "Profile", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
+           "profile_columns", "flow",
+           "Result", "Profile", "Flow", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
 
 
 class Result(dict):
@@ -67,12 +69,16 @@ class Profile(Result):
     --json`` writes it, one Result per position in ``profile``. Processed by
     pdp.process, each position keeps its detail: ``profile[i].windows`` (the
     AWCC window table), ``.correlation``, ``.spectrum``, ``.bubbles`` (event
-    detection's bubble table) and ``.vectors`` (the multi-tip vector table)."""
+    detection's bubble table) and ``.vectors`` (the multi-tip vector table).
+    With every position given, ``flow`` is the profile as a flow (a Flow)."""
 
     def __getattr__(self, name):
         if name in _DETAIL and name not in self:
             raise AttributeError(f"a profile has no '{name}' of its own: each position has its own, "
                                  f"profile[i].{name}")
+        if name == "flow" and name not in self:
+            raise AttributeError("this profile has no flow quantities: give every file its position "
+                                 "(positions=[...], m) to pdp.process")
         return super().__getattr__(name)
 
     def to_dataframe(self):
@@ -99,11 +105,116 @@ class Profile(Result):
         return frame
 
 
-def _wrap(value):
+# The quantities of a profile's flow, in the order Flow.to_dataframe lists
+# them: (name, unit, where in the flow JSON).
+_FLOW_QUANTITIES = (("Y90", "m", ("y90",)), ("C_mean", "-", ("c_mean",)), ("d", "m", ("clear_water_depth",)),
+                    ("N", "-", ("power_law", "n")), ("u90", "m/s", ("power_law", "u90")),
+                    ("q_w", "m2/s", ("water_discharge",)), ("q_a", "m2/s", ("air_discharge",)),
+                    ("continuity_error", "-", ("continuity_error",)), ("D'", "-", ("smooth_chute",)),
+                    ("D_0", "-", ("stepped_chute",)))
+
+
+class ConcentrationFit(Result):
+    """A fitted air-concentration model of a Flow (``smooth_chute``: D',
+    Chanson 1997; ``stepped_chute``: D_0, Chanson & Toombes 2002): ``value``
+    (the diffusivity), ``ci95``, ``reason``, ``residual`` (rms of c_i -
+    c(y_i)), ``points``, ``k_prime``; ``curve(y)`` evaluates c at y (m)."""
+
+    def curve(self, y):
+        """c(y) of the fitted model at every y (m; a number or an array), by
+        the library's formula (awcc/profile_flow.hpp). Raises ValueError,
+        with the fit's reason, when the fit has no value."""
+        if self.get("value") is None:
+            raise ValueError(f"no fitted curve: {self.get('reason')}")
+        values = _pdp.concentration_curve(self._kind, float(self["value"]), float(self._y90),
+                                          _np.atleast_1d(_np.asarray(y, dtype=float)))
+        return values.reshape(_np.shape(y)) if _np.ndim(y) else float(values[0])
+
+
+class Flow(Result):
+    """A profile as a flow (METHOD 12, awcc/profile_flow.hpp): the ``flow``
+    object of the profile JSON (docs/output.md), with attribute access.
+    Every quantity (``y90``, each of ``levels``, ``c_mean``,
+    ``clear_water_depth``, ``power_law.n`` and ``.u90``,
+    ``water_discharge``, ``air_discharge``, ``continuity_error``,
+    ``smooth_chute``, ``stepped_chute``) has ``value``, ``ci95`` (95 % by
+    Monte Carlo over the rows' own uncertainty) and ``reason`` (why none, or
+    how to read it); ``rows`` each with its ``velocity_source``; ``notes``;
+    ``status`` (ok, incomplete, refused) and ``message``. The fits'
+    ``curve(y)`` evaluates c(y); ``to_dataframe()`` is the quantities'
+    table; ``report()`` the summary pdp prints."""
+
+    @property
+    def message(self):
+        """Why the status is not ok (the JSON's ``reason``); None when ok."""
+        return self.get("reason")
+
+    def report(self):
+        """The summary ``pdp process`` prints for the profile: every quantity
+        with its interval or its reason, the notes, each row's velocity."""
+        return self._report
+
+    def to_dataframe(self):
+        """The quantities as a pandas DataFrame, one row each: ``quantity``
+        (Y90, Y50 ..., C_mean, d, N, u90, q_w, q_a, continuity_error, D',
+        D_0), ``value``, ``ci95_lower``, ``ci95_upper``, ``unit`` and
+        ``reason`` (NaN/None where there is none); the units also in
+        ``attrs["units"]``. Needs pandas (Debian's python3-pandas)."""
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("Flow.to_dataframe needs pandas: install Debian's python3-pandas "
+                              "(scripts/setup installs it)") from None
+        rows = []
+
+        def add(name, unit, q):
+            ci = q.get("ci95") or [None, None]
+            rows.append({"quantity": name, "value": q.get("value"), "ci95_lower": ci[0], "ci95_upper": ci[1],
+                         "unit": unit, "reason": q.get("reason")})
+
+        for name, unit, path in _FLOW_QUANTITIES:
+            q = self
+            for key in path:
+                q = q[key]
+            add(name, unit, q)
+            if name == "Y90":
+                for level in self["levels"]:
+                    add(f"Y{100 * level['level']:g}", "m", level)
+        frame = pandas.DataFrame(rows, columns=["quantity", "value", "ci95_lower", "ci95_upper", "unit", "reason"])
+        for column in ("value", "ci95_lower", "ci95_upper"):
+            frame[column] = frame[column].astype(float)
+        frame.attrs["units"] = dict(zip(frame["quantity"], frame["unit"]))
+        return frame
+
+
+def _flow_of(answer):
+    """A Flow from the compiled core's profile_flow answer (None when the
+    source has no profile's flow), its warnings issued."""
+    if answer["flow"] is None:
+        return None
+    import warnings as _warnings
+    for w in answer["warnings"]:
+        _warnings.warn(w, stacklevel=3)
+    f = _wrap(answer["flow"], "flow")
+    f._report = answer["report"]
+    return f
+
+
+def _wrap(value, key=None):
     if isinstance(value, dict):
+        if key == "flow":
+            f = Flow((k, _wrap(v, k)) for k, v in value.items())
+            y90 = f["y90"].get("value") if isinstance(f.get("y90"), dict) else None
+            for kind in ("smooth_chute", "stepped_chute"):
+                if isinstance(f.get(kind), dict):
+                    fit = ConcentrationFit(f[kind])
+                    fit._kind, fit._y90 = kind, y90
+                    f[kind] = fit
+            f._report = None
+            return f
         if isinstance(value.get("profile"), list):
-            return Profile((k, _wrap(v)) for k, v in value.items())
-        return Result((k, _wrap(v)) for k, v in value.items())
+            return Profile((k, _wrap(v, k)) for k, v in value.items())
+        return Result((k, _wrap(v, k)) for k, v in value.items())
     if isinstance(value, list):
         return [_wrap(v) for v in value]
     return value
@@ -148,14 +259,16 @@ class Recording:
 # --- options -----------------------------------------------------------------
 
 _OPTIONS = _pdp.options()
-_NAMES = {o["name"] for o in _OPTIONS if o["group"] != "scene"}
+_NAMES = {o["name"] for o in _OPTIONS if o["group"] not in ("scene", "flow")}
+# A profile's flow quantities (awcc/profile_flow.hpp): discharge, invert, depth_levels, flow_draws, flow_seed.
+_FLOW_NAMES = {o["name"] for o in _OPTIONS if o["group"] == "flow"}
 
 
 def options(group=None):
     """Every option with its group, name, unit, help and default (the
     declarations the command line reads); only ``group``'s when given
     ("probe and methods", "input", "binarisation", "fscc", "awcc",
-    "structure", "event detection", "multi-tip", "scene")."""
+    "structure", "event detection", "multi-tip", "flow", "scene")."""
     return [Result(o) for o in _OPTIONS if group is None or o["group"] == group]
 
 
@@ -181,6 +294,30 @@ def profile_columns(result=None):
 
 
 _UNITS = {o["name"]: o["unit"] for o in _OPTIONS if o["group"] != "scene"}
+
+
+def _flow_settings(options):
+    """Splits keyword options into the flow's (as (declared name, text)
+    pairs) and the rest (a dict), by the declarations' group "flow"."""
+    flow, rest = [], {}
+    for key, value in options.items():
+        name = key.replace("_", "-")
+        if name in _FLOW_NAMES:
+            if value is not None:
+                flow.append((name, _text(value, _UNITS[name])))
+        else:
+            rest[key] = value
+    return flow, rest
+
+
+def _refuse_flow(settings, why):
+    """The flow's options given where there is no profile's flow: refused,
+    naming the first (as pdp process refuses them)."""
+    name = settings[0][0]
+    err = OptionError(f"{name}: a profile's flow quantities need two or more recordings with their positions"
+                      f"{': ' + why if why else ' (positions=[...], m)'} (keyword {name.replace('-', '_')})")
+    err.quantity = name
+    raise err
 
 
 def _text(value, unit=""):
@@ -355,9 +492,25 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     with four or more tips; the JSON's ``multi_tip``), else None. A probe's
     tips: ``tips=[[0, 0, 0], [5e-3, 0, 0], ...]`` (m) or the command line's
     text. A profile is a Profile: each position ``result.profile[i]`` has
-    them, and ``result.to_dataframe()`` is the profile CSV's table."""
-    settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
+    them, and ``result.to_dataframe()`` is the profile CSV's table. With a
+    position for every file, ``result.flow`` is the profile as a flow (a
+    Flow: Y90, C_mean, d, power law, discharges, both air-concentration
+    fits, 95 % intervals), with the corrected velocities when ``correct`` is
+    given; its options are the flow group's (``discharge="0.2m2/s"``,
+    ``invert``, ``depth_levels``, ``flow_draws``, ``flow_seed``)."""
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
+    flow_settings, options = _flow_settings(options)
+    profile = isinstance(source, (list, tuple)) and len(source) >= 2 and positions is not None
+    if flow_settings and not profile:
+        _refuse_flow(flow_settings, "")
+    if profile and len(positions) == len(source):
+        why = _pdp.repeated_position([float(y) for y in positions],
+                                     [_os.path.basename(_os.fspath(p)) for p in source])
+        if why:
+            err = OptionError(f"positions: {why} (keyword positions)")
+            err.quantity = "positions"
+            raise err
+    settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
     if isinstance(source, (str, _os.PathLike)):
         r, windows, detail = _pdp.process_file(_os.fspath(source), settings, preset or "")
         inputs = [_os.fspath(source)]
@@ -382,7 +535,10 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
             import warnings as _warnings
             _warnings.warn(w, stacklevel=2)
     out["provenance"] = _pdp.provenance(inputs, settings, preset or "", call)
+    flow = _flow_of(_pdp.profile_flow(_json.dumps(out), "results", flow_settings)) if profile else None
     result = _wrap(out)
+    if flow is not None:
+        result["flow"] = flow
     if isinstance(source, (list, tuple)):
         for row, row_detail in zip(result.profile, details):
             row.__dict__.update(row_detail)
@@ -438,7 +594,7 @@ def _settings_scene(fields):
     return out
 
 
-def correct(results, model, *, dx=None, dy=None, np=None):
+def correct(results, model, *, dx=None, dy=None, np=None, **options):
     """Bias-corrects AWCC's velocity and turbulence intensity with a
     correction model (.qrf from ``pdp train``): ``results`` is what
     ``pdp.process`` returns (one recording or a profile) or a process JSON
@@ -446,18 +602,55 @@ def correct(results, model, *, dx=None, dy=None, np=None):
     recording (median, 80 % and 95 % quantiles of u and Tu, or why not
     corrected), as ``pdp correct`` writes them, each recording's windows,
     correlation, spectrum, bubbles and vectors kept. ``dx``, ``dy`` (m) and ``np``
-    fill values the results lack."""
+    fill values the results lack. A profile with every position gets its
+    ``flow`` anew with the corrected velocities (the flow group's options, as
+    ``pdp correct`` takes them: ``discharge="0.2m2/s"``, ...)."""
+    flow_settings, unknown = _flow_settings(options)
+    if unknown:
+        _settings(unknown)  # refused by name
+    results = {k: v for k, v in results.items() if k != "flow"} if isinstance(results, dict) else results
     out, warnings = _pdp.correct(_json.dumps(results), _os.fspath(model), dx, dy, np)
     for w in warnings:
         import warnings as _warnings
         _warnings.warn(w, stacklevel=2)
+    answer = _pdp.profile_flow(_json.dumps(out), "results", flow_settings)
+    if answer["flow"] is None and flow_settings:
+        _refuse_flow(flow_settings, answer["why_none"])
+    flow = _flow_of(answer)
     corrected = _wrap(out)
+    if flow is not None:
+        corrected["flow"] = flow
     # What pdp.process kept beside the JSON stays with its recording.
     before = results.get("profile", [results]) if isinstance(results, dict) else []
     after = corrected.profile if isinstance(corrected, Profile) else [corrected]
     for old, new in zip(before, after):
         new.__dict__.update({k: v for k, v in getattr(old, "__dict__", {}).items() if k in _DETAIL})
     return corrected
+
+
+def flow(source, **options):
+    """A profile's flow quantities (METHOD 12) from a profile read back:
+    ``source`` is a profile JSON (``pdp process --json`` with positions, or
+    ``pdp correct``'s), a profile CSV (``pdp process --csv``, corrected or
+    not), or such a JSON loaded as a dict (what pdp.process returns). Each
+    row's velocity is chosen as ``pdp process`` chooses it (the corrected
+    AWCC median where the row is corrected). Options are the flow group's
+    (``discharge="0.2m2/s"``, ``invert``, ``depth_levels``, ``flow_draws``,
+    ``flow_seed``). Returns a Flow; raises InputError when the source is not
+    a profile with every position."""
+    settings, unknown = _flow_settings(options)
+    if unknown:
+        _settings(unknown)  # refused by name
+    if isinstance(source, dict):
+        text, name = _json.dumps({k: v for k, v in source.items() if k != "flow"}), "results"
+    else:
+        name = _os.fspath(source)
+        with open(name, encoding="utf-8") as f:
+            text = f.read()
+    answer = _pdp.profile_flow(text, name, settings)
+    if answer["flow"] is None:
+        raise InputError(answer["why_none"])
+    return _flow_of(answer)
 
 
 # --- help from the declarations ------------------------------------------------
@@ -469,7 +662,8 @@ _GROUPS = {
     fscc: ["probe and methods", "binarisation", "fscc"],
     awcc: ["probe and methods", "binarisation", "awcc"],
     process: ["probe and methods", "input", "binarisation", "fscc", "awcc", "structure", "event detection",
-              "multi-tip"],
+              "multi-tip", "flow"],
+    flow: ["flow"],
     synth: ["scene"],
 }
 

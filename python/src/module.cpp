@@ -31,6 +31,7 @@
 #include "awcc/serialise.hpp"
 #include "awcc/version.hpp"
 #include "correction/model.hpp"
+#include "correction/profile_rows.hpp"
 #include "correction/rows.hpp"
 #include "synth/recording.hpp"
 #include "synth/scene.hpp"
@@ -247,6 +248,7 @@ py::list options() {
   describe(out, "structure", awcc::structure_option_fields(), p.structure);
   describe(out, "event detection", awcc::event_option_fields(), p.event_options);
   describe(out, "multi-tip", awcc::multi_tip_option_fields(), p.multi_tip_options);
+  describe(out, "flow", awcc::profile_flow_option_fields(), awcc::ProfileFlowOptions{});
   const synth::Scene scene;
   for (const auto& f : synth::scene_fields()) {
     py::dict d;
@@ -428,6 +430,62 @@ py::dict synthesise(const Settings& settings, const std::string& signal) {
   return out;
 }
 
+// A profile's flow quantities (awcc/profile_flow.hpp) from a process JSON's
+// or profile CSV's text, its rows read back by correction::profile_rows_of_*
+// (the one row builder): {"flow": the JSON's flow object or None, "why_none":
+// why the file has no profile's flow, "report", "warnings"}.
+py::dict profile_flow(const std::string& text, const std::string& file, const Settings& settings) {
+  const auto options = awcc::profile_flow_options(option_settings(settings));
+  py::dict out;
+  correction::ProfileRowsRead read;
+  std::optional<awcc::ProfileFlowResult> flow;
+  {
+    py::gil_scoped_release unlocked;
+    const auto first = text.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && (text[first] == '{' || text[first] == '[')) {
+      nlohmann::json j;
+      try {
+        j = nlohmann::json::parse(text);
+      } catch (const nlohmann::json::parse_error& e) {
+        throw awcc::InputError(fmt::format("{}: not valid JSON ({}); give a pdp process JSON or profile CSV", file,
+                                           e.what()));
+      }
+      read = correction::profile_rows_of_json(j, file);
+    } else {
+      read = correction::profile_rows_of_csv(text, file);
+    }
+    if (read.why_none.empty()) flow = correction::profile_flow_of(std::move(read.rows), options);
+  }
+  out["flow"] = flow ? python_of(awcc::to_json(*flow)) : py::object(py::none());
+  out["why_none"] = read.why_none;
+  out["report"] = flow ? flow->report() : std::string();
+  out["warnings"] = flow ? flow->warnings() : std::vector<std::string>{};
+  return out;
+}
+
+// c(y) of a fitted air-concentration model (awcc::ConcentrationModel, the
+// one owner of its formula), named by its key in the flow JSON, at every y (m).
+py::array_t<double> concentration_curve(const std::string& kind, double diffusivity, double y90,
+                                        const py::array_t<double, py::array::c_style | py::array::forcecast>& y) {
+  awcc::ConcentrationModel model;
+  if (kind == awcc::process_key::smooth_chute) {
+    model.kind = awcc::ConcentrationModelKind::smooth_chute;
+  } else if (kind == awcc::process_key::stepped_chute) {
+    model.kind = awcc::ConcentrationModelKind::stepped_chute;
+  } else {
+    throw awcc::OptionError(fmt::format("'{}' is not an air-concentration model: give {} or {}", kind,
+                                        awcc::process_key::smooth_chute, awcc::process_key::stepped_chute),
+                            "model");
+  }
+  model.diffusivity = diffusivity;
+  model.y90 = y90;
+  py::array_t<double> out(y.request().shape);
+  const auto* in = y.data();
+  auto* values = out.mutable_data();
+  for (py::ssize_t i = 0; i < y.size(); ++i) values[i] = model(in[i]);
+  return out;
+}
+
 // The keyword of a declared option: its name with underscores. The one
 // place the module spells the libraries' option names.
 std::string keyword_of(std::string name) {
@@ -442,7 +500,7 @@ bool declared(std::string_view name) {
   return in(awcc::process_option_fields()) || in(awcc::reader_option_fields()) ||
          in(awcc::binarisation_option_fields()) || in(awcc::fscc_option_fields()) ||
          in(awcc::awcc_option_fields()) || in(awcc::structure_option_fields()) || in(awcc::event_option_fields()) ||
-         in(awcc::multi_tip_option_fields()) || in(synth::scene_fields());
+         in(awcc::multi_tip_option_fields()) || in(awcc::profile_flow_option_fields()) || in(synth::scene_fields());
 }
 
 // Library errors as Python exceptions with the library's message, the
@@ -517,4 +575,10 @@ PYBIND11_MODULE(_pdp, m) {
   m.def("provenance", &provenance, py::arg("inputs"), py::arg("settings"), py::arg("preset"), py::arg("call"));
   m.def("correct", &correct, py::arg("json"), py::arg("model"), py::arg("dx"), py::arg("dy"), py::arg("np"));
   m.def("synthesise", &synthesise, py::arg("settings"), py::arg("signal"));
+  m.def("profile_flow", &profile_flow, py::arg("text"), py::arg("file"), py::arg("settings"));
+  m.def("concentration_curve", &concentration_curve, py::arg("kind"), py::arg("diffusivity"), py::arg("y90"),
+        py::arg("y"));
+  m.def("repeated_position", [](const std::vector<double>& y, const std::vector<std::string>& names) {
+    return awcc::repeated_position(y, names);
+  }, py::arg("y"), py::arg("names"));
 }

@@ -9,7 +9,12 @@
 
 #include "awcc/atomic_output.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/json_text.hpp"
+#include "awcc/options.hpp"
+#include "awcc/read_back.hpp"
+#include "awcc/serialise.hpp"
 #include "awcc/units.hpp"
+#include "correction/profile_rows.hpp"
 #include "correction/rows.hpp"
 
 namespace pdp {
@@ -31,6 +36,8 @@ void setup_correct(CLI::App& app, Command& command, CorrectOptions& o) {
   cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(1, 1000));
   cmd->add_option("--fs", o.fs, "sampling rate, Hz (units allowed), where the input has none (extended models)");
   cmd->add_option("--duration", o.duration, "record length, s (units allowed), where the input has none (extended models)");
+  o.flow.add(cmd, awcc::profile_flow_option_fields(), awcc::ProfileFlowOptions{},
+             "Profile quantities (a profile with positions: Y90, C_mean, discharge, models, with the corrected velocities)");
 }
 
 int run_correct(const CorrectOptions& o) {
@@ -70,12 +77,41 @@ int run_correct(const CorrectOptions& o) {
     const auto first = text.find_first_not_of(" \t\r\n");
     const bool json = first != std::string::npos && (text[first] == '{' || text[first] == '[');
     const std::string model_name = std::filesystem::path(o.model).filename().string();
-    const auto out = json ? correction::correct_process_json(model, text, defaults, o.input, model_name)
-                          : correction::correct_profile_csv(model, text, defaults, o.input);
+    const auto flow_options = awcc::profile_flow_options(o.flow.settings());
+    auto out = json ? correction::correct_process_json(model, text, defaults, o.input, model_name)
+                    : correction::correct_profile_csv(model, text, defaults, o.input);
+    // The profile's flow with the corrected velocities, read back from the
+    // corrected file: the rows a later reader of it gets.
+    std::optional<awcc::ProfileFlowResult> flow;
+    nlohmann::json corrected;
+    if (json) corrected = nlohmann::json::parse(out.text);
+    const auto read = json ? correction::profile_rows_of_json(corrected, o.input)
+                           : correction::profile_rows_of_csv(out.text, o.input);
+    if (read.why_none.empty()) {
+      flow = correction::profile_flow_of(read.rows, flow_options);
+      if (json) {
+        corrected[awcc::process_key::flow] = awcc::to_json(*flow);
+        out.text = awcc::json_text(corrected);
+      }
+    } else if (!o.flow.settings().empty()) {
+      const std::string name = o.flow.settings().front().name;
+      throw awcc::OptionError(fmt::format("--{}: a profile's flow quantities need two or more recordings with their "
+                                          "positions: {}",
+                                          name, read.why_none),
+                              name);
+    }
     // One line per distinct warning (a profile repeats them row by row).
     for (const auto& w : std::set<std::string>(out.warnings.begin(), out.warnings.end())) spdlog::warn("{}", w);
-    if (o.output.empty()) fmt::print("{}", out.text);
-    else awcc::write_text_atomically(o.output, out.text);
+    if (flow) {
+      for (const auto& w : flow->warnings()) spdlog::warn("{}", w);
+    }
+    if (o.output.empty()) {
+      fmt::print("{}", out.text);
+    } else {
+      awcc::write_text_atomically(o.output, out.text);
+      // stdout holds no table: the profile's flow quantities are read there.
+      if (flow) fmt::print("{}", flow->report());
+    }
   } catch (const std::exception& e) {
     return report_error(e);
   }

@@ -1,4 +1,5 @@
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/json_text.hpp"
+#include "awcc/read_back.hpp"
 #include "awcc/serialise.hpp"
 #include "correction/profile_rows.hpp"
 #include "command.hpp"
@@ -78,18 +80,17 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
   };
   Rendered out;
   // A profile's flow quantities (METHOD 12): every recording kept has a position.
+  // A profile (several files) whose files were all skipped but one still has
+  // its flow, refused with the reason.
   std::optional<awcc::ProfileFlowResult> flow;
-  std::vector<std::string> flow_notes;
-  if (results.size() >= 2 && std::all_of(positions.begin(), positions.end(),
-                                         [](const std::optional<double>& y) { return y.has_value(); })) {
-    std::vector<awcc::ProfileRow> rows;
+  if (o.files.size() >= 2 && !results.empty() &&
+      std::all_of(positions.begin(), positions.end(), [](const std::optional<double>& y) { return y.has_value(); })) {
+    std::vector<correction::ProfileRowOf> rows;
     for (std::size_t i = 0; i < results.size(); ++i) {
-      auto r = correction::profile_row(results[i], *positions[i], corrected ? &corrections[i] : nullptr);
-      if (!r.note.empty()) flow_notes.push_back(std::move(r.note));
-      rows.push_back(std::move(r.row));
+      rows.push_back(correction::profile_row(results[i], *positions[i], corrected ? &corrections[i] : nullptr));
     }
-    flow = awcc::profile_flow(std::move(rows), plan.flow);
-    flow->notes.insert(flow->notes.end(), flow_notes.begin(), flow_notes.end());
+    flow = correction::profile_flow_of(std::move(rows), plan.flow);
+    for (const auto& w : flow->warnings()) spdlog::warn("{}", w);
   }
   if (!o.json.empty() || !o.report.empty()) {
     nlohmann::json j;
@@ -100,12 +101,12 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
       j["profile"] = nlohmann::json::array();
       for (std::size_t i = 0; i < results.size(); ++i) {
         auto row = awcc::to_json(results[i]);
-        row["position"] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
+        row[awcc::process_key::position] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
         if (corrected) row["correction"] = correction_json(i);
         j["profile"].push_back(row);
       }
       if (!p.skipped.empty()) j["skipped"] = p.skipped;
-      if (flow) j["flow"] = awcc::to_json(*flow);
+      if (flow) j[awcc::process_key::flow] = awcc::to_json(*flow);
     }
     // Hashing the inputs costs a read of each: only for the JSON, which records it.
     j["provenance"] = awcc::provenance_json(plan.options, p.inputs, command_line());

@@ -220,6 +220,10 @@ struct ProfileFlowResult {
   [[nodiscard]] bool ok() const { return status == ProfileFlowStatus::ok; }
   ProfileFlowOptions options;
   std::vector<std::string> notes;  ///< what was done to the input (sorted) and how to read it
+  /// Those of the notes a user must not miss, for a front end to log (pdp
+  /// writes them to stderr): the rows sorted, a row without a velocity. With
+  /// warnings() the refusal and the depths flagged below the first position.
+  std::vector<std::string> alerts;
   std::vector<ProfileRow> rows;    ///< in increasing y
   std::vector<std::size_t> input_index;  ///< rows[i] was input row input_index[i]
 
@@ -239,7 +243,15 @@ struct ProfileFlowResult {
   /// A few readable lines: every quantity with its interval or its reason,
   /// the rule below the first position, each row's velocity source.
   [[nodiscard]] std::string report() const;
+  /// The refusal (message), the alerts, and each depth flagged below the
+  /// first position with its reason: what a front end logs as warnings.
+  [[nodiscard]] std::vector<std::string> warnings() const;
 };
+
+/// Why `y` cannot be a profile's positions: a position given twice, naming
+/// the two by `names` (one each); empty when none is. profile_flow refuses
+/// such rows; a front end may call it before processing, to fail fast.
+std::string repeated_position(std::span<const double> y, std::span<const std::string> names);
 
 /// The profile quantities of `rows` (any order). Throws OptionError when the
 /// options are refused; a profile that cannot be used (fewer than two rows,

@@ -74,6 +74,13 @@ std::vector<std::string_view> written_values(std::string_view column);
 /// recording's object:
 namespace process_key {
 inline constexpr std::string_view profile = "profile";  ///< a profile's list of recordings' objects
+inline constexpr std::string_view flow = "flow";        ///< a profile's flow quantities (awcc/profile_flow.hpp)
+/// In a profile's flow: the air-concentration models' fits (the Python module evaluates their curves).
+inline constexpr std::string_view smooth_chute = "smooth_chute";
+inline constexpr std::string_view stepped_chute = "stepped_chute";
+inline constexpr std::string_view file = "file";        ///< the recording's path
+inline constexpr std::string_view position = "position";  ///< a profile entry's position, m (null: none given)
+inline constexpr std::string_view chord_velocity_source = "chord_velocity_source";  ///< ProcessResult::velocity_source()
 inline constexpr std::string_view tips = "tips";
 inline constexpr std::string_view fscc = "fscc";
 inline constexpr std::string_view awcc = "awcc";
@@ -91,8 +98,11 @@ inline constexpr std::string_view flags = "flags";
 inline constexpr std::string_view status = "status";
 inline constexpr std::string_view reason = "reason";
 inline constexpr std::string_view void_fraction = "void_fraction";
+inline constexpr std::string_view void_fraction_ci95 = "void_fraction_ci95";  ///< [lower, upper]
 inline constexpr std::string_view bubble_count_rate = "bubble_count_rate";
+inline constexpr std::string_view bubble_count_rate_ci95 = "bubble_count_rate_ci95";
 inline constexpr std::string_view velocity = "velocity";
+inline constexpr std::string_view velocity_ci95 = "velocity_ci95";  ///< FSCC's or AWCC's; null when none
 inline constexpr std::string_view r12_max = "r12_max";
 inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
 inline constexpr std::string_view windows_accepted = "windows_accepted";
@@ -115,8 +125,18 @@ inline constexpr std::string_view retired_defined = "defined";
 /// The profile CSV's columns that are read back; profile_csv_columns
 /// declares them (with units and meanings) by these names.
 namespace profile_column {
+inline constexpr std::string_view file = "file";
+inline constexpr std::string_view position = "position";
 inline constexpr std::string_view void_fraction = "void_fraction";
 inline constexpr std::string_view bubble_count_rate = "bubble_count_rate";
+inline constexpr std::string_view void_fraction_ci95_lower = "void_fraction_ci95_lower";
+inline constexpr std::string_view void_fraction_ci95_upper = "void_fraction_ci95_upper";
+inline constexpr std::string_view bubble_count_rate_ci95_lower = "bubble_count_rate_ci95_lower";
+inline constexpr std::string_view bubble_count_rate_ci95_upper = "bubble_count_rate_ci95_upper";
+inline constexpr std::string_view fscc_velocity_ci95_lower = "fscc_velocity_ci95_lower";
+inline constexpr std::string_view fscc_velocity_ci95_upper = "fscc_velocity_ci95_upper";
+inline constexpr std::string_view awcc_velocity_ci95_lower = "awcc_velocity_ci95_lower";
+inline constexpr std::string_view awcc_velocity_ci95_upper = "awcc_velocity_ci95_upper";
 inline constexpr std::string_view fscc_velocity = "fscc_velocity";
 inline constexpr std::string_view events_velocity = "events_velocity";
 inline constexpr std::string_view events_quality = "events_quality";

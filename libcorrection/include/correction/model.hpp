@@ -91,6 +91,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "awcc/serialise.hpp"
@@ -103,6 +104,24 @@ namespace correction {
 inline constexpr std::array<double, 7> correction_levels{0.025, 0.1, 0.25, 0.5, 0.75, 0.9, 0.975};
 /// Their JSON keys and CSV suffixes.
 inline constexpr std::array<const char*, 7> correction_level_names{"0.025", "0.1", "0.25", "0.5", "0.75", "0.9", "0.975"};
+
+/// The keys of a correction as to_json(Correction) writes it that are read
+/// back (a profile's flow reads the corrected velocity), and the key of a
+/// process JSON's row that holds it.
+namespace correction_key {
+inline constexpr std::string_view correction = "correction";
+inline constexpr std::string_view status = "status";
+inline constexpr std::string_view forest = "forest";
+inline constexpr std::string_view velocity = "velocity";
+inline constexpr std::string_view quantiles = "quantiles";  ///< by correction_level_names
+}  // namespace correction_key
+/// The correction's CSV columns read back (correction_csv_columns declares them).
+namespace correction_column {
+inline constexpr std::string_view status = "correction_status";
+inline constexpr std::string_view forest = "correction_forest";
+/// Followed by a level's name: the velocity's quantile at that level.
+inline constexpr std::string_view velocity_quantile = "corrected_velocity_q";
+}  // namespace correction_column
 
 enum class TargetForm : std::uint8_t { value = 0, ratio = 1, difference = 2 };
 std::string_view to_string(TargetForm f);
