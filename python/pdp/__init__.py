@@ -59,7 +59,7 @@ class Result(dict):
 # What pdp.process keeps of a recording beside its JSON, as attributes of its
 # Result: the window table, R11 and R12, the velocity spectrum, event
 # detection's bubble table and the multi-tip vector table.
-_DETAIL = ("windows", "correlation", "spectrum", "bubbles", "vectors")
+_DETAIL = ("windows", "correlation", "spectrum", "bubbles", "vectors", "sizes")
 
 
 class Profile(Result):
@@ -124,6 +124,36 @@ def _table(columns, name="windows"):
         return columns
     frame = pandas.DataFrame(columns)
     frame.attrs["units"] = dict(_TABLE_UNITS[name])
+    return frame
+
+
+def _sizes_table(sizes):
+    """The JSON's ``sizes`` (docs/output.md) as a table of its bins: one row
+    per diameter bin, ``diameter`` (geometric centre), ``lower``, ``upper``
+    (edges, m), ``density`` (number density n(D), 1/m) and ``cumulative``
+    (number fraction below ``upper``); the moments, counts and status in
+    ``attrs`` (``status``, ``reason``, ``dispersed_phase``, ``median``,
+    ``d10``, ``d20``, ``d30``, ``d32``, ``d32_chords``, ``d32_flux`` in m,
+    ``chords_used``, ``chords_by_velocity``). No rows without a distribution
+    (``attrs["status"]`` says why); None when sizes were not computed."""
+    if sizes is None:
+        return None
+    bins = sizes.get("bins") or {"edges": [], "diameters": [], "density": [], "cumulative": []}
+    edges, cumulative = bins["edges"], bins["cumulative"]
+    columns = {"diameter": list(bins["diameters"]), "lower": list(edges[:-1]), "upper": list(edges[1:]),
+               "density": list(bins["density"]), "cumulative": list(cumulative[1:])}
+    units = {"diameter": "m", "lower": "m", "upper": "m", "density": "1/m", "cumulative": "-"}
+    attrs = {k: v for k, v in sizes.items() if k != "bins"}
+    try:
+        import pandas
+    except ImportError:
+        import numpy
+        out = Result((k, numpy.asarray(v, dtype=float)) for k, v in columns.items())
+        out["attrs"] = {**attrs, "units": units}
+        return out
+    frame = pandas.DataFrame(columns, columns=list(columns))
+    frame.attrs.update(attrs)
+    frame.attrs["units"] = units
     return frame
 
 
@@ -355,7 +385,10 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     with four or more tips; the JSON's ``multi_tip``), else None. A probe's
     tips: ``tips=[[0, 0, 0], [5e-3, 0, 0], ...]`` (m) or the command line's
     text. A profile is a Profile: each position ``result.profile[i]`` has
-    them, and ``result.to_dataframe()`` is the profile CSV's table."""
+    them, and ``result.to_dataframe()`` is the profile CSV's table.
+    ``result.sizes`` is the size distribution's table of bins with its
+    moments in ``attrs`` (on a recording and on each position of a profile;
+    ``result["sizes"]`` is the JSON object it comes from)."""
     settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
     if isinstance(source, (str, _os.PathLike)):
@@ -388,6 +421,9 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
             row.__dict__.update(row_detail)
     else:
         result.__dict__.update(_detail(windows, detail))
+    # The size distribution's table beside its JSON (result["sizes"] stays the object).
+    for row in (result.profile if isinstance(result, Profile) else [result]):
+        row.__dict__["sizes"] = _sizes_table(row.get("sizes"))
     return result
 
 
