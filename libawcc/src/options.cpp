@@ -609,8 +609,8 @@ const OptionField<P> kProcess[] = {
      [](P& o, std::string_view t) { o.size_options.inversion.bin_width = quantity(t, Dimension::dimensionless); },
      [](const P& o) { return fmt::format("{:g}", o.size_options.inversion.bin_width); }},
     {"size-samples-min", "-",
-     "sizes: least length in samples of the chord where the diameter grid starts (the 2 % quantile chord); below, "
-     "the sampling grid shapes the distribution and none is given",
+     "sizes: least number median diameter in samples (its chord time's); below, the sampling grid shapes the "
+     "distribution and none is given (at 2 samples the median comes out 15 % low)",
      [](P& o, std::string_view t) { o.size_options.samples_min = quantity(t, Dimension::dimensionless); },
      [](const P& o) { return fmt::format("{:g}", o.size_options.samples_min); }},
     {"spectrum-segment", "-", "Welch segment length of the velocity spectrum, in resampled points",

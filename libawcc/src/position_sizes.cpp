@@ -167,28 +167,20 @@ SizesResult position_sizes(const AirIntervals& leading, const PhaseStatistics& p
     out.message = d.message;
     return out;
   }
-  // The floor chord's samples: the shortest length from the grid's floor
-  // up (the floor is that chord's length), the fewest samples among the
-  // chords of exactly that length.
-  const double floor = d.edges.front();
-  double floor_length = 0.0, floor_samples = 0.0;
+  // The number median in samples (header): the chords' length per sample.
+  double total_length = 0.0, total_samples = 0.0;
   for (std::size_t i = 0; i < lengths.size(); ++i) {
-    if (!(lengths[i] >= floor) || counts[i] == 0) continue;
-    const auto k = static_cast<double>(samples_of[i]);
-    if (floor_length == 0.0 || lengths[i] < floor_length || (lengths[i] == floor_length && k < floor_samples)) {
-      floor_length = lengths[i];
-      floor_samples = k;
-    }
+    total_length += static_cast<double>(counts[i]) * lengths[i];
+    total_samples += static_cast<double>(counts[i]) * static_cast<double>(samples_of[i]);
   }
-  out.floor_chord_samples = floor_samples;
-  if (floor_samples < options.samples_min) {
+  out.median_samples = d.median * total_samples / total_length;
+  if (out.median_samples < options.samples_min) {
     out.status = SizesStatus::coarse_sampling;
-    out.message = fmt::format("the diameter grid starts at a chord of {:g} samples, fewer than size-samples-min = "
-                              "{:g}: a chord is known to about one sample, so the sampling grid, not the bubbles, "
-                              "would shape the small sizes and the number median; sample faster (or the flow is "
-                              "faster than the sampling resolves). 1.5 x mean chord = {:.4g} mm is d32 without "
-                              "inversion",
-                              floor_samples, options.samples_min, 1e3 * d.sauter_from_chords);
+    out.message = fmt::format("the inverted number median, {:.3g} mm, spans {:.2g} samples, fewer than "
+                              "size-samples-min = {:g}: chord times are whole samples, and at 2 samples the median "
+                              "comes out 15 % low (size_distribution_bench --sampling); sample faster. 1.5 x mean "
+                              "chord = {:.4g} mm is d32 without inversion",
+                              1e3 * d.median, out.median_samples, options.samples_min, 1e3 * d.sauter_from_chords);
     SizeDistribution kept;
     kept.status = SizeStatus::too_few_chords;
     kept.options = d.options;
@@ -221,10 +213,10 @@ std::string SizesResult::report() const {
   }
   if (has_distribution()) {
     const auto& d = distribution;
-    s += fmt::format("  number distribution, {} bins {:.4g}-{:.4g} mm (floor chord {:g} samples): median {:.4g} mm, "
-                     "d10 {:.4g} mm, d20 {:.4g} mm, d30 {:.4g} mm, d32 {:.4g} mm; {} EM iterations\n",
-                     d.diameters.size(), 1e3 * d.edges.front(), 1e3 * d.edges.back(), floor_chord_samples,
-                     1e3 * d.median, 1e3 * d.d10, 1e3 * d.d20, 1e3 * d.d30, 1e3 * d.d32, d.iterations);
+    s += fmt::format("  number distribution, {} bins {:.4g}-{:.4g} mm: median {:.4g} mm ({:.3g} samples), "
+                     " d10 {:.4g} mm, d20 {:.4g} mm, d30 {:.4g} mm, d32 {:.4g} mm; {} EM iterations\n",
+                     d.diameters.size(), 1e3 * d.edges.front(), 1e3 * d.edges.back(),
+                     1e3 * d.median, median_samples, 1e3 * d.d10, 1e3 * d.d20, 1e3 * d.d30, 1e3 * d.d32, d.iterations);
   }
   return s;
 }

@@ -633,8 +633,8 @@ json sizes_json(const SizesResult& r) {
               {"chords_by_velocity", by},
               {"record_velocity_source", r.record_velocity_source},
               {"mean_chord", d.chords_used > 0 ? json(d.mean_chord) : json(nullptr)},
-              {"floor_chord_samples", dist || r.status == SizesStatus::coarse_sampling ? json(r.floor_chord_samples)
-                                                                                       : json(nullptr)},
+              {"median_samples", dist || r.status == SizesStatus::coarse_sampling ? json(r.median_samples)
+                                                                                  : json(nullptr)},
               {k::median, value(d.median)},
               {k::d10, value(d.d10)},
               {k::d20, value(d.d20)},

@@ -195,15 +195,17 @@ TEST(PositionSizes, DropletsAreTheWaterChordsAndCoarseSamplingIsSaid) {
   // d32 of the droplets by the flux: 1.5 u (1 - c) / F of the spray.
   EXPECT_NEAR(*b.sauter_flux, 1.5 * 5.0 * (1.0 - p_spray.void_fraction) / p_spray.bubble_count_rate, 1e-15);
 
-  // Sampled 20 times slower (one sample per 1 mm at 5 m/s): the floor chord
-  // is a few samples and no distribution is given, with the reason.
+  // The median bubble (2 mm at 5 m/s, 100 kHz) spans 40 samples: asked for
+  // more, no distribution is given, with the reason.
+  EXPECT_NEAR(a.median_samples, a.distribution.median / (5.0 / 100e3), 1e-9 * a.median_samples);
   awcc::SizesOptions coarse;
-  coarse.samples_min = 1e6;
+  coarse.samples_min = a.median_samples * 1.01;
   const auto c = awcc::position_sizes(syn.signals[0], p_bubbly, std::nullopt, std::nullopt, 5.0, "fscc", coarse);
   EXPECT_EQ(c.status, awcc::SizesStatus::coarse_sampling);
   EXPECT_FALSE(c.has_distribution());
   EXPECT_NE(c.message.find("size-samples-min"), std::string::npos);
-  EXPECT_EQ(c.floor_chord_samples, a.floor_chord_samples);
+  EXPECT_EQ(c.median_samples, a.median_samples);
+  EXPECT_EQ(c.distribution.mean_chord, a.distribution.mean_chord);
 }
 
 TEST(PositionSizes, JsonHoldsTheResultAndSizesOffLeavesItNull) {

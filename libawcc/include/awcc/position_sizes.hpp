@@ -24,17 +24,25 @@
 // distinct lengths with their counts: chords of one velocity repeat a few
 // hundred lengths (whole samples times it).
 //
-// Sampling. A chord of k samples is known to about one sample: its
-// measured count is the true duration times fs rounded up or down by the
-// interface's phase on the sampling grid (a triangular error of sd
-// 1 / sqrt(6) samples). The inverted number distribution rests on its
-// shortest resolved chords (n = g / D^2 weights the small bubbles up), the
-// grid floor's (the 2 % quantile chord). Where that chord is fewer than
-// samples_min samples long, the sampling grid, not the bubbles, shapes the
-// small end and the number median: status coarse_sampling and no
-// distribution (d32 from the mean chord, which the rounding does not bias,
-// stays). SizesOptions::samples_min gives the measurement.
-//
+// Sampling. A chord's time is whole samples: a chord of length l at sample
+// spacing delta covers floor(l / delta + U) samples, U the interface's phase
+// on the grid. Measured (bench/size_distribution_bench --sampling, 5,000
+// chords, 10 draws, log-normal sigma 0.3 / 0.6), by the population's number
+// median D50 in samples:
+//   D50 / delta   number median: bias, worst     d32: bias, worst
+//   2             -15 / -16 %, 21 / 24 %          +3 %, 6 / 4 %
+//   4             +1.7 / +2.9 %, 3.8 / 12 %       +1.6 / +1.0 %, 3 %
+//   8             +0.7 / +1.1 %, 2.7 / 9.7 %      +0.5 / +0.3 %, 2 %
+//   >= 16         within 0.5 %, as unrounded      within 0.2 %
+// (the worst at sigma 0.6 is the inversion's own spread at 5,000 chords,
+// 8.7 %). The grid floor's chord is then a single sample from D50 = 4 to
+// 8 delta and still the answer holds: what decides is how many samples the
+// median bubble spans. So where the inverted number median is fewer than
+// samples_min samples long (delta = the chords' total length over their
+// total samples: u / fs for one velocity), the sampling grid, not the
+// bubbles, shapes the small sizes: status coarse_sampling and no
+// distribution (d32 from the mean chord, which the rounding biases by
+// under 3 %, stays).
 // Interfacial area, dual tip (METHOD 12; Kataoka et al. 1986 for a flow
 // along the probe): each passage of a sphere through a point adds on average
 // 4 / u of interface per unit volume and time (two interfaces, E[1 / cos] = 2
@@ -78,12 +86,9 @@ struct SizesOptions {
   /// The inversion's options (size-chords-min, size-penalty, size-bin-width
   /// are declared; the rest keep their measured defaults).
   SizeDistributionOptions inversion;
-  /// Least length, in samples, of the chord at the grid's floor (the 2 %
-  /// quantile chord) for a distribution (status coarse_sampling below).
-  /// 5: measured (bench/size_distribution_bench --sampling) on log-normal
-  /// sizes of sigma 0.3-0.6 with chord times rounded to whole samples at a
-  /// random phase: see docs/validation.md.
-  double samples_min = 5.0;
+  /// Least number median diameter, in samples (status coarse_sampling
+  /// below). 4: the table above (bias under 3 % at 4, -15 % at 2).
+  double samples_min = 4.0;
 
   [[nodiscard]] Validation validate() const;
 };
@@ -94,7 +99,7 @@ enum class SizesStatus {
   no_velocity,                 ///< no chord has a velocity: no lengths
   intermediate_void_fraction,  ///< 0.3 <= c <= 0.7: neither bubbles nor droplets are particles
   too_few_chords,              ///< fewer usable chords than size-chords-min
-  coarse_sampling,             ///< the floor chord is fewer than size-samples-min samples long
+  coarse_sampling,             ///< the number median spans fewer than size-samples-min samples
 };
 std::string_view to_string(SizesStatus status);
 
@@ -123,9 +128,9 @@ struct SizesResult {
   std::array<std::int64_t, 4> chords_by_velocity{};  ///< indexed by ChordVelocity
   [[nodiscard]] std::int64_t count(ChordVelocity v) const { return chords_by_velocity[static_cast<std::size_t>(v)]; }
   std::string record_velocity_source;   ///< as ProcessResult::velocity_source's text
-  /// The grid floor's chord (the inversion's edges[0]) in samples of its
-  /// own chord time (length / its velocity x fs); 0 without a distribution.
-  double floor_chord_samples = 0.0;
+  /// The inverted number median in samples (its length over the chords'
+  /// total length per total samples); 0 unless the inversion ran.
+  double median_samples = 0.0;
   /// 1.5 u c / F (droplets: 1.5 u (1 - c) / F), m; none without a velocity.
   std::optional<double> sauter_flux;
   /// The inversion: counts, mean chord and 1.5 x mean chord always; the
