@@ -59,7 +59,7 @@ class Result(dict):
 # What pdp.process keeps of a recording beside its JSON, as attributes of its
 # Result: the window table, R11 and R12, the velocity spectrum, event
 # detection's bubble table and the multi-tip vector table.
-_DETAIL = ("windows", "correlation", "spectrum", "bubbles", "vectors", "sizes")
+_DETAIL = ("windows", "correlation", "spectrum", "bubbles", "vectors")
 
 
 class Profile(Result):
@@ -103,7 +103,11 @@ def _wrap(value):
     if isinstance(value, dict):
         if isinstance(value.get("profile"), list):
             return Profile((k, _wrap(v)) for k, v in value.items())
-        return Result((k, _wrap(v)) for k, v in value.items())
+        out = Result((k, _wrap(v)) for k, v in value.items())
+        sizes = out.get("sizes")
+        if isinstance(sizes, Result) and "bins" in sizes:  # a recording's size distribution: its bins as a table
+            sizes.__dict__["table"] = _sizes_table(sizes)
+        return out
     if isinstance(value, list):
         return [_wrap(v) for v in value]
     return value
@@ -128,16 +132,15 @@ def _table(columns, name="windows"):
 
 
 def _sizes_table(sizes):
-    """The JSON's ``sizes`` (docs/output.md) as a table of its bins: one row
+    """The JSON's ``sizes`` (docs/output.md) as a table of its bins
+    (``result.sizes.table``): one row
     per diameter bin, ``diameter`` (geometric centre), ``lower``, ``upper``
     (edges, m), ``density`` (number density n(D), 1/m) and ``cumulative``
     (number fraction below ``upper``); the moments, counts and status in
     ``attrs`` (``status``, ``reason``, ``dispersed_phase``, ``median``,
     ``d10``, ``d20``, ``d30``, ``d32``, ``d32_chords``, ``d32_flux`` in m,
     ``chords_used``, ``chords_by_velocity``). No rows without a distribution
-    (``attrs["status"]`` says why); None when sizes were not computed."""
-    if sizes is None:
-        return None
+    (``attrs["status"]`` says why)."""
     bins = sizes.get("bins") or {"edges": [], "diameters": [], "density": [], "cumulative": []}
     edges, cumulative = bins["edges"], bins["cumulative"]
     columns = {"diameter": list(bins["diameters"]), "lower": list(edges[:-1]), "upper": list(edges[1:]),
@@ -386,9 +389,9 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     tips: ``tips=[[0, 0, 0], [5e-3, 0, 0], ...]`` (m) or the command line's
     text. A profile is a Profile: each position ``result.profile[i]`` has
     them, and ``result.to_dataframe()`` is the profile CSV's table.
-    ``result.sizes`` is the size distribution's table of bins with its
-    moments in ``attrs`` (on a recording and on each position of a profile;
-    ``result["sizes"]`` is the JSON object it comes from)."""
+    ``result.sizes`` is the JSON's size distribution (status, moments,
+    counts) and ``result.sizes.table`` its bins as a table, the moments in
+    its ``attrs`` (on a recording and on each position of a profile)."""
     settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
     if isinstance(source, (str, _os.PathLike)):
@@ -421,9 +424,6 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
             row.__dict__.update(row_detail)
     else:
         result.__dict__.update(_detail(windows, detail))
-    # The size distribution's table beside its JSON (result["sizes"] stays the object).
-    for row in (result.profile if isinstance(result, Profile) else [result]):
-        row.__dict__["sizes"] = _sizes_table(row.get("sizes"))
     return result
 
 
