@@ -69,6 +69,11 @@ std::string_view to_string(PhaseStatus status) {
   return "?";
 }
 
+std::optional<double> sauter_diameter(double velocity, double fraction, double count_rate) {
+  if (!(count_rate > 0.0)) return std::nullopt;
+  return 1.5 * std::fabs(velocity) * fraction / count_rate;
+}
+
 PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisticsOptions& options) {
   PhaseStatistics p;
   const double fs = signal.fs;
@@ -121,7 +126,7 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
     lengths.reserve(air.size());
     for (double t : air) lengths.push_back(t * std::fabs(u));
     p.air_chord_length = summarise(lengths);
-    if (p.bubble_count_rate > 0.0) p.sauter_diameter = 1.5 * std::fabs(u) * p.void_fraction / p.bubble_count_rate;
+    p.sauter_diameter = sauter_diameter(u, p.void_fraction, p.bubble_count_rate);
   }
   return p;
 }

@@ -50,7 +50,7 @@ Validation ProcessOptions::validate() const {
   }
   for (const auto& part : {binarisation.validate(), signal_check.validate(), fscc_options.validate(),
                            awcc_options.validate(), structure.validate(), spectrum.validate(),
-                           event_options.validate(), multi_tip_options.validate()}) {
+                           event_options.validate(), multi_tip_options.validate(), size_options.validate()}) {
     if (!part.ok()) return part;
   }
   if (block_frames < 1) return Validation::invalid("", "block_frames must be >= 1");
@@ -671,12 +671,33 @@ void add_structure(ProcessResult& out, const BinarisedRecording& b, const Proces
                                     options.structure);
 }
 
+// The sizes and interfacial area (awcc/position_sizes.hpp), from every
+// velocity the other steps gave.
+void add_sizes(ProcessResult& out, const BinarisedRecording& b, const ProcessOptions& options) {
+  const PhaseStatistics& leading = out.tips.at(0).phase;
+  if (options.sizes) {
+    out.sizes = position_sizes(b.leading, leading, out.awcc, out.events, out.velocity(),
+                               to_string(out.velocity_source()), options.size_options);
+  }
+  const MultiTipResult* vectors = out.probe ? &out.probe->vectors : nullptr;
+  const bool probe_ok = out.probe && out.probe->quality == AwccQuality::ok;
+  out.interfacial_area = interfacial_area(leading, out.velocity(), out.velocity_ci95(), vectors, probe_ok,
+                                          out.probe ? out.probe->quality_reason : std::string());
+}
+
 }  // namespace
 
 std::optional<double> ProcessResult::velocity() const {
   const auto s = velocity_source();
   if (s == VelocitySource::awcc) return awcc->velocity;
   if (s == VelocitySource::fscc) return fscc->velocity;
+  return std::nullopt;
+}
+
+std::optional<Interval95> ProcessResult::velocity_ci95() const {
+  const auto s = velocity_source();
+  if (s == VelocitySource::awcc) return awcc->velocity_ci95;
+  if (s == VelocitySource::fscc) return fscc->velocity_ci95;
   return std::nullopt;
 }
 
@@ -857,6 +878,7 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   apply_tip_order(out);
   out.tips = tip_results(r, options, out.velocity());
   add_bubble_methods(out, r, options);
+  add_sizes(out, r, options);
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     add_structure(out, r, options);
     add_spectrum(out, options);
@@ -1059,6 +1081,7 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
     apply_tip_order(out);
     out.tips = tip_results(binarised, options, out.velocity());
     add_bubble_methods(out, binarised, options);
+    add_sizes(out, binarised, options);
     add_structure(out, binarised, options);
     add_spectrum(out, options);
     out.warnings = assess(out);

@@ -148,6 +148,13 @@ constexpr MultiTipStatus kMultiTipStatuses[] = {MultiTipStatus::ok, MultiTipStat
 constexpr WindowFate kWindowFates[] = {WindowFate::accepted, WindowFate::correlation, WindowFate::lag,
                                        WindowFate::roc,      WindowFate::constant,    WindowFate::too_short,
                                        WindowFate::correction};
+constexpr SizesStatus kSizesStatuses[] = {SizesStatus::ok,
+                                          SizesStatus::not_converged,
+                                          SizesStatus::no_velocity,
+                                          SizesStatus::intermediate_void_fraction,
+                                          SizesStatus::too_few_chords,
+                                          SizesStatus::coarse_sampling};
+constexpr AreaSource kAreaSources[] = {AreaSource::dual_tip, AreaSource::multi_tip};
 constexpr VelocitySource kVelocitySources[] = {VelocitySource::none, VelocitySource::awcc, VelocitySource::fscc};
 constexpr auto kFlags = [] {
   std::array<Flag, flag_names.size()> out{};
@@ -231,6 +238,8 @@ std::vector<std::string_view> written_values(std::string_view column) {
   if (column == c::awcc_signal) return texts(values::signal);
   if (column == c::awcc_subsample) return texts(values::subsample);
   if (column == c::chord_velocity_source) return texts(kVelocitySources);
+  if (column == c::sizes_status) return texts(kSizesStatuses);
+  if (column == c::interfacial_area_source) return texts(kAreaSources);
   if (column == c::awcc_roc || column == c::awcc_probe_corrected) return texts(kSwitches);
   if (column == c::flags) return texts(kFlags);
   return {};
@@ -601,6 +610,54 @@ json events_json(const EventResult& e) {
   return out;
 }
 
+json sizes_json(const SizesResult& r) {
+  namespace k = process_key;
+  const SizeDistribution& d = r.distribution;
+  const bool dist = r.has_distribution();
+  auto value = [&](double v) { return dist ? json(v) : json(nullptr); };
+  json by = json::object();
+  for (std::size_t i = 0; i < chord_velocity_names.size(); ++i) {
+    by[std::string(chord_velocity_names[i])] = r.chords_by_velocity[i];
+  }
+  json bins = nullptr;
+  if (dist) {
+    bins = json{{k::bin_edges, d.edges}, {k::bin_diameters, d.diameters}, {k::bin_density, d.density},
+                {k::bin_cumulative, d.cumulative}};
+  }
+  return json{{k::status, to_string(r.status)},
+              {k::reason, r.message.empty() ? json(nullptr) : json(r.message)},
+              {"velocity_note", r.velocity_note.empty() ? json(nullptr) : json(r.velocity_note)},
+              {k::dispersed_phase, r.phase ? json(to_string(*r.phase)) : json(nullptr)},
+              {"chords_given", r.chords_given},
+              {k::chords_used, d.chords_used},
+              {"chords_by_velocity", by},
+              {"record_velocity_source", r.record_velocity_source},
+              {"mean_chord", d.chords_used > 0 ? json(d.mean_chord) : json(nullptr)},
+              {"median_samples", dist || r.status == SizesStatus::coarse_sampling ? json(r.median_samples)
+                                                                                  : json(nullptr)},
+              {k::median, value(d.median)},
+              {k::d10, value(d.d10)},
+              {k::d20, value(d.d20)},
+              {k::d30, value(d.d30)},
+              {k::d32, value(d.d32)},
+              {k::d32_chords, d.chords_used > 0 ? json(d.sauter_from_chords) : json(nullptr)},
+              {k::d32_flux, optional(r.sauter_flux)},
+              {"iterations", dist ? json(d.iterations) : json(nullptr)},
+              {k::bins, bins}};
+}
+
+json interfacial_area_json(const InterfacialArea& a) {
+  auto interval = [](const std::optional<Interval95>& i) { return i ? ci(*i) : json(nullptr); };
+  return json{{"value", optional(a.value())},
+              {"ci95", interval(a.ci95())},
+              {"source", a.source ? json(to_string(*a.source)) : json(nullptr)},
+              {"dual_tip", optional(a.dual_tip)},
+              {"dual_tip_ci95", interval(a.dual_tip_ci95)},
+              {"multi_tip", optional(a.multi_tip)},
+              {"multi_tip_ci95", interval(a.multi_tip_ci95)},
+              {process_key::reason, a.message.empty() ? json(nullptr) : json(a.message)}};
+}
+
 json multi_tip_json(const ProbeResult& p) {
   const MultiTipResult& v = p.vectors;
   const bool ok = v.ok();
@@ -779,6 +836,8 @@ json to_json(const ProcessResult& r) {
   if (r.awcc) out[process_key::awcc] = awcc_json(*r.awcc);
   if (r.events) out[process_key::events] = events_json(*r.events);
   if (r.probe) out[process_key::multi_tip] = multi_tip_json(*r.probe);
+  out[process_key::sizes] = r.sizes ? sizes_json(*r.sizes) : json(nullptr);
+  out[process_key::interfacial_area] = interfacial_area_json(r.interfacial_area);
   return out;
 }
 
@@ -860,6 +919,15 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"multi_tip_diameter", "m", "/multi_tip/diameter_front", "multi-tip mean bubble diameter (front interfaces)"},
       {"multi_tip_interfacial_area", "1/m", "/multi_tip/interfacial_area", "multi-tip interfacial area concentration"},
       {"multi_tip_bubbles_accepted", "-", "/multi_tip/bubbles_accepted", "bubbles with an accepted velocity vector"},
+      {profile_column::sizes_status, "", "/sizes/status", "size distribution: ok, or why none (docs/output.md)"},
+      {"sizes_d10", "m", "/sizes/d10", "number mean diameter d10 of the inverted size distribution"},
+      {"sizes_d32", "m", "/sizes/d32", "Sauter diameter d32 of the inverted size distribution"},
+      {"sizes_median", "m", "/sizes/median", "number median diameter of the inverted size distribution"},
+      {"interfacial_area", "1/m", "/interfacial_area/value", "interfacial area concentration (interfacial_area_source's)"},
+      {"interfacial_area_ci95_lower", "1/m", "/interfacial_area/ci95/0", "interfacial area, 95 % interval, lower"},
+      {"interfacial_area_ci95_upper", "1/m", "/interfacial_area/ci95/1", "interfacial area, 95 % interval, upper"},
+      {profile_column::interfacial_area_source, "", "/interfacial_area/source",
+       "which estimate interfacial_area is: dual_tip (4 F / u = 6 c / d32) or multi_tip"},
   };
   return columns;
 }
@@ -943,6 +1011,17 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   } else {
     out += ",,,,,,,,,,,";
   }
+  const bool sized = r.sizes && r.sizes->has_distribution();
+  auto size = [&](double SizeDistribution::* m) {
+    return csv_number(sized ? std::optional(r.sizes->distribution.*m) : std::nullopt);
+  };
+  const auto& area = r.interfacial_area;
+  const auto area_ci = area.ci95();
+  out += fmt::format(",{},{},{},{},{},{},{},{}", r.sizes ? to_string(r.sizes->status) : "", size(&SizeDistribution::d10),
+                     size(&SizeDistribution::d32), size(&SizeDistribution::median), csv_number(area.value()),
+                     csv_number(area_ci ? std::optional(area_ci->lower) : std::nullopt),
+                     csv_number(area_ci ? std::optional(area_ci->upper) : std::nullopt),
+                     area.source ? to_string(*area.source) : "");
   return out;
 }
 
@@ -1243,6 +1322,19 @@ std::string ProcessResult::report() const {
   if (const auto s = velocity_source(); s != VelocitySource::awcc && (awcc || fscc)) {
     line(s == VelocitySource::fscc ? "  chord lengths and d32 use FSCC's velocity (AWCC's is not of quality ok)"
                                    : "  chord lengths and d32: no velocity");
+  }
+  if (sizes) {
+    const std::string text = sizes->report();
+    for (std::size_t from = 0; from < text.size();) {
+      const auto end = std::min(text.find('\n', from), text.size());
+      line("  " + text.substr(from, end - from));
+      from = end + 1;
+    }
+  }
+  {
+    std::string text = interfacial_area.report();
+    if (!text.empty() && text.back() == '\n') text.pop_back();
+    line("  " + text);
   }
   for (const auto& w : warnings) line(fmt::format("  warning: {} [{}]", w.text, to_string(w.flag)));
   return out;

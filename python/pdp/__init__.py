@@ -214,7 +214,11 @@ def _wrap(value, key=None):
             return f
         if isinstance(value.get("profile"), list):
             return Profile((k, _wrap(v, k)) for k, v in value.items())
-        return Result((k, _wrap(v, k)) for k, v in value.items())
+        out = Result((k, _wrap(v, k)) for k, v in value.items())
+        sizes = out.get("sizes")
+        if isinstance(sizes, Result) and "bins" in sizes:  # a recording's size distribution: its bins as a table
+            sizes.__dict__["table"] = _sizes_table(sizes)
+        return out
     if isinstance(value, list):
         return [_wrap(v) for v in value]
     return value
@@ -235,6 +239,35 @@ def _table(columns, name="windows"):
         return columns
     frame = pandas.DataFrame(columns)
     frame.attrs["units"] = dict(_TABLE_UNITS[name])
+    return frame
+
+
+def _sizes_table(sizes):
+    """The JSON's ``sizes`` (docs/output.md) as a table of its bins
+    (``result.sizes.table``): one row
+    per diameter bin, ``diameter`` (geometric centre), ``lower``, ``upper``
+    (edges, m), ``density`` (number density n(D), 1/m) and ``cumulative``
+    (number fraction below ``upper``); the moments, counts and status in
+    ``attrs`` (``status``, ``reason``, ``dispersed_phase``, ``median``,
+    ``d10``, ``d20``, ``d30``, ``d32``, ``d32_chords``, ``d32_flux`` in m,
+    ``chords_used``, ``chords_by_velocity``). No rows without a distribution
+    (``attrs["status"]`` says why)."""
+    bins = sizes.get("bins") or {"edges": [], "diameters": [], "density": [], "cumulative": []}
+    edges, cumulative = bins["edges"], bins["cumulative"]
+    columns = {"diameter": list(bins["diameters"]), "lower": list(edges[:-1]), "upper": list(edges[1:]),
+               "density": list(bins["density"]), "cumulative": list(cumulative[1:])}
+    units = {"diameter": "m", "lower": "m", "upper": "m", "density": "1/m", "cumulative": "-"}
+    attrs = {k: v for k, v in sizes.items() if k != "bins"}
+    try:
+        import pandas
+    except ImportError:
+        import numpy
+        out = Result((k, numpy.asarray(v, dtype=float)) for k, v in columns.items())
+        out["attrs"] = {**attrs, "units": units}
+        return out
+    frame = pandas.DataFrame(columns, columns=list(columns))
+    frame.attrs.update(attrs)
+    frame.attrs["units"] = units
     return frame
 
 
@@ -497,7 +530,10 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
     Flow: Y90, C_mean, d, power law, discharges, both air-concentration
     fits, 95 % intervals), with the corrected velocities when ``correct`` is
     given; its options are the flow group's (``discharge="0.2m2/s"``,
-    ``invert``, ``depth_levels``, ``flow_draws``, ``flow_seed``)."""
+    ``invert``, ``depth_levels``, ``flow_draws``, ``flow_seed``).
+    ``result.sizes`` is the JSON's size distribution (status, moments,
+    counts) and ``result.sizes.table`` its bins as a table, the moments in
+    its ``attrs`` (on a recording and on each position of a profile)."""
     call = _call_text("process", [source], {**options, "fs": fs, "preset": preset, "correct": correct})
     flow_settings, options = _flow_settings(options)
     profile = isinstance(source, (list, tuple)) and len(source) >= 2 and positions is not None

@@ -77,6 +77,12 @@ struct PhaseStatistics {
   std::optional<double> sauter_diameter;    ///< d32 = 1.5 u c / F, m, with a velocity and F > 0
 };
 
+/// The Sauter diameter d32 = 1.5 u c / F of spheres of volume fraction c
+/// passing a point at F per second with velocity u (|u| used), m: the one
+/// place of the formula (PhaseStatistics::sauter_diameter, and the
+/// droplets' 1.5 u (1 - c) / F in awcc/position_sizes.hpp). None unless F > 0.
+std::optional<double> sauter_diameter(double velocity, double fraction, double count_rate);
+
 Summary summarise(std::vector<double> values);
 /// Same, sorting `values` in place.
 Summary summarise_in_place(std::vector<double>& values);

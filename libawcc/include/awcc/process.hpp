@@ -17,6 +17,7 @@
 #include "awcc/fscc.hpp"
 #include "awcc/multi_tip.hpp"
 #include "awcc/phase_statistics.hpp"
+#include "awcc/position_sizes.hpp"
 #include "awcc/probe_tips.hpp"
 #include "awcc/recording.hpp"
 #include "awcc/signal_check.hpp"
@@ -72,6 +73,12 @@ struct ProcessOptions {
   int histogram_bins = 50;            ///< chord-time histogram bins
   /// Chord and voltage PDFs, clusters, inter-particle arrivals (and Felder's conventions).
   StructureOptions structure;
+  /// The number distribution of bubble (droplet) diameters inverted from
+  /// the leading tip's chord lengths (awcc/position_sizes.hpp). On: a lab
+  /// expects it, and it costs little against the rest (docs/performance.md:
+  /// the repeated lengths of one velocity are inverted once each).
+  bool sizes = true;
+  SizesOptions size_options;
   /// The AWCC velocity series' spectrum and integral time scale (METHOD 10).
   bool velocity_spectrum = true;
   SpectrumOptions spectrum;
@@ -207,6 +214,10 @@ struct ProcessResult {
   std::optional<VelocitySpectrum> spectrum;  ///< of AWCC's series, when AWCC ran
   std::optional<EventResult> events;  ///< event detection on the tip pair (options.events)
   std::optional<ProbeResult> probe;   ///< a multi-tip probe bubble by bubble (options.multi_tip)
+  /// The leading tip's size distribution (options.sizes; awcc/position_sizes.hpp).
+  std::optional<SizesResult> sizes;
+  /// Dual-tip 4 F / u and the multi-tip estimate where there is one.
+  InterfacialArea interfacial_area;
   /// Every warning of the recording with its flag, in one list (awcc/assess.hpp
   /// assembles it; every output writes it).
   std::vector<Warning> warnings;
@@ -217,6 +228,8 @@ struct ProcessResult {
   /// AWCC's of quality ok; else FSCC's when defined; else AWCC's of low
   /// quality (flagged); else none (METHOD 4, item 10).
   [[nodiscard]] VelocitySource velocity_source() const;
+  /// The 95 % sampling interval of velocity(), where its method gives one.
+  [[nodiscard]] std::optional<Interval95> velocity_ci95() const;
 
   [[nodiscard]] std::string report() const;
 };

@@ -86,6 +86,8 @@ inline constexpr std::string_view fscc = "fscc";
 inline constexpr std::string_view awcc = "awcc";
 inline constexpr std::string_view events = "events";        ///< event detection on the tip pair
 inline constexpr std::string_view multi_tip = "multi_tip";  ///< a multi-tip probe bubble by bubble
+inline constexpr std::string_view sizes = "sizes";          ///< the size distribution (awcc/position_sizes.hpp)
+inline constexpr std::string_view interfacial_area = "interfacial_area";
 inline constexpr std::string_view fs = "fs";
 inline constexpr std::string_view samples = "samples";
 inline constexpr std::string_view duration = "duration";
@@ -117,6 +119,21 @@ inline constexpr std::string_view weighting = "weighting";
 /// Also a tip's object's key of its signal check (awcc/signal_check.hpp).
 inline constexpr std::string_view signal = "signal";
 inline constexpr std::string_view subsample = "subsample";
+// In sizes (docs/output.md; the Python module's `sizes` reads them):
+inline constexpr std::string_view bins = "bins";
+inline constexpr std::string_view bin_edges = "edges";
+inline constexpr std::string_view bin_diameters = "diameters";
+inline constexpr std::string_view bin_density = "density";
+inline constexpr std::string_view bin_cumulative = "cumulative";
+inline constexpr std::string_view median = "median";
+inline constexpr std::string_view d10 = "d10";
+inline constexpr std::string_view d20 = "d20";
+inline constexpr std::string_view d30 = "d30";
+inline constexpr std::string_view d32 = "d32";
+inline constexpr std::string_view d32_chords = "d32_chords";
+inline constexpr std::string_view d32_flux = "d32_flux";
+inline constexpr std::string_view dispersed_phase = "dispersed_phase";
+inline constexpr std::string_view chords_used = "chords_used";
 /// Retired by issue 28: a JSON written before the "status" keys existed says
 /// only whether FSCC or AWCC gave a value (docs/output.md).
 inline constexpr std::string_view retired_defined = "defined";
@@ -165,6 +182,8 @@ inline constexpr std::string_view chord_velocity_source = "chord_velocity_source
 inline constexpr std::string_view awcc_probe_corrected = "awcc_probe_corrected";
 inline constexpr std::string_view warnings = "warnings";  ///< the texts, joined by "; "
 inline constexpr std::string_view flags = "flags";        ///< the codes, joined by "; "
+inline constexpr std::string_view sizes_status = "sizes_status";
+inline constexpr std::string_view interfacial_area_source = "interfacial_area_source";
 }  // namespace profile_column
 
 }  // namespace awcc

@@ -73,8 +73,12 @@
 // are pierced). No bias to speak of at any count: few chords widen the
 // spread, they do not shift the answer. 1.5 mean(l) and the inversion's d32
 // differ by at most 0.4 % at 5,000 chords, 2.7 % at 200, 6.3 % at 50.
-// 5-9 ms per inversion of 50-200 chords, 24-34 ms of 5,000 (the E-step is
-// O(chords x bins), 35-45 EM iterations).
+// 5-9 ms per inversion of 50-200 chords, 24-34 ms of 5,000 (35-45 EM
+// iterations; measured with an E-step of O(chords x bins)). The E-step and
+// the mixture are now O(distinct chords + bins) an iteration (the kernel is
+// linear in l below a bin and the bins are ordered: prefix and suffix sums),
+// and repeated lengths are inverted once with their count; the Newton
+// M-step is O(bins^3). docs/performance.md gives the cost on a record.
 // so chords_min = 200 (below: status too_few_chords, no distribution).
 
 #include <cstdint>
@@ -182,5 +186,13 @@ struct SizeDistribution {
 /// (counted). Deterministic: the result depends on the multiset of chords
 /// only, not their order. Throws OptionError when the options are refused.
 SizeDistribution size_distribution(std::span<const double> chord_lengths, const SizeDistributionOptions& options = {});
+/// The same from distinct lengths and how often each occurred (any order; a
+/// length given twice adds its counts): the identical result as the
+/// lengths repeated, without materialising them. Chords of one velocity are
+/// whole sample counts times it, so a record's chords repeat a few hundred
+/// lengths. chords_given is the sum of the counts. Throws
+/// std::invalid_argument for a negative count or spans of different sizes.
+SizeDistribution size_distribution(std::span<const double> chord_lengths, std::span<const std::int64_t> counts,
+                                   const SizeDistributionOptions& options = {});
 
 }  // namespace awcc
