@@ -69,8 +69,9 @@ def test_the_four_tip_report_holds_the_vector_figure_and_bubble_panels(folder):
     assert "multi_tip_doubtful" not in rows[0]["flags"] and "multi_tip_doubtful" in rows[1]["flags"]
     text = report.build(str(folder / "four.json"))
     page = Page(text)
-    assert page.figures == [key for key, _, _ in plotting.PROFILE_FIGURES] + ["multi-tip-vector"] + \
-        [key for key, _, _ in plotting.FLOW_FIGURES]  # two positions: a profile's flow
+    assert page.figures == [key for key, _, _ in plotting.PROFILE_FIGURES] + \
+        ["multi-tip-vector", "size-distributions", "size-d32"] + \
+        [key for key, _, _ in plotting.FLOW_FIGURES]  # two positions: a profile's flow; every row has its sizes
     for i in range(2):
         for key, _ in plotting.POSITION_PANELS + plotting.BUBBLE_PANELS["multi_tip"]:
             assert f"p{i}-{key}" in page.gids, (i, key)

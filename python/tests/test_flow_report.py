@@ -393,4 +393,9 @@ def test_the_report_draws_the_size_figures_when_a_row_has_sizes(sized, real_prof
     text = (tmp_path / "r.html").read_text()
     for key in ("size-distributions", "size-d32"):
         assert f'data-figure="{key}"' in text
-    assert 'data-figure="size-d32"' not in (d / "report.html").read_text()  # a JSON without sizes: none
+    bare = dict(data, profile=[{k: v for k, v in r.items() if k != "sizes"} for r in data["profile"]])
+    (tmp_path / "bare.json").write_text(json.dumps(bare))
+    made("report", tmp_path / "bare.json", "-o", tmp_path / "bare.html", "--no-detail")
+    bare_text = (tmp_path / "bare.html").read_text()
+    for key in ("size-distributions", "size-d32"):
+        assert f'data-figure="{key}"' not in bare_text  # rows without sizes: no size figure
