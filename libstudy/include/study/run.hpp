@@ -40,8 +40,10 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
 /// Two binary signals of a synthesised record as pdp process reads them from
 /// the recording libsynth writes: binary input, two levels per tip, whose
 /// thresholds process.cpp's rule (awcc::choose_threshold of the two-level
-/// histogram) marks as not applied again; fs and frames from the signals.
-/// `binarisation` is the processing's (it names the rule in the thresholds).
+/// histogram) marks as not applied again, and whose signal check is the
+/// file's (binary input; air_continuous for a spray scene); fs and frames
+/// from the signals. `binarisation` is the processing's (it names the rule
+/// in the thresholds and the probe type the check reads).
 awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
                                              const awcc::BinarisationOptions& binarisation = {});
 
