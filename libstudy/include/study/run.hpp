@@ -80,7 +80,7 @@ struct RunResult {
   double truth_velocity = 0.0;          ///< realised mean u_x, m/s
   double truth_turbulence_intensity = 0.0;  ///< realised Tu_x
   double truth_void_fraction = 0.0;     ///< leading tip
-  double truth_count_rate = 0.0;        ///< bubbles pierced by the leading tip per second, 1/s
+  double truth_count_rate = 0.0;        ///< particles (bubbles; droplets above c = 0.5) pierced by the leading tip per second, 1/s
   double truth_d32 = 0.0;               ///< E[d^3] / E[d^2] of the bubbles, m
   /// The record processed as pdp process would (tips, fscc, awcc).
   awcc::ProcessResult processed;
