@@ -70,7 +70,9 @@ ArrivalAnalysis arrival_analysis(const ChordSequence& chords, double void_fracti
   if (out.regime == FlowRegime::bubbly) {
     for (std::size_t i = 0; i < n; ++i) particles.push_back({static_cast<double>(chords.air(i)) * scale, chords.start[i], 0});
   } else {
-    for (std::size_t i = 0; i + 1 < n; ++i) particles.push_back({static_cast<double>(chords.water(i)) * scale, chords.end[i], 0});
+    const auto droplets = complete_droplets(chords);
+    for (std::size_t i = 0; i < droplets.droplets(); ++i)
+      particles.push_back({static_cast<double>(droplets.water(i)) * scale, droplets.start[i], 0});
   }
   out.classes = empty_classes(limits, 1.0);
   const auto bins = static_cast<std::size_t>(options.bins);

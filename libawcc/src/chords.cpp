@@ -12,11 +12,33 @@ ChordSequence complete_chords(const AirIntervals& signal) {
   out.fs = signal.fs;
   out.sample_count = signal.sample_count;
   for (const auto& iv : signal.intervals) {
-    if (iv.start == 0 || iv.stop == signal.sample_count) continue;  // cut by the record's start or end
+    const bool cut_start = iv.start == 0, cut_end = iv.stop == signal.sample_count;
+    // A water chord follows air cut by the start unless that air fills the record.
+    if (cut_start && !cut_end) out.water_after_cut_start = iv.stop;
+    if (cut_end && !cut_start) out.air_cut_by_end = iv.start;
+    if (cut_start || cut_end) continue;  // cut by the record's start or end
     out.start.push_back(iv.start);
     out.end.push_back(iv.stop);
   }
   return out;
+}
+
+DropletSequence complete_droplets(const ChordSequence& c) {
+  DropletSequence d;
+  const std::size_t n = c.bubbles();
+  if (c.water_after_cut_start && (n > 0 || c.air_cut_by_end)) {
+    d.start.push_back(*c.water_after_cut_start);
+    d.end.push_back(n > 0 ? c.start[0] : *c.air_cut_by_end);
+  }
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    d.start.push_back(c.end[i]);
+    d.end.push_back(c.start[i + 1]);
+  }
+  if (c.air_cut_by_end && n > 0) {
+    d.start.push_back(c.end[n - 1]);
+    d.end.push_back(*c.air_cut_by_end);
+  }
+  return d;
 }
 
 FelderChords felder_chords(const AirIntervals& signal) {

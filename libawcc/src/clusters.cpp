@@ -100,8 +100,10 @@ ClusterAnalysis cluster_analysis(const ChordSequence& chords, double void_fracti
     for (std::size_t i = 0; i < n; ++i) particle.push_back(chords.air(i));
     for (std::size_t i = 0; i + 1 < n; ++i) gap.push_back(chords.water(i));
   } else if (out.regime == FlowRegime::droplet) {
-    for (std::size_t i = 0; i + 1 < n; ++i) particle.push_back(chords.water(i));
-    for (std::size_t i = 1; i + 1 < n; ++i) gap.push_back(chords.air(i));  // between droplets i - 1 and i
+    const auto droplets = complete_droplets(chords);
+    const std::size_t m = droplets.droplets();
+    for (std::size_t i = 0; i < m; ++i) particle.push_back(droplets.water(i));
+    for (std::size_t i = 0; i + 1 < m; ++i) gap.push_back(droplets.air(i));  // between droplets i and i + 1
   }
   if (refused(out, void_fraction, basis, velocity, particle.size())) return out;
   const double scale = (basis == ChordBasis::length ? velocity : 1.0) / chords.fs;  // s or m per sample

@@ -53,6 +53,11 @@ awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::A
   out.trailing_histogram = two_levels(trailing);
   out.leading_threshold = awcc::choose_threshold(*out.leading_histogram, binarisation);
   out.trailing_threshold = awcc::choose_threshold(*out.trailing_histogram, binarisation.for_trailing_tip());
+  // The signal check pdp process makes of the file's channels: binary input,
+  // flagged air_continuous where air holds the droplet regime's share (a
+  // spray scene, synth::DispersedPhase::droplets).
+  out.leading_signal = awcc::check_signal(*out.leading_histogram, binarisation.probe, std::nullopt);
+  out.trailing_signal = awcc::check_signal(*out.trailing_histogram, binarisation.probe, std::nullopt);
   out.leading = std::move(leading);
   out.trailing = std::move(trailing);
   return out;
@@ -74,6 +79,7 @@ awcc::BinarisedRecording binarised_probe(std::vector<awcc::AirIntervals> signals
     tip.channel = static_cast<int>(k + 2);
     tip.histogram = two_levels(further[k]);
     tip.threshold = awcc::choose_threshold(*tip.histogram, binarisation.for_trailing_tip());
+    tip.check = awcc::check_signal(*tip.histogram, binarisation.probe, std::nullopt);
     tip.signal = std::move(further[k]);
   }
   out.tip_positions = positions;

@@ -72,6 +72,18 @@ std::string_view to_string(ArrivalRule rule) {
   return "?";
 }
 
+DispersedPhase dispersed_phase(double void_fraction) {
+  return void_fraction > 0.5 ? DispersedPhase::droplets : DispersedPhase::bubbles;
+}
+
+double dispersed_fraction(double void_fraction) {
+  return dispersed_phase(void_fraction) == DispersedPhase::droplets ? 1.0 - void_fraction : void_fraction;
+}
+
+std::string_view to_string(DispersedPhase phase) {
+  return phase == DispersedPhase::bubbles ? "bubbles" : "droplets";
+}
+
 std::string_view to_string(VelocityUpdate update) {
   return update == VelocityUpdate::exact ? "exact" : "euler";
 }
@@ -122,8 +134,11 @@ awcc::Validation Scene::validate() const {
           rho_xy, rho_xz, rho_yz, min_eig));
     }
   }
-  if (!(finite(void_fraction) && void_fraction > 0.0 && void_fraction <= 0.6))
-    bad("void-fraction", fmt::format("{}", void_fraction), "it must lie in (0, 0.6] (studied range 0.005-0.4)");
+  // Above 0.99 the droplets (at 1 - c) grow too rare for a record of any
+  // practical length to hold a statistic of them.
+  if (!(finite(void_fraction) && void_fraction > 0.0 && void_fraction <= 0.99))
+    bad("void-fraction", fmt::format("{}", void_fraction),
+        "it must lie in (0, 0.99] (studied range 0.005-0.99: bubbles up to 0.5, droplets at 1 - c above)");
   if (!(finite(bubble_diameter) && bubble_diameter > 0.0 && bubble_diameter <= 1.0))
     bad("bubble-diameter", q(bubble_diameter, Dimension::length), "it must lie in (0, 1 m] (studied range 0.5-20 mm)");
   if (!(finite(diameter_log_sd) && diameter_log_sd >= 0.0 && diameter_log_sd <= 1.0))
@@ -270,13 +285,18 @@ const SceneField kFields[] = {
     PDP_QUANTITY_FIELD("rho-xy", rho_xy, Dimension::dimensionless, "correlation of u_x and u_y, -"),
     PDP_QUANTITY_FIELD("rho-xz", rho_xz, Dimension::dimensionless, "correlation of u_x and u_z, -"),
     PDP_QUANTITY_FIELD("rho-yz", rho_yz, Dimension::dimensionless, "correlation of u_y and u_z, -"),
-    PDP_QUANTITY_FIELD("void-fraction", void_fraction, Dimension::dimensionless, "void fraction c, -"),
+    PDP_QUANTITY_FIELD("void-fraction", void_fraction, Dimension::dimensionless,
+                       "void fraction c in (0, 0.99]: bubbles in water up to 0.5, water droplets in air at 1 - c "
+                       "above (the spray region), -"),
     PDP_QUANTITY_FIELD("bubble-diameter", bubble_diameter, Dimension::length,
-                       "volume-equivalent bubble diameter d_b (median if log-normal), m"),
+                       "volume-equivalent diameter d_b (median if log-normal) of the dispersed particle: bubble, "
+                       "or droplet for c > 0.5, m"),
     PDP_QUANTITY_FIELD("diameter-log-sd", diameter_log_sd, Dimension::dimensionless,
-                       "standard deviation of ln(d_b): 0 = equal diameters, > 0 = log-normal, -"),
+                       "standard deviation of ln(d_b) of bubbles or droplets: 0 = equal diameters, > 0 = "
+                       "log-normal, -"),
     PDP_QUANTITY_FIELD("aspect-ratio", aspect_ratio, Dimension::dimensionless,
-                       "ellipsoid semi-axis along x over lateral semi-axes (volume kept), 1 = sphere, -"),
+                       "bubble's or droplet's ellipsoid semi-axis along x over lateral semi-axes (volume kept), "
+                       "1 = sphere, -"),
     SceneField{"arrival", Dimension::dimensionless,
                "bubble arrivals: equal-time | poisson-time | equal-space | poisson-space",
                [](Scene& s, std::string_view t) {

@@ -76,6 +76,7 @@ json truth_to_json(const Truth& t) {
         {"rho_xz", s.rho_xz},
         {"rho_yz", s.rho_yz},
         {"void_fraction", s.void_fraction},
+        {"dispersed_phase", std::string(to_string(t.dispersed_phase))},
         {"bubble_diameter", s.bubble_diameter},
         {"pierce_rate", t.expected_pierce_rate},
         {"interfacial_area", t.expected_interfacial_area}}},

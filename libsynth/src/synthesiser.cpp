@@ -91,6 +91,20 @@ inline double wrap(double separation, double length) {
   return separation;
 }
 
+// The complement over [0, samples) of sorted, disjoint, non-touching
+// intervals inside it: the gaps between them, which are as well.
+std::vector<awcc::AirInterval> complement(const std::vector<awcc::AirInterval>& intervals, std::int64_t samples) {
+  std::vector<awcc::AirInterval> out;
+  out.reserve(intervals.size() + 1);
+  std::int64_t from = 0;
+  for (const auto& i : intervals) {
+    if (i.start > from) out.push_back({from, i.start});
+    from = i.stop;
+  }
+  if (from < samples) out.push_back({from, samples});
+  return out;
+}
+
 struct ActiveBubble {
   Vec3 key;        // D(t_entry)
   Vec3 entry;      // relative to the probe centre
@@ -313,13 +327,15 @@ class Synthesiser {
     length_[2] = (hi.z - lo.z) + 4.0 * a_lat_max;
     entry_x_ = -0.5 * length_[0];
 
+    // Bubbles, or droplets in the spray region: the particles are placed at
+    // their own volume fraction, c or 1 - c (synth::DispersedPhase).
     const double mean_volume = std::numbers::pi / 6.0 * sizes_.moment(3.0);
     const double area = length_[1] * length_[2];
-    rate_ = scene.void_fraction * scene.velocity * area / mean_volume;
-    // Tip pierce rate: flux of bubble cross-sections pi a_y a_z through the tip.
+    rate_ = fraction_ * scene.velocity * area / mean_volume;
+    // Tip pierce rate: flux of particle cross-sections pi a_y a_z through the tip.
     const double mean_section = std::numbers::pi * 0.25 * sizes_.lateral_factor * sizes_.lateral_factor *
                                 sizes_.moment(2.0);
-    expected_pierce_rate_ = scene.void_fraction * scene.velocity * mean_section / mean_volume;
+    expected_pierce_rate_ = fraction_ * scene.velocity * mean_section / mean_volume;
     spacing_ = scene.velocity / rate_;  // metres of flow between entries (space rules)
     reversal_allowance_ = std::max(2.0 * length_[0], 4.0 * scene.velocity * scene.tu * scene.time_scale_of(0));
 
@@ -400,8 +416,9 @@ class Synthesiser {
     for (int i = 0; i < 3; ++i) truth.control_volume[i] = length_[i];
     truth.bubble_rate = rate_;
     truth.expected_pierce_rate = expected_pierce_rate_;
+    truth.dispersed_phase = phase_;
     truth.expected_interfacial_area =
-        scene_.void_fraction * sizes_.unit_surface() * sizes_.moment(2.0) / (std::numbers::pi / 6.0 * sizes_.moment(3.0));
+        fraction_ * sizes_.unit_surface() * sizes_.moment(2.0) / (std::numbers::pi / 6.0 * sizes_.moment(3.0));
     truth.realised = flow.finish();
     truth.bubbles_generated = generated_;
     truth.overlaps_unresolved = overlaps_unresolved_;
@@ -414,6 +431,8 @@ class Synthesiser {
       signal.sample_count = samples_;
       signal.intervals = std::move(pierces_[j]);
       awcc::normalise(signal.intervals);
+      // The pierces are the particles': for droplets air is everything else.
+      if (phase_ == DispersedPhase::droplets) signal.intervals = complement(signal.intervals, samples_);
       TipTruth tip;
       tip.position = given_tips[j];
       tip.void_fraction = signal.void_fraction();
@@ -856,6 +875,8 @@ class Synthesiser {
 
   const Scene& scene_;
   const SynthesisOptions& options_;
+  DispersedPhase phase_ = dispersed_phase(scene_.void_fraction);
+  double fraction_ = dispersed_fraction(scene_.void_fraction);
   bool bubble_truth_ = options_.bubble_truth;
   SizeModel sizes_;
   bool spherical_ = sizes_.lateral_factor == 1.0;
@@ -973,8 +994,11 @@ std::span<const awcc::OptionField<SynthesisOptions>> synthesis_option_fields() {
 std::vector<std::vector<std::uint8_t>> brute_force_signals(const Scene& scene, const ReferenceData& reference) {
   std::vector<std::vector<std::uint8_t>> out(reference.tips.size(),
                                              std::vector<std::uint8_t>(static_cast<std::size_t>(scene.sample_count())));
+  // Inside a particle is air for a bubble, water for a droplet.
+  const bool droplets = dispersed_phase(scene.void_fraction) == DispersedPhase::droplets;
   for_each_sample_min_form(scene, reference, [&](std::size_t j, std::int64_t n, double form) {
-    out[j][static_cast<std::size_t>(n)] = form < 1.0 ? 1 : 0;
+    const bool inside = form < 1.0;
+    out[j][static_cast<std::size_t>(n)] = inside != droplets ? 1 : 0;
   });
   return out;
 }
@@ -982,8 +1006,9 @@ std::vector<std::vector<std::uint8_t>> brute_force_signals(const Scene& scene, c
 std::vector<std::vector<double>> brute_force_distances(const Scene& scene, const ReferenceData& reference) {
   std::vector<std::vector<double>> out(reference.tips.size(),
                                        std::vector<double>(static_cast<std::size_t>(scene.sample_count())));
+  const bool droplets = dispersed_phase(scene.void_fraction) == DispersedPhase::droplets;
   for_each_sample_min_form(scene, reference, [&](std::size_t j, std::int64_t n, double form) {
-    out[j][static_cast<std::size_t>(n)] = form;
+    out[j][static_cast<std::size_t>(n)] = droplets ? 2.0 - form : form;
   });
   return out;
 }

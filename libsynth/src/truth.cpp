@@ -59,23 +59,30 @@ std::string Truth::report() const {
   line(fmt::format("    rho_xy          {:>9.4f}        {}", s.rho_xy, opt(realised.rho_xy, "{:>9.4f}")));
   line(fmt::format("    rho_xz          {:>9.4f}        {}", s.rho_xz, opt(realised.rho_xz, "{:>9.4f}")));
   line(fmt::format("    rho_yz          {:>9.4f}        {}", s.rho_yz, opt(realised.rho_yz, "{:>9.4f}")));
-  line(fmt::format("  bubbles: d_b {}, {} generated in the record ({:.1f} /s into a {:.2f} x {:.2f} x {:.2f} mm "
+  const std::string_view particles = to_string(dispersed_phase);
+  if (dispersed_phase == DispersedPhase::droplets) {
+    line(fmt::format("  spray region: the tips pierce water droplets at the volume fraction 1 - c = {:.4f}; air is "
+                     "outside them",
+                     dispersed_fraction(s.void_fraction)));
+  }
+  line(fmt::format("  {}: d_b {}, {} generated in the record ({:.1f} /s into a {:.2f} x {:.2f} x {:.2f} mm "
                    "control volume), {} overlaps unresolved",
-                   format_quantity(s.bubble_diameter, Dimension::length), bubbles_generated, bubble_rate,
+                   particles, format_quantity(s.bubble_diameter, Dimension::length), bubbles_generated, bubble_rate,
                    control_volume[0] * 1e3, control_volume[1] * 1e3, control_volume[2] * 1e3, overlaps_unresolved));
   line(fmt::format("  tips (imposed c {:.4f}, expected pierce rate {:.2f} /s):", s.void_fraction, expected_pierce_rate));
   for (std::size_t j = 0; j < tips.size(); ++j) {
     const auto& t = tips[j];
-    line(fmt::format("    tip {} at ({:.3f}, {:.3f}, {:.3f}) mm: void fraction {:.5f}, {} bubbles pierced "
+    line(fmt::format("    tip {} at ({:.3f}, {:.3f}, {:.3f}) mm: void fraction {:.5f}, {} {} pierced "
                      "({:.2f} /s), {} chords{}",
                      j, t.position.x * 1e3, t.position.y * 1e3, t.position.z * 1e3, t.void_fraction, t.bubbles_pierced,
+                     particles,
                      static_cast<double>(t.bubbles_pierced) / s.duration, t.chords,
                      t.interfacial_area ? fmt::format(", interfacial area {:.2f} 1/m (expected {:.2f})",
                                                       *t.interfacial_area, expected_interfacial_area)
                                         : std::string()));
   }
   for (const auto& p : pairs) {
-    line(fmt::format("    tips {} and {}: {} bubbles pierced by both", p.first, p.second, p.pierced_by_both));
+    line(fmt::format("    tips {} and {}: {} {} pierced by both", p.first, p.second, p.pierced_by_both, particles));
   }
   if (reentries_missed > 0) {
     line(fmt::format("  WARNING: {} steps where a retired bubble could have re-entered (flow reversal beyond the "

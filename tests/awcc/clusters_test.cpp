@@ -123,6 +123,44 @@ TEST(Clusters, DropletsUseTheAirChordBetweenThemAndFeldersTheOneBefore) {
   EXPECT_DOUBLE_EQ(fk.percent_in_clusters, static_cast<double>(3.0f / 5.0f * 100.0f));  // of n - 1 droplets
 }
 
+TEST(Clusters, ASprayRecordThatStartsAndEndsInAirKeepsItsEndDroplets) {
+  // A spray record (issue 31): air cut by the start (100 samples), droplets
+  // of 10, 20 and 30 samples with air chords of 5 and 200 between them, air
+  // to the record's end at 10 kHz, c = 0.994. The droplets next to the cut
+  // air are complete: three particles, where the water chords between
+  // complete bubbles alone are one (the defect issue 31 found: two complete
+  // droplets of every spray record dropped). Constant criterion (1 ms = 10
+  // samples): the first two cluster, mean chord 1.5 ms, lead 10 / 15.
+  const auto s = bubbles({{100, 10}, {5, 20}, {200, 30}, {9635, 0}}, 0, 10'000, 10e3);
+  ASSERT_EQ(s.intervals.back().stop, 10'000);
+  const auto chords = awcc::complete_chords(s);
+  EXPECT_EQ(chords.bubbles(), 2u);
+  const auto droplets = awcc::complete_droplets(chords);
+  ASSERT_EQ(droplets.droplets(), 3u);
+  EXPECT_EQ(droplets.water(0), 10);
+  EXPECT_EQ(droplets.water(2), 30);
+  EXPECT_EQ(droplets.air(0), 5);
+  EXPECT_EQ(droplets.air(1), 200);
+  const auto d = awcc::cluster_analysis(chords, s.void_fraction(), awcc::ChordBasis::time, {});
+  ASSERT_EQ(d.status, awcc::ClusterStatus::ok) << d.message;
+  EXPECT_EQ(d.regime, awcc::FlowRegime::droplet);
+  const auto& k = by(d, awcc::ClusterCriterion::constant);
+  EXPECT_EQ(k.particles, 3);
+  EXPECT_EQ(k.clusters, 1);
+  EXPECT_EQ(k.in_clusters, 2);
+  EXPECT_NEAR(*k.mean_chord_in_cluster, 1.5e-3, 1e-15);
+  EXPECT_NEAR(*k.ratio_lead_to_cluster_mean_chord, 10.0 / 15.0, 1e-12);
+  // One air interval filling the record: no droplet at all; one cut at each
+  // end and nothing between: the one droplet between them.
+  const auto all_air = bubbles({{10'000, 0}}, 0, 10'000, 10e3);
+  EXPECT_EQ(awcc::complete_droplets(awcc::complete_chords(all_air)).droplets(), 0u);
+  const auto one = bubbles({{100, 50}, {9850, 0}}, 0, 10'000, 10e3);
+  const auto single = awcc::complete_droplets(awcc::complete_chords(one));
+  ASSERT_EQ(single.droplets(), 1u);
+  EXPECT_EQ(single.start[0], 100);
+  EXPECT_EQ(single.end[0], 150);
+}
+
 TEST(Clusters, NothingBetweenTheRegimesAndTooFewParticlesAreSaid) {
   EXPECT_EQ(awcc::flow_regime(0.2999), awcc::FlowRegime::bubbly);
   EXPECT_EQ(awcc::flow_regime(0.3), awcc::FlowRegime::intermediate);

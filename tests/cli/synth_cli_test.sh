@@ -55,7 +55,7 @@ expect_refusal() {  # name, expected message fragment, pdp arguments...
   [[ ! -e $target && ! -e $dir/$name.truth.json ]] || fail "$name: wrote a file"
   ls -a "$dir" | grep -q partial && fail "$name: left a temporary file"
 }
-expect_refusal big_c "void-fraction" --void-fraction 0.7
+expect_refusal big_c "void-fraction" --void-fraction 0.995
 expect_refusal zero_size "bubble-diameter" --bubble-diameter 0mm
 expect_refusal neg_size "bubble-diameter" --bubble-diameter -3mm
 expect_refusal zero_fs "fs" --fs 0
@@ -99,6 +99,31 @@ PY
 printf 'duration = "0.2s"\nbubble-truth = true\n' >"$dir/bt.toml"
 "$pdp" --log-level warn synth -q --config "$dir/bt.toml" -o "$dir/bt2.wav" || fail "bubble-truth from a settings file"
 [[ -s $dir/bt2.truth.bubbles.csv ]] || fail "bubble-truth = true in a settings file wrote no table"
+
+# The spray region (issue 31): above c = 0.5 the tips pierce water droplets at
+# 1 - c and air is the continuous phase; pdp process reads the record as a
+# spray signal (flagged, not refused) and recovers c within its interval
+# (equal-space arrivals: the expectation is c itself).
+out=$("$pdp" --log-level warn synth --void-fraction 0.9 --duration 4s --fs 100kHz --bubble-diameter 6mm --dy 0 \
+  --tu 0.05 --tu-y 0.025 --tu-z 0.025 --time-scale 1s --arrival equal-space -o "$dir/spray.flac") || fail "spray run"
+grep -q "spray region" <<<"$out" || fail "spray: the summary does not say it is a spray region"
+grep -q "droplets pierced" <<<"$out" || fail "spray: the summary does not count droplets"
+grep -q '"dispersed_phase": "droplets"' "$dir/spray.truth.json" || fail "spray sidecar: dispersed_phase"
+grep -q '"dispersed_phase": "bubbles"' "$dir/ok.truth.json" || fail "bubbly sidecar: dispersed_phase"
+"$pdp" --log-level warn process "$dir/spray.flac" --dx 5mm --json "$dir/spray.json" >/dev/null 2>&1 ||
+  fail "pdp process on the spray record"
+python3 - "$dir/spray.truth.json" "$dir/spray.json" <<'PY' || fail "spray: processed c and the signal flag"
+import json, sys
+truth = json.load(open(sys.argv[1]))
+result = json.load(open(sys.argv[2]))
+for k, tip in enumerate(result["tips"]):
+    assert tip["void_fraction"] == truth["realised"]["void_fraction"][k], (tip["void_fraction"], k)
+    low, high = tip["void_fraction_ci95"]
+    assert low <= 0.9 <= high, (low, high)
+    assert tip["signal"]["status"] == "air_continuous", tip["signal"]
+assert any(f == "signal_check" for f in result["flags"]), result["flags"]
+assert result["awcc"]["status"] == "ok" and abs(result["awcc"]["velocity"] / truth["realised"]["mean_velocity"][0] - 1) < 0.02
+PY
 
 if ((failures)); then
   echo "$failures failures"

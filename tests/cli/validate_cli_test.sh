@@ -25,8 +25,8 @@ a=$("$pdp" validate --duration 2s --fs 100kHz | head -3)
 b=$("$pdp" validate --duration 2s --fs 100kHz | head -3)
 [[ "$a" == "$b" ]] || fail "validate is not reproducible"
 
-"$pdp" validate --void-fraction 0.9 -o /dev/null >/dev/null 2>&1 && fail "bad option accepted"
-err=$("$pdp" validate --void-fraction 0.9 2>&1) && fail "bad scene accepted"
+"$pdp" validate --void-fraction 0.995 -o /dev/null >/dev/null 2>&1 && fail "bad option accepted"
+err=$("$pdp" validate --void-fraction 0.995 2>&1) && fail "bad scene accepted"
 grep -q "void-fraction" <<<"$err" || fail "bad scene message: $err"
 
 # Fewer than two distinct tips: a validation error naming tips, exit status 2.

@@ -71,11 +71,11 @@ TEST(Scene, ValidationNamesTheFieldAndTheRange) {
   s.bubble_diameter = -2e-3;
   expect_invalid(s, "bubble-diameter", "-2mm");
   s = Scene{};
-  s.void_fraction = 0.7;
-  expect_invalid(s, "void-fraction", "(0, 0.6]");
+  s.void_fraction = 0.995;
+  expect_invalid(s, "void-fraction", "(0, 0.99]");
   s = Scene{};
   s.void_fraction = 0.0;
-  expect_invalid(s, "void-fraction", "(0, 0.6]");
+  expect_invalid(s, "void-fraction", "(0, 0.99]");
   s = Scene{};
   s.fs = 0.0;
   expect_invalid(s, "fs", "> 0 Hz");

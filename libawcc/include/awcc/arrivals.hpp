@@ -2,7 +2,8 @@
 // Inter-particle arrival times per particle-size class (METHOD.md 8; Chanson
 // and Toombes 2002, Felder 2013).
 //
-// Particles (bubbles when c < 0.3, droplets when c > 0.7, nothing between)
+// Particles (complete bubbles when c < 0.3, complete droplets when c > 0.7
+// (complete_droplets), nothing between)
 // are sorted into classes by their own chord (length: <= 1, 3, 6, 10, > 10 mm;
 // time: <= 0.5, 1.5, 3, 5, > 5 ms). For each particle, the time to the next
 // particle of its class is one interval; a class of N particles gives N - 1.

@@ -8,7 +8,9 @@
 // samples / fs, chord length = chord time x u.
 //
 // Default: the complete bubbles only (a bubble cut by the record's start or
-// end is not a chord), and the water chords between them. Felder's program
+// end is not a chord), and the water chords between them; for the droplet
+// regime the complete droplets (complete_droplets), which in a record that
+// starts or ends in air include the water chords next to the cut air. Felder's program
 // (felder_chords): every bubble, a first bubble that starts the record one
 // sample too long, the last bubble's end moved to the record's end, and the
 // bubble counts of his float32 arithmetic (n_pdf for the PDFs, n_cluster for
@@ -33,6 +35,13 @@ struct ChordSequence {
   double fs = 0.0;                     ///< Hz
   std::int64_t sample_count = 0;       ///< of the record
   std::vector<std::int64_t> start, end;  ///< per bubble: first air sample, first water sample after it
+  /// The complete water chords beyond the complete bubbles, at the record's
+  /// ends: where an air interval is cut by the record's start, the first
+  /// water sample after it (a water chord then runs from here to start[0],
+  /// or to the cut air at the end); where one is cut by the record's end,
+  /// its first air sample. A spray record starts and ends in air, and its
+  /// droplets there are complete (complete_droplets).
+  std::optional<std::int64_t> water_after_cut_start, air_cut_by_end;
 
   [[nodiscard]] std::size_t bubbles() const { return start.size(); }
   [[nodiscard]] std::int64_t air(std::size_t i) const { return end[i] - start[i]; }
@@ -41,6 +50,21 @@ struct ChordSequence {
 
 /// The complete bubbles of a binary signal (default analysis).
 ChordSequence complete_chords(const AirIntervals& signal);
+
+/// The complete droplets (water chords cut by neither end of the record),
+/// the particles of the droplet regime, as the complete bubbles are the
+/// bubbly regime's: the water chords between complete bubbles and, in a
+/// record that starts or ends in air, the one before the first and after
+/// the last complete bubble. Droplet i runs from start[i] (its first water
+/// sample) to end[i] (the first air sample after it); the air chord between
+/// droplets i and i + 1 is start[i + 1] - end[i].
+struct DropletSequence {
+  std::vector<std::int64_t> start, end;
+  [[nodiscard]] std::size_t droplets() const { return start.size(); }
+  [[nodiscard]] std::int64_t water(std::size_t i) const { return end[i] - start[i]; }
+  [[nodiscard]] std::int64_t air(std::size_t i) const { return start[i + 1] - end[i]; }  ///< i < droplets() - 1
+};
+DropletSequence complete_droplets(const ChordSequence& chords);
 
 /// Felder's bubbles (every air interval, his start and end rules; indices 1-based as his).
 struct FelderChords {

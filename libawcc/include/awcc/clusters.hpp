@@ -2,9 +2,12 @@
 // Cluster analysis of the leading tip's particles (METHOD.md 8; Chanson and
 // Toombes 2002, Felder 2013).
 //
-// Regime from the void fraction c: bubbly (c < 0.3), particles are the air
-// chords and separations the water chords between them; droplet (c > 0.7),
-// the roles swap; in between nothing is computed (status says so).
+// Regime from the void fraction c: bubbly (c < 0.3), particles are the
+// complete air chords and separations the water chords between them;
+// droplet (c > 0.7), the roles swap: the complete water chords
+// (complete_droplets, those next to air cut by the record's ends included)
+// and the air chords between them; in between nothing is computed (status
+// says so).
 // Particles p_1..p_m with separations g_i between p_i and p_{i+1}: the pair
 // (i, i+1) is clustered when g_i <= a criterion:
 //   median:    f x the median separation (f = 0.1);

@@ -40,8 +40,10 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
 /// Two binary signals of a synthesised record as pdp process reads them from
 /// the recording libsynth writes: binary input, two levels per tip, whose
 /// thresholds process.cpp's rule (awcc::choose_threshold of the two-level
-/// histogram) marks as not applied again; fs and frames from the signals.
-/// `binarisation` is the processing's (it names the rule in the thresholds).
+/// histogram) marks as not applied again, and whose signal check is the
+/// file's (binary input; air_continuous for a spray scene); fs and frames
+/// from the signals. `binarisation` is the processing's (it names the rule
+/// in the thresholds and the probe type the check reads).
 awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
                                              const awcc::BinarisationOptions& binarisation = {});
 
@@ -78,7 +80,7 @@ struct RunResult {
   double truth_velocity = 0.0;          ///< realised mean u_x, m/s
   double truth_turbulence_intensity = 0.0;  ///< realised Tu_x
   double truth_void_fraction = 0.0;     ///< leading tip
-  double truth_count_rate = 0.0;        ///< bubbles pierced by the leading tip per second, 1/s
+  double truth_count_rate = 0.0;        ///< particles (bubbles; droplets above c = 0.5) pierced by the leading tip per second, 1/s
   double truth_d32 = 0.0;               ///< E[d^3] / E[d^2] of the bubbles, m
   /// The record processed as pdp process would (tips, fscc, awcc).
   awcc::ProcessResult processed;

@@ -32,6 +32,11 @@
 // tip pierces: at the front interface it points roughly along the bubble's
 // motion (the tip meets the bubble's leading face), at the rear against it.
 //
+// Spray. Above c = 0.5 the particles are droplets (synth::DispersedPhase):
+// the table holds one row per pierced droplet with the same columns, its
+// front the tip's entry into the droplet (air -> water) and its rear the exit
+// (water -> air); the chord is the droplet's.
+//
 // Memory: one row per pierced bubble, 84 bytes plus 48 bytes a tip.
 
 #include <array>
@@ -52,8 +57,12 @@ namespace synth {
 /// has NaN times.
 struct TipPierce {
   static constexpr double none = std::numeric_limits<double>::quiet_NaN();
-  double front = none;  ///< water -> air, s; before 0 when the tip was inside as the record began
-  double rear = none;   ///< air -> water, s; NaN when the record ended with the tip inside
+  /// The tip enters the particle (bubble: water -> air; droplet: air ->
+  /// water), s; before 0 when the tip was inside as the record began.
+  double front = none;
+  /// The tip leaves it (bubble: air -> water; droplet: water -> air), s;
+  /// NaN when the record ended with the tip inside.
+  double rear = none;
   double chord = none;  ///< distance between the front and rear pierce points, m (NaN with rear)
   /// Outward unit normals of the bubble's surface at the front and rear pierce
   /// points, NaN with their time (float: validation compares angles to a

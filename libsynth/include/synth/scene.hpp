@@ -23,13 +23,37 @@ struct Vec3 {
   friend bool operator==(const Vec3&, const Vec3&) = default;
 };
 
-/// When bubbles enter the control volume.
+/// When bubbles (droplets, above c = 0.5) enter the control volume. Under
+/// the time rules the particle flux is constant while the velocity
+/// fluctuates, so a tip sees the dispersed fraction c_d (1 + Tu_x^2) (c_d = c
+/// for bubbles, 1 - c for droplets: void fraction 1 - (1 - c)(1 + Tu_x^2));
+/// under the space rules it sees c_d itself (METHOD 5.2).
 enum class ArrivalRule {
   equal_time,     ///< equal inter-arrival times (the paper's rule, default)
   poisson_time,   ///< Poisson process in time
   equal_space,    ///< equally spaced along the flow (enter as the flow advances)
   poisson_space,  ///< Poisson process along the flow
 };
+
+/// What the probe's tips pierce, decided by the void fraction alone. Up to
+/// c = 0.5 the dispersed phase is air: bubbles in water. Above it, water:
+/// droplets carried through air (the spray region of a self-aerated flow),
+/// at the volume fraction 1 - c, with the same size model (bubble_diameter,
+/// diameter_log_sd, aspect_ratio describe the droplet), velocity field,
+/// arrival rules, overlap avoidance and piercing; a tip's signal is then the
+/// complement, air outside the droplets. One scene type so covers c from
+/// 0.005 to 0.99 with the truth defined alike (air samples / samples, air
+/// chords).
+enum class DispersedPhase {
+  bubbles,   ///< c <= 0.5: air bubbles in water
+  droplets,  ///< c > 0.5: water droplets in air
+};
+
+/// The dispersed phase of a void fraction c: bubbles for c <= 0.5, droplets above.
+[[nodiscard]] DispersedPhase dispersed_phase(double void_fraction);
+/// The dispersed phase's volume fraction: c for bubbles, 1 - c for droplets.
+[[nodiscard]] double dispersed_fraction(double void_fraction);
+std::string_view to_string(DispersedPhase phase);
 
 /// Time stepping of the Ornstein-Uhlenbeck velocity.
 enum class VelocityUpdate {
@@ -49,9 +73,11 @@ struct Scene {
   double rho_xy = 0.0;                    ///< velocity correlation u_x u_y, -
   double rho_xz = -0.45;                  ///< velocity correlation u_x u_z, -
   double rho_yz = 0.0;                    ///< velocity correlation u_y u_z, -
-  // Bubbles.
-  double void_fraction = 0.25;            ///< c, -
-  double bubble_diameter = 3e-3;          ///< volume-equivalent (median) diameter d_b, m
+  // The dispersed phase (bubbles, or droplets above c = 0.5: DispersedPhase).
+  double void_fraction = 0.25;            ///< c, - (0, 0.99]; the dispersed fraction is c or 1 - c
+  /// Volume-equivalent (median) diameter d_b of the dispersed particle, m:
+  /// the bubble's, or the droplet's in the spray region; so are the two below.
+  double bubble_diameter = 3e-3;
   double diameter_log_sd = 0.0;           ///< std of ln(d_b); 0 = all equal, > 0 = log-normal
   double aspect_ratio = 1.0;              ///< ellipsoid semi-axis along x over the lateral ones
   ArrivalRule arrival = ArrivalRule::equal_time;

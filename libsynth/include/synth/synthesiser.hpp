@@ -2,12 +2,18 @@
 // The synthetic probe: bubbles carried by the fluid past point tips
 // (METHOD.md 5.2-5.4), with each tip's air intervals found exactly.
 //
+// Spray. Above c = 0.5 the particles are water droplets in air
+// (synth::DispersedPhase): everything below holds for them with the
+// dispersed fraction c_d = 1 - c in place of c, and a tip's air intervals
+// are the complement of its pierces over [0, N samples). "Bubble" below
+// means the particle of either phase.
+//
 // Geometry. The probe's centre is the middle of the tips' bounding box. The
 // control volume has edges L_i = spread_i + 4 a_max,i (spread_i the tips'
 // extent along i, a_max,i the largest bubble semi-axis along i: 2 d_b for
 // spheres). Bubbles enter at x = -L_x/2 at a uniform (y, z) of the cross
-// section A = L_y L_z, at the rate F_cv = c |u| A / E[V_b], so that a tip sees
-// the void fraction c. No slip: every bubble moves with the fluid, so all
+// section A = L_y L_z, at the rate F_cv = c_d |u| A / E[V_b] (c_d = c for
+// bubbles), so that a tip sees the dispersed fraction c_d. No slip: every bubble moves with the fluid, so all
 // bubbles share one displacement D(t) and bubble k sits at
 //
 //   x_k(t) = E_k + D(t) - D(t_k),     t >= t_k (its entry time).
@@ -97,14 +103,16 @@ std::span<const awcc::OptionField<SynthesisOptions>> synthesis_option_fields();
 Synthesis synthesise(const Scene& scene, const SynthesisOptions& options = {});
 
 /// Reference piercing by testing every sample of every tip against every
-/// candidate bubble (the dense method the exact one replaces): returns one 0/1
-/// vector per tip. For tests and the benchmark.
+/// candidate particle (the dense method the exact one replaces): returns one
+/// 0/1 vector per tip, 1 = air (inside a bubble; outside every droplet in the
+/// spray region). For tests and the benchmark.
 std::vector<std::vector<std::uint8_t>> brute_force_signals(const Scene& scene, const ReferenceData& reference);
 
-/// Same, but for each sample also the largest |q/a|^2 - 1 sign margin: for
-/// every tip and sample, the value min over bubbles of |(x_tip - x_k)/a|^2 (1
-/// on the surface). Lets a test tell a genuine disagreement from a sample that
-/// sits on a bubble surface to rounding.
+/// Same, but as a form whose sign margin says how close the sample is to a
+/// surface: for every tip and sample, f = min over particles of
+/// |(x_tip - x_k)/a|^2 for bubbles, 2 - that for droplets; so in either phase
+/// f < 1 is air, f > 1 water and f = 1 a surface. Lets a test tell a genuine
+/// disagreement from a sample that sits on a surface to rounding.
 std::vector<std::vector<double>> brute_force_distances(const Scene& scene, const ReferenceData& reference);
 
 }  // namespace synth

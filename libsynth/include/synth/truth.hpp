@@ -29,9 +29,11 @@ struct RealisedFlow {
 
 struct TipTruth {
   Vec3 position;                      ///< m, as given in the scene
-  double void_fraction = 0.0;         ///< air samples / samples, -
-  std::int64_t bubbles_pierced = 0;   ///< distinct bubbles whose piercing overlaps the record
-  std::int64_t chords = 0;            ///< air intervals in the sampled signal
+  double void_fraction = 0.0;         ///< air samples / samples, - (either dispersed phase)
+  /// Distinct dispersed particles whose piercing overlaps the record:
+  /// bubbles, or droplets in the spray region (Truth::dispersed_phase).
+  std::int64_t bubbles_pierced = 0;
+  std::int64_t chords = 0;            ///< air intervals in the sampled signal (either phase)
   /// The true local interfacial area concentration at the tip, 1/m, with
   /// SynthesisOptions::bubble_truth (else empty): the time average of the
   /// interfaces passing the point,
@@ -48,30 +50,38 @@ struct TipTruth {
   /// point sees: the tip's void fraction is c (1 + Tu_x^2) under equal-time
   /// arrivals, and the IAC at the point scales with it. For one sphere size
   /// its expectation is 6 c_tip / d_b: a pierce at a uniform offset on the
-  /// disc gives E[1 / cos theta] = 2 per interface.
+  /// disc gives E[1 / cos theta] = 2 per interface. Droplets have the same
+  /// interfaces: there c_tip is the tip's droplet fraction 1 - c_tip,air,
+  /// (1 - c)(1 + Tu_x^2) under equal-time arrivals.
   std::optional<double> interfacial_area;
 };
 
 struct PairTruth {
   int first = 0, second = 0;               ///< tip indices
-  std::int64_t pierced_by_both = 0;        ///< distinct bubbles pierced by both tips in the record
+  std::int64_t pierced_by_both = 0;        ///< distinct particles (bubbles or droplets) pierced by both tips in the record
 };
 
 struct Truth {
   Scene imposed;
   double realisation_step = 0.0;           ///< dt_r actually used, s
   double control_volume[3] = {0, 0, 0};    ///< edges L_x, L_y, L_z, m
-  double bubble_rate = 0.0;                ///< bubbles entering the control volume per second, 1/s
-  double expected_pierce_rate = 0.0;       ///< mean pierce rate of a tip, c u E[pi a_y a_z] / E[V], 1/s
-  /// c E[S_b] / E[V_b] of the imposed population (S_b the surface of the
-  /// bubble's ellipsoid): 6 c / d_b for one sphere size, 1/m. The realised
+  /// What the tips pierce: bubbles (c <= 0.5), or droplets at 1 - c
+  /// (synth::dispersed_phase). The counts and rates below are of these
+  /// particles, whichever they are, with c_d = c or 1 - c.
+  DispersedPhase dispersed_phase = DispersedPhase::bubbles;
+  double bubble_rate = 0.0;                ///< particles entering the control volume per second, 1/s
+  /// Mean pierce rate of a tip, c_d u E[pi a_y a_z] / E[V] (1.5 c_d u / d_b
+  /// for spheres), 1/s.
+  double expected_pierce_rate = 0.0;
+  /// c_d E[S_b] / E[V_b] of the imposed population (S_b the surface of the
+  /// particle's ellipsoid): 6 c_d / d_b for one sphere size, 1/m. The realised
   /// value at each tip is TipTruth::interfacial_area.
   double expected_interfacial_area = 0.0;
   RealisedFlow realised;
   std::vector<TipTruth> tips;
   std::vector<PairTruth> pairs;
-  std::int64_t bubbles_generated = 0;      ///< bubbles entering during [0, duration)
-  std::int64_t overlaps_unresolved = 0;    ///< bubbles placed overlapping after all retries
+  std::int64_t bubbles_generated = 0;      ///< particles entering during [0, duration)
+  std::int64_t overlaps_unresolved = 0;    ///< particles placed overlapping after all retries
   std::int64_t reentries_missed = 0;       ///< steps where a retired bubble could have come back (0 expected)
   std::int64_t sample_count = 0;
 
