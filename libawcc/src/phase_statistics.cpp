@@ -69,6 +69,10 @@ std::string_view to_string(PhaseStatus status) {
   return "?";
 }
 
+double dispersed_fraction(double void_fraction) { return void_fraction <= 0.5 ? void_fraction : 1.0 - void_fraction; }
+
+std::string_view dispersed_particle(double void_fraction) { return void_fraction <= 0.5 ? "bubble" : "droplet"; }
+
 std::optional<double> sauter_diameter(double velocity, double fraction, double count_rate) {
   if (!(count_rate > 0.0)) return std::nullopt;
   return 1.5 * std::fabs(velocity) * fraction / count_rate;
@@ -126,7 +130,7 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
     lengths.reserve(air.size());
     for (double t : air) lengths.push_back(t * std::fabs(u));
     p.air_chord_length = summarise(lengths);
-    p.sauter_diameter = sauter_diameter(u, p.void_fraction, p.bubble_count_rate);
+    p.sauter_diameter = sauter_diameter(u, dispersed_fraction(p.void_fraction), p.bubble_count_rate);
   }
   return p;
 }

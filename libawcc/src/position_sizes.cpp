@@ -68,7 +68,7 @@ SizesResult position_sizes(const AirIntervals& leading, const PhaseStatistics& p
   out.phase = bubbles ? DispersedPhase::bubbles : DispersedPhase::droplets;
   const double u = record_velocity ? std::fabs(*record_velocity) : 0.0;
   if (u > 0.0) {
-    out.sauter_flux = sauter_diameter(u, bubbles ? c : 1.0 - c, phase.bubble_count_rate);
+    out.sauter_flux = sauter_diameter(u, dispersed_fraction(c), phase.bubble_count_rate);
   }
 
   // The complete chords of the dispersed phase.

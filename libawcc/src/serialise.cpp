@@ -858,7 +858,7 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"fscc_t05", "s", "/fscc/t05", "T05: R11 first at or below 0.5"},
       {"fscc_tau05", "s", "/fscc/tau05", "tau05: half-width of R12 right of its peak"},
       {"fscc_turbulence_intensity_chanson", "-", "/fscc/turbulence_intensity_chanson", "Chanson's Tu from T05 and tau05"},
-      {"sauter_diameter", "m", "/tips/0/sauter_diameter", "Sauter diameter d32 = 1.5 u c / F"},
+      {"sauter_diameter", "m", "/tips/0/sauter_diameter", "Sauter diameter d32 = 1.5 u c / F (droplets above c = 0.5: 1.5 u (1 - c) / F)"},
       {"fscc_reason", "", "/fscc/reason", "why FSCC has no velocity"},
       {profile_column::awcc_velocity, "m/s", "/awcc/velocity", "AWCC mean interfacial velocity"},
       {"awcc_velocity_rms", "m/s", "/awcc/velocity_rms", "AWCC velocity fluctuation u_rms"},
@@ -1165,8 +1165,8 @@ std::string ProcessResult::report() const {
                      t.threshold.binary_input ? ", binary input" : "", t.threshold.air_level, t.threshold.water_level));
     line(fmt::format("    void fraction        {:.5f}  (95 % CI {:.5f} - {:.5f})", p.void_fraction,
                      p.void_fraction_ci95.lower, p.void_fraction_ci95.upper));
-    line(fmt::format("    bubble count rate    {:.3f} /s  (95 % CI {:.3f} - {:.3f}), {} complete chords",
-                     p.bubble_count_rate, p.bubble_count_rate_ci95.lower, p.bubble_count_rate_ci95.upper,
+    line(fmt::format("    {:<20} {:.3f} /s  (95 % CI {:.3f} - {:.3f}), {} complete chords",
+                     fmt::format("{} count rate", dispersed_particle(p.void_fraction)), p.bubble_count_rate, p.bubble_count_rate_ci95.lower, p.bubble_count_rate_ci95.upper,
                      p.air_chord_time.count));
     line(fmt::format("    air chord time       mean {:.4f} ms, median {:.4f} ms, std {:.4f} ms", p.air_chord_time.mean * 1e3,
                      p.air_chord_time.median * 1e3, p.air_chord_time.std * 1e3));
@@ -1176,7 +1176,10 @@ std::string ProcessResult::report() const {
       line(fmt::format("    air chord length     mean {:.4f} mm, median {:.4f} mm", p.air_chord_length->mean * 1e3,
                        p.air_chord_length->median * 1e3));
     }
-    if (p.sauter_diameter) line(fmt::format("    Sauter diameter d32  {:.4f} mm", *p.sauter_diameter * 1e3));
+    if (p.sauter_diameter) {
+      line(fmt::format("    Sauter diameter d32  {:.4f} mm{}", *p.sauter_diameter * 1e3,
+                       p.void_fraction > 0.5 ? " (droplets: 1.5 u (1 - c) / F)" : ""));
+    }
     if (!t.threshold.note.empty()) line("    note: " + t.threshold.note);
     if (p.status != PhaseStatus::ok) line("    note: " + p.message);
   }

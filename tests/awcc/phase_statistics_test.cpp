@@ -100,3 +100,15 @@ TEST(PhaseStatus, EachStatusAtItsLimit) {
   EXPECT_LT(enough.void_fraction_ci95.lower, enough.void_fraction);
   EXPECT_GT(enough.void_fraction_ci95.upper, enough.void_fraction);
 }
+
+// The dispersed phase's fraction at and around its rule's limit: bubbles'
+// c up to 0.5, droplets' 1 - c above, continuous at 0.5 (d32 and the sizes
+// read it).
+TEST(DispersedFraction, BubblesUpToOneHalfDropletsAbove) {
+  EXPECT_EQ(awcc::dispersed_fraction(0.2), 0.2);
+  EXPECT_EQ(awcc::dispersed_fraction(0.5), 0.5);
+  EXPECT_EQ(awcc::dispersed_particle(0.5), "bubble");
+  EXPECT_NEAR(awcc::dispersed_fraction(std::nextafter(0.5, 1.0)), 0.5, 1e-15);
+  EXPECT_EQ(awcc::dispersed_particle(std::nextafter(0.5, 1.0)), "droplet");
+  EXPECT_DOUBLE_EQ(awcc::dispersed_fraction(0.9), 0.1);
+}

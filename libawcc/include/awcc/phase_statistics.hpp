@@ -74,8 +74,19 @@ struct PhaseStatistics {
   Summary interarrival_time;           ///< s, between starts of successive air chords
   Histogram air_chord_histogram, water_chord_histogram;
   std::optional<Summary> air_chord_length;  ///< m, with a velocity
-  std::optional<double> sauter_diameter;    ///< d32 = 1.5 u c / F, m, with a velocity and F > 0
+  /// d32 = 1.5 u c_d / F of the dispersed phase, m, with a velocity and F >
+  /// 0: c_d = dispersed_fraction(c), the bubbles' c up to 0.5, the droplets'
+  /// 1 - c above (F counts both alike: a droplet is the water between two
+  /// air chords).
+  std::optional<double> sauter_diameter;
 };
+
+/// The volume fraction of the dispersed phase at void fraction c: c up to
+/// 0.5 (bubbles in water), 1 - c above (droplets in air), -. The one place
+/// of the rule; at 0.5 both are the same.
+double dispersed_fraction(double void_fraction);
+/// "bubble" or "droplet": the dispersed phase's name by the same rule.
+std::string_view dispersed_particle(double void_fraction);
 
 /// The Sauter diameter d32 = 1.5 u c / F of spheres of volume fraction c
 /// passing a point at F per second with velocity u (|u| used), m: the one
