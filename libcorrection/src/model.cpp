@@ -273,8 +273,8 @@ std::string how_to_give(const std::string& feature) {
 // What a value outside its training range means, in the field's words
 // where the flow itself is outside what the simulator models.
 std::string out_of_range_meaning(const FeatureRange& r, double v) {
-  if (r.name == "void_fraction" && v > 0.6) {
-    return ": above c = 0.6 the flow is droplets in air, which the synthetic probe the model learnt from does not model";
+  if (r.name == "void_fraction" && v > 0.5) {
+    return ": above c = 0.5 the flow is droplets in air, which this model was not trained on (its campaigns stop at c = 0.6; the synthetic probe models the spray region since issue 31)";
   }
   if (r.name == "duration" && v < r.min) return ": a shorter record holds less than any the model learnt from";
   return {};
