@@ -14,13 +14,13 @@ src=$3
 rm -rf "$dir" && mkdir -p "$dir"
 source "$(dirname "$0")/lib.sh"
 
-# The smooth-chute sample, short: 14 positions from 2.5 to 60 mm (through
+# The smooth-chute sample, short: 24 positions from 2.5 to 60 mm (through
 # Y90 = 50 mm), 2 s each at 50 kHz.
 short=(--duration 2s --fs 50kHz)
 "$pdp" --log-level error synth --profile "$src/samples/smooth-profile.toml" "${short[@]}" -q -o "$dir/s.flac" \
   || fail "pdp synth --profile"
 n=$(ls "$dir"/s-*.flac 2>/dev/null | wc -l)
-[[ $n -eq 14 ]] || fail "expected 14 recordings, found $n"
+[[ $n -eq 24 ]] || fail "expected 24 recordings, found $n"
 [[ -f "$dir/s.positions.csv" && -f "$dir/s.profile.json" && -f "$dir/s-01.truth.json" ]] || fail "manifest, truth or sidecar missing"
 "$pdp" --log-level error process "$dir"/s-*.flac --manifest "$dir/s.positions.csv" --dx 5mm --dy 1mm \
   --json "$dir/p.json" >"$dir/p.txt" || fail "pdp process of the synthetic profile"
@@ -38,15 +38,15 @@ t = json.load(open(f"{d}/s.profile.json"))
 def quantities(f):
     out = {k: f[k] for k in ("y90", "c_mean", "clear_water_depth", "water_discharge", "air_discharge")}
     out.update({f"n": f["power_law"]["n"], "u90": f["power_law"]["u90"]})
-    out.update({f"D_{m}": f[m]["diffusivity"] for m in ("smooth_chute", "stepped_chute")})
+    out.update({f"D_{m}": f[m] for m in ("smooth_chute", "stepped_chute")})
     out.update({f"level_{l['level']}": {"value": l["value"], "ci95": l["ci95"]} for l in f["levels"]})
     return out
 a, b = quantities(p), quantities(v["flow"])
 for k in a:
     assert a[k]["value"] == b[k]["value"] and a[k]["ci95"] == b[k]["ci95"], (k, a[k], b[k])
 assert a["y90"]["value"] is not None, "the profile crosses 0.9: Y90 expected"
-rows_p = [(r["y"], r["c"], r["u"]) for r in p["rows"]]
-rows_v = [(r["y"], r["c"], r["u"]) for r in v["flow"]["rows"]]
+rows_p = [(r["position"], r["void_fraction"], r["velocity"], r["velocity_source"]) for r in p["rows"]]
+rows_v = [(r["position"], r["void_fraction"], r["velocity"], r["velocity_source"]) for r in v["flow"]["rows"]]
 assert rows_p == rows_v, (rows_p, rows_v)
 # The truth file: the laws at the positions (smooth chute, D' = 0.3).
 assert t["truth"]["y90"] == 0.05 and t["truth"]["model"] == "smooth-chute" and t["truth"]["diffusivity"] == 0.3
@@ -60,17 +60,18 @@ assert abs(t["truth"]["c_mean"] - 2 * 0.3 * (math.tanh(K) - math.sqrt(0.1))) < 1
 assert v["truth"] == t["truth"]
 # The manifest names each file with its position.
 lines = open(f"{d}/s.positions.csv").read().split("\n")
-assert lines[0] == "file,position" and lines[1] == "s-01.flac,2.5mm" and lines[14] == "s-14.flac,60mm", lines
+assert lines[0] == "file,position" and lines[1] == "s-01.flac,2.5mm" and lines[24] == "s-24.flac,60mm", lines
 PY
 
-# Mistakes: refused with exit 2, naming the field, and nothing written.
+# Mistakes: refused naming the field (exit 1 for what the file says, 2 for a
+# setting that cannot work), and nothing written.
 printf '[profile]\ny90 = "50mm"\npositions = "5mm,10mm"\n[scene]\nvoid-fraction = 0.3\n' >"$dir/law.toml"
-expect 2 "void-fraction" "$pdp" synth --profile "$dir/law.toml" -o "$dir/law.flac"
+expect 1 "void-fraction" "$pdp" synth --profile "$dir/law.toml" -o "$dir/law.flac"
 printf '[profile]\ny90 = "50mm"\npositions = "10mm,5mm"\n' >"$dir/order.toml"
 expect 2 "do not increase" "$pdp" synth --profile "$dir/order.toml" -o "$dir/order.flac"
 expect 2 "do not increase" "$pdp" validate --profile "$dir/order.toml"
 printf '[profile]\ny90 = 50\npositions = "5mm,10mm"\n' >"$dir/unit.toml"
-expect 2 "y90" "$pdp" synth --profile "$dir/unit.toml" -o "$dir/unit.flac"
+expect 1 "y90" "$pdp" synth --profile "$dir/unit.toml" -o "$dir/unit.flac"
 expect 2 "--velocity" "$pdp" synth --profile "$src/samples/smooth-profile.toml" --velocity 3m/s -o "$dir/v3.flac"
 expect 2 "--repeat" "$pdp" validate --profile "$src/samples/smooth-profile.toml" --repeat 3
 expect 2 "--invert" "$pdp" validate --invert zero

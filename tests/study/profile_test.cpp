@@ -150,7 +150,7 @@ TEST(ProfileFile, TheSampleReadsAndALawFieldInSceneIsRefused) {
   const auto spec = study::load_profile_spec(pdp_test::source_dir() / "samples/stepped-profile.toml");
   EXPECT_EQ(spec.model, ConcentrationModelKind::stepped_chute);
   EXPECT_DOUBLE_EQ(spec.y90, 0.05);
-  EXPECT_EQ(spec.positions.size(), 14u);
+  EXPECT_EQ(spec.positions.size(), 24u);
   EXPECT_DOUBLE_EQ(spec.scene.fs, 100e3);
   EXPECT_EQ(spec.scene.arrival, synth::ArrivalRule::equal_space);
 
