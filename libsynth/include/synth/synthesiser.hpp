@@ -50,7 +50,9 @@
 // rules compensate nothing: there a particle's volume per unit of flow is
 // c_d U / u(t), above 1 while the flow is slow, particles pile up on each
 // other and the pairwise sum counts the same volume many times; bringing
-// arrivals forward then feeds the pile (measured: the base case ran away).
+// arrivals forward then feeds the pile (measured: compensated, the base case
+// and samples/high-tu.toml ran for minutes where they take a fraction of a
+// second).
 // A scene without an unresolved overlap, and every scene under the time
 // rules, gives the output it gave before. Deterministic: the positions tried
 // are the draws made anyway, and the marks move at events, whatever the
