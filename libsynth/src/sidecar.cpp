@@ -95,6 +95,7 @@ json truth_to_json(const Truth& t) {
         {"pierced_by_both", pairs},
         {"bubbles_generated", t.bubbles_generated},
         {"overlaps_unresolved", t.overlaps_unresolved},
+        {"compensated_volume_fraction", t.compensated_volume_fraction},
         {"reentries_missed", t.reentries_missed},
         {"velocity_steps", r.steps}}},
       {"realisation_step", t.realisation_step},

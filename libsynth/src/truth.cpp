@@ -69,6 +69,17 @@ std::string Truth::report() const {
                    "control volume), {} overlaps unresolved",
                    particles, format_quantity(s.bubble_diameter, Dimension::length), bubbles_generated, bubble_rate,
                    control_volume[0] * 1e3, control_volume[1] * 1e3, control_volume[2] * 1e3, overlaps_unresolved));
+  if (overlaps_unresolved > 0) {
+    const bool space_rule = s.arrival == ArrivalRule::equal_space || s.arrival == ArrivalRule::poisson_space;
+    if (space_rule) {
+      line(fmt::format("  the overlapping {} share {:.5f} of the flow's volume, given back by arrivals brought forward",
+                       particles, compensated_volume_fraction));
+    } else {
+      line(fmt::format("  the overlapping {} piled up while the flow was slow: their shared volume is lost to the "
+                       "realised fraction (time arrival rules)",
+                       particles));
+    }
+  }
   line(fmt::format("  tips (imposed c {:.4f}, expected pierce rate {:.2f} /s):", s.void_fraction, expected_pierce_rate));
   for (std::size_t j = 0; j < tips.size(); ++j) {
     const auto& t = tips[j];

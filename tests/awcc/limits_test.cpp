@@ -251,8 +251,9 @@ TEST(Limits, ExtremeVoidFractionsRunToFiniteResults) {
     const auto a = awcc::awcc(syn.signals[0], syn.signals[1], s.dx, {});
     EXPECT_TRUE(a.ok() || !a.message.empty()) << c;
     EXPECT_TRUE(std::isfinite(a.velocity) && std::isfinite(a.turbulence_intensity)) << c;
-    // Above the jamming limit of sequential placement the realised void
-    // fraction falls short of c, and says so through overlaps.
+    // Above the jamming limit of sequential placement particles are placed
+    // overlapping, and the truth says so (under equal-time arrivals, as
+    // here, their shared volume is lost; the space rules give it back).
     if (c == 0.5) {
       EXPECT_GT(syn.truth.overlaps_unresolved, 0);
     }

@@ -82,6 +82,16 @@ struct Truth {
   std::vector<PairTruth> pairs;
   std::int64_t bubbles_generated = 0;      ///< particles entering during [0, duration)
   std::int64_t overlaps_unresolved = 0;    ///< particles placed overlapping after all retries
+  /// Under the space arrival rules, the dispersed volume that the record's
+  /// particles placed overlapping share with those they overlap, per volume
+  /// of flow through the control volume's cross-section in the record (A
+  /// times the streamwise displacement), -: the arrivals were brought forward
+  /// by as much, so the realised dispersed fraction is the imposed one
+  /// (synth/synthesiser.hpp, "Dense placement"). 0 when no particle overlaps,
+  /// and under the time rules, which compensate nothing: there overlaps come
+  /// from particles piling up while the flow is slow, and the realised
+  /// fraction falls short by their shared volume.
+  double compensated_volume_fraction = 0.0;
   std::int64_t reentries_missed = 0;       ///< steps where a retired bubble could have come back (0 expected)
   std::int64_t sample_count = 0;
 
