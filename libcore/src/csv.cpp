@@ -34,6 +34,14 @@ std::vector<std::string> split_cells(std::string_view line, char separator) {
   return out;
 }
 
+CsvHeader csv_header(std::string line, char separator) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  CsvHeader h;
+  h.names = split_cells(line, separator);
+  for (std::size_t i = 0; i < h.names.size(); ++i) h.index[h.names[i]] = i;
+  return h;
+}
+
 std::string csv_cell(std::string_view text, char separator) {
   if (text.find_first_of(std::string{separator, '"', '\n', '\r'}) == std::string_view::npos) return std::string(text);
   std::string out = "\"";

@@ -290,10 +290,8 @@ ProfileRowsRead profile_rows_of_csv(const std::string& text, const std::string& 
   std::stringstream in(text);
   std::string line;
   if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file", file));
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  const auto header = awcc::split_cells(line);
-  std::map<std::string, std::size_t, std::less<>> col;
-  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  const auto header = awcc::csv_header(line);
+  const auto& col = header.index;
   for (const auto name : {column::file, column::position, column::void_fraction, column::void_fraction_ci95_lower,
                           column::bubble_count_rate, column::chord_velocity_source}) {
     if (!col.count(name)) {
@@ -308,9 +306,9 @@ ProfileRowsRead profile_rows_of_csv(const std::string& text, const std::string& 
     if (line.empty()) continue;
     const auto cells = awcc::split_cells(line);
     const CsvRow r{col, cells, file, fmt::format("line {}", number)};
-    if (cells.size() != header.size()) {
+    if (cells.size() != header.names.size()) {
       throw awcc::InputError(fmt::format("{}: {}: {} cells where the header has {}", file, r.line, cells.size(),
-                                         header.size()));
+                                         header.names.size()));
     }
     const auto position = r.optional(column::position);
     if (!position) {

@@ -189,9 +189,8 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
   std::string line;
   std::getline(in, line);
   if (!line.empty() && line.back() == '\r') line.pop_back();
-  const auto header = awcc::split_cells(line);
-  std::map<std::string, std::size_t> col;
-  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  const auto header = awcc::csv_header(line);
+  const auto& col = header.index;
   for (const char* name : {"u [m/s]", "u_rms [m/s]", "c [-]", "d_32a [m]"}) {
     if (!col.count(name)) throw awcc::InputError(fmt::format("{}: no column '{}'. {}", file, name, kLayouts));
   }
@@ -205,7 +204,7 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     for (const char* l : correction_level_names) out.text += fmt::format(",{}_q{} [{}]", q, l, unit);
   }
   out.text += ",correction_status [-],correction_reason [-],correction_notes [-]\n";
-  for_each_row(in, file, header.size(), [&](const std::string& row, const std::vector<std::string>& cells,
+  for_each_row(in, file, header.names.size(), [&](const std::string& row, const std::vector<std::string>& cells,
                                             const std::string& where) {
     auto value = [&](const char* name) -> std::optional<double> {
       const std::string& t = cells[col.at(name)];
@@ -338,9 +337,8 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
   std::string line;
   if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file", file));
   if (!line.empty() && line.back() == '\r') line.pop_back();
-  const auto header = awcc::split_cells(line);
-  std::map<std::string, std::size_t, std::less<>> col;
-  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  const auto header = awcc::csv_header(line);
+  const auto& col = header.index;
   if (!col.count(column::awcc_velocity) && col.count("u [m/s]")) return correct_tool_csv(model, text, d, file);
   for (const auto name : {column::void_fraction, column::bubble_count_rate, column::awcc_velocity,
                           column::awcc_turbulence_intensity, column::awcc_windows_accepted, column::awcc_status}) {
@@ -355,7 +353,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
                               col.count(column::awcc_weighting) && col.count(column::awcc_signal) &&
                               col.count(column::awcc_subsample);
   out.text = line + "," + correction_csv_header() + "\n";
-  for_each_row(in, file, header.size(), [&](const std::string& row, const std::vector<std::string>& cells,
+  for_each_row(in, file, header.names.size(), [&](const std::string& row, const std::vector<std::string>& cells,
                                             const std::string& where) {
     auto text_of = [&](std::string_view name) -> std::string {
       const auto it = col.find(name);

@@ -243,9 +243,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     if (!in) throw awcc::InputError(fmt::format("{}: cannot open the sweep CSV; check the path", path.string()));
     std::string line;
     if (!std::getline(in, line)) throw awcc::InputError(fmt::format("{}: empty file; give a CSV written by pdp sweep", path.string()));
-    const auto header = split_cells(line);
-    std::map<std::string, std::size_t, std::less<>> col;
-    for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+    const auto header = awcc::csv_header(line);
+    const auto& col = header.index;
     using C = SweepColumn;
     using Scene = SweepSceneColumns;
     const std::string_view needed[] = {sweep_key_columns[0].name, sweep_key_columns[1].name, Scene::dx, Scene::dy,
@@ -276,10 +275,10 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       ++number;
       if (line.empty()) continue;
       const auto cells = split_cells(line);
-      if (cells.size() != header.size()) {
+      if (cells.size() != header.names.size()) {
         throw awcc::InputError(fmt::format("{}:{}: {} cells where the header has {}; a sweep CSV cut short? pdp sweep "
                                            "resumes and repairs it",
-                                           path.string(), number, cells.size(), header.size()));
+                                           path.string(), number, cells.size(), header.names.size()));
       }
       auto cell = [&](std::string_view name) -> const std::string& { return cells[col.find(name)->second]; };
       auto number_of = [&](std::string_view name) {

@@ -190,3 +190,17 @@ TEST(Rows, AJsonWrittenBeforeStatusReadsItsDefinedKey) {
 }
 
 }  // namespace
+
+// The header every CSV reader of the correction reads by (awcc/csv.hpp): a
+// Windows line end is not part of the last name, a quoted name loses its
+// quotes, and of a name given twice the last column is the one read.
+TEST(CsvHeader, NamesTheirColumnsWithoutTheLineEnd) {
+  const auto h = awcc::csv_header("file,\"a,b\",u,u\r");
+  ASSERT_EQ(h.names.size(), 4u);
+  EXPECT_EQ(h.names[1], "a,b");
+  EXPECT_EQ(h.names[3], "u");
+  EXPECT_EQ(h.index.at("a,b"), 1u);
+  EXPECT_EQ(h.index.at("u"), 3u);
+  EXPECT_EQ(h.index.count("u\r"), 0u);
+  EXPECT_TRUE(awcc::csv_header("").index.count(""));
+}

@@ -36,6 +36,18 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
 
 namespace {
 
+// The results printed, the JSON written when asked (under a temporary name):
+// the exit status.
+int finish(const ValidateOptions& o, const nlohmann::json& j) {
+  if (o.json.empty()) return exit_ok;
+  try {
+    awcc::write_text_atomically(o.json, awcc::json_text(j));
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  return exit_ok;
+}
+
 // A probe of four or more tips: validated bubble by bubble
 // (study/multi_tip_validate.hpp), the dual tip's FSCC and AWCC with the
 // method options.
@@ -66,14 +78,7 @@ int run_multi_tip_validate(const synth::Scene& scene, const ValidateOptions& o) 
     fmt::print("{}", study::multi_tip_repeats_report(runs, summary, scene.seed));
     j = study::multi_tip_repeats_to_json(runs, summary);
   }
-  if (!o.json.empty()) {
-    try {
-      awcc::write_text_atomically(o.json, awcc::json_text(j));
-    } catch (const std::exception& e) {
-      return report_error(e);
-    }
-  }
-  return exit_ok;
+  return finish(o, j);
 }
 
 // A synthetic profile: every position processed, the profile quantities
@@ -107,14 +112,7 @@ int run_profile_validate(const ValidateOptions& o) {
     return report_error(e);
   }
   fmt::print("{}", v.report());
-  if (!o.json.empty()) {
-    try {
-      awcc::write_text_atomically(o.json, awcc::json_text(study::profile_validation_json(v)));
-    } catch (const std::exception& e) {
-      return report_error(e);
-    }
-  }
-  return exit_ok;
+  return finish(o, study::profile_validation_json(v));
 }
 
 }  // namespace
@@ -163,14 +161,7 @@ int run_validate(const ValidateOptions& o) {
     fmt::print("{}", study::repeats_report(runs, summary, scene.seed));
     j = study::repeats_to_json(runs, summary);
   }
-  if (!o.json.empty()) {
-    try {
-      awcc::write_text_atomically(o.json, awcc::json_text(j));
-    } catch (const std::exception& e) {
-      return report_error(e);
-    }
-  }
-  return exit_ok;
+  return finish(o, j);
 }
 
 }  // namespace pdp

@@ -4,6 +4,9 @@
 // line break is written in double quotes with inner quotes doubled, and read
 // back the same way. One owner for every CSV of the toolkit.
 
+#include <cstddef>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -14,6 +17,15 @@ namespace awcc {
 /// The cells of a line, an empty last cell kept ("a," is two cells); quoted
 /// cells lose their quotes.
 std::vector<std::string> split_cells(std::string_view line, char separator = ',');
+
+/// A CSV's header row: its names in order and each name's column.
+struct CsvHeader {
+  std::vector<std::string> names;
+  std::map<std::string, std::size_t, std::less<>> index;  ///< of a name given twice, the last column
+};
+
+/// The header of a CSV's first line (a trailing carriage return dropped).
+CsvHeader csv_header(std::string line, char separator = ',');
 
 /// A cell as written: quoted when it holds the separator, a quote or a line break.
 std::string csv_cell(std::string_view text, char separator = ',');
