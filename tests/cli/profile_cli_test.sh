@@ -75,6 +75,9 @@ expect 1 "y90" "$pdp" synth --profile "$dir/unit.toml" -o "$dir/unit.flac"
 expect 2 "--velocity" "$pdp" synth --profile "$src/samples/smooth-profile.toml" --velocity 3m/s -o "$dir/v3.flac"
 expect 2 "--repeat" "$pdp" validate --profile "$src/samples/smooth-profile.toml" --repeat 3
 expect 2 "--invert" "$pdp" validate --invert zero
+expect 2 "--correct" "$pdp" validate --correct "$src/samples/model/awcc.qrf"
+printf "not a model" >"$dir/bad.qrf"
+expect 1 "bad.qrf" "$pdp" validate --profile "$src/samples/smooth-profile.toml" --correct "$dir/bad.qrf"
 ls "$dir"/law* "$dir"/order-* "$dir"/unit-* "$dir"/v3* 2>/dev/null | grep -v '\.toml$' && fail "a refused profile wrote files"
 
 [[ $failures -eq 0 ]] && echo "profile_cli: all passed"
