@@ -269,6 +269,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
     const std::string_view dx_column = col.count(column_name(C::probe_dx)) ? column_name(C::probe_dx) : Scene::dx;
     const std::string_view dy_column = col.count(column_name(C::probe_dy)) ? column_name(C::probe_dy) : Scene::dy;
     const std::string_view study_column = sweep_key_columns[0].name, run_column = sweep_key_columns[1].name;
+    const bool has_version = col.count(column_name(C::generator_version)) > 0;
     std::set<std::string> studies;
     std::int64_t number = 1;
     while (std::getline(in, line)) {
@@ -291,6 +292,8 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       };
       ++set.total;
       studies.insert(cell(study_column));
+      // Rows written before the column existed are generator version 1.
+      set.generator_versions.insert(has_version ? static_cast<int>(number_of(column_name(C::generator_version))) : 1);
       const auto run = static_cast<std::int64_t>(number_of(run_column));
       if (!seen.insert({cell(study_column), run}).second) {
         throw awcc::InputError(fmt::format("{}:{}: run {} of study {} was already read; give each sweep CSV once",
@@ -893,12 +896,13 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
   std::string sources;
   for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
   std::string provenance = fmt::format(
-      "pdp train {}: {}; {} features ({}); processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
+      "pdp train {}: {} (generator version {}); {} features ({}); processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
       "windows); trained on {}, {} set aside to calibrate the intervals, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
       "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
       "{:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; Tu RMSE {:.4f} raw, {:.4f} corrected, 80/95 % coverage "
       "{:.1f}/{:.1f} %.",
-      awcc::version, sources, o.feature_set, fmt::join(names, ", "), describe(set.processing),
+      awcc::version, sources, fmt::join(set.generator_versions, " and "), o.feature_set, fmt::join(names, ", "),
+      describe(set.processing),
       set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
       set.excluded_windows, o.min_windows, split.training.size(), split.calibration.size(), split.held_out.size(), o.seed,
       to_string(hp.velocity_form), vopt.trees, vopt.min_leaf, vopt.features_per_split, to_string(hp.turbulence_form),

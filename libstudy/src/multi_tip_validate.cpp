@@ -494,6 +494,7 @@ json multi_tip_to_json(const MultiTipValidation& v) {
   json out;
   const auto& g = v.geometry;
   out["seed"] = v.scene.seed;
+  out["generator_version"] = awcc::generator_version;
   json tips = json::array();
   for (const auto& p : g.positions()) tips.push_back({p[0], p[1], p[2]});
   out["probe"] = {{"tips", tips}, {"leading_tip", g.leading()}, {"conditioning", v.conditioning}};

@@ -424,6 +424,7 @@ nlohmann::json profile_truth_json(const ProfileSpec& spec, const ProfileTruth& t
                          {"seed", scene.seed}});
   }
   j["positions"] = positions;
+  j["generator_version"] = awcc::generator_version;
   return j;
 }
 

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <stdexcept>
 
+#include "awcc/random.hpp"
 #include "study/clock.hpp"
 
 namespace study {
@@ -222,6 +223,7 @@ json run_to_json(const RunResult& r) {
   const auto& p = r.processed;
   json out;
   out["seed"] = r.scene.seed;
+  out["generator_version"] = awcc::generator_version;
   out["truth"] = {{"velocity", r.truth_velocity},
                   {"turbulence_intensity", r.truth_turbulence_intensity},
                   {"void_fraction", r.truth_void_fraction},

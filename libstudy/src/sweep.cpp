@@ -297,6 +297,7 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
     cell(SweepColumn::awcc_weighting) = awcc::to_string(processing.weighting);
     cell(SweepColumn::awcc_signal) = awcc::to_string(processing.signal);
     cell(SweepColumn::awcc_subsample) = awcc::to_string(processing.subsample);
+    cell(SweepColumn::generator_version) = std::to_string(awcc::generator_version);
     for (const auto& c : cells) row += "," + c;
     return row;
   };
@@ -385,7 +386,18 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
   }
   const std::string header = sweep_header();
   const auto first_newline = content.find('\n');
-  if (first_newline == std::string::npos || content.substr(0, first_newline) != header) {
+  const std::string_view first_line =
+      first_newline == std::string::npos ? std::string_view(content) : std::string_view(content).substr(0, first_newline);
+  const std::string version_column = "," + std::string(correction::column_name(correction::SweepColumn::generator_version));
+  if (first_line.size() + version_column.size() == header.size() && header.ends_with(version_column) &&
+      header.starts_with(first_line)) {
+    throw awcc::InputError(fmt::format(
+        "{}: written by pdp's generator version 1 (before the column generator_version); this pdp's generator is "
+        "version {}, whose streams give other scenes for the same seeds; refusing to resume it: write the study to "
+        "another file",
+        csv.string(), awcc::generator_version));
+  }
+  if (first_newline == std::string::npos || first_line != header) {
     throw awcc::InputError(fmt::format(
         "{}: not a pdp sweep CSV (its header differs); refusing to append to it: write the study to another file or "
         "remove this one",
@@ -423,6 +435,13 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
       throw awcc::InputError(fmt::format("{}:{}: the row belongs to another study (its sweep definition differs); "
                                          "write this study to another file",
                                          csv.string(), line));
+    }
+    // The last cell: the generator version of the row's streams.
+    const std::string_view version = row.substr(row.rfind(',') + 1);
+    if (version != std::to_string(awcc::generator_version)) {
+      throw awcc::InputError(fmt::format("{}:{}: the run was made by generator version '{}', this pdp's is {}: the same "
+                                         "seeds give other scenes; refusing to mix them: write the study to another file",
+                                         csv.string(), line, version, awcc::generator_version));
     }
     done.insert(run);
     pos = end + 1;

@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include "awcc/random.hpp"
 #include "awcc/version.hpp"
 
 namespace synth {
@@ -130,6 +131,7 @@ json sidecar_json(const Truth& truth, const RecordingOptions& options, const std
                                   : json(nullptr);
   out["fs"] = truth.imposed.fs;
   out["seed"] = truth.imposed.seed;
+  out["generator_version"] = awcc::generator_version;
   return out;
 }
 

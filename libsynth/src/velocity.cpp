@@ -81,21 +81,17 @@ VelocityProcess::VelocityProcess(const Scene& scene, double dt)
 }
 
 Vec3 VelocityProcess::next() {
-  const Vec3 current{state_[0], state_[1], state_[2]};
-  const double xi0 = rng_.normal();
-  const double xi1 = rng_.normal();
-  const double xi2 = rng_.normal();
-  const double e0 = forcing_[0] * xi0;
-  const double e1 = forcing_[3] * xi0 + forcing_[4] * xi1;
-  const double e2 = forcing_[6] * xi0 + forcing_[7] * xi1 + forcing_[8] * xi2;
-  state_[0] = mean_[0] + decay_[0] * (state_[0] - mean_[0]) + innovation_[0] * e0;
-  state_[1] = mean_[1] + decay_[1] * (state_[1] - mean_[1]) + innovation_[1] * e1;
-  state_[2] = mean_[2] + decay_[2] * (state_[2] - mean_[2]) + innovation_[2] * e2;
+  Vec3 current;
+  double xi[3];
+  rng_.normals(xi);
+  advance(current, xi);
   return current;
 }
 
 void VelocityProcess::generate(std::span<Vec3> out) {
-  for (auto& v : out) v = next();
+  forcing_draws_.resize(3 * out.size());
+  rng_.normals(forcing_draws_);
+  for (std::size_t k = 0; k < out.size(); ++k) advance(out[k], &forcing_draws_[3 * k]);
 }
 
 }  // namespace synth

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <random>
+#include <set>
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
@@ -71,6 +72,26 @@ TEST(Training, LoadCountsEveryExcludedRunByCause) {
   // d32 by the feature contract: 1.5 u c / F = 1.5 x 20 x 0.2 / 2000.
   EXPECT_NEAR(set.rows[1].features.d32, 0.003, 1e-15);
   EXPECT_TRUE(set.processing_assumed);  // no processing columns: the default, said
+  EXPECT_EQ(set.generator_versions, std::set<int>{1});  // no generator_version column: version 1
+}
+
+// Each row's generator version is read; sweeps of two versions load together
+// (their statistics are the same) and the set says both, for the warning and
+// the provenance.
+TEST(Training, LoadRecordsTheGeneratorVersionsOfTheRows) {
+  const std::string header = kHeader + ",generator_version";
+  auto versioned = [&](std::int64_t run, const std::string& version) {
+    auto r = row(run, good(10, 9.5));
+    r.pop_back();
+    return r + "," + version + "\n";
+  };
+  const auto v2 = write("training_v2.csv", header + "\n" + versioned(0, "2") + versioned(1, "2"));
+  EXPECT_EQ(correction::load_training_set({v2}, 100).generator_versions, std::set<int>{2});
+  // A version-1 sweep (no column) of another study beside it.
+  auto old_row = row(0, good(10, 9.5));
+  old_row.replace(0, 2, "43");
+  const auto v1 = write("training_v1.csv", kHeader + "\n" + old_row);
+  EXPECT_EQ(correction::load_training_set({v2, v1}, 100).generator_versions, (std::set<int>{1, 2}));
 }
 
 // The geometry processed (probe_dx, probe_dy) wins over the scene's dx and

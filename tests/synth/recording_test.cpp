@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "awcc/errors.hpp"
+#include "awcc/random.hpp"
 #include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
@@ -204,6 +205,7 @@ TEST(ShippedSample, IsReproducedExactlyFromItsScene) {
   s.duration = sidecar["scene"]["duration"].get<double>();
   s.fs = sidecar["fs"].get<double>();
   EXPECT_EQ(sidecar["seed"].get<std::uint64_t>(), s.seed);
+  EXPECT_EQ(sidecar["generator_version"].get<int>(), awcc::generator_version);
   const auto synthesis = synth::synthesise(s);
   RecordingOptions o;
   o.signal = SignalKind::voltage;

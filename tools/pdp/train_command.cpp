@@ -1,6 +1,7 @@
 #include "train_command.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -40,10 +41,20 @@ void setup_train(CLI::App& app, Command& command, TrainCommandOptions& o) {
 
 namespace {
 
+// Rows of two generator versions share their statistics by design (awcc/random.hpp) but not their scenes.
+void say_generator_versions(const correction::TrainingSet& set) {
+  if (set.generator_versions.size() > 1) {
+    spdlog::warn("the sweep CSVs mix runs of generator versions {}: their statistics are the same by design, a "
+                 "seed gives a different scene in each; the model's provenance records both",
+                 fmt::join(set.generator_versions, " and "));
+  }
+}
+
 int run_envelope(const TrainCommandOptions& o, const correction::TrainOptions& t) {
   const auto model = correction::CorrectionModel::load(o.envelope_of);
   std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
   const auto set = correction::load_training_set(csvs, model.min_windows);
+  say_generator_versions(set);
   const auto result = correction::measure_trust(model, set, t);
   awcc::check_output_folder(o.output);
   if (!o.report.empty()) awcc::check_output_folder(o.report);
@@ -70,6 +81,7 @@ int run_train(const TrainCommandOptions& o) {
     if (!o.envelope_of.empty()) return run_envelope(o, t);
     std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
     const auto set = correction::load_training_set(csvs, t.min_windows);
+    say_generator_versions(set);
     spdlog::info("{} runs read, {} used: {} failed, {} without an AWCC velocity, {} with fewer than {} accepted windows",
                  set.total, set.rows.size(), set.excluded_error, set.excluded_undefined, set.excluded_windows,
                  t.min_windows);

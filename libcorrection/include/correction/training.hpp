@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,10 @@ struct TrainingSet {
   std::vector<TrainingRow> fscc_rows;
   Processing processing;                ///< how every run was processed
   bool processing_assumed = false;      ///< the CSVs do not say: the default was assumed
+  /// The generator versions of the rows read (awcc::generator_version; 1 for
+  /// sweeps without the column). More than one is allowed (the statistics
+  /// are the same) but said: a warning and the model's provenance.
+  std::set<int> generator_versions;
 };
 
 /// Reads sweep CSVs (pdp sweep's columns); throws InputError naming

@@ -25,6 +25,7 @@
 
 #include <array>
 #include <span>
+#include <vector>
 
 #include "synth/random.hpp"
 #include "synth/scene.hpp"
@@ -41,12 +42,24 @@ class VelocityProcess {
   /// stream in step order only, so any chunking gives the same series.
   Vec3 next();
 
-  /// Fills `out` with consecutive velocities (same as calling next() repeatedly).
+  /// Fills `out` with consecutive velocities (same as calling next() repeatedly:
+  /// the forcing is drawn in one block, in the same order).
   void generate(std::span<Vec3> out);
 
   [[nodiscard]] double step() const { return dt_; }
 
  private:
+  // Writes the current velocity to `current` and steps with the forcing draws xi[0..2].
+  void advance(Vec3& current, const double* xi) {
+    current = {state_[0], state_[1], state_[2]};
+    const double e0 = forcing_[0] * xi[0];
+    const double e1 = forcing_[3] * xi[0] + forcing_[4] * xi[1];
+    const double e2 = forcing_[6] * xi[0] + forcing_[7] * xi[1] + forcing_[8] * xi[2];
+    state_[0] = mean_[0] + decay_[0] * (state_[0] - mean_[0]) + innovation_[0] * e0;
+    state_[1] = mean_[1] + decay_[1] * (state_[1] - mean_[1]) + innovation_[1] * e1;
+    state_[2] = mean_[2] + decay_[2] * (state_[2] - mean_[2]) + innovation_[2] * e2;
+  }
+
   Rng rng_;
   double dt_;
   std::array<double, 3> mean_{};
@@ -55,6 +68,7 @@ class VelocityProcess {
   std::array<double, 3> innovation_{};  // sigma_i sqrt(1 - a_i^2) or sigma_i sqrt(2 dt / T_i)
   std::array<double, 9> forcing_{};   // lower Cholesky factor of the forcing correlation
   std::array<double, 3> state_{};     // current velocity
+  std::vector<double> forcing_draws_;  // scratch of generate(): 3 normals a step
 };
 
 /// Lower Cholesky factor (row-major 3x3) of the forcing correlation for the
