@@ -4,11 +4,13 @@
 // N calls, and the whole processing as run_bench times it.
 //
 //   processing_stages [--duration SECONDS] [--repeat N] [--seed S] [--stage phase|fscc|awcc|sizes|whole]
+//                     [--dump FILE.json]
 #include <time.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/position_sizes.hpp"
+#include "awcc/serialise.hpp"
 #include "bench_util.hpp"
 #include "study/run.hpp"
 
@@ -35,11 +38,13 @@ int main(int argc, char** argv) {
   int repeat = 5;
   std::uint64_t seed = 1;
   std::string only;  // one stage (its name's first word), for a profile of it
+  const char* dump = nullptr;  // the whole result as JSON (every double to 17 digits), to compare two builds
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--stage") && i + 1 < argc) only = argv[++i];
+    else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) dump = argv[++i];
   }
   synth::Scene scene;
   scene.duration = duration;
@@ -90,5 +95,8 @@ int main(int argc, char** argv) {
   show("whole processing", timed("whole", repeat, [&] {
          (void)study::process_synthesis(x, y, options);
        }));
+  if (dump) {
+    std::ofstream(dump) << awcc::to_json(study::process_synthesis(x, y, options)).dump(1) << "\n";
+  }
   return 0;
 }
