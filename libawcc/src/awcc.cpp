@@ -211,18 +211,32 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   if (!(qx > 0.0) || !(qy > 0.0) || k_max < k_min) return;
 
   // Overlap sums from the pairs of air intervals (overlap_impulses.hpp).
-  // Impulses and every other kink (the mean terms' kinks at
-  // the edges of intervals entering or leaving the overlapping ranges, and
-  // lag 0 where n = L - |k| turns) are marked on a byte per lag: cheaper than
-  // sorting them.
+  // Impulses and every other kink (the mean terms' kinks at the edges of
+  // intervals entering or leaving the overlapping ranges, and lag 0 where
+  // n = L - |k| turns) are marked on a bit per lag: cheaper than sorting
+  // them. The impulses go to an array that is zero between windows: the
+  // sweep visits every lag holding one and clears it (no 4 bytes per lag to
+  // zero per window).
   const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
   auto& impulse = scratch.impulse;
   auto& mark = scratch.mark;
-  impulse.assign(lags, 0);
-  mark.assign(lags + 8, 0);  // padding for the word-wise scan
+  if (impulse.size() < lags) impulse.resize(lags, 0);
+  mark.assign((lags + 63) / 64, 0);
+  // Should the sweep not finish (an allocation failing), the array is
+  // cleared whole, so that the workspace stays usable.
+  struct Clear {
+    std::vector<std::int32_t>& impulse;
+    bool swept = false;
+    ~Clear() {
+      if (!swept) std::fill(impulse.begin(), impulse.end(), 0);
+    }
+  } clear{impulse};
   detail::OverlapImpulses<std::int32_t> sum{k_min, k_max, impulse, mark.data()};
   auto add_break = [&](std::int64_t k) {
-    if (k >= k_min && k <= k_max) mark[static_cast<std::size_t>(k - k_min)] = 1;
+    if (k >= k_min && k <= k_max) {
+      const auto i = static_cast<std::size_t>(k - k_min);
+      mark[i >> 6] |= std::uint64_t{1} << (i & 63);
+    }
   };
   for (const auto& ia : a) {
     for (const auto& ib : b) sum.add_pair(ia.start, ia.stop, ib.start, ib.stop);
@@ -251,36 +265,28 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   const double norm = 1.0 / std::sqrt(qx * qy);
   AirBelow air_a(a, ca), air_b(b, cb);
   std::int64_t at = k_min;
-  for (std::size_t i = 0; i < lags;) {
-    std::uint64_t word;
-    std::memcpy(&word, mark.data() + i, 8);
-    if (word == 0) {
-      i += 8;
-      continue;
+  for (std::size_t word = 0; word < mark.size(); ++word) {
+    for (std::uint64_t bits = mark[word]; bits != 0; bits &= bits - 1) {
+      const std::size_t i = word * 64 + static_cast<std::size_t>(std::countr_zero(bits));
+      const std::int64_t k = k_min + static_cast<std::int64_t>(i);
+      value += slope * (k - at);  // slope is constant on [at, k)
+      at = k;
+      double sx, sy;
+      if (k >= 0) {
+        sx = air_a(length - k);
+        sy = ay - air_b(k);
+      } else {
+        sx = ax - air_a(-k);
+        sy = air_b(length + k);
+      }
+      const double n = static_cast<double>(length - (k >= 0 ? k : -k));
+      out.lags.push_back(k);
+      out.values.push_back((static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm);
+      slope += impulse[i];
+      impulse[i] = 0;
     }
-    // The first marked byte of the word (bytes are 0 or 1; the padding is 0).
-    if constexpr (std::endian::native == std::endian::little) {
-      i += static_cast<std::size_t>(std::countr_zero(word)) / 8;
-    } else {
-      while (!mark[i]) ++i;
-    }
-    const std::int64_t k = k_min + static_cast<std::int64_t>(i);
-    value += slope * (k - at);  // slope is constant on [at, k)
-    at = k;
-    double sx, sy;
-    if (k >= 0) {
-      sx = air_a(length - k);
-      sy = ay - air_b(k);
-    } else {
-      sx = ax - air_a(-k);
-      sy = air_b(length + k);
-    }
-    const double n = static_cast<double>(length - (k >= 0 ? k : -k));
-    out.lags.push_back(k);
-    out.values.push_back((static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm);
-    slope += impulse[i];
-    ++i;
   }
+  clear.swept = true;
 }
 
 std::vector<double> window_correlation_intervals(const AirIntervals& x, const AirIntervals& y, std::int64_t start,
@@ -337,17 +343,15 @@ std::vector<double> window_correlation_fft(std::span<const double> x, std::span<
 
 namespace {
 
-// Local maxima (flat tops at the middle of their positions, as findpeaks /
-// scipy) and their prominences, for samples at increasing positions.
-template <class Position>
-std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double> r, Position position,
-                                                        AwccScratch& scratch) {
+// Local maxima of r (a flat top spans [first, last], as findpeaks / scipy)
+// and their prominences, into scratch.tops and scratch.prominence.
+void top_prominences(std::span<const double> r, AwccScratch& scratch) {
   const std::size_t n = r.size();
-  std::vector<std::pair<std::int64_t, double>> peaks;
-  if (n < 3) return peaks;
-  // A flat top spans [first, last].
   auto& tops = scratch.tops;
+  auto& prominence = scratch.prominence;
   tops.clear();
+  prominence.clear();
+  if (n < 3) return;
   for (std::size_t i = 1; i + 1 < n; ++i) {
     if (!(r[i - 1] < r[i])) continue;
     std::size_t j = i;
@@ -355,7 +359,7 @@ std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double>
     if (j + 1 < n && r[j + 1] < r[i]) tops.push_back({i, j});
     i = j;
   }
-  if (tops.empty()) return peaks;
+  if (tops.empty()) return;
   // Bases in O(n): for each sample, the minimum of r between it and the
   // nearest strictly higher sample on one side (or the end), from a stack of
   // strictly decreasing values whose entries carry the minimum of the samples
@@ -388,28 +392,43 @@ std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double>
   };
   bases(true, left);
   bases(false, right);
-  for (const auto& t : tops) {
-    // A flat top's bases are those of its outer ends.
-    const double prominence = r[t.first] - std::max(left[t.first], right[t.second]);
-    peaks.emplace_back((position(t.first) + position(t.second)) / 2, prominence);
+  prominence.reserve(tops.size());
+  // A flat top's bases are those of its outer ends.
+  for (const auto& t : tops) prominence.push_back(r[t.first] - std::max(left[t.first], right[t.second]));
+}
+
+// The same as (position of the top's middle, prominence) pairs, for samples
+// at increasing positions.
+template <class Position>
+std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double> r, Position position,
+                                                        AwccScratch& scratch) {
+  top_prominences(r, scratch);
+  std::vector<std::pair<std::int64_t, double>> peaks;
+  peaks.reserve(scratch.tops.size());
+  for (std::size_t i = 0; i < scratch.tops.size(); ++i) {
+    const auto& t = scratch.tops[i];
+    peaks.emplace_back((position(t.first) + position(t.second)) / 2, scratch.prominence[i]);
   }
   return peaks;
 }
 
-// Second-tallest prominent peak over the tallest (0 with one).
-double secondary_peak_ratio(const std::vector<std::pair<std::int64_t, double>>& peaks,
-                            const std::vector<double>& heights, double prominence_fraction) {
-  if (peaks.size() < 2) return 0.0;
+// Second-tallest prominent peak over the tallest (0 with one), of the tops
+// top_prominences found in r. A peak's height is its top's value (a flat
+// top is flat: every sample of it, its middle too, holds that value).
+double secondary_peak_ratio(std::span<const double> r, const AwccScratch& scratch, double prominence_fraction) {
+  const auto& tops = scratch.tops;
+  const auto& prominence = scratch.prominence;
+  if (tops.size() < 2) return 0.0;
   std::size_t tallest = 0;
-  for (std::size_t i = 1; i < peaks.size(); ++i)
-    if (heights[i] > heights[tallest]) tallest = i;
-  const double min_prominence = prominence_fraction * peaks[tallest].second;
+  for (std::size_t i = 1; i < tops.size(); ++i)
+    if (r[tops[i].first] > r[tops[tallest].first]) tallest = i;
+  const double min_prominence = prominence_fraction * prominence[tallest];
   double second = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < peaks.size(); ++i) {
-    if (i == tallest || peaks[i].second < min_prominence) continue;
-    second = std::max(second, heights[i]);
+  for (std::size_t i = 0; i < tops.size(); ++i) {
+    if (i == tallest || prominence[i] < min_prominence) continue;
+    second = std::max(second, r[tops[i].first]);
   }
-  const double top = heights[tallest];
+  const double top = r[tops[tallest].first];
   return std::isfinite(second) && top > 0.0 ? std::max(0.0, second / top) : 0.0;
 }
 
@@ -417,31 +436,35 @@ double secondary_peak_ratio(const std::vector<std::pair<std::int64_t, double>>& 
 // of the slope changes, plateau ends included, and the two ends): the minimum
 // between a peak and the first higher sample is a turning point, and the scan
 // for a higher sample stops at the turning point that follows it. Keeping
-// only those makes the prominence scan a few hundred points long. Positions
-// empty: the samples sit at 0, 1, 2, ...
-std::vector<std::pair<std::int64_t, double>> turning_point_prominences(std::span<const double> r,
-                                                                      std::span<const std::int64_t> positions,
-                                                                      AwccScratch& scratch) {
-  auto& turns = scratch.turns;
-  auto& where = scratch.where;
-  turns.clear();
-  where.clear();
-  auto position = [&](std::size_t i) { return positions.empty() ? static_cast<std::int64_t>(i) : positions[i]; };
+// only those makes the prominence scan a few hundred points long. Between two
+// consecutive turning points r is monotone, so a flat top among them is flat
+// in r too, and its height is the turning points' value.
+void turning_points(std::span<const double> r, std::vector<double>& turns) {
+  const std::size_t n = r.size();
+  turns.resize(n);
+  if (n == 0) return;
+  // Every sample is written, and kept (the count advanced) where it turns:
+  // no branch to mispredict on the turns, about one sample in three.
+  double* out = turns.data();
+  std::size_t m = 0;
+  out[m++] = r[0];
   auto sign = [](double d) { return (d > 0.0) - (d < 0.0); };
-  if (r.empty()) return {};
-  turns.push_back(r[0]);
-  where.push_back(position(0));
-  for (std::size_t i = 1; i + 1 < r.size(); ++i) {
-    if (sign(r[i] - r[i - 1]) != sign(r[i + 1] - r[i])) {
-      turns.push_back(r[i]);
-      where.push_back(position(i));
-    }
+  int before = n > 1 ? sign(r[1] - r[0]) : 0;
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const int after = sign(r[i + 1] - r[i]);
+    out[m] = r[i];
+    m += static_cast<std::size_t>(before != after);
+    before = after;
   }
-  if (r.size() > 1) {
-    turns.push_back(r.back());
-    where.push_back(position(r.size() - 1));
-  }
-  return prominences(std::span<const double>(turns), [&](std::size_t i) { return where[i]; }, scratch);
+  if (n > 1) out[m++] = r[n - 1];
+  turns.resize(m);
+}
+
+// The SPR of a correlation from its turning points.
+double spr_of(std::span<const double> r, double prominence_fraction, AwccScratch& scratch) {
+  turning_points(r, scratch.turns);
+  top_prominences(scratch.turns, scratch);
+  return secondary_peak_ratio(scratch.turns, scratch, prominence_fraction);
 }
 
 double parabolic(double a, double b, double c) {
@@ -475,11 +498,7 @@ CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsamp
   if (subsample == Subsample::parabolic && p.index > 0 && p.index + 1 < r.size()) {
     p.refined_index += parabolic(r[p.index - 1], r[p.index], r[p.index + 1]);
   }
-  const auto peaks = turning_point_prominences(r, {}, workspace.scratch());
-  std::vector<double> heights;
-  heights.reserve(peaks.size());
-  for (const auto& [i, prominence] : peaks) heights.push_back(r[static_cast<std::size_t>(i)]);
-  p.spr = secondary_peak_ratio(peaks, heights, prominence_fraction);
+  p.spr = spr_of(r, prominence_fraction, workspace.scratch());
   return p;
 }
 
@@ -495,11 +514,9 @@ CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample sub
   if (subsample == Subsample::parabolic && k > k_min && k < r.lags.back()) {
     p.refined_index += parabolic(r.at(k - 1), p.height, r.at(k + 1));
   }
-  const auto peaks = turning_point_prominences(r.values, r.lags, workspace.scratch());
-  std::vector<double> heights;
-  heights.reserve(peaks.size());
-  for (const auto& [lag, prominence] : peaks) heights.push_back(r.at(lag));
-  p.spr = secondary_peak_ratio(peaks, heights, prominence_fraction);
+  // Peaks, prominences and heights of the piecewise-linear function are
+  // those of its breakpoints' values (the bases and the tops sit on breakpoints).
+  p.spr = spr_of(r.values, prominence_fraction, workspace.scratch());
   return p;
 }
 

@@ -230,8 +230,11 @@ std::optional<std::int64_t> positive_peak_lag(std::span<const double> r, std::in
 
 // Felder's segmented Pearson coefficients of binary signals, averaged over
 // the segments; each segment's R12 peak is kept for the velocity's interval.
+// Without `auto_correlation` R11 is left at zero and only whether each
+// segment has one is found (what the velocity's interval reads: the segments'
+// peaks and the status), without its lagged products.
 void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const FsccLags& lags, FftPlanCache& plans,
-               CorrelationFunctions& f) {
+               CorrelationFunctions& f, bool auto_correlation = true) {
   const std::int64_t n = x.sample_count;
   const std::int64_t length = n / segments;
   f.r11.assign(static_cast<std::size_t>(lags.r11_last + 1), 0.0);
@@ -260,13 +263,29 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
     }
     return r;
   };
+  // Whether pearson() gives a coefficient (its checks, without the products).
+  auto has_pearson = [&](const AirPrefix& pa, const AirPrefix& pb, std::int64_t s0, std::int64_t kmin,
+                         std::int64_t kmax) {
+    const auto [t0, t1] = segment_window(s0, length, kmin, kmax);
+    const std::int64_t w = t1 - t0;
+    if (w < 2) return false;
+    const double wd = static_cast<double>(w);
+    const double ma = static_cast<double>(pa.in(t0, t1)) / wd;
+    if (!(ma * (1 - ma) > 0.0)) return false;
+    for (std::int64_t k = kmin; k <= kmax; ++k) {
+      const double mb = static_cast<double>(pb.in(t0 + k, t1 + k)) / wd;
+      if (!(mb * (1 - mb) > 0.0)) return false;
+    }
+    return true;
+  };
   auto add = [](const std::vector<double>& r, std::vector<double>& acc) {
     for (std::size_t j = 0; j < r.size(); ++j) acc[j] += r[j];
     return !r.empty();
   };
   for (int s = 0; s < segments; ++s) {
     const std::int64_t s0 = static_cast<std::int64_t>(s) * length;
-    used11 += add(pearson(x, px, px, x, s0, 0, lags.r11_last), f.r11);
+    if (auto_correlation) used11 += add(pearson(x, px, px, x, s0, 0, lags.r11_last), f.r11);
+    else used11 += has_pearson(px, px, s0, 0, lags.r11_last);
     const auto r12 = pearson(x, px, py, y, s0, lags.r12_first, lags.r12_last);
     used12 += add(r12, f.r12);
     if (const auto peak = positive_peak_lag(r12, lags.r12_first)) f.segment_peak_lags.push_back(*peak);
@@ -649,7 +668,19 @@ void add_velocity_interval(FsccResult& result, const CorrelationFunctions& sprea
 
 FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options) {
   auto out = fscc_from_functions(correlation_functions(leading, trailing, options), dx, options);
-  if (out.ok()) add_velocity_interval(out, correlation_functions(leading, trailing, interval_options(options)), dx);
+  if (out.ok()) {
+    // The interval reads the segments' R12 peaks and the status only: the
+    // segments' R11 is not computed (correlation_functions would).
+    const FsccOptions spread_options = interval_options(options);
+    CorrelationFunctions spread;
+    spread.fs = leading.fs;
+    spread.signal = CorrelationSignal::binary;
+    const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, spread_options);
+    spread.r12_first_lag = lags.r12_first;
+    FftPlanCache plans;
+    segmented(leading, trailing, spread_options.segments, lags, plans, spread, false);
+    add_velocity_interval(out, spread, dx);
+  }
   return out;
 }
 

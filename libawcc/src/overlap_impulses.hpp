@@ -16,7 +16,7 @@ template <class Count>
 struct OverlapImpulses {
   std::int64_t k_min, k_max;
   std::vector<Count>& impulse;     ///< per lag of [k_min, k_max], zeroed by the caller
-  std::uint8_t* mark = nullptr;    ///< when set, lags holding an impulse are marked 1
+  std::uint64_t* mark = nullptr;   ///< when set, a bitset of the lags holding an impulse
   std::int64_t slope = 0;          ///< slope before k_min from impulses before it
   std::int64_t value = 0;          ///< overlap sum at k_min from impulses before it
 
@@ -31,7 +31,7 @@ struct OverlapImpulses {
     }
     const auto i = static_cast<std::size_t>(k - k_min);
     impulse[i] += static_cast<Count>(weight);
-    if (mark) mark[i] = 1;
+    if (mark) mark[i >> 6] |= std::uint64_t{1} << (i & 63);
   }
 
   /// One pair of air intervals; pairs whose trapezoid ends at or before

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
 #include <fmt/format.h>
 
 #include "awcc/order_statistics.hpp"
@@ -31,15 +34,39 @@ double variance(const std::vector<double>& v, double mean) {
   return s / static_cast<double>(v.size() - 1);
 }
 
-}  // namespace
+// Sorts whole numbers of samples (>= 0) in O(n): LSD radix, 11 bits a
+// pass, as many passes as the largest needs (two for chords up to 4 M samples).
+void sort_samples(std::vector<std::int64_t>& v, std::vector<std::int64_t>& buffer) {
+  std::int64_t largest = 0;
+  for (const auto x : v) largest = std::max(largest, x);
+  buffer.resize(v.size());
+  constexpr int bits = 11;
+  constexpr std::size_t radix = std::size_t{1} << bits;
+  std::vector<std::size_t> count(radix);
+  for (int shift = 0; shift < 63 && (largest >> shift) != 0; shift += bits) {
+    std::fill(count.begin(), count.end(), 0);
+    for (const auto x : v) ++count[static_cast<std::size_t>(x >> shift) & (radix - 1)];
+    std::size_t total = 0;
+    for (auto& c : count) total += std::exchange(c, total);
+    for (const auto x : v) buffer[count[static_cast<std::size_t>(x >> shift) & (radix - 1)]++] = x;
+    v.swap(buffer);
+  }
+}
 
-Summary summarise(std::vector<double> values) { return summarise_in_place(values); }
+// Durations of whole samples, sorted, in s: sorting the integers sorts the
+// durations (k / fs is increasing in k and exact in k), faster than sorting doubles.
+std::vector<double> sorted_durations(std::vector<std::int64_t>& samples, std::vector<std::int64_t>& buffer,
+                                     double fs) {
+  sort_samples(samples, buffer);
+  std::vector<double> out(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) out[i] = static_cast<double>(samples[i]) / fs;
+  return out;
+}
 
-Summary summarise_in_place(std::vector<double>& values) {
+Summary summarise_sorted(const std::vector<double>& values) {
   Summary s;
   s.count = static_cast<std::int64_t>(values.size());
   if (values.empty()) return s;
-  std::sort(values.begin(), values.end());
   double sum = 0.0;
   for (double v : values) sum += v;
   const double n = static_cast<double>(values.size());
@@ -57,6 +84,15 @@ Summary summarise_in_place(std::vector<double>& values) {
   };
   s.median_ci95 = {rank(n / 2.0 - spread - 0.5), rank(n / 2.0 + spread - 0.5)};
   return s;
+}
+
+}  // namespace
+
+Summary summarise(std::vector<double> values) { return summarise_in_place(values); }
+
+Summary summarise_in_place(std::vector<double>& values) {
+  std::sort(values.begin(), values.end());
+  return summarise_sorted(values);
 }
 
 std::string_view to_string(PhaseStatus status) {
@@ -83,22 +119,29 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
   const double fs = signal.fs;
   p.duration = fs > 0.0 ? static_cast<double>(signal.sample_count) / fs : 0.0;
   p.void_fraction = signal.void_fraction();
-  std::vector<double> air, water, arrivals;
+  // Chords and interarrival times in samples, then sorted durations (the
+  // order of chords is not needed again).
+  std::vector<std::int64_t> air_samples, water_samples, arrival_samples, buffer;
   const auto& iv = signal.intervals;
+  air_samples.reserve(iv.size());
+  water_samples.reserve(iv.size());
+  arrival_samples.reserve(iv.size());
   for (std::size_t i = 0; i < iv.size(); ++i) {
     const bool complete = iv[i].start > 0 && iv[i].stop < signal.sample_count;
-    if (complete) air.push_back(static_cast<double>(iv[i].stop - iv[i].start) / fs);
+    if (complete) air_samples.push_back(iv[i].stop - iv[i].start);
     if (i + 1 < iv.size()) {
-      water.push_back(static_cast<double>(iv[i + 1].start - iv[i].stop) / fs);
-      if (i > 0 || iv[i].start > 0) arrivals.push_back(static_cast<double>(iv[i + 1].start - iv[i].start) / fs);
+      water_samples.push_back(iv[i + 1].start - iv[i].stop);
+      if (i > 0 || iv[i].start > 0) arrival_samples.push_back(iv[i + 1].start - iv[i].start);
     }
   }
+  const std::vector<double> air = sorted_durations(air_samples, buffer, fs);
+  const std::vector<double> water = sorted_durations(water_samples, buffer, fs);
+  const std::vector<double> arrivals = sorted_durations(arrival_samples, buffer, fs);
   const auto n = static_cast<double>(air.size());
   p.bubble_count_rate = p.duration > 0.0 ? n / p.duration : 0.0;
-  // Sorted in place from here on (the order of chords is not needed again).
-  p.air_chord_time = summarise_in_place(air);
-  p.water_chord_time = summarise_in_place(water);
-  p.interarrival_time = summarise_in_place(arrivals);
+  p.air_chord_time = summarise_sorted(air);
+  p.water_chord_time = summarise_sorted(water);
+  p.interarrival_time = summarise_sorted(arrivals);
   p.air_chord_histogram = histogram_of(air, options.histogram_bins);
   p.water_chord_histogram = histogram_of(water, options.histogram_bins);
   // Confidence intervals of c and F (alternating renewal process, see header).
@@ -129,7 +172,7 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
     std::vector<double> lengths;
     lengths.reserve(air.size());
     for (double t : air) lengths.push_back(t * std::fabs(u));
-    p.air_chord_length = summarise(lengths);
+    p.air_chord_length = summarise_sorted(lengths);  // ascending: |u| >= 0 keeps the chords' order
     p.sauter_diameter = sauter_diameter(u, dispersed_fraction(p.void_fraction), p.bubble_count_rate);
   }
   return p;

@@ -105,11 +105,16 @@ SizesResult position_sizes(const AirIntervals& leading, const PhaseStatistics& p
     window_starts.reserve(awcc->windows.size());
     for (const auto& w : awcc->windows) window_starts.push_back(w.start);
   }
+  // The chords come in increasing `first`: the window holding one is found
+  // by walking on from the last one's (the window a binary search finds, the
+  // last starting at or before `first`, without a search per chord).
+  std::size_t next_window = 0;  // windows [0, next_window) start at or before the last chord's first sample
   const auto window_velocity = [&](std::int64_t first) -> double {
     if (!windows || window_starts.empty()) return 0.0;
-    const auto it = std::upper_bound(window_starts.begin(), window_starts.end(), first);
-    if (it == window_starts.begin()) return 0.0;
-    const AwccWindow& w = awcc->windows[static_cast<std::size_t>(it - window_starts.begin()) - 1];
+    while (next_window > 0 && window_starts[next_window - 1] > first) --next_window;
+    while (next_window < window_starts.size() && window_starts[next_window] <= first) ++next_window;
+    if (next_window == 0) return 0.0;
+    const AwccWindow& w = awcc->windows[next_window - 1];
     if (first >= w.start + w.length || w.fate != WindowFate::accepted || !(w.velocity > 0.0)) return 0.0;
     return w.velocity;
   };

@@ -160,11 +160,10 @@ struct AwccScratch {
   PiecewiseCorrelation piecewise;               // the interval path's correlation of the window
   std::vector<AirInterval> clipped_x, clipped_y;
   std::vector<double> air_x, air_y;             // cumulative air of the clipped intervals
-  std::vector<std::int32_t> impulse;
-  std::vector<std::uint8_t> mark;
+  std::vector<std::int32_t> impulse;            // per lag; all zero between windows (the sweep clears what it used)
+  std::vector<std::uint64_t> mark;              // a bit per lag: a kink of the window's correlation there
   std::vector<std::complex<double>> spectrum;
-  std::vector<double> turns, left, right;
-  std::vector<std::int64_t> where;
+  std::vector<double> turns, left, right, prominence;
   std::vector<std::pair<std::size_t, std::size_t>> tops;
   std::vector<std::pair<double, double>> stack;
 };
