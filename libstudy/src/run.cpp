@@ -25,6 +25,7 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
   p.awcc_options = options.awcc;
   p.structure.enabled = false;
   p.velocity_spectrum = false;
+  p.sizes = false;
   return p;
 }
 

@@ -33,8 +33,8 @@ struct RunOptions {
 
 /// The processing of a synthesised record: pdp process's with the study's
 /// methods and settings, for a probe of separations dx and dy (m). The
-/// structure outputs and the velocity spectrum are not made: a study reads
-/// none of them, and they change nothing else.
+/// structure outputs, the velocity spectrum and the sizes per position are
+/// not made: a study reads none of them, and they change nothing else.
 awcc::ProcessOptions processing_options(const RunOptions& options, double dx, double dy);
 
 /// Two binary signals of a synthesised record as pdp process reads them from
