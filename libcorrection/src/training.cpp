@@ -1051,22 +1051,9 @@ TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const T
   return result;
 }
 
-std::string TrainResult::report() const {
-  std::string out = model.provenance + "\n\n";
+std::string scores_report(const HeldOutScores& h, const std::vector<HeldOutPrediction>& predictions) {
+  std::string out;
   auto line = [&out](const std::string& s) { out += s + "\n"; };
-  if (!cv.empty()) {
-    line("Cross-validation (mean pinball loss over the correction levels; velocity relative to the truth):");
-    line("  target                form        min_leaf  features/split  pinball");
-    for (const auto& e : cv) {
-      line(fmt::format("  {:<21} {:<11} {:>8}  {:>14}  {:.6f}", e.target, to_string(e.form), e.min_leaf,
-                       e.features_per_split, e.pinball));
-    }
-    line(fmt::format("  ({:.1f} s)", seconds_cv));
-  }
-  const auto& h = held_out;
-  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored; {} of the scored untrusted by the "
-                   "trust rules: {} outside the envelope, {} multimodal); training {} runs in {:.2f} s",
-                   h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, training_rows, seconds_train));
   line("                         raw AWCC    corrected median");
   line(fmt::format("  velocity RMSE          {:7.3f} %   {:7.3f} %", 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected));
   line(fmt::format("  velocity median |err|  {:7.3f} %   {:7.3f} %", 100 * h.velocity_median_abs_raw,
@@ -1091,6 +1078,26 @@ std::string TrainResult::report() const {
                        100 * b.velocity95, 100 * b.tu80, 100 * b.tu95));
     }
   }
+  return out;
+}
+
+std::string TrainResult::report() const {
+  std::string out = model.provenance + "\n\n";
+  auto line = [&out](const std::string& s) { out += s + "\n"; };
+  if (!cv.empty()) {
+    line("Cross-validation (mean pinball loss over the correction levels; velocity relative to the truth):");
+    line("  target                form        min_leaf  features/split  pinball");
+    for (const auto& e : cv) {
+      line(fmt::format("  {:<21} {:<11} {:>8}  {:>14}  {:.6f}", e.target, to_string(e.form), e.min_leaf,
+                       e.features_per_split, e.pinball));
+    }
+    line(fmt::format("  ({:.1f} s)", seconds_cv));
+  }
+  const auto& h = held_out;
+  line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored; {} of the scored untrusted by the "
+                   "trust rules: {} outside the envelope, {} multimodal); training {} runs in {:.2f} s",
+                   h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, training_rows, seconds_train));
+  out += scores_report(h, predictions);
   if (!learning_curve.empty()) {
     line("Learning curve (held-out scores against training runs):");
     line("  (gain: paired decrease of the pinball loss from the previous point, +/- its standard error)");

@@ -43,6 +43,23 @@ head -1 "$dir/lc.csv" | grep -q "^training_runs," || fail "learning curve header
 "$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/b.qrf" --trees 20 --folds 2 --cv-trees 5 --min-leaf 3,5 \
   --features-per-split 3,7 --min-windows 20 --calibration 0 --threads 2 >/dev/null || fail "train, 2 threads"
 cmp -s "$dir/a.qrf" "$dir/b.qrf" || fail "models differ between 1 and 2 threads"
+# pdp score: the model on every run of the sweep, none trained; the held-out
+# runs' predictions are training's to the last digit (one scorer), and the
+# report says what was scored.
+"$pdp" --log-level warn score -m "$dir/a.qrf" "$dir/mc.csv" --predictions "$dir/score.csv" --report "$dir/score.txt" \
+  >"$dir/score.out" || fail "score"
+cmp -s "$dir/score.out" "$dir/score.txt" || fail "score: the report file differs from stdout"
+grep -q "^pdp score a.qrf: mc.csv (study [0-9]*) (generator version 2); 48 runs read" "$dir/score.txt" ||
+  fail "score header: $(head -1 "$dir/score.txt")"
+grep -q "coverage 80 % / 95 %" "$dir/score.txt" || fail "no coverage in the score report"
+/usr/bin/python3 - "$dir/pred.csv" "$dir/score.csv" <<'PY' || fail "pdp score's predictions differ from training's held-out ones"
+import csv, sys
+held = list(csv.DictReader(open(sys.argv[1])))
+scored = {r["run"]: r for r in csv.DictReader(open(sys.argv[2]))}
+assert held and len(scored) > len(held), (len(held), len(scored))
+for r in held:
+    assert r == scored[r["run"]], (r, scored[r["run"]])
+PY
 # Calibrating intervals (the default) needs 100 calibration runs: a small sweep is told so, and no model is written.
 out=$("$pdp" train "$dir/mc.csv" -o "$dir/c.qrf" --trees 5 --folds 0 --min-windows 20 2>&1) && fail "calibrated on a few runs"
 [[ $out == *"calibration runs are too few"*"set calibration to 0"* ]] || fail "calibration message: $out"

@@ -16,6 +16,7 @@
 #include "command.hpp"
 #include "compare_command.hpp"
 #include "correct_command.hpp"
+#include "score_command.hpp"
 #include "design_command.hpp"
 #include "process_command.hpp"
 #include "report_command.hpp"
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
     pdp::Command command;
     std::function<int()> run;
   };
-  std::vector<Entry> commands(10);
+  std::vector<Entry> commands(11);
   pdp::SynthOptions synth_options;
   pdp::setup_synth(app, commands[0].command, synth_options);
   commands[0].run = [&] { return pdp::run_synth(synth_options); };
@@ -78,6 +79,9 @@ int main(int argc, char** argv) {
   pdp::DesignOptions design_options;
   pdp::setup_design(app, commands[9].command, design_options);
   commands[9].run = [&] { return pdp::run_design(design_options); };
+  pdp::ScoreOptions score_options;
+  pdp::setup_score(app, commands[10].command, score_options);
+  commands[10].run = [&] { return pdp::run_score(score_options); };
 
   std::vector<std::string> arguments;
   try {

@@ -247,6 +247,10 @@ struct BandScores {
 /// corrected row are left out.
 std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& predictions);
 
+/// The scores as the training report prints them: raw and corrected errors,
+/// coverage, and the table of scores_by_band.
+std::string scores_report(const HeldOutScores& scores, const std::vector<HeldOutPrediction>& predictions);
+
 /// The rows of `predictions` that `other` also corrected (the same runs in
 /// the same order): to score two models on the runs both correct.
 std::vector<HeldOutPrediction> corrected_by_both(const std::vector<HeldOutPrediction>& predictions,

@@ -1,0 +1,27 @@
+#pragma once
+// pdp score: a trained correction model scored on sweep runs it was not
+// trained on (another seed of its distribution, another generator version, a
+// foreign simulator's conventions): every run is held out, nothing is
+// trained. The scores are the training report's, band by band.
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_options.hpp"
+#include "command.hpp"
+
+namespace pdp {
+
+struct ScoreOptions {
+  std::string model;                ///< .qrf model file
+  std::vector<std::string> sweeps;  ///< pdp sweep CSVs
+  std::string predictions;          ///< the predictions as CSV
+  std::string report;               ///< the report as a text file (also on stdout)
+  int threads = 0;                  ///< worker threads (0 = all cores)
+};
+
+void setup_score(CLI::App& app, Command& command, ScoreOptions& options);
+int run_score(const ScoreOptions& options);
+
+}  // namespace pdp
