@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "synth/overlap.hpp"
+#include "synth/placement.hpp"
 #include "synth/random.hpp"
 #include "synth/velocity.hpp"
 
@@ -163,10 +164,9 @@ class BubbleQueue {
 };
 
 // A neighbour of a bubble being placed, as every placement attempt tests it.
+// Its lateral disc is the placement's (same index).
 struct Neighbour {
-  double sx2, r2;                 // squared streamwise separation and squared sum of radii
-  double entry_y, key_dy;         // its entry y, and key_b.y - key_o.y
-  double entry_z, key_dz;
+  double sx2, r2;  // squared streamwise separation and squared sum of radii (sphere-mapped)
 };
 
 struct Pending {
@@ -327,6 +327,7 @@ class Synthesiser {
     length_[1] = (hi.y - lo.y) + 4.0 * a_lat_max;
     length_[2] = (hi.z - lo.z) + 4.0 * a_lat_max;
     entry_x_ = -0.5 * length_[0];
+    placement_ = LateralPlacement(length_[1], length_[2]);
 
     // Bubbles, or droplets in the spray region: the particles are placed at
     // their own volume fraction, c or 1 - c (synth::DispersedPhase).
@@ -527,13 +528,6 @@ class Synthesiser {
     }
   }
 
-  // A lateral separation in the sphere-mapped space. Spherical bubbles (the
-  // usual case) skip the division: x / 1 is x, and a division is the slowest
-  // step of the placement test.
-  [[nodiscard]] double to_sphere(double lateral) const {
-    return spherical_ ? lateral : lateral / sizes_.lateral_factor;
-  }
-
   bool try_place(double diameter, double t_entry, const Vec3& key, bool must_place) {
     ActiveBubble b;
     b.key = key;
@@ -553,89 +547,76 @@ class Synthesiser {
     const auto lo = bubbles_.first_not_below(key.x - reach, place_hint_lo_);
     // partition_point(o.key.x <= key.x + reach): the first key above it.
     const auto hi = bubbles_.first_not_below(std::nextafter(key.x + reach, HUGE_VAL), place_hint_hi_);
-    // What the attempts share, once: each neighbour's streamwise separation
-    // and the parts of its lateral ones that do not depend on the entry
-    // drawn. Neighbours streamwise too far for any lateral position drop out
-    // (sx^2 >= r^2: the sum below cannot fall under r^2 either).
+    // What the attempts share, once: each neighbour's disc in the entry
+    // plane (synth/placement.hpp). Neighbours streamwise too far for any
+    // lateral position drop out (sx^2 >= r^2: no lateral separation brings
+    // the sum under r^2).
     auto& near = neighbours_;
     near.clear();
+    placement_.clear();
+    const double lateral2 = sizes_.lateral_factor * sizes_.lateral_factor;
     for (auto it = lo; it != hi; ++it) {
       // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
       const double sx = (it->key.x - key.x) / sizes_.x_factor;
       const double r = b.radius + it->radius;
       if (sx * sx >= r * r) continue;
-      near.push_back({sx * sx, r * r, it->entry.y, key.y - it->key.y, it->entry.z, key.z - it->key.z});
+      near.push_back({sx * sx, r * r});
+      placement_.add_disc(it->entry.y + key.y - it->key.y, it->entry.z + key.z - it->key.z,
+                          (r * r - sx * sx) * lateral2);
     }
-    bool placed = false;
-    const bool keep_tried = must_place && !time_rule_;
-    if (keep_tried) tried_.clear();
-    for (int attempt = 0; attempt <= scene_.overlap_retries; ++attempt) {
-      b.entry = {entry_x_, (bubble_rng_.uniform() - 0.5) * length_[1], (bubble_rng_.uniform() - 0.5) * length_[2]};
-      if (keep_tried) tried_.push_back(b.entry);
-      bool overlaps = false;
-      for (const auto& o : near) {
-        const double sy = to_sphere(wrap(b.entry.y - o.entry_y - o.key_dy, length_[1]));
-        const double sxy = o.sx2 + sy * sy;
-        if (sxy >= o.r2) continue;  // adding sz^2 cannot bring it under r^2
-        const double sz = to_sphere(wrap(b.entry.z - o.entry_z - o.key_dz, length_[2]));
-        if (sxy + sz * sz < o.r2) {
-          overlaps = true;
-          break;
-        }
-      }
-      if (!overlaps) {
-        placed = true;
-        break;
-      }
-    }
+    const auto outcome = placement_.place(bubble_rng_, scene_.overlap_retries + 1);
+    const bool placed = outcome.placed;
+    b.entry = {entry_x_, placement_.y(outcome.attempts - 1), placement_.z(outcome.attempts - 1)};
     if (!placed && !must_place) return false;
     if (!placed) {
       ++overlaps_unresolved_;
-      place_overlapping(b, t_entry, key);
+      place_overlapping(b, t_entry, key, outcome.attempts);
     }
     b.serial = serial_++;
     if (t_entry >= 0.0 && t_entry < duration_) ++generated_;
     if (options_.keep_reference_data) {
       records_.push_back({t_entry, b.entry, b.key, {b.a_x, 1.0 / b.inv_axes.y, 1.0 / b.inv_axes.z}});
     }
-        bubbles_.insert_sorted(b);
+    bubbles_.insert_sorted(b);
     return true;
   }
 
-  // The volume particle b, entered at b.entry, shares with the neighbours
-  // of try_place's list, in the sphere-mapped space (volume-preserving): the
-  // sum of the pairwise lenses. A point also inside a second neighbour is
-  // counted twice, but two neighbours can share volume only when one of them
-  // was itself placed overlapping (docs/validation.md measures the excess).
-  [[nodiscard]] double shared_volume(const ActiveBubble& b) const {
+  // The volume particle b, entered at lateral (y, z), shares with the
+  // neighbours of try_place's list, in the sphere-mapped space
+  // (volume-preserving): the sum of the pairwise lenses. A point also inside
+  // a second neighbour is counted twice, but two neighbours can share volume
+  // only when one of them was itself placed overlapping (docs/validation.md
+  // measures the excess).
+  [[nodiscard]] double shared_volume(const ActiveBubble& b, double y, double z) const {
+    const double lateral2 = sizes_.lateral_factor * sizes_.lateral_factor;
     double volume = 0.0;
-    for (const auto& o : neighbours_) {
-      const double sy = to_sphere(wrap(b.entry.y - o.entry_y - o.key_dy, length_[1]));
-      const double sz = to_sphere(wrap(b.entry.z - o.entry_z - o.key_dz, length_[2]));
-      const double separation2 = o.sx2 + sy * sy + sz * sz;
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      const Neighbour& o = neighbours_[k];
+      const double separation2 = o.sx2 + placement_.distance2(k, y, z) / lateral2;
       if (separation2 >= o.r2) continue;
       volume += lens_volume(b.radius, std::sqrt(o.r2) - b.radius, std::sqrt(separation2));
     }
     return volume;
   }
 
-  // Every lateral position tried overlaps. Under the space rules b goes
-  // where it shares the least volume, and that volume is owed to the flow
-  // (bring_forward); under the time rules it stays at the last position
-  // tried and the volume is lost (synthesiser.hpp, "Dense placement").
-  void place_overlapping(ActiveBubble& b, double t_entry, const Vec3& key) {
+  // Every lateral position tried (the placement's first `tried`) overlaps.
+  // Under the space rules b goes where it shares the least volume, and that
+  // volume is owed to the flow (bring_forward); under the time rules it
+  // stays at the last position tried and the volume is lost
+  // (synthesiser.hpp, "Dense placement").
+  void place_overlapping(ActiveBubble& b, double t_entry, const Vec3& key, int tried) {
     if (time_rule_) return;
     double least = std::numeric_limits<double>::infinity();
-    Vec3 best = b.entry;
-    for (const auto& entry : tried_) {
-      b.entry = entry;
-      const double v = shared_volume(b);
+    int best = tried - 1;
+    for (int i = 0; i < tried; ++i) {
+      const double v = shared_volume(b, placement_.y(i), placement_.z(i));
       if (v < least) {
         least = v;
-        best = entry;
+        best = i;
       }
     }
-    b.entry = best;
+    b.entry.y = placement_.y(best);
+    b.entry.z = placement_.z(best);
     if (t_entry >= 0.0 && t_entry < duration_) compensated_volume_ += least;
     debt_volume_ += least;
     bring_forward(key.x);
@@ -803,7 +784,9 @@ class Synthesiser {
   void emit(std::size_t j, ActiveBubble& b, double t_in, double t_out, const Interface* front = nullptr,
             const Interface* rear = nullptr) {
     if (t_out <= 0.0 || t_in >= duration_) return;
-    if (front) record_pierce(j, b, *front, rear);
+    // A rear interface after the record's end is not in it: the pierce is
+    // censored there, as when the record ends with the step (finish_open).
+    if (front) record_pierce(j, b, *front, rear && rear->t < duration_ ? rear : nullptr);
     b.pierced_mask |= std::uint64_t{1} << j;
     // Samples strictly inside (t_in, t_out).
     const auto start = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(t_in * fs_)) + 1);
@@ -947,7 +930,6 @@ class Synthesiser {
   double fraction_ = dispersed_fraction(scene_.void_fraction);
   bool bubble_truth_ = options_.bubble_truth;
   SizeModel sizes_;
-  bool spherical_ = sizes_.lateral_factor == 1.0;
   Rng bubble_rng_;
   double dt_ = 0.0, fs_ = 0.0, duration_ = 0.0;
   std::int64_t samples_ = 0;
@@ -969,7 +951,7 @@ class Synthesiser {
   double lateral_path_ = 0.0, lateral_path_next_ = 0.0;
   BubbleQueue bubbles_;
   std::vector<Neighbour> neighbours_;  // scratch of try_place
-  std::vector<Vec3> tried_;            // scratch of try_place: the entries tried by a particle that must be placed
+  LateralPlacement placement_{0.0, 0.0};  // scratch of try_place: its discs and the positions tried
   // Dispersed volume shared by particles placed overlapping (space rules):
   // what bring_forward has yet to give back, and all of the record's.
   double debt_volume_ = 0.0, compensated_volume_ = 0.0;
