@@ -216,7 +216,10 @@ class FlowAccumulator {
       sum_[i] += y[i];
       for (int j = i; j < 3; ++j) cross_[i][j] += y[i] * y[j];
     }
-    if (count_ % decimation_ == 0) {
+    // Every decimation_-th step from the first, by a countdown (an integer
+    // division a step was a tenth of the step loop).
+    if (--until_decimated_ == 0) {
+      until_decimated_ = decimation_;
       const std::size_t slot = decimated_ % (lags_ + 1);
       const std::size_t available = std::min<std::size_t>(decimated_, lags_);
       for (int i = 0; i < 3; ++i) {
@@ -294,6 +297,7 @@ class FlowAccumulator {
   double sum_[3] = {0, 0, 0};
   double cross_[3][3] = {};
   std::int64_t decimation_ = 1;
+  std::int64_t until_decimated_ = 1;  // steps to the next decimated one, this one included
   std::size_t lags_ = 16;
   std::size_t decimated_ = 0;
   double dsum_[3] = {0, 0, 0};
@@ -677,15 +681,36 @@ class Synthesiser {
   // skipping changes no output.
   static constexpr double lateral_margin = 1e-3;
 
+  // The lateral path length below which the tip cannot reach b, from the
+  // tip's offset (lateral_y, lateral_z) at the step's start: the distance
+  // to the tip's nearest periodic image (lateral_y is one image of the
+  // offset, as the bubble's image is chosen before the tip's offset is
+  // taken; the other is length - |lateral_y|) less a_lat and the margin.
+  // Lateral semi-axes are equal (try_place): a_lat = 1 / inv_axes.y.
+  [[nodiscard]] double clear_until(const ActiveBubble& b, double lateral_y, double lateral_z) const {
+    const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
+    const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
+    const double distance = std::sqrt(ny * ny + nz * nz);
+    return lateral_path_ + distance - (1.0 + lateral_margin) / b.inv_axes.y;
+  }
+
   void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
     const Vec3& p = tips_[j];
     const bool was_inside = (b.open_mask >> j) & 1u;
     const bool cached = j < ActiveBubble::cached_tips;
     if (cached && !was_inside && lateral_path_next_ < b.clear_until[j]) return;
-    const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
-    const double vx = u.x * b.inv_axes.x;
     const double lateral_y = wrap(b.entry.y + d_.y - b.key.y, length_[1]) - p.y;
     const double lateral_z = wrap(b.entry.z + d_.z - b.key.z, length_[2]) - p.z;
+    if (cached && !was_inside) {
+      // The skip below, before the roots: a bubble further from the tip
+      // than a_lat and the step's lateral path cannot hold it during the
+      // step, whatever its streamwise position (most candidates pass at a
+      // distance: this spares them the quadratic).
+      b.clear_until[j] = clear_until(b, lateral_y, lateral_z);
+      if (lateral_path_next_ < b.clear_until[j]) return;
+    }
+    const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
+    const double vx = u.x * b.inv_axes.x;
     const double qy = lateral_y * b.inv_axes.y;
     const double vy = u.y * b.inv_axes.y;
     const double qz = lateral_z * b.inv_axes.z;
@@ -729,16 +754,7 @@ class Synthesiser {
       return;
     }
     if (!crosses || r2 <= s0 || r1 >= dt_) {
-      if (cached) {
-        // The distance to the tip's nearest periodic image: lateral_y is one
-        // image of the tip's offset (the bubble's image is chosen before the
-        // tip's offset is taken), the other is length - |lateral_y|. Lateral
-        // semi-axes are equal (try_place): a_lat = 1 / inv_axes.y.
-        const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
-        const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
-        const double distance = std::sqrt(ny * ny + nz * nz);
-        b.clear_until[j] = lateral_path_ + distance - (1.0 + lateral_margin) / b.inv_axes.y;
-      }
+      if (cached) b.clear_until[j] = clear_until(b, lateral_y, lateral_z);
       return;
     }
     const double s_in = std::max(r1, s0);

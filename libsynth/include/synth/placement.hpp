@@ -28,6 +28,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "awcc/random.hpp"
@@ -58,8 +59,8 @@ class LateralPlacement {
   /// A forbidden disc: centre (y, z) anywhere (reduced here to the tile
   /// [-L/2, L/2]), squared radius in lateral units.
   void add_disc(double y, double z, double radius2) {
-    cy_.push_back(y - ly_ * std::nearbyint(y / ly_));
-    cz_.push_back(z - lz_ * std::nearbyint(z / lz_));
+    cy_.push_back(reduce(y, ly_));
+    cz_.push_back(reduce(z, lz_));
     rho2_.push_back(radius2);
   }
 
@@ -95,8 +96,11 @@ class LateralPlacement {
         y[i] = (fraction(r >> 32) - 0.5) * ly_;
         z[i] = (fraction(r & 0xffffffffu) - 0.5) * lz_;
       }
-      // covered[i] stays 0 while lane i overlaps no disc.
-      std::uint64_t covered[batch] = {};
+      // margin[i]: the least of d^2 - rho^2 over the discs, negative once
+      // lane i is inside one (the sign of a difference of doubles is exact,
+      // so this is d^2 < rho^2). All doubles: the lanes vectorise.
+      double margin[batch];
+      for (int i = 0; i < batch; ++i) margin[i] = std::numeric_limits<double>::infinity();
       for (std::size_t k = 0; k < count; ++k) {
         const double cy = cy_[k], cz = cz_[k], rho2 = rho2_[k];
         for (int i = 0; i < batch; ++i) {
@@ -104,18 +108,29 @@ class LateralPlacement {
           double dz = std::fabs(z[i] - cz);
           dy = std::min(dy, ly_ - dy);
           dz = std::min(dz, lz_ - dz);
-          covered[i] |= static_cast<std::uint64_t>(dy * dy + dz * dz < rho2);
+          margin[i] = std::min(margin[i], dy * dy + dz * dz - rho2);
         }
       }
       const int lanes = std::min(batch, n - first);
       for (int i = 0; i < lanes; ++i) {
-        if (!covered[i]) return {true, first + i + 1};
+        if (!(margin[i] < 0.0)) return {true, first + i + 1};
       }
     }
     return {false, n};
   }
 
  private:
+  // v reduced to [-L/2, L/2] by whole periods. A centre is an entry in the
+  // tile plus the drift since, rarely a period: one shift each way, and a
+  // division only beyond that.
+  static double reduce(double v, double length) {
+    const double half = 0.5 * length;
+    if (v > half) v -= length;
+    else if (v < -half) v += length;
+    if (v > half || v < -half) [[unlikely]] v -= length * std::nearbyint(v / length);
+    return v;
+  }
+
   // A 32-bit integer as a fraction in [0, 1): its bits as the top of a
   // mantissa of a double in [1, 2), minus 1 (exact).
   static double fraction(std::uint64_t bits32) {
