@@ -107,20 +107,23 @@ std::vector<awcc::AirInterval> complement(const std::vector<awcc::AirInterval>& 
   return out;
 }
 
+// What the step loop reads of every candidate (key, t_entry, open_mask,
+// clear_until) comes first, on one cache line.
 struct ActiveBubble {
   Vec3 key;        // D(t_entry)
-  Vec3 entry;      // relative to the probe centre
-  Vec3 inv_axes;   // 1 / semi-axes
-  double a_x;      // semi-axis along x
-  double radius;   // d/2, for overlap tests in the sphere-mapped space
   double t_entry;
-  std::uint64_t serial;
-  std::uint64_t pierced_mask = 0;
   std::uint64_t open_mask = 0;  // tips inside this bubble at the end of the last step (in open_)
   // Per tip (the first few): the probe's lateral path length below which
   // the tip cannot reach this bubble (Synthesiser::pierce_tip).
   static constexpr std::size_t cached_tips = 4;
   std::array<double, cached_tips> clear_until{};
+  Vec3 entry;      // relative to the probe centre
+  Vec3 inv_axes;   // 1 / semi-axes
+  double a_x;      // semi-axis along x
+  double radius;   // d/2, for overlap tests in the sphere-mapped space
+  double clear_reach;  // (1 + lateral_margin) a_lat (Synthesiser::clear_until)
+  std::uint64_t serial;
+  std::uint64_t pierced_mask = 0;
 };
 
 // Active bubbles sorted by key.x: a vector with a moving head, so that the
@@ -210,29 +213,24 @@ class FlowAccumulator {
     for (auto& p : lagged_) p.assign(lags_ + 1, 0.0);
   }
 
+  // Scalars, not an array: stored as a pair and a single and read back
+  // across the two, an array stalled each step on a failed store forward.
   void add(const Vec3& u) {
-    const double y[3] = {u.x - mean_[0], u.y - mean_[1], u.z - mean_[2]};
-    for (int i = 0; i < 3; ++i) {
-      sum_[i] += y[i];
-      for (int j = i; j < 3; ++j) cross_[i][j] += y[i] * y[j];
-    }
+    const double yx = u.x - mean_[0], yy = u.y - mean_[1], yz = u.z - mean_[2];
+    sum_[0] += yx;
+    sum_[1] += yy;
+    sum_[2] += yz;
+    cross_[0][0] += yx * yx;
+    cross_[0][1] += yx * yy;
+    cross_[0][2] += yx * yz;
+    cross_[1][1] += yy * yy;
+    cross_[1][2] += yy * yz;
+    cross_[2][2] += yz * yz;
     // Every decimation_-th step from the first, by a countdown (an integer
     // division a step was a tenth of the step loop).
     if (--until_decimated_ == 0) {
       until_decimated_ = decimation_;
-      const std::size_t slot = decimated_ % (lags_ + 1);
-      const std::size_t available = std::min<std::size_t>(decimated_, lags_);
-      for (int i = 0; i < 3; ++i) {
-        auto& ring = ring_[i];
-        auto& lagged = lagged_[i];
-        ring[slot] = y[i];
-        // ring[slot - k] for k <= slot, then wrapped around the end.
-        const std::size_t direct = std::min(available, slot);
-        for (std::size_t k = 0; k <= direct; ++k) lagged[k] += y[i] * ring[slot - k];
-        for (std::size_t k = direct + 1; k <= available; ++k) lagged[k] += y[i] * ring[slot + lags_ + 1 - k];
-        dsum_[i] += y[i];
-      }
-      ++decimated_;
+      decimate(yx, yy, yz);
     }
     ++count_;
   }
@@ -289,6 +287,23 @@ class FlowAccumulator {
       previous = r;
     }
     return integral;
+  }
+
+  [[gnu::noinline]] void decimate(double yx, double yy, double yz) {
+    const double y[3] = {yx, yy, yz};
+    const std::size_t slot = decimated_ % (lags_ + 1);
+    const std::size_t available = std::min<std::size_t>(decimated_, lags_);
+    for (int i = 0; i < 3; ++i) {
+      auto& ring = ring_[i];
+      auto& lagged = lagged_[i];
+      ring[slot] = y[i];
+      // ring[slot - k] for k <= slot, then wrapped around the end.
+      const std::size_t direct = std::min(available, slot);
+      for (std::size_t k = 0; k <= direct; ++k) lagged[k] += y[i] * ring[slot - k];
+      for (std::size_t k = direct + 1; k <= available; ++k) lagged[k] += y[i] * ring[slot + lags_ + 1 - k];
+      dsum_[i] += y[i];
+    }
+    ++decimated_;
   }
 
   double dt_;
@@ -539,6 +554,7 @@ class Synthesiser {
     b.a_x = b.radius * sizes_.x_factor;
     const double a_lat = b.radius * sizes_.lateral_factor;
     b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
+    b.clear_reach = (1.0 + lateral_margin) * a_lat;
     b.t_entry = t_entry;
 
     // Test the neighbours in the sphere-mapped space (x scaled by 1/x_factor,
@@ -686,12 +702,12 @@ class Synthesiser {
   // to the tip's nearest periodic image (lateral_y is one image of the
   // offset, as the bubble's image is chosen before the tip's offset is
   // taken; the other is length - |lateral_y|) less a_lat and the margin.
-  // Lateral semi-axes are equal (try_place): a_lat = 1 / inv_axes.y.
+  // Lateral semi-axes are equal (try_place).
   [[nodiscard]] double clear_until(const ActiveBubble& b, double lateral_y, double lateral_z) const {
     const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
     const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
     const double distance = std::sqrt(ny * ny + nz * nz);
-    return lateral_path_ + distance - (1.0 + lateral_margin) / b.inv_axes.y;
+    return lateral_path_ + distance - b.clear_reach;
   }
 
   void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
