@@ -154,10 +154,15 @@ class BubbleQueue {
     hint = i + erased_;
     return items_.begin() + static_cast<std::ptrdiff_t>(i);
   }
-  void insert_sorted(const ActiveBubble& b) {
-    auto pos = end();
-    while (pos != begin() && std::prev(pos)->key.x > b.key.x) --pos;
-    items_.insert(pos, b);
+  /// A new bubble at the end, to be filled in, then settle_last().
+  ActiveBubble& append() { return items_.emplace_back(); }
+  /// Moves the last bubble back to its place in key order (it is there
+  /// already unless the flow reversed while it entered).
+  void settle_last() {
+    const auto last = items_.end() - 1;
+    auto pos = last;
+    while (pos != begin() && std::prev(pos)->key.x > last->key.x) --pos;
+    if (pos != last) std::rotate(pos, last, items_.end());
   }
 
  private:
@@ -488,6 +493,8 @@ class Synthesiser {
 
   // Arrivals and retries of waiting bubbles during the step, in time order.
   void arrivals(double t, const Vec3& u, const Vec3& d_next) {
+    // Most steps have no event: what the loop below finds first, cheaply.
+    if (pending_.empty() && (time_rule_ ? next_time_ - t >= dt_ : next_key_ > d_next.x)) return;
     auto at = [&](double s) { return Vec3{d_.x + u.x * s, d_.y + u.y * s, d_.z + u.z * s}; };
     double cursor = 0.0;  // offset into the step of the last event
     for (;;) {
@@ -548,14 +555,7 @@ class Synthesiser {
   }
 
   bool try_place(double diameter, double t_entry, const Vec3& key, bool must_place) {
-    ActiveBubble b;
-    b.key = key;
-    b.radius = 0.5 * diameter;
-    b.a_x = b.radius * sizes_.x_factor;
-    const double a_lat = b.radius * sizes_.lateral_factor;
-    b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
-    b.clear_reach = (1.0 + lateral_margin) * a_lat;
-    b.t_entry = t_entry;
+    const double radius = 0.5 * diameter;
 
     // Test the neighbours in the sphere-mapped space (x scaled by 1/x_factor,
     // lateral by 1/lateral_factor) where every bubble is a sphere of radius
@@ -578,68 +578,77 @@ class Synthesiser {
     for (auto it = lo; it != hi; ++it) {
       // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
       const double sx = (it->key.x - key.x) / sizes_.x_factor;
-      const double r = b.radius + it->radius;
+      const double r = radius + it->radius;
       if (sx * sx >= r * r) continue;
       near.push_back({sx * sx, r * r});
       placement_.add_disc(it->entry.y + key.y - it->key.y, it->entry.z + key.z - it->key.z,
                           (r * r - sx * sx) * lateral2);
     }
     const auto outcome = placement_.place(bubble_rng_, scene_.overlap_retries + 1);
-    const bool placed = outcome.placed;
-    b.entry = {entry_x_, placement_.y(outcome.attempts - 1), placement_.z(outcome.attempts - 1)};
-    if (!placed && !must_place) return false;
-    if (!placed) {
+    if (!outcome.placed && !must_place) return false;
+    int chosen = outcome.attempts - 1;  // the free one, or the last tried
+    if (!outcome.placed) {
       ++overlaps_unresolved_;
-      place_overlapping(b, t_entry, key, outcome.attempts);
+      chosen = place_overlapping(radius, t_entry, key, outcome.attempts);
     }
+    // Built where it is kept: a copy of a bubble just written field by field
+    // stalled on the store forwards.
+    ActiveBubble& b = bubbles_.append();
+    b.key = key;
+    b.t_entry = t_entry;
+    b.entry = {entry_x_, placement_.y(chosen), placement_.z(chosen)};
+    b.radius = radius;
+    b.a_x = radius * sizes_.x_factor;
+    const double a_lat = radius * sizes_.lateral_factor;
+    b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
+    b.clear_reach = (1.0 + lateral_margin) * a_lat;
     b.serial = serial_++;
     if (t_entry >= 0.0 && t_entry < duration_) ++generated_;
     if (options_.keep_reference_data) {
       records_.push_back({t_entry, b.entry, b.key, {b.a_x, 1.0 / b.inv_axes.y, 1.0 / b.inv_axes.z}});
     }
-    bubbles_.insert_sorted(b);
+    bubbles_.settle_last();
     return true;
   }
 
-  // The volume particle b, entered at lateral (y, z), shares with the
-  // neighbours of try_place's list, in the sphere-mapped space
-  // (volume-preserving): the sum of the pairwise lenses. A point also inside
-  // a second neighbour is counted twice, but two neighbours can share volume
-  // only when one of them was itself placed overlapping (docs/validation.md
-  // measures the excess).
-  [[nodiscard]] double shared_volume(const ActiveBubble& b, double y, double z) const {
+  // The volume a particle of the given radius shares, entered at lateral
+  // (y, z), with the neighbours of try_place's list, in the sphere-mapped
+  // space (volume-preserving): the sum of the pairwise lenses. A point also
+  // inside a second neighbour is counted twice, but two neighbours can share
+  // volume only when one of them was itself placed overlapping
+  // (docs/validation.md measures the excess).
+  [[nodiscard]] double shared_volume(double radius, double y, double z) const {
     const double lateral2 = sizes_.lateral_factor * sizes_.lateral_factor;
     double volume = 0.0;
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
       const Neighbour& o = neighbours_[k];
       const double separation2 = o.sx2 + placement_.distance2(k, y, z) / lateral2;
       if (separation2 >= o.r2) continue;
-      volume += lens_volume(b.radius, std::sqrt(o.r2) - b.radius, std::sqrt(separation2));
+      volume += lens_volume(radius, std::sqrt(o.r2) - radius, std::sqrt(separation2));
     }
     return volume;
   }
 
-  // Every lateral position tried (the placement's first `tried`) overlaps.
-  // Under the space rules b goes where it shares the least volume, and that
-  // volume is owed to the flow (bring_forward); under the time rules it
-  // stays at the last position tried and the volume is lost
-  // (synthesiser.hpp, "Dense placement").
-  void place_overlapping(ActiveBubble& b, double t_entry, const Vec3& key, int tried) {
-    if (time_rule_) return;
+  // Every lateral position tried (the placement's first `tried`) overlaps:
+  // the one the particle takes. Under the space rules it goes where it
+  // shares the least volume, and that volume is owed to the flow
+  // (bring_forward); under the time rules it stays at the last position
+  // tried and the volume is lost (synthesiser.hpp, "Dense placement").
+  int place_overlapping(double radius, double t_entry, const Vec3& key, int tried) {
+    if (time_rule_) return tried - 1;
     double least = std::numeric_limits<double>::infinity();
     int best = tried - 1;
     for (int i = 0; i < tried; ++i) {
-      const double v = shared_volume(b, placement_.y(i), placement_.z(i));
+      const double v = shared_volume(radius, placement_.y(i), placement_.z(i));
       if (v < least) {
         least = v;
         best = i;
       }
     }
-    b.entry.y = placement_.y(best);
-    b.entry.z = placement_.z(best);
     if (t_entry >= 0.0 && t_entry < duration_) compensated_volume_ += least;
     debt_volume_ += least;
     bring_forward(key.x);
+    return best;
   }
 
   // Brings the next mark forward by the flow that carries the owed volume
@@ -734,6 +743,11 @@ class Synthesiser {
     const double a = vx * vx + vy * vy + vz * vz;
     const double bh = qx * vx + qy * vy + qz * vz;
     const double c = qx * qx + qy * qy + qz * qz - 1.0;
+
+    // Inside at the step's start (the pierce is open) and at its end: an
+    // ellipsoid is convex, so inside all step, and no roots are needed
+    // (most steps of a pierce; the roots below decide the rest as before).
+    if (was_inside && c + dt_ * (2.0 * bh + a * dt_) < 0.0) return;
 
     // Roots of a s^2 + 2 bh s + c = 0: the tip is inside for s in (r1, r2).
     double r1 = 0.0, r2 = 0.0;
