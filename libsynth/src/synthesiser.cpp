@@ -602,6 +602,14 @@ class Synthesiser {
     const double a_lat = radius * sizes_.lateral_factor;
     b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
     b.clear_reach = (1.0 + lateral_margin) * a_lat;
+    // The lateral skip from the entry on (pierce_tip): at entry the bubble
+    // sits at lateral offset entry - P_j from tip j (D = key), and the
+    // path since the step's start, not counted here, only makes the
+    // threshold lower than it could be. Most bubbles pass every tip at a
+    // distance and are never looked at again.
+    for (std::size_t j = 0; j < std::min(tips_.size(), ActiveBubble::cached_tips); ++j) {
+      b.clear_until[j] = clear_until(b, b.entry.y - tips_[j].y, b.entry.z - tips_[j].z);
+    }
     b.serial = serial_++;
     if (t_entry >= 0.0 && t_entry < duration_) ++generated_;
     if (options_.keep_reference_data) {
@@ -713,10 +721,12 @@ class Synthesiser {
   // taken; the other is length - |lateral_y|) less a_lat and the margin.
   // Lateral semi-axes are equal (try_place).
   [[nodiscard]] double clear_until(const ActiveBubble& b, double lateral_y, double lateral_z) const {
+    return lateral_path_ + std::sqrt(nearest_image2(lateral_y, lateral_z)) - b.clear_reach;
+  }
+  [[nodiscard]] double nearest_image2(double lateral_y, double lateral_z) const {
     const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
     const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
-    const double distance = std::sqrt(ny * ny + nz * nz);
-    return lateral_path_ + distance - b.clear_reach;
+    return ny * ny + nz * nz;
   }
 
   void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
@@ -730,9 +740,14 @@ class Synthesiser {
       // The skip below, before the roots: a bubble further from the tip
       // than a_lat and the step's lateral path cannot hold it during the
       // step, whatever its streamwise position (most candidates pass at a
-      // distance: this spares them the quadratic).
-      b.clear_until[j] = clear_until(b, lateral_y, lateral_z);
-      if (lateral_path_next_ < b.clear_until[j]) return;
+      // distance: this spares them the quadratic). Decided on squares,
+      // L_next - L + reach < D as (L_next - L + reach)^2 < D^2 (both sides
+      // positive), so that the branch does not wait for the square root,
+      // which only the threshold kept for later steps needs.
+      const double d2 = nearest_image2(lateral_y, lateral_z);
+      const double need = lateral_path_next_ - lateral_path_ + b.clear_reach;
+      b.clear_until[j] = lateral_path_ + std::sqrt(d2) - b.clear_reach;
+      if (need * need < d2) return;
     }
     const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
     const double vx = u.x * b.inv_axes.x;
