@@ -150,6 +150,10 @@ class BubbleQueue {
   iterator first_not_below(double key, std::size_t& hint) {
     std::size_t i = hint >= erased_ ? std::clamp(hint - erased_, head_, items_.size()) : head_;
     while (i > head_ && items_[i - 1].key.x >= key) --i;
+    // Mostly one bubble or none: that one without a branch, so that the
+    // loop's test is nearly always false (a walk of 0 or 1 was a
+    // mispredicted branch a step).
+    if (i < items_.size()) i += static_cast<std::size_t>(items_[i].key.x < key);
     while (i < items_.size() && items_[i].key.x < key) ++i;
     hint = i + erased_;
     return items_.begin() + static_cast<std::ptrdiff_t>(i);
@@ -484,7 +488,9 @@ class Synthesiser {
   void advance(double t, const Vec3& u) {
     const Vec3 d_next{d_.x + u.x * dt_, d_.y + u.y * dt_, d_.z + u.z * dt_};
     lateral_path_next_ = lateral_path_ + std::sqrt(u.y * u.y + u.z * u.z) * dt_;
-    arrivals(t, u, d_next);
+    // Most steps have no event: what arrivals' loop finds first, checked
+    // here, without the call.
+    if (!pending_.empty() || (time_rule_ ? next_time_ - t < dt_ : next_key_ <= d_next.x)) arrivals(t, u, d_next);
     pierce(t, u, d_next);
     retire(d_next);
     d_ = d_next;
@@ -493,8 +499,6 @@ class Synthesiser {
 
   // Arrivals and retries of waiting bubbles during the step, in time order.
   void arrivals(double t, const Vec3& u, const Vec3& d_next) {
-    // Most steps have no event: what the loop below finds first, cheaply.
-    if (pending_.empty() && (time_rule_ ? next_time_ - t >= dt_ : next_key_ > d_next.x)) return;
     auto at = [&](double s) { return Vec3{d_.x + u.x * s, d_.y + u.y * s, d_.z + u.z * s}; };
     double cursor = 0.0;  // offset into the step of the last event
     for (;;) {
@@ -568,18 +572,18 @@ class Synthesiser {
     // partition_point(o.key.x <= key.x + reach): the first key above it.
     const auto hi = bubbles_.first_not_below(std::nextafter(key.x + reach, HUGE_VAL), place_hint_hi_);
     // What the attempts share, once: each neighbour's disc in the entry
-    // plane (synth/placement.hpp). Neighbours streamwise too far for any
-    // lateral position drop out (sx^2 >= r^2: no lateral separation brings
-    // the sum under r^2).
+    // plane (synth/placement.hpp).
     auto& near = neighbours_;
     near.clear();
     placement_.clear();
     const double lateral2 = sizes_.lateral_factor * sizes_.lateral_factor;
+    // Every bubble in reach is a disc, without a branch: one streamwise too
+    // far has r^2 - sx^2 <= 0, a disc that covers no point (d^2 >= 0), and
+    // lenses nothing (shared_volume).
     for (auto it = lo; it != hi; ++it) {
       // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
       const double sx = (it->key.x - key.x) / sizes_.x_factor;
       const double r = radius + it->radius;
-      if (sx * sx >= r * r) continue;
       near.push_back({sx * sx, r * r});
       placement_.add_disc(it->entry.y + key.y - it->key.y, it->entry.z + key.z - it->key.z,
                           (r * r - sx * sx) * lateral2);
@@ -687,10 +691,17 @@ class Synthesiser {
       const double key_lo = entry_x_ + d_lo - tips_[j].x - a_x_max_;
       const double key_hi = entry_x_ + d_hi - tips_[j].x + a_x_max_;
       auto it = bubbles_.first_not_below(key_lo, pierce_hint_[j]);
+      // The candidates that the lateral skip does not pass over, gathered
+      // without a branch a candidate (most are skipped, unpredictably).
+      const bool cached = j < ActiveBubble::cached_tips;
+      std::size_t due = 0;
       for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
-        const double s0 = std::max(0.0, it->t_entry - t);
-        pierce_tip(*it, j, t, s0, u);
+        if (due == due_.size()) [[unlikely]] due_.resize(2 * due + 8);
+        due_[due] = &*it;
+        const bool skip = cached & !((it->open_mask >> j) & 1u) & (lateral_path_next_ < it->clear_until[j]);
+        due += static_cast<std::size_t>(!skip);
       }
+      for (std::size_t k = 0; k < due; ++k) pierce_tip(*due_[k], j, t, std::max(0.0, due_[k]->t_entry - t), u);
     }
   }
 
@@ -1023,6 +1034,7 @@ class Synthesiser {
   double max_retired_key_ = -std::numeric_limits<double>::infinity();
   std::vector<std::vector<OpenPierce>> open_;
   std::vector<std::size_t> pierce_hint_;  // per tip: where the last candidate search ended
+  std::vector<ActiveBubble*> due_;        // scratch of pierce: the candidates of one tip not skipped
   std::size_t place_hint_lo_ = 0, place_hint_hi_ = 0;
   std::vector<std::vector<awcc::AirInterval>> pierces_;
   std::vector<std::int64_t> pair_counts_;

@@ -167,12 +167,13 @@ class LateralPlacement {
   }
 
   // v reduced to [-L/2, L/2] by whole periods. A centre is an entry in the
-  // tile plus the drift since, rarely a period: one shift each way, and a
-  // division only beyond that.
+  // tile plus the drift since, rarely a period: one shift each way without
+  // a branch, and a division only beyond that.
   static double reduce(double v, double length) {
     const double half = 0.5 * length;
-    if (v > half) v -= length;
-    else if (v < -half) v += length;
+    const double above = length * static_cast<double>(v > half);
+    const double below = length * static_cast<double>(v < -half);
+    v = (v - above) + below;
     if (v > half || v < -half) [[unlikely]] v -= length * std::nearbyint(v / length);
     return v;
   }
