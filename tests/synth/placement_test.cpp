@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <ostream>
 #include <vector>
 
 #include "synth/synthesiser.hpp"
@@ -218,6 +219,10 @@ struct Limit {
   double aspect, log_sd;
 };
 
+void PrintTo(const Limit& l, std::ostream* os) {
+  *os << "c " << l.c << ", arrival " << static_cast<int>(l.arrival) << ", aspect " << l.aspect << ", log sd " << l.log_sd;
+}
+
 class PlacementEndToEnd : public ::testing::TestWithParam<Limit> {};
 
 // Student's t of the batch means of v (in order) against `expected`.
@@ -328,6 +333,10 @@ struct TimeCase {
   double c, tu, aspect, log_sd;
   bool check_c;
 };
+
+void PrintTo(const TimeCase& t, std::ostream* os) {
+  *os << "c " << t.c << ", Tu " << t.tu << ", aspect " << t.aspect << ", log sd " << t.log_sd;
+}
 
 class TimeRules : public ::testing::TestWithParam<TimeCase> {};
 
