@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "synth/overlap.hpp"
+#include "synth/placement.hpp"
 #include "synth/random.hpp"
 #include "synth/velocity.hpp"
 
@@ -106,20 +107,23 @@ std::vector<awcc::AirInterval> complement(const std::vector<awcc::AirInterval>& 
   return out;
 }
 
+// What the step loop reads of every candidate (key, t_entry, open_mask,
+// clear_until) comes first, on one cache line.
 struct ActiveBubble {
   Vec3 key;        // D(t_entry)
-  Vec3 entry;      // relative to the probe centre
-  Vec3 inv_axes;   // 1 / semi-axes
-  double a_x;      // semi-axis along x
-  double radius;   // d/2, for overlap tests in the sphere-mapped space
   double t_entry;
-  std::uint64_t serial;
-  std::uint64_t pierced_mask = 0;
   std::uint64_t open_mask = 0;  // tips inside this bubble at the end of the last step (in open_)
   // Per tip (the first few): the probe's lateral path length below which
   // the tip cannot reach this bubble (Synthesiser::pierce_tip).
   static constexpr std::size_t cached_tips = 4;
   std::array<double, cached_tips> clear_until{};
+  Vec3 entry;      // relative to the probe centre
+  Vec3 inv_axes;   // 1 / semi-axes
+  double a_x;      // semi-axis along x
+  double radius;   // d/2, for overlap tests in the sphere-mapped space
+  double clear_reach;  // (1 + lateral_margin) a_lat (Synthesiser::clear_until)
+  std::uint64_t serial;
+  std::uint64_t pierced_mask = 0;
 };
 
 // Active bubbles sorted by key.x: a vector with a moving head, so that the
@@ -146,14 +150,23 @@ class BubbleQueue {
   iterator first_not_below(double key, std::size_t& hint) {
     std::size_t i = hint >= erased_ ? std::clamp(hint - erased_, head_, items_.size()) : head_;
     while (i > head_ && items_[i - 1].key.x >= key) --i;
+    // Mostly one bubble or none: that one without a branch, so that the
+    // loop's test is nearly always false (a walk of 0 or 1 was a
+    // mispredicted branch a step).
+    if (i < items_.size()) i += static_cast<std::size_t>(items_[i].key.x < key);
     while (i < items_.size() && items_[i].key.x < key) ++i;
     hint = i + erased_;
     return items_.begin() + static_cast<std::ptrdiff_t>(i);
   }
-  void insert_sorted(const ActiveBubble& b) {
-    auto pos = end();
-    while (pos != begin() && std::prev(pos)->key.x > b.key.x) --pos;
-    items_.insert(pos, b);
+  /// A new bubble at the end, to be filled in, then settle_last().
+  ActiveBubble& append() { return items_.emplace_back(); }
+  /// Moves the last bubble back to its place in key order (it is there
+  /// already unless the flow reversed while it entered).
+  void settle_last() {
+    const auto last = items_.end() - 1;
+    auto pos = last;
+    while (pos != begin() && std::prev(pos)->key.x > last->key.x) --pos;
+    if (pos != last) std::rotate(pos, last, items_.end());
   }
 
  private:
@@ -163,10 +176,9 @@ class BubbleQueue {
 };
 
 // A neighbour of a bubble being placed, as every placement attempt tests it.
+// Its lateral disc is the placement's (same index).
 struct Neighbour {
-  double sx2, r2;                 // squared streamwise separation and squared sum of radii
-  double entry_y, key_dy;         // its entry y, and key_b.y - key_o.y
-  double entry_z, key_dz;
+  double sx2, r2;  // squared streamwise separation and squared sum of radii (sphere-mapped)
 };
 
 struct Pending {
@@ -210,26 +222,24 @@ class FlowAccumulator {
     for (auto& p : lagged_) p.assign(lags_ + 1, 0.0);
   }
 
+  // Scalars, not an array: stored as a pair and a single and read back
+  // across the two, an array stalled each step on a failed store forward.
   void add(const Vec3& u) {
-    const double y[3] = {u.x - mean_[0], u.y - mean_[1], u.z - mean_[2]};
-    for (int i = 0; i < 3; ++i) {
-      sum_[i] += y[i];
-      for (int j = i; j < 3; ++j) cross_[i][j] += y[i] * y[j];
-    }
-    if (count_ % decimation_ == 0) {
-      const std::size_t slot = decimated_ % (lags_ + 1);
-      const std::size_t available = std::min<std::size_t>(decimated_, lags_);
-      for (int i = 0; i < 3; ++i) {
-        auto& ring = ring_[i];
-        auto& lagged = lagged_[i];
-        ring[slot] = y[i];
-        // ring[slot - k] for k <= slot, then wrapped around the end.
-        const std::size_t direct = std::min(available, slot);
-        for (std::size_t k = 0; k <= direct; ++k) lagged[k] += y[i] * ring[slot - k];
-        for (std::size_t k = direct + 1; k <= available; ++k) lagged[k] += y[i] * ring[slot + lags_ + 1 - k];
-        dsum_[i] += y[i];
-      }
-      ++decimated_;
+    const double yx = u.x - mean_[0], yy = u.y - mean_[1], yz = u.z - mean_[2];
+    sum_[0] += yx;
+    sum_[1] += yy;
+    sum_[2] += yz;
+    cross_[0][0] += yx * yx;
+    cross_[0][1] += yx * yy;
+    cross_[0][2] += yx * yz;
+    cross_[1][1] += yy * yy;
+    cross_[1][2] += yy * yz;
+    cross_[2][2] += yz * yz;
+    // Every decimation_-th step from the first, by a countdown (an integer
+    // division a step was a tenth of the step loop).
+    if (--until_decimated_ == 0) {
+      until_decimated_ = decimation_;
+      decimate(yx, yy, yz);
     }
     ++count_;
   }
@@ -288,12 +298,30 @@ class FlowAccumulator {
     return integral;
   }
 
+  [[gnu::noinline]] void decimate(double yx, double yy, double yz) {
+    const double y[3] = {yx, yy, yz};
+    const std::size_t slot = decimated_ % (lags_ + 1);
+    const std::size_t available = std::min<std::size_t>(decimated_, lags_);
+    for (int i = 0; i < 3; ++i) {
+      auto& ring = ring_[i];
+      auto& lagged = lagged_[i];
+      ring[slot] = y[i];
+      // ring[slot - k] for k <= slot, then wrapped around the end.
+      const std::size_t direct = std::min(available, slot);
+      for (std::size_t k = 0; k <= direct; ++k) lagged[k] += y[i] * ring[slot - k];
+      for (std::size_t k = direct + 1; k <= available; ++k) lagged[k] += y[i] * ring[slot + lags_ + 1 - k];
+      dsum_[i] += y[i];
+    }
+    ++decimated_;
+  }
+
   double dt_;
   std::array<double, 3> mean_{};
   std::int64_t count_ = 0;
   double sum_[3] = {0, 0, 0};
   double cross_[3][3] = {};
   std::int64_t decimation_ = 1;
+  std::int64_t until_decimated_ = 1;  // steps to the next decimated one, this one included
   std::size_t lags_ = 16;
   std::size_t decimated_ = 0;
   double dsum_[3] = {0, 0, 0};
@@ -327,6 +355,7 @@ class Synthesiser {
     length_[1] = (hi.y - lo.y) + 4.0 * a_lat_max;
     length_[2] = (hi.z - lo.z) + 4.0 * a_lat_max;
     entry_x_ = -0.5 * length_[0];
+    placement_ = LateralPlacement(length_[1], length_[2]);
 
     // Bubbles, or droplets in the spray region: the particles are placed at
     // their own volume fraction, c or 1 - c (synth::DispersedPhase).
@@ -459,7 +488,9 @@ class Synthesiser {
   void advance(double t, const Vec3& u) {
     const Vec3 d_next{d_.x + u.x * dt_, d_.y + u.y * dt_, d_.z + u.z * dt_};
     lateral_path_next_ = lateral_path_ + std::sqrt(u.y * u.y + u.z * u.z) * dt_;
-    arrivals(t, u, d_next);
+    // Most steps have no event: what arrivals' loop finds first, checked
+    // here, without the call.
+    if (!pending_.empty() || (time_rule_ ? next_time_ - t < dt_ : next_key_ <= d_next.x)) arrivals(t, u, d_next);
     pierce(t, u, d_next);
     retire(d_next);
     d_ = d_next;
@@ -527,21 +558,8 @@ class Synthesiser {
     }
   }
 
-  // A lateral separation in the sphere-mapped space. Spherical bubbles (the
-  // usual case) skip the division: x / 1 is x, and a division is the slowest
-  // step of the placement test.
-  [[nodiscard]] double to_sphere(double lateral) const {
-    return spherical_ ? lateral : lateral / sizes_.lateral_factor;
-  }
-
   bool try_place(double diameter, double t_entry, const Vec3& key, bool must_place) {
-    ActiveBubble b;
-    b.key = key;
-    b.radius = 0.5 * diameter;
-    b.a_x = b.radius * sizes_.x_factor;
-    const double a_lat = b.radius * sizes_.lateral_factor;
-    b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
-    b.t_entry = t_entry;
+    const double radius = 0.5 * diameter;
 
     // Test the neighbours in the sphere-mapped space (x scaled by 1/x_factor,
     // lateral by 1/lateral_factor) where every bubble is a sphere of radius
@@ -553,92 +571,96 @@ class Synthesiser {
     const auto lo = bubbles_.first_not_below(key.x - reach, place_hint_lo_);
     // partition_point(o.key.x <= key.x + reach): the first key above it.
     const auto hi = bubbles_.first_not_below(std::nextafter(key.x + reach, HUGE_VAL), place_hint_hi_);
-    // What the attempts share, once: each neighbour's streamwise separation
-    // and the parts of its lateral ones that do not depend on the entry
-    // drawn. Neighbours streamwise too far for any lateral position drop out
-    // (sx^2 >= r^2: the sum below cannot fall under r^2 either).
+    // What the attempts share, once: each neighbour's disc in the entry
+    // plane (synth/placement.hpp).
     auto& near = neighbours_;
     near.clear();
+    placement_.clear();
+    const double lateral2 = sizes_.lateral_factor * sizes_.lateral_factor;
+    // Every bubble in reach is a disc, without a branch: one streamwise too
+    // far has r^2 - sx^2 <= 0, a disc that covers no point (d^2 >= 0), and
+    // lenses nothing (shared_volume).
     for (auto it = lo; it != hi; ++it) {
       // Separation now: (E_b - E_o) - (key_b - key_o), with E_x equal.
       const double sx = (it->key.x - key.x) / sizes_.x_factor;
-      const double r = b.radius + it->radius;
-      if (sx * sx >= r * r) continue;
-      near.push_back({sx * sx, r * r, it->entry.y, key.y - it->key.y, it->entry.z, key.z - it->key.z});
+      const double r = radius + it->radius;
+      near.push_back({sx * sx, r * r});
+      placement_.add_disc(it->entry.y + key.y - it->key.y, it->entry.z + key.z - it->key.z,
+                          (r * r - sx * sx) * lateral2);
     }
-    bool placed = false;
-    const bool keep_tried = must_place && !time_rule_;
-    if (keep_tried) tried_.clear();
-    for (int attempt = 0; attempt <= scene_.overlap_retries; ++attempt) {
-      b.entry = {entry_x_, (bubble_rng_.uniform() - 0.5) * length_[1], (bubble_rng_.uniform() - 0.5) * length_[2]};
-      if (keep_tried) tried_.push_back(b.entry);
-      bool overlaps = false;
-      for (const auto& o : near) {
-        const double sy = to_sphere(wrap(b.entry.y - o.entry_y - o.key_dy, length_[1]));
-        const double sxy = o.sx2 + sy * sy;
-        if (sxy >= o.r2) continue;  // adding sz^2 cannot bring it under r^2
-        const double sz = to_sphere(wrap(b.entry.z - o.entry_z - o.key_dz, length_[2]));
-        if (sxy + sz * sz < o.r2) {
-          overlaps = true;
-          break;
-        }
-      }
-      if (!overlaps) {
-        placed = true;
-        break;
-      }
-    }
-    if (!placed && !must_place) return false;
-    if (!placed) {
+    const auto outcome = placement_.place(bubble_rng_, scene_.overlap_retries + 1);
+    if (!outcome.placed && !must_place) return false;
+    int chosen = outcome.attempts - 1;  // the free one, or the last tried
+    if (!outcome.placed) {
       ++overlaps_unresolved_;
-      place_overlapping(b, t_entry, key);
+      chosen = place_overlapping(radius, t_entry, key, outcome.attempts);
+    }
+    // Built where it is kept: a copy of a bubble just written field by field
+    // stalled on the store forwards.
+    ActiveBubble& b = bubbles_.append();
+    b.key = key;
+    b.t_entry = t_entry;
+    b.entry = {entry_x_, placement_.y(chosen), placement_.z(chosen)};
+    b.radius = radius;
+    b.a_x = radius * sizes_.x_factor;
+    const double a_lat = radius * sizes_.lateral_factor;
+    b.inv_axes = {1.0 / b.a_x, 1.0 / a_lat, 1.0 / a_lat};
+    b.clear_reach = (1.0 + lateral_margin) * a_lat;
+    // The lateral skip from the entry on (pierce_tip): at entry the bubble
+    // sits at lateral offset entry - P_j from tip j (D = key), and the
+    // path since the step's start, not counted here, only makes the
+    // threshold lower than it could be. Most bubbles pass every tip at a
+    // distance and are never looked at again.
+    for (std::size_t j = 0; j < std::min(tips_.size(), ActiveBubble::cached_tips); ++j) {
+      b.clear_until[j] = clear_until(b, b.entry.y - tips_[j].y, b.entry.z - tips_[j].z);
     }
     b.serial = serial_++;
     if (t_entry >= 0.0 && t_entry < duration_) ++generated_;
     if (options_.keep_reference_data) {
       records_.push_back({t_entry, b.entry, b.key, {b.a_x, 1.0 / b.inv_axes.y, 1.0 / b.inv_axes.z}});
     }
-        bubbles_.insert_sorted(b);
+    bubbles_.settle_last();
     return true;
   }
 
-  // The volume particle b, entered at b.entry, shares with the neighbours
-  // of try_place's list, in the sphere-mapped space (volume-preserving): the
-  // sum of the pairwise lenses. A point also inside a second neighbour is
-  // counted twice, but two neighbours can share volume only when one of them
-  // was itself placed overlapping (docs/validation.md measures the excess).
-  [[nodiscard]] double shared_volume(const ActiveBubble& b) const {
+  // The volume a particle of the given radius shares, entered at lateral
+  // (y, z), with the neighbours of try_place's list, in the sphere-mapped
+  // space (volume-preserving): the sum of the pairwise lenses. A point also
+  // inside a second neighbour is counted twice, but two neighbours can share
+  // volume only when one of them was itself placed overlapping
+  // (docs/validation.md measures the excess).
+  [[nodiscard]] double shared_volume(double radius, double y, double z) const {
+    const double lateral2 = sizes_.lateral_factor * sizes_.lateral_factor;
     double volume = 0.0;
-    for (const auto& o : neighbours_) {
-      const double sy = to_sphere(wrap(b.entry.y - o.entry_y - o.key_dy, length_[1]));
-      const double sz = to_sphere(wrap(b.entry.z - o.entry_z - o.key_dz, length_[2]));
-      const double separation2 = o.sx2 + sy * sy + sz * sz;
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      const Neighbour& o = neighbours_[k];
+      const double separation2 = o.sx2 + placement_.distance2(k, y, z) / lateral2;
       if (separation2 >= o.r2) continue;
-      volume += lens_volume(b.radius, std::sqrt(o.r2) - b.radius, std::sqrt(separation2));
+      volume += lens_volume(radius, std::sqrt(o.r2) - radius, std::sqrt(separation2));
     }
     return volume;
   }
 
-  // Every lateral position tried overlaps. Under the space rules b goes
-  // where it shares the least volume, and that volume is owed to the flow
+  // Every lateral position tried (the placement's first `tried`) overlaps:
+  // the one the particle takes. Under the space rules it goes where it
+  // shares the least volume, and that volume is owed to the flow
   // (bring_forward); under the time rules it stays at the last position
   // tried and the volume is lost (synthesiser.hpp, "Dense placement").
-  void place_overlapping(ActiveBubble& b, double t_entry, const Vec3& key) {
-    if (time_rule_) return;
+  int place_overlapping(double radius, double t_entry, const Vec3& key, int tried) {
+    if (time_rule_) return tried - 1;
     double least = std::numeric_limits<double>::infinity();
-    Vec3 best = b.entry;
-    for (const auto& entry : tried_) {
-      b.entry = entry;
-      const double v = shared_volume(b);
+    int best = tried - 1;
+    for (int i = 0; i < tried; ++i) {
+      const double v = shared_volume(radius, placement_.y(i), placement_.z(i));
       if (v < least) {
         least = v;
-        best = entry;
+        best = i;
       }
     }
-    b.entry = best;
     if (t_entry >= 0.0 && t_entry < duration_) compensated_volume_ += least;
     debt_volume_ += least;
     bring_forward(key.x);
+    return best;
   }
 
   // Brings the next mark forward by the flow that carries the owed volume
@@ -669,10 +691,17 @@ class Synthesiser {
       const double key_lo = entry_x_ + d_lo - tips_[j].x - a_x_max_;
       const double key_hi = entry_x_ + d_hi - tips_[j].x + a_x_max_;
       auto it = bubbles_.first_not_below(key_lo, pierce_hint_[j]);
+      // The candidates that the lateral skip does not pass over, gathered
+      // without a branch a candidate (most are skipped, unpredictably).
+      const bool cached = j < ActiveBubble::cached_tips;
+      std::size_t due = 0;
       for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
-        const double s0 = std::max(0.0, it->t_entry - t);
-        pierce_tip(*it, j, t, s0, u);
+        if (due == due_.size()) [[unlikely]] due_.resize(2 * due + 8);
+        due_[due] = &*it;
+        const bool skip = cached & !((it->open_mask >> j) & 1u) & (lateral_path_next_ < it->clear_until[j]);
+        due += static_cast<std::size_t>(!skip);
       }
+      for (std::size_t k = 0; k < due; ++k) pierce_tip(*due_[k], j, t, std::max(0.0, due_[k]->t_entry - t), u);
     }
   }
 
@@ -696,15 +725,43 @@ class Synthesiser {
   // skipping changes no output.
   static constexpr double lateral_margin = 1e-3;
 
+  // The lateral path length below which the tip cannot reach b, from the
+  // tip's offset (lateral_y, lateral_z) at the step's start: the distance
+  // to the tip's nearest periodic image (lateral_y is one image of the
+  // offset, as the bubble's image is chosen before the tip's offset is
+  // taken; the other is length - |lateral_y|) less a_lat and the margin.
+  // Lateral semi-axes are equal (try_place).
+  [[nodiscard]] double clear_until(const ActiveBubble& b, double lateral_y, double lateral_z) const {
+    return lateral_path_ + std::sqrt(nearest_image2(lateral_y, lateral_z)) - b.clear_reach;
+  }
+  [[nodiscard]] double nearest_image2(double lateral_y, double lateral_z) const {
+    const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
+    const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
+    return ny * ny + nz * nz;
+  }
+
   void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
     const Vec3& p = tips_[j];
     const bool was_inside = (b.open_mask >> j) & 1u;
     const bool cached = j < ActiveBubble::cached_tips;
     if (cached && !was_inside && lateral_path_next_ < b.clear_until[j]) return;
-    const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
-    const double vx = u.x * b.inv_axes.x;
     const double lateral_y = wrap(b.entry.y + d_.y - b.key.y, length_[1]) - p.y;
     const double lateral_z = wrap(b.entry.z + d_.z - b.key.z, length_[2]) - p.z;
+    if (cached && !was_inside) {
+      // The skip below, before the roots: a bubble further from the tip
+      // than a_lat and the step's lateral path cannot hold it during the
+      // step, whatever its streamwise position (most candidates pass at a
+      // distance: this spares them the quadratic). Decided on squares,
+      // L_next - L + reach < D as (L_next - L + reach)^2 < D^2 (both sides
+      // positive), so that the branch does not wait for the square root,
+      // which only the threshold kept for later steps needs.
+      const double d2 = nearest_image2(lateral_y, lateral_z);
+      const double need = lateral_path_next_ - lateral_path_ + b.clear_reach;
+      b.clear_until[j] = lateral_path_ + std::sqrt(d2) - b.clear_reach;
+      if (need * need < d2) return;
+    }
+    const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
+    const double vx = u.x * b.inv_axes.x;
     const double qy = lateral_y * b.inv_axes.y;
     const double vy = u.y * b.inv_axes.y;
     const double qz = lateral_z * b.inv_axes.z;
@@ -712,6 +769,11 @@ class Synthesiser {
     const double a = vx * vx + vy * vy + vz * vz;
     const double bh = qx * vx + qy * vy + qz * vz;
     const double c = qx * qx + qy * qy + qz * qz - 1.0;
+
+    // Inside at the step's start (the pierce is open) and at its end: an
+    // ellipsoid is convex, so inside all step, and no roots are needed
+    // (most steps of a pierce; the roots below decide the rest as before).
+    if (was_inside && c + dt_ * (2.0 * bh + a * dt_) < 0.0) return;
 
     // Roots of a s^2 + 2 bh s + c = 0: the tip is inside for s in (r1, r2).
     double r1 = 0.0, r2 = 0.0;
@@ -748,16 +810,7 @@ class Synthesiser {
       return;
     }
     if (!crosses || r2 <= s0 || r1 >= dt_) {
-      if (cached) {
-        // The distance to the tip's nearest periodic image: lateral_y is one
-        // image of the tip's offset (the bubble's image is chosen before the
-        // tip's offset is taken), the other is length - |lateral_y|. Lateral
-        // semi-axes are equal (try_place): a_lat = 1 / inv_axes.y.
-        const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
-        const double nz = std::min(std::fabs(lateral_z), length_[2] - std::fabs(lateral_z));
-        const double distance = std::sqrt(ny * ny + nz * nz);
-        b.clear_until[j] = lateral_path_ + distance - (1.0 + lateral_margin) / b.inv_axes.y;
-      }
+      if (cached) b.clear_until[j] = clear_until(b, lateral_y, lateral_z);
       return;
     }
     const double s_in = std::max(r1, s0);
@@ -803,7 +856,9 @@ class Synthesiser {
   void emit(std::size_t j, ActiveBubble& b, double t_in, double t_out, const Interface* front = nullptr,
             const Interface* rear = nullptr) {
     if (t_out <= 0.0 || t_in >= duration_) return;
-    if (front) record_pierce(j, b, *front, rear);
+    // A rear interface after the record's end is not in it: the pierce is
+    // censored there, as when the record ends with the step (finish_open).
+    if (front) record_pierce(j, b, *front, rear && rear->t < duration_ ? rear : nullptr);
     b.pierced_mask |= std::uint64_t{1} << j;
     // Samples strictly inside (t_in, t_out).
     const auto start = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(t_in * fs_)) + 1);
@@ -947,7 +1002,6 @@ class Synthesiser {
   double fraction_ = dispersed_fraction(scene_.void_fraction);
   bool bubble_truth_ = options_.bubble_truth;
   SizeModel sizes_;
-  bool spherical_ = sizes_.lateral_factor == 1.0;
   Rng bubble_rng_;
   double dt_ = 0.0, fs_ = 0.0, duration_ = 0.0;
   std::int64_t samples_ = 0;
@@ -969,7 +1023,7 @@ class Synthesiser {
   double lateral_path_ = 0.0, lateral_path_next_ = 0.0;
   BubbleQueue bubbles_;
   std::vector<Neighbour> neighbours_;  // scratch of try_place
-  std::vector<Vec3> tried_;            // scratch of try_place: the entries tried by a particle that must be placed
+  LateralPlacement placement_{0.0, 0.0};  // scratch of try_place: its discs and the positions tried
   // Dispersed volume shared by particles placed overlapping (space rules):
   // what bring_forward has yet to give back, and all of the record's.
   double debt_volume_ = 0.0, compensated_volume_ = 0.0;
@@ -980,6 +1034,7 @@ class Synthesiser {
   double max_retired_key_ = -std::numeric_limits<double>::infinity();
   std::vector<std::vector<OpenPierce>> open_;
   std::vector<std::size_t> pierce_hint_;  // per tip: where the last candidate search ended
+  std::vector<ActiveBubble*> due_;        // scratch of pierce: the candidates of one tip not skipped
   std::size_t place_hint_lo_ = 0, place_hint_hi_ = 0;
   std::vector<std::vector<awcc::AirInterval>> pierces_;
   std::vector<std::int64_t> pair_counts_;
