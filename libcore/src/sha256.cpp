@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <openssl/evp.h>
 
+#include <algorithm>
 #include <fstream>
+#include <system_error>
 #include <new>
 #include <stdexcept>
 #include <vector>
@@ -82,30 +84,126 @@ std::string sha256_of_file(const std::filesystem::path& path) {
   return h.hex();
 }
 
-FileSha256::FileSha256(std::filesystem::path path) : path_(std::move(path)) {}
+FileSha256::FileSha256(std::filesystem::path path, std::size_t in_flight)
+    : path_(std::move(path)), in_flight_limit_(in_flight) {
+  try {
+    worker_ = std::thread([this] { work(); });
+  } catch (const std::system_error&) {
+    // No thread to be had (a process limit): nothing is copied, hex() reads the file.
+    in_flight_limit_ = 0;
+    done_ = true;
+  }
+}
+
+FileSha256::~FileSha256() {
+  if (!worker_.joinable()) return;
+  {
+    std::lock_guard lock(mutex_);
+    finishing_ = abandon_ = true;
+  }
+  changed_.notify_all();
+  worker_.join();
+}
 
 void FileSha256::saw(std::uint64_t offset, std::span<const std::uint8_t> bytes) {
   const std::uint64_t end = offset + bytes.size();
-  if (end <= hashed_) return;  // seen before (a second pass)
-  if (offset > hashed_) {
-    // A short gap (a header the reader skips, a chunk it steps over) is read
-    // now, so that the cursor follows the reading; a long one (a trailing
-    // chunk read before the data) is left for the reading to reach.
-    if (offset - hashed_ > gap_read_now) return;
-    std::ifstream in(path_, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(hashed_));
-    std::vector<char> gap(static_cast<std::size_t>(offset - hashed_));
-    in.read(gap.data(), static_cast<std::streamsize>(gap.size()));
-    if (in.gcount() != static_cast<std::streamsize>(gap.size())) return;  // hex() reads it, or says why not
-    digest_.update({reinterpret_cast<const std::uint8_t*>(gap.data()), gap.size()});
-    hashed_ = offset;
+  if (end <= queued_) return;  // seen before (a second pass)
+  // A long gap ahead of the cursor (a trailing chunk parsed before the data):
+  // left for the reading to reach, or for hex().
+  if (offset > queued_ && offset - queued_ > gap_read_now) return;
+  const std::uint64_t from = std::max(offset, queued_);
+  const auto fresh = bytes.subspan(static_cast<std::size_t>(from - offset));
+  std::vector<std::uint8_t> buffer;
+  {
+    std::lock_guard lock(mutex_);
+    queued_ = end;
+    if (done_ || in_flight_ + fresh.size() > in_flight_limit_) return;  // the hashing thread reads them itself
+    in_flight_ += fresh.size();
+    if (!spare_.empty()) {
+      buffer = std::move(spare_.back());
+      spare_.pop_back();
+    }
   }
-  digest_.update(bytes.subspan(static_cast<std::size_t>(hashed_ - offset)));
-  hashed_ = end;
+  buffer.assign(fresh.begin(), fresh.end());  // outside the lock: the copy is the reader's cost
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back({from, std::move(buffer)});
+  }
+  changed_.notify_all();
+}
+
+void FileSha256::hash_file(std::uint64_t from, std::uint64_t to) {
+  std::ifstream in(path_, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot read the file to hash it", path_.string()));
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path_, ec);
+  // Bytes seen by the reader that the file no longer holds: it changed while being read.
+  if (ec || size < from || (to != std::uint64_t(-1) && size < to)) {
+    throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
+                                 path_.string()));
+  }
+  in.seekg(static_cast<std::streamoff>(from));
+  std::vector<char> buffer(std::size_t{1} << 20);
+  std::uint64_t at = from;
+  while (in && at < to) {
+    const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(buffer.size(), to - at));
+    in.read(buffer.data(), want);
+    const auto n = static_cast<std::size_t>(in.gcount());
+    if (n == 0) break;
+    digest_.update({reinterpret_cast<const std::uint8_t*>(buffer.data()), n});
+    at += n;
+  }
+  if (in.bad()) throw InputError(fmt::format("{}: a read error while hashing the file", path_.string()));
+  if (to != std::uint64_t(-1) && at != to) {
+    throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
+                                 path_.string()));
+  }
+  read_again_ += at - from;
+  hashed_ = at;
+}
+
+void FileSha256::work() {
+  try {
+    for (;;) {
+      Piece piece;
+      {
+        std::unique_lock lock(mutex_);
+        changed_.wait(lock, [&] { return !queue_.empty() || finishing_; });
+        if (abandon_) return;
+        if (queue_.empty()) break;  // finishing, everything handed on is hashed
+        piece = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      if (piece.offset > hashed_) hash_file(hashed_, piece.offset);  // a gap, or bytes not copied
+      digest_.update(piece.bytes);
+      hashed_ = piece.offset + piece.bytes.size();
+      {
+        std::lock_guard lock(mutex_);
+        in_flight_ -= piece.bytes.size();
+        spare_.push_back(std::move(piece.bytes));
+      }
+    }
+    hash_file(hashed_, std::uint64_t(-1));
+  } catch (...) {
+    std::lock_guard lock(mutex_);
+    error_ = std::current_exception();
+  }
+  std::lock_guard lock(mutex_);
+  done_ = true;  // saw() copies nothing more
 }
 
 std::string FileSha256::hex() {
-  hash_rest(path_, hashed_, digest_);
+  if (worker_.joinable()) {
+    {
+      std::lock_guard lock(mutex_);
+      finishing_ = true;
+    }
+    changed_.notify_all();
+    worker_.join();
+    if (error_) std::rethrow_exception(error_);
+  } else {
+    hash_file(0, std::uint64_t(-1));  // no hashing thread: the whole file now
+  }
   return digest_.hex();
 }
 

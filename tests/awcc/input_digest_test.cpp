@@ -125,8 +125,9 @@ TEST(InputDigest, BytesReadOutOfOrderOrSkipped) {
   EXPECT_EQ(awcc::process_recording(dat_path, o).input_sha256, awcc::sha256_of_file(dat_path));
 }
 
-// The digest rides on the read: a file read front to back is hashed as it is
-// read, with nothing left to read at the end. Proof: bytes changed in place
+// The digest rides on the read: a file read front to back is hashed from the
+// reader's bytes (a 2 MB file: within FileSha256's bytes in flight, so none
+// is left for the hashing thread to read itself). Proof: bytes changed in place
 // after the reading do not change the digest (it is of the bytes the
 // processing read), where hashing the file again would see them.
 TEST(InputDigest, RidesOnTheRead) {
