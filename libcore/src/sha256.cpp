@@ -113,22 +113,31 @@ void FileSha256::saw(std::uint64_t offset, std::span<const std::uint8_t> bytes) 
   if (offset > queued_ && offset - queued_ > gap_read_now) return;
   const std::uint64_t from = std::max(offset, queued_);
   const auto fresh = bytes.subspan(static_cast<std::size_t>(from - offset));
-  std::vector<std::uint8_t> buffer;
+  queued_ = end;
+  // Small reads (a FLAC decoder's) gather into one piece, so that handing
+  // pieces over costs little against hashing them.
+  if (!filling_.bytes.empty() && filling_.offset + filling_.bytes.size() != from) hand_on();
   {
     std::lock_guard lock(mutex_);
-    queued_ = end;
     if (done_ || in_flight_ + fresh.size() > in_flight_limit_) return;  // the hashing thread reads them itself
     in_flight_ += fresh.size();
-    if (!spare_.empty()) {
-      buffer = std::move(spare_.back());
+    if (filling_.bytes.empty() && !spare_.empty()) {
+      filling_.bytes = std::move(spare_.back());
       spare_.pop_back();
     }
   }
-  buffer.assign(fresh.begin(), fresh.end());  // outside the lock: the copy is the reader's cost
+  if (filling_.bytes.empty()) filling_.offset = from;
+  filling_.bytes.insert(filling_.bytes.end(), fresh.begin(), fresh.end());  // the copy is the reader's cost
+  if (filling_.bytes.size() >= piece_bytes) hand_on();
+}
+
+void FileSha256::hand_on() {
+  if (filling_.bytes.empty()) return;
   {
     std::lock_guard lock(mutex_);
-    queue_.push_back({from, std::move(buffer)});
+    queue_.push_back(std::move(filling_));
   }
+  filling_ = Piece{};
   changed_.notify_all();
 }
 
@@ -180,6 +189,7 @@ void FileSha256::work() {
       {
         std::lock_guard lock(mutex_);
         in_flight_ -= piece.bytes.size();
+        piece.bytes.clear();
         spare_.push_back(std::move(piece.bytes));
       }
     }
@@ -194,6 +204,7 @@ void FileSha256::work() {
 
 std::string FileSha256::hex() {
   if (worker_.joinable()) {
+    hand_on();
     {
       std::lock_guard lock(mutex_);
       finishing_ = true;

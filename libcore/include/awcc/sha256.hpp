@@ -73,6 +73,8 @@ class FileSha256 {
     std::uint64_t offset;
     std::vector<std::uint8_t> bytes;
   };
+  static constexpr std::size_t piece_bytes = std::size_t{1} << 20;  // reads gathered before handing on
+  void hand_on();  // the piece being filled, to the hashing thread
   void work();
   void hash_file(std::uint64_t from, std::uint64_t to);  // on the hashing thread; to = -1: the end
 
@@ -82,6 +84,7 @@ class FileSha256 {
   std::uint64_t hashed_ = 0;            // the hashing thread's
   std::uint64_t read_again_ = 0;        // the hashing thread's
   std::uint64_t queued_ = 0;            // the reader's cursor
+  Piece filling_;                       // the reader's: copies not yet handed on
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Piece> queue_;
