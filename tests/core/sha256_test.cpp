@@ -108,6 +108,20 @@ TEST(Sha256, FileDigestFromReadsInAnyOrder) {
   EXPECT_EQ(skipping.read_again(), 8u);
 }
 
+// A digest abandoned before hex() (a recording refused halfway through its
+// reading) stops its hashing thread without reading the rest of the file.
+TEST(Sha256, AbandonedDigestStops) {
+  const auto path = pdp_test::temp_dir() / "sha256_abandoned.bin";
+  const std::string text(1 << 20, 'y');
+  std::ofstream(path, std::ios::binary) << text;
+  for (int i = 0; i < 20; ++i) {
+    awcc::FileSha256 h(path, i % 2 ? text.size() : 100);
+    h.saw(0, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size() / 2});
+  }
+  awcc::FileSha256 whole(path);
+  EXPECT_EQ(whole.hex(), awcc::sha256_of_file(path));
+}
+
 // Bytes hashed that the file no longer holds (it was cut while being read) are refused, not hashed as a shorter file.
 TEST(Sha256, FileCutWhileReadIsRefused) {
   const auto path = pdp_test::temp_dir() / "sha256_cut.bin";
