@@ -1,13 +1,14 @@
 // Benchmark of reading and binarising recordings (docs/performance.md).
 //
-//   process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES]
+//   process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES] [--read-only]
 //
 // Times, on one thread, (a) reading the whole file through libawcc's reader
 // and nothing else (as volts, and as int16 counts where the file has them),
 // (b) binarising both tips from the file, (c) that plus the tips' phase,
 // chord and structure statistics (no correlation), and optionally (d) FSCC on
 // the binarised signals. Prints the median of N
-// runs, the samples per second and the peak memory of the process.
+// runs, the samples per second and the peak memory of the process. With
+// --read-only, (a) alone: the floor a whole run is compared with.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -24,16 +25,17 @@ using bench::median;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES]\n");
+    std::fprintf(stderr, "usage: process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES] [--read-only]\n");
     return 2;
   }
   awcc::ProcessOptions options;
   int repeat = 3;
-  bool with_fscc = false;
+  bool with_fscc = false, read_only = false;
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--fs") && i + 1 < argc) options.reader.fs = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--fscc")) with_fscc = true;
+    else if (!std::strcmp(argv[i], "--read-only")) read_only = true;
     else if (!std::strcmp(argv[i], "--block") && i + 1 < argc) options.block_frames = std::atoll(argv[++i]);
   }
   options.dx = 5e-3;
@@ -70,6 +72,7 @@ int main(int argc, char** argv) {
       }
       if (checksum == 12345.678) std::puts("");  // keep the loop
     }
+    if (read_only) continue;
     {
       const double t0 = now();
       const auto binarised = awcc::binarise_recording(argv[1], options);
@@ -89,15 +92,22 @@ int main(int argc, char** argv) {
     }
   }
   const double samples = static_cast<double>(frames) * channels;
-  const double t_read = median(read_times), t_proc = median(process_times);
+  const double t_read = median(read_times);
   std::printf("%s: %lld frames x %d channels\n", argv[1], static_cast<long long>(frames), channels);
   std::printf("read only (float volts):   %.3f s  (%.0f M samples/s)\n", t_read, samples / t_read / 1e6);
   if (!read16_times.empty()) {
     const double t16 = median(read16_times);
     std::printf("read only (int16 counts):  %.3f s  (%.0f M samples/s)\n", t16, samples / t16 / 1e6);
-    std::printf("binarising (both tips, from the file) / int16 read: %.3f s, %.2f x\n", median(binarise_times),
-                median(binarise_times) / t16);
+    if (!read_only) {
+      std::printf("binarising (both tips, from the file) / int16 read: %.3f s, %.2f x\n", median(binarise_times),
+                  median(binarise_times) / t16);
+    }
   }
+  if (read_only) {
+    std::printf("peak memory %.0f MB (median of %d runs)\n", peak_mb(), repeat);
+    return 0;
+  }
+  const double t_proc = median(process_times);
   std::printf("read + binarise + stats:   %.3f s  (%.0f M samples/s), %.2f x the read-only time\n", t_proc,
               samples / t_proc / 1e6, t_proc / t_read);
   if (with_fscc) std::printf("FSCC (full record, +/-20 ms): %.3f s\n", median(fscc_times));

@@ -1065,6 +1065,7 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
   given.validate().throw_if_failed();
   // The tip pair of a declared (or recorded) probe, once: every step below reads it.
   const ProcessOptions options = tip_pair_options(given, recording.info());
+  if (given.hash_input) recording.hash_while_reading();
   recording.rewind();
   // From the options as given: a declared probe's positions are the binarised tips'.
   const auto binarised = binarise_recording(recording, given);
@@ -1086,6 +1087,8 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
     add_spectrum(out, options);
     out.warnings = assess(out);
   }
+  // Whatever the reading did not hash (nothing, for a container read front to back) is read here.
+  if (given.hash_input) out.input_sha256 = recording.sha256();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

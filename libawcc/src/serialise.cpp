@@ -308,13 +308,14 @@ json options_json(const ProcessOptions& o) {
   return out;
 }
 
-json provenance_json(const ProcessOptions& options, const std::vector<std::string>& inputs,
+json provenance_json(const ProcessOptions& options, const std::vector<ProvenanceInput>& inputs,
                      const std::string& command_line) {
   json files = json::array();
-  for (const auto& path : inputs) {
+  for (const auto& input : inputs) {
     std::error_code ec;
-    const auto bytes = std::filesystem::file_size(path, ec);
-    files.push_back(json{{"file", path}, {"bytes", ec ? json(nullptr) : json(bytes)}, {"sha256", sha256_of_file(path)}});
+    const auto bytes = std::filesystem::file_size(input.file, ec);
+    const std::string digest = input.sha256.empty() ? sha256_of_file(input.file) : input.sha256;
+    files.push_back(json{{"file", input.file}, {"bytes", ec ? json(nullptr) : json(bytes)}, {"sha256", digest}});
   }
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm utc{};

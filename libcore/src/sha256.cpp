@@ -1,114 +1,221 @@
 #include "awcc/sha256.hpp"
 
 #include <fmt/format.h>
+#include <openssl/evp.h>
 
-#include <cstring>
+#include <algorithm>
 #include <fstream>
+#include <system_error>
+#include <new>
+#include <stdexcept>
 #include <vector>
 
 #include "awcc/errors.hpp"
 
 namespace awcc {
 
-namespace {
+struct Sha256::Context {
+  EVP_MD_CTX* ctx;
+};
 
-constexpr std::array<std::uint32_t, 64> k{
-    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
-    0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
-    0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
-    0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
-    0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
-    0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
-    0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
-    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
+void Sha256::Free::operator()(Context* c) const {
+  EVP_MD_CTX_free(c->ctx);
+  delete c;
+}
 
-constexpr std::uint32_t rotr(std::uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
-
-}  // namespace
-
-Sha256::Sha256()
-    : h_{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19} {}
-
-void Sha256::block(const std::uint8_t* p) {
-  std::uint32_t w[64];
-  for (int i = 0; i < 16; ++i) {
-    w[i] = (std::uint32_t{p[4 * i]} << 24) | (std::uint32_t{p[4 * i + 1]} << 16) | (std::uint32_t{p[4 * i + 2]} << 8) |
-           std::uint32_t{p[4 * i + 3]};
+Sha256::Sha256() : context_(new Context{EVP_MD_CTX_new()}) {
+  if (!context_->ctx) throw std::bad_alloc();
+  // Fails only when libcrypto has no SHA-256 at all (a FIPS provider
+  // misconfigured): no digest can be trusted then.
+  if (EVP_DigestInit_ex(context_->ctx, EVP_sha256(), nullptr) != 1) {
+    throw std::runtime_error("libcrypto (OpenSSL) cannot compute SHA-256 here: check its installation");
   }
-  for (int i = 16; i < 64; ++i) {
-    const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
-    const std::uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
-    w[i] = w[i - 16] + s0 + w[i - 7] + s1;
-  }
-  std::uint32_t a = h_[0], b = h_[1], c = h_[2], d = h_[3], e = h_[4], f = h_[5], g = h_[6], h = h_[7];
-  for (int i = 0; i < 64; ++i) {
-    const std::uint32_t s1 = rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25);
-    const std::uint32_t ch = (e & f) ^ (~e & g);
-    const std::uint32_t t1 = h + s1 + ch + k[static_cast<std::size_t>(i)] + w[i];
-    const std::uint32_t s0 = rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22);
-    const std::uint32_t maj = (a & b) ^ (a & c) ^ (b & c);
-    const std::uint32_t t2 = s0 + maj;
-    h = g;
-    g = f;
-    f = e;
-    e = d + t1;
-    d = c;
-    c = b;
-    b = a;
-    a = t1 + t2;
-  }
-  h_[0] += a;
-  h_[1] += b;
-  h_[2] += c;
-  h_[3] += d;
-  h_[4] += e;
-  h_[5] += f;
-  h_[6] += g;
-  h_[7] += h;
 }
 
 void Sha256::update(std::span<const std::uint8_t> data) {
-  length_ += data.size();
-  std::size_t i = 0;
-  if (used_ > 0) {
-    const std::size_t take = std::min(data.size(), 64 - used_);
-    std::memcpy(buffer_.data() + used_, data.data(), take);
-    used_ += take;
-    i = take;
-    if (used_ < 64) return;
-    block(buffer_.data());
-    used_ = 0;
+  if (data.empty()) return;
+  if (EVP_DigestUpdate(context_->ctx, data.data(), data.size()) != 1) {
+    throw std::runtime_error("libcrypto (OpenSSL) failed while computing SHA-256");
   }
-  for (; i + 64 <= data.size(); i += 64) block(data.data() + i);
-  used_ = data.size() - i;
-  if (used_ > 0) std::memcpy(buffer_.data(), data.data() + i, used_);
 }
 
 std::string Sha256::hex() {
-  const std::uint64_t bits = length_ * 8;
-  const std::uint8_t one = 0x80;
-  update({&one, 1});
-  const std::uint8_t zero = 0;
-  while (used_ != 56) update({&zero, 1});
-  std::uint8_t tail[8];
-  for (int i = 0; i < 8; ++i) tail[i] = static_cast<std::uint8_t>(bits >> (56 - 8 * i));
-  update({tail, 8});
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int size = 0;
+  if (EVP_DigestFinal_ex(context_->ctx, digest, &size) != 1 || size != 32) {
+    throw std::runtime_error("libcrypto (OpenSSL) failed while computing SHA-256");
+  }
   std::string out;
-  for (auto v : h_) out += fmt::format("{:08x}", v);
+  out.reserve(64);
+  for (unsigned int i = 0; i < size; ++i) out += fmt::format("{:02x}", digest[i]);
   return out;
 }
 
-std::string sha256_of_file(const std::filesystem::path& path) {
+namespace {
+
+// Hashes the file's bytes from `from` to its end into `digest`.
+void hash_rest(const std::filesystem::path& path, std::uint64_t from, Sha256& digest) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot read the file to hash it", path.string()));
-  Sha256 h;
-  std::vector<char> buffer(1 << 20);
+  if (from > 0) {
+    // Bytes already hashed that the file no longer holds: it changed while being read.
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    in.seekg(static_cast<std::streamoff>(from));
+    if (ec || size < from || !in) {
+      throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
+                                   path.string()));
+    }
+  }
+  std::vector<char> buffer(std::size_t{1} << 20);
   while (in) {
     in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     const auto n = static_cast<std::size_t>(in.gcount());
-    if (n > 0) h.update({reinterpret_cast<const std::uint8_t*>(buffer.data()), n});
+    if (n > 0) digest.update({reinterpret_cast<const std::uint8_t*>(buffer.data()), n});
   }
+  if (in.bad()) throw InputError(fmt::format("{}: a read error while hashing the file", path.string()));
+}
+
+}  // namespace
+
+std::string sha256_of_file(const std::filesystem::path& path) {
+  Sha256 h;
+  hash_rest(path, 0, h);
   return h.hex();
+}
+
+FileSha256::FileSha256(std::filesystem::path path, std::size_t in_flight)
+    : path_(std::move(path)), in_flight_limit_(in_flight) {
+  try {
+    worker_ = std::thread([this] { work(); });
+  } catch (const std::system_error&) {
+    // No thread to be had (a process limit): nothing is copied, hex() reads the file.
+    in_flight_limit_ = 0;
+    done_ = true;
+  }
+}
+
+FileSha256::~FileSha256() {
+  if (!worker_.joinable()) return;
+  {
+    std::lock_guard lock(mutex_);
+    finishing_ = abandon_ = true;
+  }
+  changed_.notify_all();
+  worker_.join();
+}
+
+void FileSha256::saw(std::uint64_t offset, std::span<const std::uint8_t> bytes) {
+  const std::uint64_t end = offset + bytes.size();
+  if (end <= queued_) return;  // seen before (a second pass)
+  // A long gap ahead of the cursor (a trailing chunk parsed before the data):
+  // left for the reading to reach, or for hex().
+  if (offset > queued_ && offset - queued_ > gap_read_now) return;
+  const std::uint64_t from = std::max(offset, queued_);
+  const auto fresh = bytes.subspan(static_cast<std::size_t>(from - offset));
+  queued_ = end;
+  // Small reads (a FLAC decoder's) gather into one piece, so that handing
+  // pieces over costs little against hashing them.
+  if (!filling_.bytes.empty() && filling_.offset + filling_.bytes.size() != from) hand_on();
+  {
+    std::lock_guard lock(mutex_);
+    if (done_ || in_flight_ + fresh.size() > in_flight_limit_) return;  // the hashing thread reads them itself
+    in_flight_ += fresh.size();
+    if (filling_.bytes.empty() && !spare_.empty()) {
+      filling_.bytes = std::move(spare_.back());
+      spare_.pop_back();
+    }
+  }
+  if (filling_.bytes.empty()) filling_.offset = from;
+  filling_.bytes.insert(filling_.bytes.end(), fresh.begin(), fresh.end());  // the copy is the reader's cost
+  if (filling_.bytes.size() >= piece_bytes) hand_on();
+}
+
+void FileSha256::hand_on() {
+  if (filling_.bytes.empty()) return;
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(std::move(filling_));
+  }
+  filling_ = Piece{};
+  changed_.notify_all();
+}
+
+void FileSha256::hash_file(std::uint64_t from, std::uint64_t to) {
+  std::ifstream in(path_, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot read the file to hash it", path_.string()));
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path_, ec);
+  // Bytes seen by the reader that the file no longer holds: it changed while being read.
+  if (ec || size < from || (to != std::uint64_t(-1) && size < to)) {
+    throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
+                                 path_.string()));
+  }
+  in.seekg(static_cast<std::streamoff>(from));
+  std::vector<char> buffer(std::size_t{1} << 20);
+  std::uint64_t at = from;
+  while (in && at < to) {
+    const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(buffer.size(), to - at));
+    in.read(buffer.data(), want);
+    const auto n = static_cast<std::size_t>(in.gcount());
+    if (n == 0) break;
+    digest_.update({reinterpret_cast<const std::uint8_t*>(buffer.data()), n});
+    at += n;
+  }
+  if (in.bad()) throw InputError(fmt::format("{}: a read error while hashing the file", path_.string()));
+  if (to != std::uint64_t(-1) && at != to) {
+    throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
+                                 path_.string()));
+  }
+  read_again_ += at - from;
+  hashed_ = at;
+}
+
+void FileSha256::work() {
+  try {
+    for (;;) {
+      Piece piece;
+      {
+        std::unique_lock lock(mutex_);
+        changed_.wait(lock, [&] { return !queue_.empty() || finishing_; });
+        if (abandon_) return;
+        if (queue_.empty()) break;  // finishing, everything handed on is hashed
+        piece = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      if (piece.offset > hashed_) hash_file(hashed_, piece.offset);  // a gap, or bytes not copied
+      digest_.update(piece.bytes);
+      hashed_ = piece.offset + piece.bytes.size();
+      {
+        std::lock_guard lock(mutex_);
+        in_flight_ -= piece.bytes.size();
+        piece.bytes.clear();
+        spare_.push_back(std::move(piece.bytes));
+      }
+    }
+    hash_file(hashed_, std::uint64_t(-1));
+  } catch (...) {
+    std::lock_guard lock(mutex_);
+    error_ = std::current_exception();
+  }
+  std::lock_guard lock(mutex_);
+  done_ = true;  // saw() copies nothing more
+}
+
+std::string FileSha256::hex() {
+  if (worker_.joinable()) {
+    hand_on();
+    {
+      std::lock_guard lock(mutex_);
+      finishing_ = true;
+    }
+    changed_.notify_all();
+    worker_.join();
+    if (error_) std::rethrow_exception(error_);
+  } else {
+    hash_file(0, std::uint64_t(-1));  // no hashing thread: the whole file now
+  }
+  return digest_.hex();
 }
 
 }  // namespace awcc

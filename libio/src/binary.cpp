@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "awcc/sha256.hpp"
 #include "reader_support.hpp"
 
 namespace awcc {
@@ -69,6 +70,7 @@ class BinaryRecording final : public Recording {
       reader_fail(info_.path, fmt::format("the data ends early, after frame {} of {}: the file is truncated", position_,
                                    info_.frames));
     }
+    saw(bytes_.data(), bytes_.size());
     const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(layout_.channels);
     const auto scale = static_cast<float>(layout_.volts_per_count);
     const char* p = bytes_.data();
@@ -123,6 +125,7 @@ class BinaryRecording final : public Recording {
       reader_fail(info_.path, fmt::format("the data ends early, after frame {} of {}: the file is truncated", position_,
                                    info_.frames));
     }
+    saw(out.data(), count * 2);  // as stored, before any swap
     if (swap_) {
       for (std::size_t i = 0; i < count; ++i) {
         const auto u = static_cast<std::uint16_t>(out[i]);
@@ -133,7 +136,23 @@ class BinaryRecording final : public Recording {
     return n;
   }
 
+  void hash_while_reading() override { digest_ = std::make_unique<FileSha256>(info_.path); }
+
+  std::string sha256() override {
+    if (!digest_) return Recording::sha256();
+    const auto digest = std::move(digest_);
+    return digest->hex();
+  }
+
  private:
+  // The bytes just read, as stored: they end at the stream's position.
+  void saw(const void* bytes, std::size_t n) {
+    if (!digest_) return;
+    const auto end = static_cast<std::uint64_t>(layout_.header_bytes) + static_cast<std::uint64_t>(position_) * frame_bytes_ + n;
+    digest_->saw(end - n, {static_cast<const std::uint8_t*>(bytes), n});
+  }
+
+  std::unique_ptr<FileSha256> digest_;  // while hashing as read
   RawLayout layout_;
   std::ifstream in_;
   std::size_t frame_bytes_ = 0;

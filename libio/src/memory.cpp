@@ -55,6 +55,8 @@ class MemoryRecording final : public Recording {
     return advance(n);
   }
   void rewind() override { position_ = 0; }
+  // No file to name: `name` only stands for one in messages.
+  std::string sha256() override { return {}; }
   [[nodiscard]] bool has_int16() const override { return std::is_same_v<Sample, std::int16_t>; }
   std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
     if constexpr (std::is_same_v<Sample, std::int16_t>) {

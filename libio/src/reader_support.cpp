@@ -7,6 +7,7 @@
 
 #include "awcc/errors.hpp"
 #include "awcc/pdpsim_layout.hpp"
+#include "awcc/sha256.hpp"
 #include "awcc/units.hpp"
 #include "reader_support.hpp"
 
@@ -15,6 +16,8 @@ namespace awcc {
 std::int64_t Recording::read_int16(std::span<std::int16_t>, std::int64_t) {
   throw std::logic_error("read_int16 on a recording without 16-bit integer samples");
 }
+
+std::string Recording::sha256() { return sha256_of_file(info_.path); }
 
 namespace detail {
 

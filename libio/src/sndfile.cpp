@@ -1,7 +1,13 @@
 // Audio containers through libsndfile (awcc/recording.hpp): WAV, W64, RF64,
 // FLAC, AIFF, ... A data chunk shorter than its header promises is checked
 // here, as libsndfile reads it as if it were whole.
+#include <fcntl.h>
 #include <sndfile.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <bit>
 #include <cmath>
@@ -9,6 +15,7 @@
 #include <fstream>
 #include <optional>
 
+#include "awcc/sha256.hpp"
 #include "reader_support.hpp"
 
 namespace awcc::detail {
@@ -79,6 +86,64 @@ std::optional<DataChunk> declared_data(const fs::path& path) {
 }
 
 // ---------------------------------------------------------------------------
+// The file as libsndfile reads it (sf_open_virtual): every byte it reads
+// passes through read(), so the file's digest rides on the read (in the
+// read-ahead thread when there is one) instead of costing a second one.
+
+class VirtualFile {
+ public:
+  explicit VirtualFile(const fs::path& path) : fd_(::open(path.c_str(), O_RDONLY | O_CLOEXEC)) {}
+  VirtualFile(const VirtualFile&) = delete;
+  VirtualFile& operator=(const VirtualFile&) = delete;
+  ~VirtualFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  [[nodiscard]] bool is_open() const { return fd_ >= 0; }
+  void hash_into(FileSha256* digest) { digest_ = digest; }
+
+  static SF_VIRTUAL_IO* io() {
+    static SF_VIRTUAL_IO v{&length, &seek, &read, &write, &tell};
+    return &v;
+  }
+
+ private:
+  static VirtualFile& of(void* self) { return *static_cast<VirtualFile*>(self); }
+  static sf_count_t length(void* self) {
+    struct stat st {};
+    return ::fstat(of(self).fd_, &st) == 0 ? static_cast<sf_count_t>(st.st_size) : -1;
+  }
+  static sf_count_t seek(sf_count_t offset, int whence, void* self) {
+    VirtualFile& f = of(self);
+    sf_count_t to = offset;
+    if (whence == SEEK_CUR) to = f.offset_ + offset;
+    if (whence == SEEK_END) to = length(self) + offset;
+    if (to < 0) return -1;
+    f.offset_ = to;
+    return to;
+  }
+  static sf_count_t read(void* out, sf_count_t count, void* self) {
+    VirtualFile& f = of(self);
+    auto* bytes = static_cast<std::uint8_t*>(out);
+    sf_count_t got = 0;
+    while (got < count) {
+      const ssize_t n = ::pread(f.fd_, bytes + got, static_cast<std::size_t>(count - got), f.offset_ + got);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;  // the end, or an error libsndfile reports as a short read
+      got += n;
+    }
+    if (f.digest_ && got > 0) f.digest_->saw(static_cast<std::uint64_t>(f.offset_), {bytes, static_cast<std::size_t>(got)});
+    f.offset_ += got;
+    return got;
+  }
+  static sf_count_t write(const void*, sf_count_t, void*) { return 0; }
+  static sf_count_t tell(void* self) { return of(self).offset_; }
+
+  int fd_;
+  sf_count_t offset_ = 0;
+  FileSha256* digest_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------
 // libsndfile containers.
 
 class SndfileRecording final : public Recording {
@@ -86,7 +151,8 @@ class SndfileRecording final : public Recording {
   SndfileRecording(const fs::path& path, const ReaderOptions& options) {
     SF_INFO sf{};
     // Owned from here: a refusal below (thrown from the constructor) closes it.
-    file_.reset(sf_open(path.c_str(), SFM_READ, &sf));
+    open(path, sf);
+    if (!virtual_->is_open()) reader_fail(path, fmt::format("cannot be opened for reading: {}", std::strerror(errno)));
     if (!file_) {
       reader_fail(path, fmt::format("not a readable audio file (libsndfile: {}); check the file or state its format", 
                              sf_strerror(nullptr)));
@@ -179,7 +245,7 @@ class SndfileRecording final : public Recording {
   // pass read the header as samples; found by fuzz_read_sndfile).
   void rewind() override {
     SF_INFO sf{};
-    file_.reset(sf_open(info_.path.c_str(), SFM_READ, &sf));
+    open(info_.path, sf);
     if (!file_ || sf.channels != info_.channels) {
       reader_fail(info_.path, "cannot be opened again for a second pass: the file changed or went away");
     }
@@ -188,6 +254,18 @@ class SndfileRecording final : public Recording {
   }
 
   [[nodiscard]] bool has_int16() const override { return int16_; }
+
+  void hash_while_reading() override {
+    digest_ = std::make_unique<FileSha256>(info_.path);
+    virtual_->hash_into(digest_.get());
+  }
+
+  std::string sha256() override {
+    if (!digest_) return Recording::sha256();
+    virtual_->hash_into(nullptr);
+    const auto digest = std::move(digest_);
+    return digest->hex();
+  }
 
   std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames) override {
     const sf_count_t got = sf_readf_short(file_.get(), out.data(), max_frames);
@@ -201,6 +279,16 @@ class SndfileRecording final : public Recording {
   }
 
  private:
+  // The file through its own descriptor and virtual I/O; a failure leaves file_ empty.
+  void open(const fs::path& path, SF_INFO& sf) {
+    file_.reset();  // closed before the file it reads
+    virtual_ = std::make_unique<VirtualFile>(path);
+    virtual_->hash_into(digest_.get());
+    if (virtual_->is_open()) file_.reset(sf_open_virtual(VirtualFile::io(), SFM_READ, &sf, virtual_.get()));
+  }
+
+  std::unique_ptr<FileSha256> digest_;  // while hashing as read
+  std::unique_ptr<VirtualFile> virtual_;
   std::unique_ptr<SNDFILE, int (*)(SNDFILE*)> file_{nullptr, &sf_close};
   bool floating_ = false;
   bool floating_double_ = false;

@@ -349,7 +349,10 @@ py::object provenance(const std::vector<std::string>& inputs, const Settings& se
   nlohmann::json j;
   {
     py::gil_scoped_release unlocked;
-    j = awcc::provenance_json(o, inputs, call);
+    // Hashed here: process_file's reading is over by the time Python asks.
+    std::vector<awcc::ProvenanceInput> files;
+    for (const auto& f : inputs) files.push_back({f, {}});
+    j = awcc::provenance_json(o, files, call);
   }
   return python_of(j);
 }

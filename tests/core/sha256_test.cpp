@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <random>
 #include <string>
+#include <vector>
 
+#include "awcc/errors.hpp"
 #include "test_paths.hpp"
 
 namespace {
@@ -25,6 +28,18 @@ TEST(Sha256, NistVectors) {
   EXPECT_EQ(digest(std::string(1000000, 'a')), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
 }
 
+// The padding edges: a message of 55 bytes pads in its own block, 56 needs a
+// second; 64 and 120 likewise one block on. References from Python's hashlib.
+TEST(Sha256, PaddingEdges) {
+  EXPECT_EQ(digest(std::string(55, 'a')), "9f4390f8d30c2dd92ec9f095b65e2b9ae9b0a925a5258e241c9f1e910f734318");
+  EXPECT_EQ(digest(std::string(56, 'a')), "b35439a4ac6f0948b6d6f9e3c6af0f5f590ce20f1bde7090ef7970686ec6738a");
+  EXPECT_EQ(digest(std::string(63, 'a')), "7d3e74a05d7db15bce4ad9ec0658ea98e3f06eeecf16b4c6fff2da457ddc2f34");
+  EXPECT_EQ(digest(std::string(64, 'a')), "ffe054fe7ae0cb6dc65c3af9b61d5209f439851db43d0ba5997337df154668eb");
+  EXPECT_EQ(digest(std::string(65, 'a')), "635361c48bb9eab14198e76ea8ab7f1a41685d6ad62aa9146d301d4f17eb0ae0");
+  EXPECT_EQ(digest(std::string(119, 'a')), "31eba51c313a5c08226adf18d4a359cfdfd8d2e816b13f4af952f7ea6584dcfb");
+  EXPECT_EQ(digest(std::string(120, 'a')), "2f3d335432c70b580af0e8e1b3674a7c020d683aa5f73aaaedfdc55af904c21c");
+}
+
 // Fed in pieces of every size, the digest is the same as in one piece.
 TEST(Sha256, PiecesGiveTheSameDigest) {
   std::string text;
@@ -41,6 +56,81 @@ TEST(Sha256, PiecesGiveTheSameDigest) {
   const auto path = pdp_test::temp_dir() / "sha256.bin";
   std::ofstream(path, std::ios::binary) << text;
   EXPECT_EQ(awcc::sha256_of_file(path), whole);
+}
+
+// A file's digest from the bytes a reader happens to read equals the whole
+// file's, whatever the order: reads in sequence, reads overlapping the
+// cursor, re-reads from the start, jumps ahead (a trailing chunk read before
+// the data), and bytes never read at all, in 200 random orders.
+TEST(Sha256, FileDigestFromReadsInAnyOrder) {
+  std::mt19937 random(7);
+  std::vector<std::uint8_t> bytes(100000);
+  for (auto& b : bytes) b = static_cast<std::uint8_t>(random());
+  const auto path = pdp_test::temp_dir() / "sha256_reads.bin";
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                              static_cast<std::streamsize>(bytes.size()));
+  const std::string whole = awcc::sha256_of_file(path);
+  for (int trial = 0; trial < 200; ++trial) {
+    // Half the trials with room for every copy, half with room for one read's
+    // (the hashing thread then reads what was not copied from the file).
+    awcc::FileSha256 h(path, trial % 2 ? std::size_t{1} << 20 : 9000);
+    const int reads = static_cast<int>(random() % 40);
+    std::uint64_t at = 0;
+    for (int r = 0; r < reads; ++r) {
+      switch (random() % 4) {
+        case 0: at = 0; break;                                   // rewind
+        case 1: at = random() % bytes.size(); break;             // seek anywhere
+        default: break;                                          // carry on
+      }
+      const std::uint64_t n = std::min<std::uint64_t>(random() % 9000, bytes.size() - at);
+      h.saw(at, std::span<const std::uint8_t>(bytes).subspan(static_cast<std::size_t>(at), static_cast<std::size_t>(n)));
+      at += n;
+    }
+    ASSERT_LE(h.seen(), bytes.size());
+    EXPECT_EQ(h.hex(), whole) << "trial " << trial;
+  }
+  // Read front to back with room for the copies, the file is not read again.
+  awcc::FileSha256 sequential(path, bytes.size());
+  for (std::size_t i = 0; i < bytes.size(); i += 4096) {
+    sequential.saw(i, std::span<const std::uint8_t>(bytes).subspan(i, std::min<std::size_t>(4096, bytes.size() - i)));
+  }
+  EXPECT_EQ(sequential.seen(), bytes.size());
+  EXPECT_EQ(sequential.hex(), whole);
+  EXPECT_EQ(sequential.read_again(), 0u);
+  // A reader that skips an 8-byte header (a UQ .dat) leaves nothing either:
+  // the short gap is read when the first data are seen.
+  awcc::FileSha256 skipping(path, bytes.size());
+  for (std::size_t i = 8; i < bytes.size(); i += 4096) {
+    skipping.saw(i, std::span<const std::uint8_t>(bytes).subspan(i, std::min<std::size_t>(4096, bytes.size() - i)));
+  }
+  EXPECT_EQ(skipping.seen(), bytes.size());
+  EXPECT_EQ(skipping.hex(), whole);
+  EXPECT_EQ(skipping.read_again(), 8u);
+}
+
+// A digest abandoned before hex() (a recording refused halfway through its
+// reading) stops its hashing thread without reading the rest of the file.
+TEST(Sha256, AbandonedDigestStops) {
+  const auto path = pdp_test::temp_dir() / "sha256_abandoned.bin";
+  const std::string text(1 << 20, 'y');
+  std::ofstream(path, std::ios::binary) << text;
+  for (int i = 0; i < 20; ++i) {
+    awcc::FileSha256 h(path, i % 2 ? text.size() : 100);
+    h.saw(0, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size() / 2});
+  }
+  awcc::FileSha256 whole(path);
+  EXPECT_EQ(whole.hex(), awcc::sha256_of_file(path));
+}
+
+// Bytes hashed that the file no longer holds (it was cut while being read) are refused, not hashed as a shorter file.
+TEST(Sha256, FileCutWhileReadIsRefused) {
+  const auto path = pdp_test::temp_dir() / "sha256_cut.bin";
+  const std::string text(5000, 'x');
+  std::ofstream(path, std::ios::binary) << text;
+  awcc::FileSha256 h(path);
+  h.saw(0, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+  std::filesystem::resize_file(path, 1000);
+  EXPECT_THROW(h.hex(), awcc::InputError);
 }
 
 }  // namespace

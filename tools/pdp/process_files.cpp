@@ -25,6 +25,8 @@ Processed process_files(const ProcessCommandOptions& o, const Plan& plan) {
   for (std::size_t i = 0; i < o.files.size(); ++i) {
     // A synthetic recording's sidecar states its volts per count.
     awcc::ProcessOptions file_options = plan.options;
+    // The JSON (or the report made from it) records each input's SHA-256: hashed as the file is read.
+    file_options.hash_input = !o.json.empty() || !o.report.empty();
     if (!(file_options.reader.volts_per_count > 0.0)) {
       if (const auto vpc = synth::sidecar_volts_per_count(o.files[i])) file_options.reader.volts_per_count = *vpc;
     }

@@ -108,8 +108,10 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processe
       if (!p.skipped.empty()) j["skipped"] = p.skipped;
       if (flow) j[awcc::process_key::flow] = awcc::to_json(*flow);
     }
-    // Hashing the inputs costs a read of each: only for the JSON, which records it.
-    j["provenance"] = awcc::provenance_json(plan.options, p.inputs, command_line());
+    // The inputs' digests were taken as they were read (process_files asks for them when the JSON is written).
+    std::vector<awcc::ProvenanceInput> inputs;
+    for (std::size_t i = 0; i < p.inputs.size(); ++i) inputs.push_back({p.inputs[i], results[i].input_sha256});
+    j["provenance"] = awcc::provenance_json(plan.options, inputs, command_line());
     if (!o.json.empty()) out.outputs.emplace_back(o.json, awcc::json_text(j));
     else out.json_for_report = awcc::json_text(j);
   }

@@ -93,6 +93,11 @@ struct ProcessOptions {
   /// second core exists (same result; decoding FLAC or copying from the page
   /// cache then overlaps with the work on the samples).
   bool read_ahead = true;
+  /// Hash the recording's file (SHA-256, ProcessResult::input_sha256) for
+  /// the provenance, on the bytes as they are read where the reader allows
+  /// (Recording::hash_while_reading). Off unless an output records it: the
+  /// hash is not free (about 2 GB/s of one core).
+  bool hash_input = false;
 
   /// The tips' channels: leading, trailing, then further_channels.
   [[nodiscard]] std::vector<int> tip_channels() const;
@@ -222,6 +227,9 @@ struct ProcessResult {
   /// assembles it; every output writes it).
   std::vector<Warning> warnings;
   double seconds = 0.0;               ///< wall time of the processing
+  /// The SHA-256 of the recording's file when options.hash_input (the
+  /// provenance's, Recording::sha256()); empty otherwise and for arrays.
+  std::string input_sha256;
 
   /// The velocity of chord lengths and d32 (velocity_source()).
   [[nodiscard]] std::optional<double> velocity() const;

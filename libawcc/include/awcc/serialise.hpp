@@ -33,9 +33,17 @@ nlohmann::json to_json(const Threshold& threshold);
 /// declared name (awcc/options.hpp) as text with its unit.
 nlohmann::json options_json(const ProcessOptions& options);
 
+/// An input as the provenance names it: the file and the SHA-256 of its
+/// bytes when the processing hashed them as it read (ProcessResult::
+/// input_sha256), or empty to hash the file now.
+struct ProvenanceInput {
+  std::string file;
+  std::string sha256;
+};
+
 /// How an output was made: {"pdp_version", "command_line", "options"
 /// (options_json), "inputs": [{"file", "bytes", "sha256"}], "utc_time"}.
-nlohmann::json provenance_json(const ProcessOptions& options, const std::vector<std::string>& inputs,
+nlohmann::json provenance_json(const ProcessOptions& options, const std::vector<ProvenanceInput>& inputs,
                                const std::string& command_line);
 
 /// A column of the AWCC window table: the CSV's and the Python module's.

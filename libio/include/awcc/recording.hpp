@@ -141,6 +141,17 @@ class Recording {
   [[nodiscard]] virtual bool has_int16() const { return false; }
   /// Like read(), but the raw int16 counts. Only when has_int16().
   virtual std::int64_t read_int16(std::span<std::int16_t> out, std::int64_t max_frames);
+  /// From here on, hash the file's bytes as they are read (for sha256()),
+  /// where the reader sees them: libsndfile's containers (through its
+  /// virtual I/O), UQ .dat and raw files. Other readers (CSV, TDMS, HDF5,
+  /// MATLAB) leave it to sha256() to read the file.
+  virtual void hash_while_reading() {}
+  /// The SHA-256 of the recording's file, the provenance's: the bytes read
+  /// since hash_while_reading() and the rest (awcc::FileSha256), or the whole
+  /// file read now; always the digest of every byte of the file. Empty for a
+  /// recording that is no file (an array in memory). Throws InputError when
+  /// the file cannot be read.
+  virtual std::string sha256();
 
  protected:
   RecordingInfo info_;
