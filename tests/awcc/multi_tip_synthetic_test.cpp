@@ -201,7 +201,8 @@ TEST(MultiTipSynthetic, InterfacialAreaOfTheCleanSceneIsSixCOverDWithinFivePerce
 // bubbles (41 % of the accepted bubbles, mean vector 1.7 m/s). The joint
 // pairing, against libsynth's truth:
 //  - pairing errors (accepted bubbles with any partner from another bubble)
-//    below 2 % of the accepted: the target; measured 1 of 360 (0.28 %).
+//    below 2 % of the accepted: the target; measured 3 of 345 (0.9 %) on the
+//    sample's seed, 0-6 (at most 1.8 %) on seeds 1-12.
 //  - the mean vector against the truth of the same accepted bubbles with the
 //    same weights, within 2 % of |V|: it then differs only by each bubble's
 //    timing error (one sample, 5 us, on 1 ms lags: 0.5 % a bubble, averaged
@@ -209,9 +210,14 @@ TEST(MultiTipSynthetic, InterfacialAreaOfTheCleanSceneIsSixCOverDWithinFivePerce
 //    speeds off by at most 60 %: 1.2 %).
 //  - the same against the duration-weighted truth of every complete
 //    leading bubble matched to the truth: the accepted are a subset chosen
-//    by where they pierce, not by their speed (pair_probe's header), so the
-//    difference is a sampling one: rms 0.94 m/s over 360 bubbles, sd
-//    0.05 m/s (1 %) as if independent; 3 % is 3 sd.
+//    by where they pierce, and where a bubble pierces all four tips depends
+//    a little on its path, so on its velocity: over seeds 1-12 (generator
+//    version 2) the accepted bubbles' true mean speed was 1.8 % below all
+//    bubbles' (sd 1.1 % between seeds; -3.2 % to +0.8 %), the mean vector
+//    2.2 % below (sd 1.3 %, at most 3.3 % off). 5 % is that mean plus 2.2
+//    sd: a pairing that took partners from other bubbles moves it by far
+//    more (1.7 m/s, 35 %, paired tip by tip). An earlier bound of 3 %
+//    assumed no selection at all, and failed on 4 of the 12 seeds.
 //  - the realised time mean is not the comparison: the synthesiser's
 //    arrivals are uniform in time, and the duration weighting (right for
 //    arrivals in proportion to the speed) is biased by about -Tu_x^2 = -4 %
@@ -273,7 +279,7 @@ TEST(MultiTipSynthetic, TheFourTipSamplePairsEachBubbleWithItsOwnPartners) {
   EXPECT_LT(static_cast<double>(wrong), 0.02 * static_cast<double>(r.bubbles_accepted));
   for (std::size_t j = 0; j < 3; ++j) {
     EXPECT_NEAR(r.velocity[j], accepted[j] / w_accepted, 0.02 * r.speed) << "component " << j;
-    EXPECT_NEAR(r.velocity[j], all[j] / w_all, 0.03 * r.speed) << "component " << j;
+    EXPECT_NEAR(r.velocity[j], all[j] / w_all, 0.05 * r.speed) << "component " << j;
   }
   EXPECT_TRUE(r.caution.empty()) << r.caution;
   EXPECT_NEAR(*r.interfacial_area / (synthesis.truth.expected_interfacial_area * (1.0 + s.tu * s.tu)), 1.0, 0.10);
