@@ -264,9 +264,21 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   //   k <  0: sx = air of x in [-k, L),    sy = air of y in [0, L + k).
   const double norm = 1.0 / std::sqrt(qx * qy);
   AirBelow air_a(a, ca), air_b(b, cb);
+  // The outputs sized once (a bit per breakpoint) and written through
+  // pointers: push_back's capacity checks and its stores of the vectors' ends
+  // kept the sweep's sums in memory.
+  std::size_t breaks = 0;
+  for (const std::uint64_t w : mark) breaks += static_cast<std::size_t>(std::popcount(w));
+  out.lags.resize(breaks);
+  out.values.resize(breaks);
+  std::int64_t* lag_out = out.lags.data();
+  double* value_out = out.values.data();
+  std::int32_t* const impulses = impulse.data();
+  const std::uint64_t* const marks = mark.data();
+  const std::size_t words = mark.size();
   std::int64_t at = k_min;
-  for (std::size_t word = 0; word < mark.size(); ++word) {
-    for (std::uint64_t bits = mark[word]; bits != 0; bits &= bits - 1) {
+  for (std::size_t word = 0; word < words; ++word) {
+    for (std::uint64_t bits = marks[word]; bits != 0; bits &= bits - 1) {
       const std::size_t i = word * 64 + static_cast<std::size_t>(std::countr_zero(bits));
       const std::int64_t k = k_min + static_cast<std::int64_t>(i);
       value += slope * (k - at);  // slope is constant on [at, k)
@@ -280,10 +292,10 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
         sy = air_b(length + k);
       }
       const double n = static_cast<double>(length - (k >= 0 ? k : -k));
-      out.lags.push_back(k);
-      out.values.push_back((static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm);
-      slope += impulse[i];
-      impulse[i] = 0;
+      *lag_out++ = k;
+      *value_out++ = (static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm;
+      slope += impulses[i];
+      impulses[i] = 0;
     }
   }
   clear.swept = true;
