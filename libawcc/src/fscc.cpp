@@ -139,7 +139,10 @@ std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y
   const double span = static_cast<double>(t1 - t0);
   const double nx = static_cast<double>(x.intervals.size()), ny = static_cast<double>(y.intervals.size());
   const double lag_span = static_cast<double>(k_max - k_min + 1);
-  const double pairs = nx * ny * std::min(1.0, (lag_span + 2.0 * span / std::max(1.0, ny)) / static_cast<double>(y.sample_count));
+  // x's intervals in [t0, t1), about nx span / n of them, each against the
+  // y intervals within the lag range.
+  const double pairs = nx * span / static_cast<double>(std::max<std::int64_t>(1, x.sample_count)) * ny *
+                       std::min(1.0, (lag_span + 2.0 * span / std::max(1.0, ny)) / static_cast<double>(y.sample_count));
   const double fft_cost = 15.0 * span * std::log2(std::max(2.0, 8.0 * lag_span));
   if (4.0 * pairs < fft_cost) return lagged_products_by_intervals(x, y, t0, t1, k_min, k_max);
   return lagged_products_by_fft(x, y, t0, t1, k_min, k_max, plans);
