@@ -155,6 +155,15 @@ class AirBelow {
   std::size_t i_ = 0;
 };
 
+// std::popcount without the popcnt instruction (the build targets plain
+// x86-64) is a call into libgcc per word; this is inline and vectorises.
+inline std::size_t bits_set(std::uint64_t w) {
+  w -= (w >> 1) & 0x5555555555555555u;
+  w = (w & 0x3333333333333333u) + ((w >> 2) & 0x3333333333333333u);
+  w = (w + (w >> 4)) & 0x0f0f0f0f0f0f0f0fu;
+  return static_cast<std::size_t>((w * 0x0101010101010101u) >> 56);
+}
+
 }  // namespace
 
 double PiecewiseCorrelation::at(std::int64_t lag) const {
@@ -268,7 +277,7 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   // pointers: push_back's capacity checks and its stores of the vectors' ends
   // kept the sweep's sums in memory.
   std::size_t breaks = 0;
-  for (const std::uint64_t w : mark) breaks += static_cast<std::size_t>(std::popcount(w));
+  for (const std::uint64_t w : mark) breaks += bits_set(w);
   out.lags.resize(breaks);
   out.values.resize(breaks);
   std::int64_t* lag_out = out.lags.data();
