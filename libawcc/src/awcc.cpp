@@ -155,6 +155,15 @@ class AirBelow {
   std::size_t i_ = 0;
 };
 
+// std::popcount without the popcnt instruction (the build targets plain
+// x86-64) is a call into libgcc per word; this is inline and vectorises.
+inline std::size_t bits_set(std::uint64_t w) {
+  w -= (w >> 1) & 0x5555555555555555u;
+  w = (w & 0x3333333333333333u) + ((w >> 2) & 0x3333333333333333u);
+  w = (w + (w >> 4)) & 0x0f0f0f0f0f0f0f0fu;
+  return static_cast<std::size_t>((w * 0x0101010101010101u) >> 56);
+}
+
 }  // namespace
 
 double PiecewiseCorrelation::at(std::int64_t lag) const {
@@ -264,9 +273,21 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   //   k <  0: sx = air of x in [-k, L),    sy = air of y in [0, L + k).
   const double norm = 1.0 / std::sqrt(qx * qy);
   AirBelow air_a(a, ca), air_b(b, cb);
+  // The outputs sized once (a bit per breakpoint) and written through
+  // pointers: push_back's capacity checks and its stores of the vectors' ends
+  // kept the sweep's sums in memory.
+  std::size_t breaks = 0;
+  for (const std::uint64_t w : mark) breaks += bits_set(w);
+  out.lags.resize(breaks);
+  out.values.resize(breaks);
+  std::int64_t* lag_out = out.lags.data();
+  double* value_out = out.values.data();
+  std::int32_t* const impulses = impulse.data();
+  const std::uint64_t* const marks = mark.data();
+  const std::size_t words = mark.size();
   std::int64_t at = k_min;
-  for (std::size_t word = 0; word < mark.size(); ++word) {
-    for (std::uint64_t bits = mark[word]; bits != 0; bits &= bits - 1) {
+  for (std::size_t word = 0; word < words; ++word) {
+    for (std::uint64_t bits = marks[word]; bits != 0; bits &= bits - 1) {
       const std::size_t i = word * 64 + static_cast<std::size_t>(std::countr_zero(bits));
       const std::int64_t k = k_min + static_cast<std::int64_t>(i);
       value += slope * (k - at);  // slope is constant on [at, k)
@@ -280,10 +301,10 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
         sy = air_b(length + k);
       }
       const double n = static_cast<double>(length - (k >= 0 ? k : -k));
-      out.lags.push_back(k);
-      out.values.push_back((static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm);
-      slope += impulse[i];
-      impulse[i] = 0;
+      *lag_out++ = k;
+      *value_out++ = (static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm;
+      slope += impulses[i];
+      impulses[i] = 0;
     }
   }
   clear.swept = true;
@@ -345,12 +366,10 @@ namespace {
 
 // Local maxima of r (a flat top spans [first, last], as findpeaks / scipy)
 // and their prominences, into scratch.tops and scratch.prominence.
-void top_prominences(std::span<const double> r, AwccScratch& scratch) {
+void find_tops(std::span<const double> r, AwccScratch& scratch) {
   const std::size_t n = r.size();
   auto& tops = scratch.tops;
-  auto& prominence = scratch.prominence;
   tops.clear();
-  prominence.clear();
   if (n < 3) return;
   for (std::size_t i = 1; i + 1 < n; ++i) {
     if (!(r[i - 1] < r[i])) continue;
@@ -359,6 +378,14 @@ void top_prominences(std::span<const double> r, AwccScratch& scratch) {
     if (j + 1 < n && r[j + 1] < r[i]) tops.push_back({i, j});
     i = j;
   }
+}
+
+void top_prominences(std::span<const double> r, AwccScratch& scratch) {
+  const std::size_t n = r.size();
+  auto& tops = scratch.tops;
+  auto& prominence = scratch.prominence;
+  prominence.clear();
+  find_tops(r, scratch);
   if (tops.empty()) return;
   // Bases in O(n): for each sample, the minimum of r between it and the
   // nearest strictly higher sample on one side (or the end), from a stack of
@@ -412,24 +439,48 @@ std::vector<std::pair<std::int64_t, double>> prominences(std::span<const double>
   return peaks;
 }
 
+// The prominence of one top of r, from its definition: the top's value less
+// the higher of its two bases, a base being the minimum of r from the top
+// (its outer end for a flat top) to the nearest strictly higher sample on
+// that side, or to the end. The same minima over the same samples as
+// top_prominences' stacks, so the same number.
+double prominence_of(std::span<const double> r, const std::pair<std::size_t, std::size_t>& t) {
+  const double h = r[t.first];
+  double left = h, right = h;
+  for (std::size_t j = t.first; j-- > 0 && !(r[j] > h);) left = std::min(left, r[j]);
+  for (std::size_t j = t.second + 1; j < r.size() && !(r[j] > h); ++j) right = std::min(right, r[j]);
+  return h - std::max(left, right);
+}
+
 // Second-tallest prominent peak over the tallest (0 with one), of the tops
-// top_prominences found in r. A peak's height is its top's value (a flat
-// top is flat: every sample of it, its middle too, holds that value).
-double secondary_peak_ratio(std::span<const double> r, const AwccScratch& scratch, double prominence_fraction) {
+// find_tops found in r. A peak's height is its top's value (a flat top is
+// flat: every sample of it, its middle too, holds that value). Only the
+// prominences the answer reads are computed: the tallest top's, then the
+// others' by decreasing height until one passes the fraction of it (the
+// tallest that passes is the second peak; ties of height give the same
+// ratio whichever is taken).
+double secondary_peak_ratio(std::span<const double> r, AwccScratch& scratch, double prominence_fraction) {
   const auto& tops = scratch.tops;
-  const auto& prominence = scratch.prominence;
   if (tops.size() < 2) return 0.0;
+  auto& height = scratch.prominence;  // heights of the tops not yet tried
+  height.resize(tops.size());
   std::size_t tallest = 0;
-  for (std::size_t i = 1; i < tops.size(); ++i)
-    if (r[tops[i].first] > r[tops[tallest].first]) tallest = i;
-  const double min_prominence = prominence_fraction * prominence[tallest];
-  double second = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < tops.size(); ++i) {
-    if (i == tallest || prominence[i] < min_prominence) continue;
-    second = std::max(second, r[tops[i].first]);
+    height[i] = r[tops[i].first];
+    if (height[i] > height[tallest]) tallest = i;
   }
-  const double top = r[tops[tallest].first];
-  return std::isfinite(second) && top > 0.0 ? std::max(0.0, second / top) : 0.0;
+  const double top = height[tallest];
+  const double min_prominence = prominence_fraction * prominence_of(r, tops[tallest]);
+  height[tallest] = -std::numeric_limits<double>::infinity();
+  for (std::size_t tried = 1; tried < tops.size(); ++tried) {
+    const std::size_t next = static_cast<std::size_t>(std::max_element(height.begin(), height.end()) - height.begin());
+    if (!(prominence_of(r, tops[next]) < min_prominence)) {
+      const double second = height[next];
+      return top > 0.0 ? std::max(0.0, second / top) : 0.0;
+    }
+    height[next] = -std::numeric_limits<double>::infinity();
+  }
+  return 0.0;
 }
 
 // Peaks and prominences depend only on the turning points (where the sign
@@ -463,7 +514,7 @@ void turning_points(std::span<const double> r, std::vector<double>& turns) {
 // The SPR of a correlation from its turning points.
 double spr_of(std::span<const double> r, double prominence_fraction, AwccScratch& scratch) {
   turning_points(r, scratch.turns);
-  top_prominences(scratch.turns, scratch);
+  find_tops(scratch.turns, scratch);
   return secondary_peak_ratio(scratch.turns, scratch, prominence_fraction);
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <iterator>
+#include <optional>
 #include <stdexcept>
 
 namespace awcc {
@@ -138,7 +139,10 @@ std::vector<double> lagged_products(const AirIntervals& x, const AirIntervals& y
   const double span = static_cast<double>(t1 - t0);
   const double nx = static_cast<double>(x.intervals.size()), ny = static_cast<double>(y.intervals.size());
   const double lag_span = static_cast<double>(k_max - k_min + 1);
-  const double pairs = nx * ny * std::min(1.0, (lag_span + 2.0 * span / std::max(1.0, ny)) / static_cast<double>(y.sample_count));
+  // x's intervals in [t0, t1), about nx span / n of them, each against the
+  // y intervals within the lag range.
+  const double pairs = nx * span / static_cast<double>(std::max<std::int64_t>(1, x.sample_count)) * ny *
+                       std::min(1.0, (lag_span + 2.0 * span / std::max(1.0, ny)) / static_cast<double>(y.sample_count));
   const double fft_cost = 15.0 * span * std::log2(std::max(2.0, 8.0 * lag_span));
   if (4.0 * pairs < fft_cost) return lagged_products_by_intervals(x, y, t0, t1, k_min, k_max);
   return lagged_products_by_fft(x, y, t0, t1, k_min, k_max, plans);
@@ -177,8 +181,10 @@ class AirPrefix {
 };
 
 // Full-record normalised correlations (METHOD 3).
+// `r12_sums`, when given, are R12's lagged products over the whole record
+// (those of window_partition below), else they are computed here.
 void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& lags, FftPlanCache& plans,
-                 CorrelationFunctions& f) {
+                 CorrelationFunctions& f, const std::vector<double>* r12_sums = nullptr) {
   const std::int64_t n = x.sample_count;
   const double sx = static_cast<double>(x.air_samples()), sy = static_cast<double>(y.air_samples());
   const double mx = sx / static_cast<double>(n), my = sy / static_cast<double>(n);
@@ -191,8 +197,9 @@ void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& l
   }
   const AirPrefix px(x), py(y);
   auto normalised = [&](const AirIntervals& a, const AirIntervals& b, const AirPrefix& pa, const AirPrefix& pb,
-                        double ma, double mb, double qa, double qb, std::int64_t kmin, std::int64_t kmax) {
-    const auto sums = lagged_products(a, b, 0, n, kmin, kmax, plans);
+                        double ma, double mb, double qa, double qb, std::int64_t kmin, std::int64_t kmax,
+                        const std::vector<double>* given) {
+    const auto sums = given ? *given : lagged_products(a, b, 0, n, kmin, kmax, plans);
     std::vector<double> r(sums.size());
     for (std::size_t j = 0; j < sums.size(); ++j) {
       const std::int64_t k = kmin + static_cast<std::int64_t>(j);
@@ -206,8 +213,8 @@ void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& l
     }
     return r;
   };
-  f.r11 = normalised(x, x, px, px, mx, mx, qx, qx, 0, lags.r11_last);
-  f.r12 = normalised(x, y, px, py, mx, my, qx, qy, lags.r12_first, lags.r12_last);
+  f.r11 = normalised(x, x, px, px, mx, mx, qx, qx, 0, lags.r11_last, nullptr);
+  f.r12 = normalised(x, y, px, py, mx, my, qx, qy, lags.r12_first, lags.r12_last, r12_sums);
   f.segments_used = 1;
 }
 
@@ -228,13 +235,50 @@ std::optional<std::int64_t> positive_peak_lag(std::span<const double> r, std::in
   return first + static_cast<std::int64_t>(it - r.begin());
 }
 
+// R12's lagged products over the record cut at the segments' R12 windows:
+// one per window, and their sum with those of the gaps between the windows
+// (and before the first, after the last), which is the whole record's. The
+// sums over t of x(t) y(t + k) add over a partition of t, and they are whole
+// numbers (exact in doubles below 2^53), so the whole record's are the ones
+// lagged_products(x, y, 0, n) gives, at about half its pairs of intervals
+// when the segments' R12 is needed anyway (the velocity's interval).
+// Empty when the windows do not partition (overlapping windows of a record
+// too short for its lags).
+struct WindowPartition {
+  std::vector<std::vector<double>> windows;
+  std::vector<double> whole;
+};
+std::optional<WindowPartition> window_partition(const AirIntervals& x, const AirIntervals& y, int segments,
+                                                const FsccLags& lags, FftPlanCache& plans) {
+  const std::int64_t n = x.sample_count;
+  const std::int64_t length = n / segments;
+  WindowPartition p;
+  p.whole.assign(static_cast<std::size_t>(lags.r12_last - lags.r12_first + 1), 0.0);
+  auto add = [&p](const std::vector<double>& sums) {
+    for (std::size_t j = 0; j < sums.size(); ++j) p.whole[j] += sums[j];
+  };
+  std::int64_t covered = 0;  // the record before here is summed
+  for (int s = 0; s < segments; ++s) {
+    const auto [t0, t1] = segment_window(static_cast<std::int64_t>(s) * length, length, lags.r12_first, lags.r12_last);
+    if (t0 < covered || t1 < t0 || t1 > n) return std::nullopt;
+    if (t0 > covered) add(lagged_products(x, y, covered, t0, lags.r12_first, lags.r12_last, plans));
+    p.windows.push_back(lagged_products(x, y, t0, t1, lags.r12_first, lags.r12_last, plans));
+    add(p.windows.back());
+    covered = t1;
+  }
+  if (n > covered) add(lagged_products(x, y, covered, n, lags.r12_first, lags.r12_last, plans));
+  return p;
+}
+
 // Felder's segmented Pearson coefficients of binary signals, averaged over
 // the segments; each segment's R12 peak is kept for the velocity's interval.
 // Without `auto_correlation` R11 is left at zero and only whether each
 // segment has one is found (what the velocity's interval reads: the segments'
-// peaks and the status), without its lagged products.
+// peaks and the status), without its lagged products. `r12_sums`, when
+// given, are R12's lagged products per segment's window (window_partition).
 void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const FsccLags& lags, FftPlanCache& plans,
-               CorrelationFunctions& f, bool auto_correlation = true) {
+               CorrelationFunctions& f, bool auto_correlation = true,
+               const std::vector<std::vector<double>>* r12_sums = nullptr) {
   const std::int64_t n = x.sample_count;
   const std::int64_t length = n / segments;
   f.r11.assign(static_cast<std::size_t>(lags.r11_last + 1), 0.0);
@@ -243,7 +287,7 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
   const AirPrefix px(x), py(y);
   // Pearson's coefficient per lag over the segment's window, empty when a signal is constant there.
   auto pearson = [&](const AirIntervals& a, const AirPrefix& pa, const AirPrefix& pb, const AirIntervals& b,
-                     std::int64_t s0, std::int64_t kmin, std::int64_t kmax) {
+                     std::int64_t s0, std::int64_t kmin, std::int64_t kmax, const std::vector<double>* given) {
     std::vector<double> r;
     const auto [t0, t1] = segment_window(s0, length, kmin, kmax);
     const std::int64_t w = t1 - t0;
@@ -252,7 +296,7 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
     const double ma = static_cast<double>(pa.in(t0, t1)) / wd;
     const double va = ma * (1 - ma);
     if (!(va > 0.0)) return r;
-    const auto sums = lagged_products(a, b, t0, t1, kmin, kmax, plans);
+    const auto sums = given ? *given : lagged_products(a, b, t0, t1, kmin, kmax, plans);
     r.resize(sums.size());
     for (std::size_t j = 0; j < sums.size(); ++j) {
       const std::int64_t k = kmin + static_cast<std::int64_t>(j);
@@ -284,9 +328,10 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
   };
   for (int s = 0; s < segments; ++s) {
     const std::int64_t s0 = static_cast<std::int64_t>(s) * length;
-    if (auto_correlation) used11 += add(pearson(x, px, px, x, s0, 0, lags.r11_last), f.r11);
+    if (auto_correlation) used11 += add(pearson(x, px, px, x, s0, 0, lags.r11_last, nullptr), f.r11);
     else used11 += has_pearson(px, px, s0, 0, lags.r11_last);
-    const auto r12 = pearson(x, px, py, y, s0, lags.r12_first, lags.r12_last);
+    const auto r12 = pearson(x, px, py, y, s0, lags.r12_first, lags.r12_last,
+                             r12_sums ? &(*r12_sums)[static_cast<std::size_t>(s)] : nullptr);
     used12 += add(r12, f.r12);
     if (const auto peak = positive_peak_lag(r12, lags.r12_first)) f.segment_peak_lags.push_back(*peak);
   }
@@ -667,20 +712,45 @@ void add_velocity_interval(FsccResult& result, const CorrelationFunctions& sprea
 }
 
 FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options) {
-  auto out = fscc_from_functions(correlation_functions(leading, trailing, options), dx, options);
-  if (out.ok()) {
-    // The interval reads the segments' R12 peaks and the status only: the
-    // segments' R11 is not computed (correlation_functions would).
-    const FsccOptions spread_options = interval_options(options);
+  // The interval reads the segments' R12 peaks and the status only: the
+  // segments' R11 is not computed (correlation_functions would).
+  const FsccOptions spread_options = interval_options(options);
+  const FsccLags spread_lags = fscc_lags(leading.sample_count, leading.fs, spread_options);
+  FftPlanCache plans;
+  auto interval = [&](FsccResult& out, const std::vector<std::vector<double>>* r12_sums) {
     CorrelationFunctions spread;
     spread.fs = leading.fs;
     spread.signal = CorrelationSignal::binary;
-    const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, spread_options);
-    spread.r12_first_lag = lags.r12_first;
-    FftPlanCache plans;
-    segmented(leading, trailing, spread_options.segments, lags, plans, spread, false);
+    spread.r12_first_lag = spread_lags.r12_first;
+    segmented(leading, trailing, spread_options.segments, spread_lags, plans, spread, false, r12_sums);
     add_velocity_interval(out, spread, dx);
+  };
+  // A full-record R12 over the interval's lags is the sum of the segments'
+  // windows and the gaps between them (window_partition): computed so, the
+  // segments' products serve the interval too.
+  std::optional<WindowPartition> partition;
+  if (options.segments == 1) {
+    options.validate().throw_if_failed();
+    const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
+    if (leading.sample_count == trailing.sample_count && leading.fs == trailing.fs && leading.air_samples() > 0 &&
+        trailing.air_samples() > 0 && lags.r12_first == spread_lags.r12_first && lags.r12_last == spread_lags.r12_last) {
+      partition = window_partition(leading, trailing, spread_options.segments, lags, plans);
+    }
   }
+  if (!partition) {
+    auto out = fscc_from_functions(correlation_functions(leading, trailing, options), dx, options);
+    if (out.ok()) interval(out, nullptr);
+    return out;
+  }
+  CorrelationFunctions f;
+  f.fs = leading.fs;
+  f.signal = CorrelationSignal::binary;
+  const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
+  f.r11_first_lag = 0;
+  f.r12_first_lag = lags.r12_first;
+  full_record(leading, trailing, lags, plans, f, &partition->whole);
+  auto out = fscc_from_functions(std::move(f), dx, options);
+  if (out.ok()) interval(out, &partition->windows);
   return out;
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "random_signals.hpp"
@@ -371,6 +372,40 @@ TEST(SecondaryPeakRatio, ConstructedShapes) {
   ASSERT_EQ(peaks.size(), 2u);
   EXPECT_EQ(peaks[1].first, 4u);
   EXPECT_NEAR(peaks[1].second, 0.5, 1e-15);
+}
+
+// The SPR computes only the prominences it reads (the tallest top's, then
+// the others' by decreasing height); it must equal the ratio read from every
+// peak's prominence (peak_prominences' stacks over the whole function), on
+// functions with ties of height, plateaus and negative tops.
+TEST(SecondaryPeakRatio, EqualsTheRatioFromEveryPeaksProminence) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  awcc::AwccWorkspace workspace;
+  int positive = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<double> r(20 + trial);
+    const double step = trial % 3 == 0 ? 4.0 : 16.0;  // coarse: many equal heights
+    for (auto& v : r) v = std::round(u(rng) * step) / step - (trial % 5 == 0 ? 1.5 : 0.0);
+    const auto peaks = awcc::detail::peak_prominences(r);
+    for (const double fraction : {0.0, 0.3, 0.7, 1.0}) {
+      double expected = 0.0;
+      if (peaks.size() >= 2) {
+        std::size_t tallest = 0;
+        for (std::size_t i = 1; i < peaks.size(); ++i)
+          if (r[peaks[i].first] > r[peaks[tallest].first]) tallest = i;
+        double second = -std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < peaks.size(); ++i)
+          if (i != tallest && peaks[i].second >= fraction * peaks[tallest].second) second = std::max(second, r[peaks[i].first]);
+        const double top = r[peaks[tallest].first];
+        if (std::isfinite(second) && top > 0.0) expected = std::max(0.0, second / top);
+      }
+      const auto p = awcc::detail::analyse_correlation(r, awcc::Subsample::none, fraction, workspace);
+      ASSERT_EQ(p.spr, expected) << "trial " << trial << " fraction " << fraction;
+      positive += p.spr > 0.0;
+    }
+  }
+  EXPECT_GT(positive, 300);  // the comparison is not all zeros
 }
 
 TEST(PeakProminences, MatchABruteForceScan) {

@@ -148,6 +148,33 @@ TEST(Fscc, SegmentedMatchesNaivePearsonAverages) {
   }
 }
 
+// fscc() builds the full record's R12 from the interval's segment windows
+// and the gaps between them; it must equal, bit for bit, the functions
+// computed over the whole record at once (correlation_functions), and its
+// interval those of the segments computed on their own. The 1,000-sample
+// record has segment lags narrower than the record's (limit L / 4 = 25), so
+// fscc() takes its plain path there: the same comparison covers it.
+TEST(Fscc, FullRecordFromSegmentWindowsEqualsTheWholeRecordsProducts) {
+  for (const std::int64_t n : {100'000, 1'000}) {
+    const auto x = telegraph(n, 31), y = shifted(telegraph(n, 31), 12);
+    awcc::FsccOptions o;
+    o.max_lag = 0.05;  // 50 samples at 1 kHz
+    const auto r = awcc::fscc(x, y, 1.0, o);
+    auto expected = awcc::fscc_from_functions(awcc::correlation_functions(x, y, o), 1.0, o);
+    ASSERT_TRUE(r.ok()) << r.message;
+    ASSERT_TRUE(expected.ok());
+    awcc::add_velocity_interval(expected, awcc::correlation_functions(x, y, awcc::interval_options(o)), 1.0);
+    EXPECT_EQ(r.r11, expected.r11) << n;
+    EXPECT_EQ(r.r12, expected.r12) << n;
+    EXPECT_EQ(r.interval_segments, expected.interval_segments) << n;
+    ASSERT_EQ(r.velocity_ci95.has_value(), expected.velocity_ci95.has_value()) << n;
+    if (r.velocity_ci95) {
+      EXPECT_EQ(r.velocity_ci95->lower, expected.velocity_ci95->lower);
+      EXPECT_EQ(r.velocity_ci95->upper, expected.velocity_ci95->upper);
+    }
+  }
+}
+
 TEST(Fscc, UndefinedResultsCarryAReason) {
   const auto x = telegraph(10'000, 3);
   AirIntervals empty;
