@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""One model's scores on two sets of runs (pdp score --predictions), side by side
+with their standard errors and the difference in units of them: whether the
+model scores the same on both (e.g. runs of generator versions 1 and 2 from
+one sweep definition, docs/validation.md "Generator version 2").
+
+Scores over the corrected rows: median |u / u_true - 1| and mean u error of
+the corrected median, the same for Tu (absolute), and the coverage of the 80
+and 95 % intervals. Standard errors by the bootstrap (2,000 resamples of the
+rows, seed 0); coverage's is also sqrt(p (1 - p) / n). The two sets are
+independent, so z = (b - a) / sqrt(se_a^2 + se_b^2).
+
+Usage: score_comparison.py NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv
+"""
+import csv
+import math
+import random
+import statistics
+import sys
+
+
+def rows(path):
+    out = []
+    for r in csv.DictReader(open(path)):
+        if r["status"] != "corrected":
+            continue
+        q = lambda name: float(r[name])
+        u, tu = q("true_velocity"), q("true_turbulence_intensity")
+        out.append({
+            "u_err": q("corrected_velocity_q0.5") / u - 1.0,
+            "tu_err": q("corrected_turbulence_intensity_q0.5") - tu,
+            "u80": q("corrected_velocity_q0.1") <= u <= q("corrected_velocity_q0.9"),
+            "u95": q("corrected_velocity_q0.025") <= u <= q("corrected_velocity_q0.975"),
+            "tu80": q("corrected_turbulence_intensity_q0.1") <= tu <= q("corrected_turbulence_intensity_q0.9"),
+            "tu95": q("corrected_turbulence_intensity_q0.025") <= tu <= q("corrected_turbulence_intensity_q0.975"),
+        })
+    return out
+
+
+SCORES = [
+    ("u median abs error (%)", lambda rs: 100 * statistics.median(abs(r["u_err"]) for r in rs)),
+    ("u mean error (%)", lambda rs: 100 * statistics.fmean(r["u_err"] for r in rs)),
+    ("Tu median abs error", lambda rs: statistics.median(abs(r["tu_err"]) for r in rs)),
+    ("Tu mean error", lambda rs: statistics.fmean(r["tu_err"] for r in rs)),
+    ("u 80 % coverage (%)", lambda rs: 100 * statistics.fmean(r["u80"] for r in rs)),
+    ("u 95 % coverage (%)", lambda rs: 100 * statistics.fmean(r["u95"] for r in rs)),
+    ("Tu 80 % coverage (%)", lambda rs: 100 * statistics.fmean(r["tu80"] for r in rs)),
+    ("Tu 95 % coverage (%)", lambda rs: 100 * statistics.fmean(r["tu95"] for r in rs)),
+]
+
+
+def bootstrap_se(rs, f, rng, n=2000):
+    values = [f([rs[rng.randrange(len(rs))] for _ in rs]) for _ in range(n)]
+    return statistics.stdev(values)
+
+
+def main():
+    a_name, a_path, b_name, b_path = sys.argv[1:5]
+    a, b = rows(a_path), rows(b_path)
+    rng = random.Random(0)
+    print(f"| score | {a_name} ({len(a)} rows) | {b_name} ({len(b)} rows) | z |")
+    print("|---|---|---|---|")
+    worst = 0.0
+    for name, f in SCORES:
+        va, vb = f(a), f(b)
+        sa, sb = bootstrap_se(a, f, rng), bootstrap_se(b, f, rng)
+        z = (vb - va) / math.hypot(sa, sb)
+        worst = max(worst, abs(z))
+        digits = 4 if name.startswith("Tu m") else 2
+        print(f"| {name} | {va:.{digits}f} +- {sa:.{digits}f} | {vb:.{digits}f} +- {sb:.{digits}f} | {z:+.2f} |")
+    print(f"\nlargest |z|: {worst:.2f}")
+
+
+if __name__ == "__main__":
+    main()
