@@ -33,6 +33,7 @@ from . import _pdp
 from ._errors import InputError, OptionError, OutputError, PdpError
 
 __version__ = _pdp.version
+generator_version = _pdp.generator_version  # the seeded streams' version (awcc/random.hpp)
 __all__ = ["read", "binarise", "phase_statistics", "fscc", "awcc", "process", "synth", "correct", "options",
            "profile_columns", "flow",
            "Result", "Profile", "Flow", "Recording", "InputError", "OptionError", "OutputError", "PdpError"]
@@ -597,11 +598,13 @@ def synth(scene=None, *, signal="binary", **fields):
     mean_velocity=2.0)``). Returns a Result: ``signals`` samples x tips
     (uint8 0/1 for ``signal="binary"``; float32 volts for ``"voltage"``, with
     the int16 ``counts`` and ``volts_per_count``), ``fs``, ``scene`` and
-    ``truth`` (the sidecar's objects)."""
+    ``truth`` (the sidecar's objects) and ``generator_version`` (the version
+    of the seeded streams: a seed gives the same numbers within a version)."""
     merged = dict(scene or {})
     merged.update(fields)
     s = _pdp.synthesise(_settings_scene(merged), signal)
-    out = _wrap({"fs": s["fs"], "scene": s["scene"], "truth": s["truth"], "volts_per_count": s["volts_per_count"]})
+    out = _wrap({"fs": s["fs"], "scene": s["scene"], "truth": s["truth"], "volts_per_count": s["volts_per_count"],
+                 "generator_version": s["generator_version"]})
     if signal == "voltage":
         out["counts"] = s["signals"]
         out["signals"] = (s["signals"] * s["volts_per_count"]).astype(_np.float32)

@@ -395,6 +395,7 @@ py::dict synthesise(const Settings& settings, const std::string& signal) {
   out["fs"] = scene.fs;
   out["scene"] = python_of(synth::scene_to_json(scene));
   out["truth"] = python_of(synth::truth_to_json(s.truth));
+  out["generator_version"] = awcc::generator_version;
   if (signal == "binary") {
     py::array_t<std::uint8_t> data({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(tips)});
     auto* p = data.mutable_data();
@@ -525,6 +526,7 @@ void translate(const char* type, std::string message, const std::string& quantit
 PYBIND11_MODULE(_pdp, m) {
   m.doc() = "The compiled core of pdp (use the pdp package, whose functions are documented)";
   m.attr("version") = awcc::version;
+  m.attr("generator_version") = awcc::generator_version;
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -139,6 +139,15 @@ def test_help_lists_options_units_and_defaults():
     assert {o.group for o in pdp.options()} >= {"awcc", "fscc", "binarisation", "input", "scene"}
 
 
+def test_a_seed_gives_the_same_numbers_and_says_its_generator_version():
+    a = pdp.synth(duration=0.5, fs=100e3, seed=3)
+    b = pdp.synth(duration=0.5, fs=100e3, seed=3)
+    c = pdp.synth(duration=0.5, fs=100e3, seed=4)
+    assert (a.signals == b.signals).all() and a.truth == b.truth
+    assert not (a.signals == c.signals).all()
+    assert a.generator_version == pdp.generator_version == 2
+
+
 def test_long_calls_release_the_gil():
     import time
 

