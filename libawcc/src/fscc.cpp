@@ -368,18 +368,28 @@ FsccLags fscc_lags(std::int64_t samples, double fs, const FsccOptions& options) 
   return l;
 }
 
+namespace {
+
+// The functions of two binary signals before their values: R11 from lag 0, R12 over the lags' range.
+CorrelationFunctions binary_functions(double fs, const FsccLags& lags) {
+  CorrelationFunctions f;
+  f.fs = fs;
+  f.signal = CorrelationSignal::binary;
+  f.r11_first_lag = 0;
+  f.r12_first_lag = lags.r12_first;
+  return f;
+}
+
+}  // namespace
+
 CorrelationFunctions correlation_functions(const AirIntervals& leading, const AirIntervals& trailing,
                                            const FsccOptions& options) {
   options.validate().throw_if_failed();
   if (leading.sample_count != trailing.sample_count || leading.fs != trailing.fs) {
     throw std::invalid_argument("FSCC needs two signals of the same length and sampling rate");
   }
-  CorrelationFunctions f;
-  f.fs = leading.fs;
-  f.signal = CorrelationSignal::binary;
   const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
-  f.r11_first_lag = 0;
-  f.r12_first_lag = lags.r12_first;
+  CorrelationFunctions f = binary_functions(leading.fs, lags);
   FftPlanCache plans;
   if (options.segments == 1) full_record(leading, trailing, lags, plans, f);
   else segmented(leading, trailing, options.segments, lags, plans, f);
@@ -742,12 +752,8 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     if (out.ok()) interval(out, nullptr);
     return out;
   }
-  CorrelationFunctions f;
-  f.fs = leading.fs;
-  f.signal = CorrelationSignal::binary;
   const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
-  f.r11_first_lag = 0;
-  f.r12_first_lag = lags.r12_first;
+  CorrelationFunctions f = binary_functions(leading.fs, lags);
   full_record(leading, trailing, lags, plans, f, &partition->whole);
   auto out = fscc_from_functions(std::move(f), dx, options);
   if (out.ok()) interval(out, &partition->windows);
