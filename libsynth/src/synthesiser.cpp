@@ -694,11 +694,14 @@ class Synthesiser {
       // The candidates that the lateral skip does not pass over, gathered
       // without a branch a candidate (most are skipped, unpredictably).
       const bool cached = j < ActiveBubble::cached_tips;
+      // The threshold is read whether or not the tip has one (no branch):
+      // a tip beyond the cached ones reads slot 0 and ignores it.
+      const std::size_t slot = cached ? j : 0;
       std::size_t due = 0;
       for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
         if (due == due_.size()) [[unlikely]] due_.resize(2 * due + 8);
         due_[due] = &*it;
-        const bool skip = cached & !((it->open_mask >> j) & 1u) & (lateral_path_next_ < it->clear_until[j]);
+        const bool skip = cached & !((it->open_mask >> j) & 1u) & (lateral_path_next_ < it->clear_until[slot]);
         due += static_cast<std::size_t>(!skip);
       }
       for (std::size_t k = 0; k < due; ++k) pierce_tip(*due_[k], j, t, std::max(0.0, due_[k]->t_entry - t), u);
