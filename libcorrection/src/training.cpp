@@ -983,13 +983,17 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   return result;
 }
 
-TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const TrainOptions& o) {
-  o.validate().throw_if_failed();
+void require_model_processing(const CorrectionModel& model, const TrainingSet& set) {
   if (const auto why = model.mismatch(set.processing); !why.empty()) {
     throw awcc::InputError(fmt::format("the runs were processed differently from the model's training data ({}); "
                                        "run the sweeps with the model's method options",
                                        why));
   }
+}
+
+TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const TrainOptions& o) {
+  o.validate().throw_if_failed();
+  require_model_processing(model, set);
   TrainOptions split_options = o;
   split_options.calibration = 0.0;  // held out, and the rest measures the envelopes
   std::vector<std::string> names;

@@ -52,6 +52,12 @@ cmp -s "$dir/score.out" "$dir/score.txt" || fail "score: the report file differs
 grep -q "^pdp score a.qrf: mc.csv (study [0-9]*) (generator version 2); 48 runs read" "$dir/score.txt" ||
   fail "score header: $(head -1 "$dir/score.txt")"
 grep -q "coverage 80 % / 95 %" "$dir/score.txt" || fail "no coverage in the score report"
+# Runs processed otherwise than the model's training data: refused, no predictions written.
+"$pdp" --log-level warn sweep "$dir/mc.toml" -o "$dir/mc-a03.csv" --filter-a 0.3 || fail "sweep, filter A 0.3"
+out=$("$pdp" score -m "$dir/a.qrf" "$dir/mc-a03.csv" --predictions "$dir/score-a03.csv" 2>&1) &&
+  fail "pdp score accepted runs processed with another filter A"
+[[ $out == *"processed differently from the model's training data"*"filter A"* ]] || fail "score processing message: $out"
+[[ -e $dir/score-a03.csv ]] && fail "pdp score wrote predictions for refused runs"
 /usr/bin/python3 - "$dir/pred.csv" "$dir/score.csv" <<'PY' || fail "pdp score's predictions differ from training's held-out ones"
 import csv, sys
 held = list(csv.DictReader(open(sys.argv[1])))

@@ -32,6 +32,10 @@ int run_score(const ScoreOptions& o) {
     const auto model = correction::CorrectionModel::load(o.model);
     const std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
     const auto set = correction::load_training_set(csvs, model.min_windows);
+    correction::require_model_processing(model, set);
+    if (set.processing_assumed) {
+      spdlog::warn("the sweep CSVs do not record how AWCC was processed; assumed as the model's");
+    }
     if (set.generator_versions.size() > 1) {
       spdlog::warn("the sweep CSVs mix runs of generator versions {}", fmt::join(set.generator_versions, " and "));
     }

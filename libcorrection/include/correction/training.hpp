@@ -209,6 +209,11 @@ struct TrustResult {
 /// otherwise than the model's training data.
 TrustResult measure_trust(CorrectionModel model, const TrainingSet& runs, const TrainOptions& options);
 
+/// Throws awcc::InputError when the runs were processed otherwise than the
+/// model's training data (its filter, ROC, weighting, signal, refinement):
+/// a model scored or measured on them would describe other estimates.
+void require_model_processing(const CorrectionModel& model, const TrainingSet& runs);
+
 /// Scores a model on rows.
 HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions = nullptr, int threads = 0);
