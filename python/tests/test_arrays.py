@@ -151,7 +151,13 @@ def test_a_seed_gives_the_same_numbers_and_says_its_generator_version():
 def test_long_calls_release_the_gil():
     import time
 
-    s = pdp.synth(duration=20, fs=200e3, velocity="2m/s", void_fraction=0.1, seed=2)
+    # Long enough that the call outlasts many switch intervals even on a fast
+    # machine: processing is ~1 ms per second of record here, so 20 s (the
+    # first choice) fell to 0.05 s once processing got 2.7x faster.
+    s = pdp.synth(duration=150, fs=200e3, velocity="2m/s", void_fraction=0.1, seed=2)
+    # A first call imports pandas lazily; its file reads release the GIL and
+    # wait a switch interval each against the spinning loop below.
+    pdp.process(s.signals[:200_000], fs=s.fs, dx=DX)
     done = threading.Event()
     took = []
 
