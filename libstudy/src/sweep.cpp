@@ -78,8 +78,8 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
       if (!t.settings.empty()) fail(t.settings.front().key, "must be a table");
       continue;
     }
-    if (t.name != "sweep" && t.name != "base" && t.name != "grid" && t.name != "ranges") {
-      fail(t.name, "unknown table; use [sweep], [base], [grid] and [ranges]");
+    if (t.name != "sweep" && t.name != "base" && t.name != "grid" && t.name != "ranges" && t.name != "choices") {
+      fail(t.name, "unknown table; use [sweep], [base], [grid], [ranges] and [choices]");
     }
     by_name[t.name] = &t;
   }
@@ -150,6 +150,22 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
     d.ranges[s.key] = {ends[0], ends[1]};
     if (log) d.log_ranges.insert(s.key);
   }
+  for (const auto& s : table("choices")) {
+    if (d.mode != "monte-carlo") fail("[choices] " + s.key, "choices are drawn per run: use them in a monte-carlo sweep");
+    if (!is_field(s.key)) fail("[choices] " + s.key, kUnknownField);
+    if (s.items.size() < 2) fail("[choices] " + s.key, "must be a list of at least two values, one drawn per run");
+    const auto ranged = table("ranges");
+    if (d.base.count(s.key) ||
+        std::any_of(ranged.begin(), ranged.end(), [&](const awcc::Setting& r) { return r.key == s.key; })) {
+      fail("[choices] " + s.key, "also set in [base] or [ranges]: give the field in one table");
+    }
+    d.ranges.erase(s.key);  // a Monte Carlo default range gives way to the choices
+    d.log_ranges.erase(s.key);
+    for (const auto& text : s.items) {
+      check_value("[choices]", s.key, text);
+      d.choices[s.key].push_back(text);
+    }
+  }
   if (d.mode == "grid" && d.grid.empty()) fail("[grid]", "a grid sweep needs at least one list of values");
   // Canonical text: every setting, sorted.
   std::string c = fmt::format("mode={};runs={};repeat={};seed={};", d.mode, d.runs, d.repeat, d.seed);
@@ -163,6 +179,11 @@ SweepDefinition load_sweep(const std::filesystem::path& path) {
     // Uniform ranges keep the text they had before log ranges existed (studies resume).
     for (const auto& [k, v] : d.ranges)
       c += fmt::format("ranges.{}={:.17g},{:.17g}{};", k, v.first, v.second, d.log_ranges.count(k) ? ",log" : "");
+    for (const auto& [k, v] : d.choices) {
+      c += "choices." + k + "=";
+      for (const auto& x : v) c += x + ",";
+      c += ";";
+    }
   }
   d.canonical = c;
   return d;
@@ -177,7 +198,9 @@ std::vector<SweepRun> SweepDefinition::expand() const {
     if (!tu_z_set) run.scene.tu_z = run.anisotropy * run.scene.tu;
     return run;
   };
-  auto set_in = [&](const std::string& name) { return base.count(name) || grid.count(name) || ranges.count(name); };
+  auto set_in = [&](const std::string& name) {
+    return base.count(name) || grid.count(name) || ranges.count(name) || choices.count(name);
+  };
   const bool tu_y_set = set_in("tu-y"), tu_z_set = set_in("tu-z");
   std::int64_t index = 0;
   if (mode == "grid") {
@@ -220,6 +243,12 @@ std::vector<SweepRun> SweepDefinition::expand() const {
         // Every digit of the draw, in SI with its unit.
         apply(run, k, fmt::format("{:.17g}{}", v, awcc::si_unit(dimension_of(k))));
       }
+      // After the ranges, so that a sweep without choices draws what it drew
+      // before choices existed.
+      for (const auto& [k, values] : choices) {
+        const auto n = values.size();
+        apply(run, k, values[std::min(n - 1, static_cast<std::size_t>(rng.uniform() * static_cast<double>(n)))]);
+      }
       run = finish(run, tu_y_set, tu_z_set);
       for (std::int64_t r = 0; r < repeat; ++r) {
         SweepRun copy = run;
@@ -261,7 +290,7 @@ std::string sweep_header() {
 }
 
 bool sets(const SweepDefinition& d, const std::string& name) {
-  return d.base.count(name) || d.grid.count(name) || d.ranges.count(name);
+  return d.base.count(name) || d.grid.count(name) || d.ranges.count(name) || d.choices.count(name);
 }
 
 std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string& error, std::uint64_t study,

@@ -72,6 +72,8 @@ std::string_view to_string(ArrivalRule rule) {
   return "?";
 }
 
+std::string_view to_string(OverlapRule rule) { return rule == OverlapRule::avoid ? "avoid" : "allow"; }
+
 DispersedPhase dispersed_phase(double void_fraction) {
   return void_fraction > 0.5 ? DispersedPhase::droplets : DispersedPhase::bubbles;
 }
@@ -314,6 +316,19 @@ const SceneField kFields[] = {
     SceneField{"overlap-retries", Dimension::dimensionless, "lateral positions tried to avoid overlapping bubbles",
                [](Scene& s, std::string_view t) { s.overlap_retries = static_cast<int>(integer(t, "overlap-retries")); },
                [](const Scene& s) { return fmt::format("{}", s.overlap_retries); }},
+    SceneField{"overlap", Dimension::dimensionless,
+               "entry points: avoid (retry, wait, compensate the volume lost) | allow (uniform, kept where they "
+               "overlap: other simulators' rule)",
+               [](Scene& s, std::string_view t) {
+                 for (auto r : {OverlapRule::avoid, OverlapRule::allow}) {
+                   if (to_string(r) == t) {
+                     s.overlap = r;
+                     return;
+                   }
+                 }
+                 throw std::invalid_argument(fmt::format("'{}' is not an overlap rule; write avoid or allow", t));
+               },
+               [](const Scene& s) { return std::string(to_string(s.overlap)); }},
     PDP_QUANTITY_FIELD("dx", dx, Dimension::length, "streamwise tip separation (trailing minus leading), m"),
     PDP_QUANTITY_FIELD("dy", dy, Dimension::length, "lateral tip separation, m"),
     PDP_QUANTITY_FIELD("dz", dz, Dimension::length, "vertical tip separation, m"),

@@ -34,6 +34,7 @@ json scene_to_json(const Scene& s) {
       {"diameter_log_sd", s.diameter_log_sd},
       {"aspect_ratio", s.aspect_ratio},
       {"arrival", std::string(to_string(s.arrival))},
+      {"overlap", std::string(to_string(s.overlap))},
       {"overlap_retries", s.overlap_retries},
       {"dx", s.dx},
       {"dy", s.dy},

@@ -395,6 +395,7 @@ class Synthesiser {
       next_key_ = first * spacing_;
     }
     time_rule_ = time_rule;
+    allow_overlap_ = scene_.overlap == OverlapRule::allow;
     poisson_ = poisson;
   }
 
@@ -549,7 +550,7 @@ class Synthesiser {
   void place_pending(double t_entry, const Vec3& key) {
     while (!pending_.empty()) {
       Pending& p = pending_.front();
-      const bool must_place = key.x - p.first_key >= 2.0 * a_x_max_;
+      const bool must_place = allow_overlap_ || key.x - p.first_key >= 2.0 * a_x_max_;
       if (!try_place(p.diameter, t_entry, key, must_place)) {
         p.next_try = std::max(p.next_try, key.x) + 0.5 * a_x_max_;
         return;
@@ -567,6 +568,13 @@ class Synthesiser {
     // hard lateral walls the retries would push bubbles towards the walls,
     // away from the tips, and the tips would see a void fraction well below c
     // (0.19 instead of 0.25 in the base case).
+    if (allow_overlap_) {
+      // Other simulators' rule: one uniform entry point, kept.
+      placement_.clear();
+      neighbours_.clear();
+      const auto drawn = placement_.place(bubble_rng_, 1);
+      return settle(radius, t_entry, key, drawn.attempts - 1);
+    }
     const double reach = 2.0 * a_x_max_;
     const auto lo = bubbles_.first_not_below(key.x - reach, place_hint_lo_);
     // partition_point(o.key.x <= key.x + reach): the first key above it.
@@ -595,6 +603,11 @@ class Synthesiser {
       ++overlaps_unresolved_;
       chosen = place_overlapping(radius, t_entry, key, outcome.attempts);
     }
+    return settle(radius, t_entry, key, chosen);
+  }
+
+  // Keeps a particle at the placement's position `chosen`.
+  bool settle(double radius, double t_entry, const Vec3& key, int chosen) {
     // Built where it is kept: a copy of a bubble just written field by field
     // stalled on the store forwards.
     ActiveBubble& b = bubbles_.append();
@@ -638,7 +651,11 @@ class Synthesiser {
       if (separation2 >= o.r2) continue;
       volume += lens_volume(radius, std::sqrt(o.r2) - radius, std::sqrt(separation2));
     }
-    return volume;
+    // A particle cannot lose more than its own volume. Summed over a pile of
+    // overlapping neighbours the lenses can exceed it, and owing that excess
+    // brought the next mark back to the current displacement for ever (a
+    // hang at c = 0.35 with one position tried, issue 33).
+    return std::min(volume, (4.0 / 3.0) * std::numbers::pi * radius * radius * radius);
   }
 
   // Every lateral position tried (the placement's first `tried`) overlaps:
@@ -1018,6 +1035,7 @@ class Synthesiser {
   std::int64_t pre_steps_ = 0, record_steps_ = 0;
   double t_start_ = 0.0;
   bool time_rule_ = true, poisson_ = false;
+  bool allow_overlap_ = false;  // OverlapRule::allow
   double next_time_ = 0.0, next_key_ = 0.0;
 
   Vec3 d_{};  // common displacement at the current step start

@@ -216,6 +216,38 @@ assert len(fs) == 400 and all(1e4 <= f <= 1e6 for f in fs)
 below = sum(f < 1e5 for f in fs) / len(fs)
 assert 0.35 <= below <= 0.65, below
 PY
+# Choices: each run takes one of the listed values, each equally likely, and
+# drawing them after the ranges leaves the ranged draws of every run as they
+# were without choices. Of 400 runs, a value of four is taken 100 times on
+# average, binomial sd sqrt(400 x 1/4 x 3/4) = 8.7: 60-140 is 4.6 sd; one of
+# two, 200 +/- 10: 150-250 is 5 sd.
+printf '[sweep]\nmode = "monte-carlo"\nruns = 400\nseed = 4\n[base]\nduration = "0.05s"\n[ranges]\nfs = ["10kHz", "1MHz", "log"]\n[choices]\narrival = ["equal-time", "poisson-time", "equal-space", "poisson-space"]\noverlap-retries = [0, 30]\n' >"$dir/choices.toml"
+"$pdp" --log-level error sweep "$dir/choices.toml" -o "$dir/choices.csv" || fail "sweep with choices"
+python3 - "$dir/log.csv" "$dir/choices.csv" <<'PY' || fail "choices not drawn as declared"
+import collections, csv, sys
+plain = list(csv.DictReader(open(sys.argv[1])))
+mixed = list(csv.DictReader(open(sys.argv[2])))
+assert len(mixed) == 400
+by_run = {r["run"]: r for r in plain}
+for r in mixed:
+    assert r["fs"] == by_run[r["run"]]["fs"], (r["run"], r["fs"])
+arrivals = collections.Counter(r["arrival"] for r in mixed)
+assert set(arrivals) == {"equal-time", "poisson-time", "equal-space", "poisson-space"}, arrivals
+assert all(60 <= n <= 140 for n in arrivals.values()), arrivals
+retries = collections.Counter(r["overlap_retries"] for r in mixed)
+assert set(retries) == {"0", "30"} and all(150 <= n <= 250 for n in retries.values()), retries
+PY
+badchoice() {  # bad TOML-body expected-message
+  printf '%b' "$1" >"$dir/bad.toml"
+  local out
+  out=$("$pdp" sweep "$dir/bad.toml" -o "$dir/bad.csv" 2>&1) && fail "accepted: $1"
+  [[ $out == *"$2"* ]] || fail "$1: message lacks '$2': $out"
+  [[ -e $dir/bad.csv ]] && fail "$1: wrote a CSV"
+}
+badchoice '[sweep]\nmode = "monte-carlo"\nruns = 4\n[choices]\narrival = ["equal-time"]\n' 'at least two values'
+badchoice '[sweep]\nmode = "monte-carlo"\nruns = 4\n[choices]\narrival = ["equal-time", "sometimes"]\n' 'sometimes'
+badchoice '[sweep]\nmode = "monte-carlo"\nruns = 4\n[ranges]\ndx = ["1mm", "2mm"]\n[choices]\ndx = ["1mm", "3mm"]\n' 'in one table'
+badchoice '[sweep]\nmode = "grid"\n[grid]\ndx = ["1mm"]\n[choices]\narrival = ["equal-time", "equal-space"]\n' 'monte-carlo sweep'
 bad() {  # bad TOML-ranges-line expected-message
   printf '[sweep]\nmode = "monte-carlo"\nruns = 4\n[ranges]\n%s\n' "$1" >"$dir/bad.toml"
   local out

@@ -15,7 +15,7 @@ void setup_sweep(CLI::App& app, Command& command, SweepOptions& o) {
   command.app = cmd;
   add_config_option(command);
   command.required.push_back(
-      path_option(cmd->add_option("study", o.study, "sweep definition (TOML: [sweep], [base], [grid], [ranges])"))
+      path_option(cmd->add_option("study", o.study, "sweep definition (TOML: [sweep], [base], [grid], [ranges], [choices])"))
           ->check(CLI::ExistingFile));
   command.required.push_back(path_option(
       cmd->add_option("-o,--output", o.output, "CSV of runs: appended row by row; an interrupted sweep resumes")));

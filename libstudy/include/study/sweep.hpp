@@ -14,6 +14,10 @@
 //            ln T = mid +/- 2 sd, truncated). Monte Carlo defaults are METHOD 5's
 //            ranges: velocity 1-50 m/s, tu 0-0.35, time-scale 1 ms-1 s,
 //            void-fraction 0.005-0.4, bubble-diameter 0.5-20 mm, dx 0.5-10 mm.
+//   [choices] a list of values per field (monte-carlo): each run takes one,
+//            each equally likely, e.g. arrival = ["equal-time", "poisson-space"]
+//            to mix the simulators' conventions in one campaign. A field is
+//            set in one table only.
 // Run i (of `repeat` per parameter set) has seed awcc::derive_seed(seed, i):
 // results do not depend on thread count, order or sharding.
 
@@ -48,13 +52,15 @@ struct SweepDefinition {
   /// Ranges drawn log-uniformly ([min, max, "log"]); the others uniformly
   /// (time-scale: log-normal, see expand).
   std::set<std::string> log_ranges;
+  /// [choices]: the values one of which each monte-carlo run takes, equally likely.
+  std::map<std::string, std::vector<std::string>> choices;
 };
 
 /// Reads and checks a sweep file; throws awcc::OptionError (a definition
 /// that cannot be run) naming the file, the table and key, and the fix.
 SweepDefinition load_sweep(const std::filesystem::path& path);
 
-/// True when the definition sets `name` (in [base], [grid] or [ranges]).
+/// True when the definition sets `name` (in [base], [grid], [ranges] or [choices]).
 [[nodiscard]] bool sets(const SweepDefinition& d, const std::string& name);
 
 /// The CSV header and one row, in the columns correction/sweep_columns.hpp

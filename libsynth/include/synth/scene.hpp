@@ -35,6 +35,19 @@ enum class ArrivalRule {
   poisson_space,  ///< Poisson process along the flow
 };
 
+/// Whether a particle's entry point avoids the particles already in the
+/// control volume. `avoid` is pdp's rule (METHOD 5.2: retry lateral
+/// positions, wait, compensate the volume lost; synth/synthesiser.hpp,
+/// "Dense placement"); `allow` is the convention of simulators that draw the
+/// entry point uniformly over the inlet and keep it: particles overlap where
+/// they fall and the volume they share is lost, so the realised void fraction
+/// falls below c as c grows (the truth reports what was realised).
+enum class OverlapRule {
+  avoid,  ///< retry, wait and compensate (default)
+  allow,  ///< one uniform entry point, kept whatever it overlaps
+};
+std::string_view to_string(OverlapRule rule);
+
 /// What the probe's tips pierce, decided by the void fraction alone. Up to
 /// c = 0.5 the dispersed phase is air: bubbles in water. Above it, water:
 /// droplets carried through air (the spray region of a self-aerated flow),
@@ -82,6 +95,7 @@ struct Scene {
   double aspect_ratio = 1.0;              ///< ellipsoid semi-axis along x over the lateral ones
   ArrivalRule arrival = ArrivalRule::equal_time;
   int overlap_retries = 30;               ///< lateral positions tried to avoid an overlap
+  OverlapRule overlap = OverlapRule::avoid;  ///< avoid overlaps, or allow them (foreign simulators' rule)
   // Probe.
   double dx = 5e-3;                       ///< trailing tip minus leading tip, streamwise, m
   double dy = 1e-3;                       ///< ... lateral, m
