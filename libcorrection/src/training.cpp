@@ -234,7 +234,16 @@ awcc::Validation TrainOptions::validate() const {
   return {};
 }
 
-TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows) {
+std::string_view to_string(TruthKind truth) { return truth == TruthKind::realised ? "realised" : "imposed"; }
+
+std::optional<TruthKind> truth_kind_of(std::string_view text) {
+  if (text == "realised") return TruthKind::realised;
+  if (text == "imposed") return TruthKind::imposed;
+  return std::nullopt;
+}
+
+TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows,
+                              TruthKind truth) {
   TrainingSet set;
   std::set<std::pair<std::string, std::int64_t>> seen;
   bool processing_seen = false;
@@ -252,7 +261,9 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
                                        column_name(C::truth_turbulence_intensity), column_name(C::awcc_velocity),
                                        column_name(C::awcc_turbulence_intensity), column_name(C::awcc_void_fraction),
                                        column_name(C::awcc_count_rate), column_name(C::awcc_windows_accepted),
-                                       column_name(C::reason)};
+                                       column_name(C::reason),
+                                       truth == TruthKind::imposed ? Scene::velocity : column_name(C::truth_velocity),
+                                       truth == TruthKind::imposed ? Scene::tu : column_name(C::truth_velocity)};
     for (const auto name : needed) {
       if (!col.count(name)) {
         throw awcc::InputError(fmt::format("{}: no column '{}'; give a CSV written by pdp sweep", path.string(), name));
@@ -362,8 +373,13 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       m.fscc_velocity = optional_number(column_name(C::fscc_velocity));
       m.r12_max = optional_number(column_name(C::fscc_r12_max));
       const auto features = make_features(m);
-      r.true_velocity = number_of(column_name(C::truth_velocity));
-      r.true_turbulence_intensity = number_of(column_name(C::truth_turbulence_intensity));
+      if (truth == TruthKind::realised) {
+        r.true_velocity = number_of(column_name(C::truth_velocity));
+        r.true_turbulence_intensity = number_of(column_name(C::truth_turbulence_intensity));
+      } else {
+        r.true_velocity = number_of(Scene::velocity);
+        r.true_turbulence_intensity = number_of(Scene::tu);
+      }
       if (fscc_unusable(features.features).empty() && features.features.fs > 0.0 && features.features.duration > 0.0) {
         TrainingRow f = r;
         f.features = features.features;

@@ -66,6 +66,36 @@ assert held and len(scored) > len(held), (len(held), len(scored))
 for r in held:
     assert r == scored[r["run"]], (r, scored[r["run"]])
 PY
+# Scored against the imposed truth, each row's truth is its scene's velocity
+# and tu (and the realised one differs: a record samples the process); the
+# predictions are the same, since the features are.
+"$pdp" --log-level warn score -m "$dir/a.qrf" "$dir/mc.csv" --truth imposed --predictions "$dir/score-imposed.csv" \
+  >"$dir/score-imposed.out" || fail "score --truth imposed"
+grep -q "^truth: imposed" "$dir/score-imposed.out" || fail "the report does not say which truth"
+/usr/bin/python3 - "$dir/mc.csv" "$dir/score.csv" "$dir/score-imposed.csv" <<'PY' || fail "imposed truth not the scene's"
+import csv, sys
+scene = {r["run"]: r for r in csv.DictReader(open(sys.argv[1]))}
+realised = {r["run"]: r for r in csv.DictReader(open(sys.argv[2]))}
+imposed = list(csv.DictReader(open(sys.argv[3])))
+assert len(imposed) == len(realised)
+differ = 0
+for r in imposed:
+    s, q = scene[r["run"]], realised[r["run"]]
+    assert float(r["true_velocity"]) == float(s["velocity"]), (r["true_velocity"], s["velocity"])
+    assert float(r["true_turbulence_intensity"]) == float(s["tu"])
+    assert float(q["true_velocity"]) == float(s["truth_velocity"])
+    differ += float(q["true_velocity"]) != float(s["velocity"])
+    for k in r:
+        if not k.startswith("true_"):
+            assert r[k] == q[k], (k, r[k], q[k])
+assert differ == len(imposed), differ
+PY
+# Runs another AWCC processed are scored when asked, and the report names
+# the difference (a foreign tool's conventions, issue 33).
+"$pdp" --log-level warn score -m "$dir/a.qrf" "$dir/mc-a03.csv" --other-processing >"$dir/score-a03.out" ||
+  fail "score --other-processing"
+grep -q "^processed otherwise than the model's training data: .*filter A" "$dir/score-a03.out" ||
+  fail "the report does not name the other processing: $(cat "$dir/score-a03.out")"
 # Calibrating intervals (the default) needs 100 calibration runs: a small sweep is told so, and no model is written.
 out=$("$pdp" train "$dir/mc.csv" -o "$dir/c.qrf" --trees 5 --folds 0 --min-windows 20 2>&1) && fail "calibrated on a few runs"
 [[ $out == *"calibration runs are too few"*"set calibration to 0"* ]] || fail "calibration message: $out"

@@ -25,14 +25,28 @@ void setup_score(CLI::App& app, Command& command, ScoreOptions& o) {
   path_option(cmd->add_option("--predictions", o.predictions, "write the predictions as CSV"));
   path_option(cmd->add_option("--report", o.report, "write the report to this file too"));
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
+  cmd->add_option("--truth", o.truth,
+                  "score against the realised statistics of each run (what pdp trains on) or the imposed scene "
+                  "parameters (other simulators' truth): realised | imposed")
+      ->check(CLI::IsMember({"realised", "imposed"}))
+      ->capture_default_str();
+  cmd->add_flag("--other-processing", o.other_processing,
+                "score runs processed otherwise than the model's training data (another AWCC convention); the "
+                "report names the difference");
 }
 
 int run_score(const ScoreOptions& o) {
   try {
     const auto model = correction::CorrectionModel::load(o.model);
     const std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
-    const auto set = correction::load_training_set(csvs, model.min_windows);
-    correction::require_model_processing(model, set);
+    const auto truth = correction::truth_kind_of(o.truth).value_or(correction::TruthKind::realised);
+    const auto set = correction::load_training_set(csvs, model.min_windows, truth);
+    std::string processed_otherwise;
+    if (o.other_processing) {
+      processed_otherwise = model.mismatch(set.processing);
+    } else {
+      correction::require_model_processing(model, set);
+    }
     if (set.processing_assumed) {
       spdlog::warn("the sweep CSVs do not record how AWCC was processed; assumed as the model's");
     }
@@ -50,6 +64,11 @@ int run_score(const ScoreOptions& o) {
         std::filesystem::path(o.model).filename().string(), sources, fmt::join(set.generator_versions, " and "),
         set.total, set.rows.size(), model.min_windows, scores.rows, scores.out_of_range, scores.untrusted,
         scores.outside_envelope, scores.multimodal);
+    report += fmt::format("truth: {}{}\n", o.truth,
+                          truth == correction::TruthKind::imposed ? " (the scene's velocity and tu)" : " (the run's realised statistics)");
+    if (!processed_otherwise.empty()) {
+      report += fmt::format("processed otherwise than the model's training data: {}\n", processed_otherwise);
+    }
     report += correction::scores_report(scores, predictions);
     if (!o.predictions.empty()) awcc::check_output_folder(o.predictions);
     if (!o.report.empty()) awcc::check_output_folder(o.report);

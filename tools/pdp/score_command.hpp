@@ -19,6 +19,10 @@ struct ScoreOptions {
   std::string predictions;          ///< the predictions as CSV
   std::string report;               ///< the report as a text file (also on stdout)
   int threads = 0;                  ///< worker threads (0 = all cores)
+  std::string truth = "realised";   ///< realised | imposed (correction::TruthKind)
+  /// Score runs processed otherwise than the model's training data (another
+  /// tool's AWCC conventions, issue 33); the report names the difference.
+  bool other_processing = false;
 };
 
 void setup_score(CLI::App& app, Command& command, ScoreOptions& options);

@@ -37,6 +37,8 @@ inline constexpr std::array<SweepColumnInfo, 3> sweep_key_columns{{
 /// The scene's columns the correction reads (declared by synth::scene_fields).
 struct SweepSceneColumns {
   static constexpr std::string_view dx = "dx", dy = "dy", fs = "fs", duration = "duration";
+  /// The imposed mean velocity and Tu_x (TruthKind::imposed).
+  static constexpr std::string_view velocity = "velocity", tu = "tu";
 };
 
 /// The columns after the scene's, in the order written.

@@ -72,10 +72,24 @@ struct TrainingSet {
   std::set<int> generator_versions;
 };
 
+/// Which truth a run's row carries. pdp trains on the realised statistics of
+/// the generated series (what the record holds); other simulators score
+/// against the imposed parameters (the process the record samples). They
+/// differ by the record's sampling error of the mean and the rms: u_rms
+/// sqrt(2 T / D) for the mean of a record of D seconds with an integral
+/// time scale T (about 0.6 % of u at Tu 0.25, T 0.1 s, 300 s).
+enum class TruthKind { realised, imposed };
+std::string_view to_string(TruthKind truth);
+/// "realised" or "imposed"; empty otherwise.
+std::optional<TruthKind> truth_kind_of(std::string_view text);
+
 /// Reads sweep CSVs (pdp sweep's columns); throws InputError naming
 /// the file, line and column when one is not such a CSV. A run index seen twice
-/// (e.g. the same shard given twice) is refused.
-TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows);
+/// (e.g. the same shard given twice) is refused. `truth`: the realised
+/// truth columns (truth_velocity, truth_turbulence_intensity) or the scene's
+/// imposed velocity and tu.
+TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, std::int64_t min_windows,
+                              TruthKind truth = TruthKind::realised);
 
 struct TrainOptions {
   int trees = 100;                      ///< trees per forest
