@@ -545,6 +545,25 @@ Attempt refused(const FeatureVector& x, const Features& f) {
   return a;
 }
 
+Attempt awcc_attempt(const CorrectionModel& m, const Features& f);
+
+// A row without the record's features, by the reduced model (its forest named).
+Attempt reduced_attempt(const CorrectionModel& m, const Features& f) {
+  std::vector<std::string> missing;
+  for (const auto& r : m.ranges)
+    if (!f.value(r.name)) missing.push_back(r.name);
+  Attempt a = awcc_attempt(*m.reduced, f);
+  auto& c = a.correction;
+  if (c.velocity) {
+    c.forest = "awcc-reduced";
+    c.notes.insert(c.notes.begin(),
+                   fmt::format("{} not known for this row: corrected by the reduced forest (u, Tu, c, d32, dx, dy, "
+                               "Np), trained over every record length and rate, whose intervals are wider",
+                               fmt::join(missing, ", ")));
+  }
+  return a;
+}
+
 Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   if (f.windows_accepted >= 0 && f.windows_accepted < m.min_windows) {
     return {not_corrected(CorrectionStatus::too_few_windows,
@@ -552,6 +571,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
                                       f.windows_accepted, m.min_windows))};
   }
   const auto x = feature_vector(m.ranges, m.range_margin, f);
+  if (x.status == CorrectionStatus::missing_feature && m.reduced) return reduced_attempt(m, f);
   if (!x.ok()) return refused(x, f);
   const auto& cal = m.calibration;
   const auto velocity_d = m.velocity.distribution(x.x);
@@ -723,6 +743,12 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
     write_envelopes(payload, fscc->calibration, {&fscc->calibration.velocity_envelope});
     write_forest(payload, "fscc_velocity", fscc->form, fscc->velocity);
   }
+  payload.u32(reduced ? 1 : 0);
+  if (reduced) {
+    const auto nested = reduced->serialise();
+    payload.u64(nested.size());
+    payload.raw(nested.data(), nested.size());
+  }
   Writer w;
   w.raw(magic, sizeof magic);
   w.u32(format_version);
@@ -857,6 +883,20 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
       if (version >= 5) read_envelopes(r, 1, {&f.calibration.velocity_envelope});
       f.velocity = forest("fscc_velocity", f.form, static_cast<std::uint32_t>(fscc_names.size()));
       m.fscc = std::move(f);
+    }
+  }
+  if (version >= 6) {
+    const auto nested = r.u32();
+    if (nested > 1) r.damaged(fmt::format("{} reduced models", nested));
+    if (nested == 1) {
+      const auto block = r.bytes(r.count(r.u64(), 1));
+      auto reduced = parse(owner, block, name + " (its reduced model)");
+      std::vector<std::string> reduced_names;
+      for (const auto& fr : reduced.ranges) reduced_names.push_back(fr.name);
+      if (feature_set_of(reduced_names) != "measured" || reduced.fscc || reduced.reduced) {
+        r.damaged("the reduced model is not one of the measured features alone");
+      }
+      m.reduced = std::make_shared<const CorrectionModel>(std::move(reduced));
     }
   }
   if (!r.done()) r.damaged("bytes after the last forest");

@@ -172,6 +172,14 @@ const awcc::OptionField<T> kTraining[] = {
        o.feature_set = std::string(t);
      },
      [](const T& o) { return o.feature_set; }},
+    {"reduced", "-",
+     "with an extended feature set, also train the reduced model (u, Tu, c, d32, dx, dy, Np) that corrects rows "
+     "without fs, duration or windows (peers' files): on | off",
+     [](T& o, std::string_view t) {
+       if (t != "on" && t != "off") throw std::invalid_argument(fmt::format("'{}': write on or off", t));
+       o.reduced = t == "on";
+     },
+     [](const T& o) { return std::string(o.reduced ? "on" : "off"); }},
     {"features-per-split", "-", "features tried per split (1 to the feature count): the values tried",
      [](T& o, std::string_view t) {
        o.features_per_split_grid = whole_list(t, 1, static_cast<std::int64_t>(Features::names.size() + Features::record_names.size()));
@@ -950,6 +958,41 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
 
 }  // namespace
 
+namespace {
+
+// The reduced model (CorrectionModel::reduced): the measured features of the
+// same training runs, the same hyperparameters, its intervals calibrated
+// pooled over the window bands (a peer's row states no windows, so every
+// record length and rate it stands for is one group), scored on the
+// held-out runs with their record features removed.
+void train_reduced(const Split& split, const TrainOptions& o, const Hyperparameters& h, const Processing& processing,
+                   TrainResult& result) {
+  const auto names = feature_set_names("measured");
+  const int most = static_cast<int>(names.size());
+  ForestOptions velocity = h.velocity, turbulence = h.turbulence;
+  velocity.features_per_split = std::min(velocity.features_per_split, most);
+  turbulence.features_per_split = std::min(turbulence.features_per_split, most);
+  auto reduced = fit_model(split.training, h.velocity_form, h.turbulence_form, velocity, turbulence, o.min_windows, names);
+  if (!split.calibration.empty()) {
+    reduced.calibration = calibrate(reduced, split.calibration, {}, o.threads, o.calibration_tu_bands);
+  }
+  reduced.processing = processing;
+  reduced.provenance = fmt::format("the reduced model (features {}) of the model below, trained on its {} training "
+                                   "runs and calibrated on its {} calibration runs pooled over the window bands",
+                                   fmt::join(names, ", "), split.training.size(), split.calibration.size());
+  auto stripped = split.held_out;
+  for (auto& r : stripped) {
+    r.features.fs = 0.0;
+    r.features.duration = 0.0;
+    r.features.windows_accepted = -1;
+    r.features.windows_total = -1;
+  }
+  result.model.reduced = std::make_shared<const CorrectionModel>(std::move(reduced));
+  result.reduced_held_out = score(result.model, stripped, &result.reduced_predictions, o.threads);
+}
+
+}  // namespace
+
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
   o.validate().throw_if_failed();
   const auto names = feature_set_names(o.feature_set);
@@ -989,6 +1032,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   }
   result.calibration_rows = static_cast<std::int64_t>(split.calibration.size());
   if (o.feature_set != "measured") train_fscc(set, o, h.velocity, result);
+  if (o.feature_set != "measured" && o.reduced) train_reduced(split, o, h, set.processing, result);
   result.seconds_train = seconds_since(train_start);
   result.held_out = score(result.model, split.held_out, &result.predictions, o.threads);
   if (progress) progress(cv_share + 0.1);
@@ -1118,6 +1162,15 @@ std::string TrainResult::report() const {
                    "trust rules: {} outside the envelope, {} multimodal); training {} runs in {:.2f} s",
                    h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, training_rows, seconds_train));
   out += scores_report(h, predictions);
+  if (model.reduced) {
+    const auto& r = reduced_held_out;
+    line(fmt::format("Reduced model (rows without fs, duration or windows: peers' files), on the same held-out runs "
+                     "with those features removed: {} runs scored ({} outside the training ranges; {} untrusted)",
+                     r.rows, r.out_of_range, r.untrusted));
+    out += scores_report(r, reduced_predictions);
+    line(fmt::format("  pinball loss: velocity {:.6f} (extended {:.6f}), Tu {:.6f} (extended {:.6f})",
+                     r.velocity_pinball, h.velocity_pinball, r.tu_pinball, h.tu_pinball));
+  }
   if (!learning_curve.empty()) {
     line("Learning curve (held-out scores against training runs):");
     line("  (gain: paired decrease of the pinball loss from the previous point, +/- its standard error)");

@@ -82,6 +82,33 @@ grep -q -- "the fs stated for the whole file" <<<"$(column "$dir/nofs-corrected.
   fail "--fs without a unit accepted"
 [[ -e "$dir/bad.csv" ]] && fail "--fs without a unit: output written"
 
+# Peers' rows (issue 33): the reduced model trained beside the extended one
+# corrects a row that states neither fs, nor the duration, nor the windows,
+# and the output names its forest; the report scores it on the held-out runs
+# with those features removed.
+grep -q "^Reduced model (rows without fs, duration or windows: peers' files)" "$dir/report.txt" ||
+  fail "report: no reduced model"
+"$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0mm --np 10 --csv "$dir/r10.csv" || fail "process, Np 10"
+/usr/bin/python3 - "$dir/r10.csv" "$dir/peer.csv" <<'PY'
+import csv, sys
+r = next(csv.DictReader(open(sys.argv[1])))
+u, c, F = float(r["awcc_velocity"]), float(r["void_fraction"]), float(r["bubble_count_rate"])
+with open(sys.argv[2], "w") as out:  # pdp-uq's layout: no fs, duration or windows
+    out.write("u [m/s],u_rms [m/s],c [-],d_32a [m]\n")
+    out.write(f"{u!r},{float(r['awcc_velocity_rms'])!r},{c!r},{1.5 * u * c / F!r}\n")
+PY
+"$pdp" --log-level error correct "$dir/peer.csv" -m "$dir/x.qrf" --dx 4.5mm --dy 0mm --np 10 \
+  -o "$dir/peer-corrected.csv" || fail "correct a peer's row"
+[[ $(column "$dir/peer-corrected.csv" "correction_status [-]") == corrected ]] ||
+  fail "peer's row: $(cat "$dir/peer-corrected.csv")"
+[[ $(column "$dir/peer-corrected.csv" "correction_forest [-]") == awcc-reduced ]] || fail "peer's row: the forest is not named"
+grep -q "not known for this row: corrected by the reduced forest" <<<"$(column "$dir/peer-corrected.csv" "correction_notes [-]")" ||
+  fail "peer's row: no note"
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/noreduced.qrf" --feature-set extended --min-windows 10 --trees 20 \
+  --folds 0 --min-leaf 5 --features-per-split 3 --reduced off >"$dir/noreduced.txt" || fail "train --reduced off"
+grep -q "^Reduced model" "$dir/noreduced.txt" && fail "--reduced off: a reduced model all the same"
+[[ $(stat -c %s "$dir/noreduced.qrf") -lt $(stat -c %s "$dir/x.qrf") ]] || fail "--reduced off: the file is not smaller"
+
 if ((failures)); then
   echo "$failures failures"
   exit 1

@@ -181,8 +181,8 @@ TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "pdp-qrf\n");
-  // Format version 5 as u32 little-endian.
-  EXPECT_EQ(bytes[8], 5);
+  // Format version 6 as u32 little-endian.
+  EXPECT_EQ(bytes[8], 6);
   EXPECT_EQ(bytes[9], 0);
   EXPECT_EQ(bytes[10], 0);
   EXPECT_EQ(bytes[11], 0);
@@ -214,8 +214,8 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   const std::string text = "velocity,turbulence_intensity\n1,2\n";
   EXPECT_NE(message({text.begin(), text.end()}).find("not a pdp model file"), std::string::npos);
   auto newer = bytes;
-  newer[8] = 6;
-  EXPECT_NE(message(newer).find("version 6"), std::string::npos) << message(newer);
+  newer[8] = 7;
+  EXPECT_NE(message(newer).find("version 7"), std::string::npos) << message(newer);
   // A structural fault with a valid checksum: the reader checks the trees too.
   auto forged = bytes;
   // The first tree's root node follows the velocity targets; find it by
@@ -447,7 +447,7 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   const auto bytes = m.serialise();
   std::uint32_t version = 0;
   std::memcpy(&version, bytes.data() + 8, 4);
-  EXPECT_EQ(version, 5u);
+  EXPECT_EQ(version, 6u);
   EXPECT_EQ(CorrectionModel::parse(bytes, "x.qrf").serialise(), bytes);
   // The data yield: accepted over formed windows, when both are known.
   Features y = inside();
@@ -461,6 +461,65 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   EXPECT_FALSE(none.value("fs"));
   EXPECT_FALSE(none.value("windows_accepted"));
   EXPECT_FALSE(none.value("colour"));
+}
+
+TEST(Correction, RowsWithoutTheRecordsFeaturesGoToTheReducedModel) {
+  // An extended model with a reduced one (issue 33, peers' rows): a row that
+  // states fs, duration and windows is the extended model's; a row without
+  // any of them is the reduced model's, exactly as that model corrects it
+  // alone, its forest named and the missing features said; the file holds
+  // both and reads back bit for bit; a reduced model that is not of the
+  // measured features alone is refused as damaged.
+  auto m = model_of("extended", 9, [](Features& f, std::mt19937_64& g) {
+    f.velocity = 1 + 49 * uniform(g);
+    f.fs = 1e4 + 1e6 * uniform(g);
+    f.duration = 20 + 280 * uniform(g);
+    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * uniform(g));
+  }, [](const Features& f) { return 1.0 + 1e-7 * f.fs; });
+  const auto reduced = std::make_shared<const CorrectionModel>(model_of(
+      "measured", 10, [](Features& f, std::mt19937_64& g) { f.velocity = 1 + 49 * uniform(g); },
+      [](const Features& f) { return 1.0 + 0.001 * f.velocity; }));
+  m.reduced = reduced;
+  Features full = inside();
+  full.fs = 5e5;
+  full.duration = 100;
+  const auto extended = m.correct(full);
+  ASSERT_TRUE(extended.corrected()) << extended.message;
+  EXPECT_EQ(extended.forest, "awcc");
+  for (auto strip : {+[](Features& f) { f.fs = 0; }, +[](Features& f) { f.duration = 0; },
+                     +[](Features& f) { f.windows_accepted = -1; }}) {
+    Features peer = full;
+    strip(peer);
+    const auto c = m.correct(peer);
+    ASSERT_TRUE(c.corrected()) << c.message;
+    EXPECT_EQ(c.forest, "awcc-reduced");
+    const auto alone = reduced->correct(peer);
+    ASSERT_TRUE(alone.corrected());
+    EXPECT_EQ(c.velocity->quantiles, alone.velocity->quantiles);
+    EXPECT_EQ(c.turbulence_intensity->quantiles, alone.turbulence_intensity->quantiles);
+    ASSERT_FALSE(c.notes.empty());
+    EXPECT_NE(c.notes.front().find("not known for this row: corrected by the reduced forest"), std::string::npos)
+        << c.notes.front();
+  }
+  const auto bytes = m.serialise();
+  const auto back = CorrectionModel::parse(bytes, "x.qrf");
+  ASSERT_TRUE(back.reduced);
+  EXPECT_EQ(back.serialise(), bytes);
+  Features peer = full;
+  peer.fs = 0;
+  EXPECT_EQ(back.correct(peer).velocity->quantiles, m.correct(peer).velocity->quantiles);
+  // A reduced model of the extended features is not a reduced model.
+  auto wrong = m;
+  auto inner = m;
+  inner.reduced = nullptr;
+  wrong.reduced = std::make_shared<const CorrectionModel>(inner);
+  try {
+    (void)CorrectionModel::parse(wrong.serialise(), "w.qrf");
+    ADD_FAILURE() << "a reduced model of the extended features was read";
+  } catch (const awcc::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reduced model is not one of the measured features alone"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {

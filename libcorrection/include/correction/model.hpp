@@ -144,8 +144,9 @@ struct Correction {
   /// The forest's quantiles: of a corrected row, or of an untrusted one
   /// (which are not a corrected value: the report draws them apart).
   std::optional<CorrectedQuantity> velocity, turbulence_intensity;
-  /// Which forest gave the quantiles: "awcc", or "fscc" (the velocity only:
-  /// Tu stays uncorrected); empty when there are none.
+  /// Which forest gave the quantiles: "awcc", "awcc-reduced" (a row without
+  /// the record's features, CorrectionModel::reduced), or "fscc" (the
+  /// velocity only: Tu stays uncorrected); empty when there are none.
   std::string forest;
   /// What the user should know of a correction that stands (a feature held
   /// at its range's end), each said once.
@@ -243,7 +244,7 @@ struct FsccForest {
 };
 
 struct CorrectionModel {
-  static constexpr std::uint32_t format_version = 5;
+  static constexpr std::uint32_t format_version = 6;
 
   std::string provenance;             ///< how the model was made (sweep, rows, options, held-out scores)
   std::vector<FeatureRange> ranges;   ///< training data [min, max] per feature, feature order
@@ -255,6 +256,14 @@ struct CorrectionModel {
   QuantileForest velocity, turbulence_intensity;
   Calibration calibration;            ///< empty: the forests' quantiles as they are (format 1, 2)
   std::optional<FsccForest> fscc;     ///< the FSCC forest (format 3, when trained)
+  /// Peers' rows (issue 33): a model of the measured features only (u, Tu,
+  /// c, d32, dx, dy, Np), trained on the same runs over the whole range of
+  /// the record's features, for rows that do not state fs, the duration or
+  /// the windows (pdp-uq's CSV, Kramer's toolbox). Its intervals are
+  /// calibrated pooled over the records it stands for, so they are wider
+  /// than the extended model's for a record it knows. The correction names
+  /// it: forest "awcc-reduced". Format 6, extended models.
+  std::shared_ptr<const CorrectionModel> reduced;
 
   /// Corrected, or too few windows / outside the training range, with the reason.
   [[nodiscard]] Correction correct(const Features& f) const;

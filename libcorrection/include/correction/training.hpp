@@ -108,6 +108,9 @@ struct TrainOptions {
   /// "measured" (the seven features of METHOD 7) or "extended" (also fs,
   /// duration and accepted windows: records of every length and rate).
   std::string feature_set = "measured";
+  /// With an extended feature set, also train the reduced model
+  /// (CorrectionModel::reduced) for rows without the record's features.
+  bool reduced = true;
   /// Fraction of the non-held-out runs set aside to calibrate the intervals
   /// (model.hpp, Calibration): the forests are trained on the rest. Without
   /// it the forest's intervals are as wide as its leaves make them, which
@@ -193,6 +196,9 @@ struct TrainResult {
   int turbulence_min_leaf = 0, turbulence_features_per_split = 0;
   HeldOutScores held_out;
   std::vector<HeldOutPrediction> predictions;
+  /// The reduced model on the held-out runs with fs, duration and windows removed.
+  HeldOutScores reduced_held_out;
+  std::vector<HeldOutPrediction> reduced_predictions;
   std::vector<LearningPoint> learning_curve;  ///< nested training subsets 1/16, 1/8, 1/4, 1/2, 3/4, 1 of the training rows
   double seconds_cv = 0.0, seconds_train = 0.0;
   [[nodiscard]] std::string report() const;
