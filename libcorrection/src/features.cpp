@@ -25,6 +25,7 @@ FeatureUnit unit_of(std::string_view feature) {
   if (feature == "d32" || feature == "fscc_d32" || feature == "dx" || feature == "dy") return {"mm", 1e3};
   if (feature == "fs") return {"kHz", 1e-3};
   if (feature == "duration") return {"s", 1.0};
+  if (feature == "chord_time" || feature == "fscc_lag") return {"ms", 1e3};
   return {"-", 1.0};
 }
 
@@ -55,6 +56,7 @@ FeatureResult make_features(const Measurement& m) {
   f.windows_total = m.windows_total;
   f.fs = m.fs;
   f.duration = m.duration;
+  if (m.bubble_count_rate > 0.0) f.chord_time = m.void_fraction / m.bubble_count_rate;
   auto d32_of = [&](double u) {
     return m.bubble_count_rate > 0.0 ? 1.5 * u * m.void_fraction / m.bubble_count_rate : m.d32.value_or(0.0);
   };
@@ -105,11 +107,14 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == "fscc_velocity" && fscc_velocity > 0.0) return fscc_velocity;
   if (name == "r12_max" && fscc_velocity > 0.0) return r12_max;
   if (name == "fscc_d32" && fscc_d32 > 0.0) return fscc_d32;
+  if (name == "chord_time" && chord_time > 0.0) return chord_time;
+  if (name == "fscc_lag" && fscc_velocity > 0.0) return dx / fscc_velocity;
   return std::nullopt;
 }
 
 std::vector<std::string> feature_set_names(std::string_view set) {
   if (set == "fscc") return {Features::fscc_names.begin(), Features::fscc_names.end()};
+  if (set == "fscc-2") return {Features::fscc2_names.begin(), Features::fscc2_names.end()};
   if (set != "measured" && set != "extended" && set != "extended-yield") {
     throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7), extended (with "
                                             "fs, duration and accepted windows) or extended-yield (fs, duration and "

@@ -860,8 +860,10 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
     if (extra > 1) r.damaged(fmt::format("{} FSCC forests", extra));
     if (extra == 1) {
       FsccForest f;
-      const auto fscc_names = feature_set_names("fscc");
       f.ranges.resize(r.count(r.u32(), 20));
+      // Set 2 from format 6 on; the names say which.
+      const auto fscc_names =
+          feature_set_names(version >= 6 && f.ranges.size() == Features::fscc2_names.size() ? "fscc-2" : "fscc");
       if (f.ranges.size() != fscc_names.size()) r.damaged(fmt::format("{} FSCC feature ranges", f.ranges.size()));
       for (std::size_t j = 0; j < f.ranges.size(); ++j) {
         auto& fr = f.ranges[j];

@@ -39,6 +39,12 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 std::vector<double> levels() { return {correction_levels.begin(), correction_levels.end()}; }
 
+std::vector<std::string> names_of(const std::vector<FeatureRange>& ranges) {
+  std::vector<std::string> names;
+  for (const auto& r : ranges) names.push_back(r.name);
+  return names;
+}
+
 // A training row's feature vector in the order of `names` (every value is
 // there: load_training_set reads them all).
 std::vector<double> vector_of(const Features& f, const std::vector<std::string>& names) {
@@ -172,6 +178,14 @@ const awcc::OptionField<T> kTraining[] = {
        o.feature_set = std::string(t);
      },
      [](const T& o) { return o.feature_set; }},
+    {"fscc-feature-set", "-",
+     "features of the FSCC forest: fscc (u_FSCC, R12max, c, d32 from u_FSCC, dx, dy, fs, duration) or fscc-2 (c / F "
+     "and FSCC's lag dx / u_FSCC in place of that d32)",
+     [](T& o, std::string_view t) {
+       if (t != "fscc" && t != "fscc-2") throw std::invalid_argument(fmt::format("'{}': write fscc or fscc-2", t));
+       o.fscc_feature_set = std::string(t);
+     },
+     [](const T& o) { return o.fscc_feature_set; }},
     {"reduced", "-",
      "with an extended feature set, also train the reduced model (u, Tu, c, d32, dx, dy, Np) that corrects rows "
      "without fs, duration or windows (peers' files): on | off",
@@ -738,7 +752,7 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   const auto& held_out = split.held_out;
   const auto& calibration_rows = split.calibration;
   const auto& training = split.training;
-  const auto names = feature_set_names("fscc");
+  const auto names = feature_set_names(o.fscc_feature_set);
   FsccForest f;
   f.form = TargetForm::ratio;
   for (const auto& n : names) f.ranges.push_back({n, 1e300, -1e300});
@@ -937,10 +951,12 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
     const auto& f = result.fscc_held_out;
     const auto& u = result.fscc_held_out_unserved;
     provenance += fmt::format(
-        " FSCC forest (velocity of rows without a usable AWCC result): trained on {} runs{}; held out, the runs AWCC "
+        " FSCC forest (velocity of rows without a usable AWCC result; features {}): trained on {} runs{}; held out, the "
+        "runs AWCC "
         "cannot serve ({} rows): velocity RMSE {:.2f} % raw FSCC, {:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; "
         "all runs with an FSCC velocity ({} rows): RMSE {:.2f} % raw, {:.2f} % corrected, coverage {:.1f}/{:.1f} %.",
-        result.fscc_training_rows, result.fscc_calibration.empty() ? "" : ", " + result.fscc_calibration, u.rows,
+        fmt::join(names_of(result.model.fscc->ranges), ", "), result.fscc_training_rows,
+        result.fscc_calibration.empty() ? "" : ", " + result.fscc_calibration, u.rows,
         100 * u.rmse_raw, 100 * u.rmse_corrected, 100 * u.coverage80, 100 * u.coverage95, f.rows, 100 * f.rmse_raw,
         100 * f.rmse_corrected, 100 * f.coverage80, 100 * f.coverage95);
   }

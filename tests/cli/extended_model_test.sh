@@ -34,7 +34,7 @@ TOML
 "$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/x.qrf" --feature-set extended --min-windows 10 --trees 20 \
   --folds 0 --min-leaf 5 --features-per-split 3 >"$dir/report.txt" || fail "train"
 grep -q "fs, duration, windows_accepted" "$dir/report.txt" || fail "report: no extended features"
-grep -q "FSCC forest (velocity of rows without a usable AWCC result): trained on" "$dir/report.txt" ||
+grep -q "FSCC forest (velocity of rows without a usable AWCC result; features fscc_velocity, r12_max, void_fraction, fscc_d32, dx, dy, fs, duration): trained on" "$dir/report.txt" ||
   fail "report: no FSCC forest"
 grep -q "set aside to calibrate the intervals" "$dir/report.txt" || fail "report: no calibration"
 grep -q "^  windows 10-29 " "$dir/report.txt" || fail "report: no coverage by band of windows"
@@ -81,6 +81,17 @@ grep -q -- "the fs stated for the whole file" <<<"$(column "$dir/nofs-corrected.
 "$pdp" --log-level error correct "$dir/nofs.csv" -m "$dir/x.qrf" --fs 60 -o "$dir/bad.csv" 2>/dev/null &&
   fail "--fs without a unit accepted"
 [[ -e "$dir/bad.csv" ]] && fail "--fs without a unit: output written"
+
+# FSCC feature set 2 (c / F and FSCC's lag for FSCC's Sauter diameter): the
+# FSCC forest of such a model takes the same row, and the file names them.
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/x2.qrf" --feature-set extended --min-windows 10 --trees 20 \
+  --folds 0 --min-leaf 5 --features-per-split 3 --fscc-feature-set fscc-2 --reduced off >"$dir/report2.txt" ||
+  fail "train --fscc-feature-set fscc-2"
+grep -q "chord_time" "$dir/report2.txt" || fail "report: FSCC set 2 not named"
+"$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0mm --np 60 --correct "$dir/x2.qrf" \
+  --csv "$dir/r2.csv" || fail "process --correct, FSCC set 2"
+[[ $(column "$dir/r2.csv" correction_forest) == fscc && $(column "$dir/r2.csv" correction_status) == corrected ]] ||
+  fail "FSCC set 2: $(column "$dir/r2.csv" correction_status) $(column "$dir/r2.csv" correction_reason)"
 
 # Peers' rows (issue 33): the reduced model trained beside the extended one
 # corrects a row that states neither fs, nor the duration, nor the windows,

@@ -522,6 +522,31 @@ TEST(Correction, RowsWithoutTheRecordsFeaturesGoToTheReducedModel) {
   }
 }
 
+TEST(Correction, FsccFeatureSetTwoTakesTheChordTimeAndTheLag) {
+  // Set 2 replaces the Sauter diameter from FSCC's velocity by c / F and
+  // adds FSCC's lag dx / u_FSCC: both from the measurement, exactly.
+  correction::Measurement m;
+  m.void_fraction = 0.02;
+  m.bubble_count_rate = 16.0;
+  m.dx = 7.15e-3;
+  m.fscc_velocity = 2.8;
+  m.r12_max = 0.04;
+  m.fs = 20e3;
+  m.duration = 45.0;
+  const auto f = correction::make_features(m).features;
+  EXPECT_DOUBLE_EQ(*f.value("chord_time"), 0.02 / 16.0);
+  EXPECT_DOUBLE_EQ(*f.value("fscc_lag"), 7.15e-3 / 2.8);
+  EXPECT_DOUBLE_EQ(*f.value("fscc_d32"), 1.5 * 2.8 * 0.02 / 16.0);
+  const auto names = correction::feature_set_names("fscc-2");
+  ASSERT_EQ(names.size(), 9u);
+  for (const auto& n : names) EXPECT_TRUE(f.value(n)) << n;
+  EXPECT_EQ(std::find(names.begin(), names.end(), "fscc_d32"), names.end());
+  // Without bubbles or an FSCC velocity, neither is known.
+  EXPECT_FALSE(Features{}.value("chord_time"));
+  EXPECT_FALSE(Features{}.value("fscc_lag"));
+  EXPECT_EQ(correction::feature_value_text("fscc_lag", 2.5e-3), "fscc_lag = 2.5 ms");
+}
+
 TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
   // An extended-yield model (data yield = accepted / formed windows) and the
   // CSV other AWCC tools write: with the columns fs, duration,

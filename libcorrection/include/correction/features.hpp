@@ -23,6 +23,16 @@
 // R12max, c, the Sauter diameter from FSCC's velocity (1.5 u_FSCC c / F, or
 // a file's stated d32), dx, dy, fs and duration.
 //
+// FSCC feature set 2 ("fscc-2", model format 6; issue 33): the same with the
+// mean air-chord time c / F in place of FSCC's Sauter diameter, and FSCC's
+// lag dx / u_FSCC. The Sauter diameter from FSCC's velocity is d32 x
+// u_FSCC / u_true, a function of the target: where FSCC under-reads (its one
+// failure at low c, a spurious peak at a long lag) it comes out small, so a
+// forest trained where small bubbles were rare read every small d32 as a
+// failed FSCC and gave the real profile's 2 mm row two modes. c / F carries
+// the bubbles' size without FSCC's velocity folded in, and the lag says where
+// in the 20 ms searched the peak fell.
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -98,6 +108,10 @@ struct Features {
   /// The FSCC forest's features.
   static constexpr std::array<const char*, 8> fscc_names{"fscc_velocity", "r12_max", "void_fraction", "fscc_d32",
                                                          "dx",            "dy",      "fs",            "duration"};
+  /// The FSCC forest's features, set 2.
+  static constexpr std::array<const char*, 9> fscc2_names{"fscc_velocity", "r12_max", "void_fraction",
+                                                          "chord_time",    "fscc_lag", "dx",
+                                                          "dy",            "fs",       "duration"};
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
   /// Rows below a model's minimum are not corrected; -1 unknown.
   std::int64_t windows_accepted = -1;
@@ -105,6 +119,8 @@ struct Features {
   double fs = 0.0, duration = 0.0;  ///< Hz, s; 0 = not known
   /// FSCC's velocity (0: none), R12max, and d32 from FSCC's velocity (0: not known).
   double fscc_velocity = 0.0, r12_max = 0.0, fscc_d32 = 0.0;
+  /// The leading tip's mean air-chord time c / F, s (0: not known).
+  double chord_time = 0.0;
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
@@ -115,8 +131,8 @@ struct Features {
 
 /// The feature names of a feature set: "measured" (the seven), "extended"
 /// (the seven and the record's three), "extended-yield" (the same with the
-/// data yield for the accepted windows) or "fscc" (the FSCC forest's). Throws
-/// std::invalid_argument otherwise.
+/// data yield for the accepted windows), "fscc" or "fscc-2" (the FSCC
+/// forest's). Throws std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// "measured" or "extended" for a model's names in order; empty when they are neither.
 std::string feature_set_of(const std::vector<std::string>& names);

@@ -111,6 +111,8 @@ struct TrainOptions {
   /// With an extended feature set, also train the reduced model
   /// (CorrectionModel::reduced) for rows without the record's features.
   bool reduced = true;
+  /// The FSCC forest's features: "fscc" or "fscc-2" (correction/features.hpp).
+  std::string fscc_feature_set = "fscc";
   /// Fraction of the non-held-out runs set aside to calibrate the intervals
   /// (model.hpp, Calibration): the forests are trained on the rest. Without
   /// it the forest's intervals are as wide as its leaves make them, which
