@@ -753,15 +753,8 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
     insufficient();
     return;
   }
-  // The weighted mean and rms of one velocity of the accepted windows (METHOD 4).
   const auto moments = [&](double AwccWindow::*velocity) {
-    std::vector<double> values, weights;
-    for (const auto& w : windows) {
-      if (w.fate != WindowFate::accepted) continue;
-      values.push_back(w.*velocity);
-      weights.push_back(options.weighting == Weighting::duration ? w.duration : 1.0);
-    }
-    return weighted_moments(values, weights);
+    return accepted_moments(windows, options.weighting, velocity);
   };
   const auto [mean, rms] = moments(&AwccWindow::velocity);
   result.status = AwccStatus::ok;
@@ -786,6 +779,19 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
 }
 
 }  // namespace detail
+
+std::pair<double, double> accepted_moments(std::span<const AwccWindow> windows, Weighting weighting,
+                                           double AwccWindow::*velocity) {
+  std::vector<double> values, weights;
+  for (const auto& w : windows) {
+    if (w.fate != WindowFate::accepted) continue;
+    values.push_back(w.*velocity);
+    weights.push_back(weighting == Weighting::duration ? w.duration : 1.0);
+  }
+  if (values.empty()) return {0.0, 0.0};
+  const auto m = detail::weighted_moments(values, weights);
+  return {m.mean, m.rms};
+}
 
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options) {
   AwccWorkspace workspace;

@@ -385,6 +385,11 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
     cell(SweepColumn::multi_tip_quality) = std::string(awcc::to_string(probe->quality));
     cell(SweepColumn::multi_tip_bubbles_accepted) = count(probe->vectors.bubbles_accepted);
   }
+  if (awcc && awcc->ok() && processing.weighting == awcc::Weighting::duration && !awcc->probe_corrected) {
+    const auto [mean, rms] = awcc::accepted_moments(awcc->windows, awcc::Weighting::none);
+    cell(SweepColumn::awcc_velocity_unweighted) = num(mean);
+    cell(SweepColumn::awcc_turbulence_intensity_unweighted) = num(rms / mean);
+  }
   cell(SweepColumn::seconds_synth) = fmt::format("{:.4f}", r->seconds_synth);
   cell(SweepColumn::seconds_process) = fmt::format("{:.4f}", r->seconds_process);
   cell(SweepColumn::reason) = clean(reason);

@@ -80,6 +80,30 @@ TEST(SweepRows, TheCorrectionsCellsAreTheRunsMeasurement) {
   EXPECT_EQ(cell(row, "seconds_awcc"), "");
 }
 
+// The unweighted moments a duration-weighted run writes beside its own are
+// AWCC's with weighting none, to the last digit: the same windows, the other
+// convention; a run processed unweighted leaves them empty.
+TEST(SweepRows, TheUnweightedMomentsAreAwccsWithWeightingNone) {
+  auto run = short_run();
+  run.scene.arrival = synth::ArrivalRule::poisson_space;  // the weighting then matters
+  run.scene.duration = 6.0;
+  study::RunOptions options;
+  options.awcc.np = run.np;
+  const auto weighted = study::run_scene(run.scene, options);
+  const auto row = study::sweep_row(run, &weighted, "", 1, options.awcc);
+  auto unweighted_options = options;
+  unweighted_options.awcc.weighting = awcc::Weighting::none;
+  const auto unweighted = study::run_scene(run.scene, unweighted_options);
+  const auto& m = unweighted.measurement.measurement;
+  ASSERT_TRUE(m.velocity && weighted.measurement.measurement.velocity);
+  EXPECT_EQ(cell(row, "awcc_velocity_unweighted"), fmt::format("{:.10g}", *m.velocity));
+  EXPECT_EQ(cell(row, "awcc_turbulence_intensity_unweighted"), fmt::format("{:.10g}", *m.turbulence_intensity));
+  EXPECT_NE(cell(row, "awcc_velocity_unweighted"), cell(row, "awcc_velocity"));
+  const auto plain = study::sweep_row(run, &unweighted, "", 1, unweighted_options.awcc);
+  EXPECT_EQ(cell(plain, "awcc_velocity_unweighted"), "");
+  EXPECT_EQ(cell(plain, "awcc_turbulence_intensity_unweighted"), "");
+}
+
 // A four-tip scene (the clean one of METHOD 11.7: 8 mm spheres, Tu 0.05,
 // tips 2 mm apart) is processed bubble by bubble in a sweep, as pdp process
 // processes a recording stating its tips: the row carries the mean vector,

@@ -201,6 +201,13 @@ std::vector<AwccWindow> awcc_windows(const AirIntervals& leading, int np);
 /// AWCC of two binary signals (correlated as binary; options.signal must be
 /// binary: raw voltages are correlated by awcc_raw in awcc/process.hpp).
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options = {});
+
+/// The mean and rms (item 7) of the accepted windows' `velocity` under a
+/// weighting: what AWCC reports with that weighting, from the same windows
+/// (the filter and the outlier cutoff do not depend on it). {0, 0} without
+/// an accepted window.
+[[nodiscard]] std::pair<double, double> accepted_moments(std::span<const AwccWindow> windows, Weighting weighting,
+                                                         double AwccWindow::*velocity = &AwccWindow::velocity);
 /// The same with the caller's workspace.
 AwccResult awcc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const AwccOptions& options,
                 AwccWorkspace& workspace);

@@ -59,6 +59,7 @@ enum class SweepColumn : std::size_t {
   multi_tip_velocity_x, multi_tip_velocity_y, multi_tip_velocity_z,
   multi_tip_turbulence_intensity_x, multi_tip_turbulence_intensity_y, multi_tip_turbulence_intensity_z,
   multi_tip_interfacial_area, multi_tip_quality, multi_tip_bubbles_accepted,
+  awcc_velocity_unweighted, awcc_turbulence_intensity_unweighted,
   generator_version,
   count
 };
@@ -115,6 +116,10 @@ inline constexpr std::array<SweepColumnInfo, sweep_result_column_count> sweep_re
     {"multi_tip_interfacial_area", "1/m", "multi-tip interfacial area concentration"},
     {"multi_tip_quality", "text", "multi-tip quality: ok, low or insufficient"},
     {"multi_tip_bubbles_accepted", "-", "bubbles with an accepted velocity vector"},
+    {"awcc_velocity_unweighted", "m/s",
+     "AWCC's mean velocity of the same accepted windows with unweighted moments, when the run was processed with "
+     "duration weighting (empty otherwise): the other tools' convention, at no cost (issue 33)"},
+    {"awcc_turbulence_intensity_unweighted", "-", "AWCC's Tu of the same accepted windows, unweighted"},
     {"generator_version", "-",
      "the version of the seeded streams that made the run (awcc::generator_version; sweeps written before the "
      "column existed are version 1)"},
