@@ -237,24 +237,18 @@ assert all(60 <= n <= 140 for n in arrivals.values()), arrivals
 retries = collections.Counter(r["overlap_retries"] for r in mixed)
 assert set(retries) == {"0", "30"} and all(150 <= n <= 250 for n in retries.values()), retries
 PY
-badchoice() {  # bad TOML-body expected-message
+refused() {  # TOML-body (printf %b escapes) expected-message: refused, named, no CSV
   printf '%b' "$1" >"$dir/bad.toml"
   local out
   out=$("$pdp" sweep "$dir/bad.toml" -o "$dir/bad.csv" 2>&1) && fail "accepted: $1"
   [[ $out == *"$2"* ]] || fail "$1: message lacks '$2': $out"
   [[ -e $dir/bad.csv ]] && fail "$1: wrote a CSV"
 }
-badchoice '[sweep]\nmode = "monte-carlo"\nruns = 4\n[choices]\narrival = ["equal-time"]\n' 'at least two values'
-badchoice '[sweep]\nmode = "monte-carlo"\nruns = 4\n[choices]\narrival = ["equal-time", "sometimes"]\n' 'sometimes'
-badchoice '[sweep]\nmode = "monte-carlo"\nruns = 4\n[ranges]\ndx = ["1mm", "2mm"]\n[choices]\ndx = ["1mm", "3mm"]\n' 'in one table'
-badchoice '[sweep]\nmode = "grid"\n[grid]\ndx = ["1mm"]\n[choices]\narrival = ["equal-time", "equal-space"]\n' 'monte-carlo sweep'
-bad() {  # bad TOML-ranges-line expected-message
-  printf '[sweep]\nmode = "monte-carlo"\nruns = 4\n[ranges]\n%s\n' "$1" >"$dir/bad.toml"
-  local out
-  out=$("$pdp" sweep "$dir/bad.toml" -o "$dir/bad.csv" 2>&1) && fail "accepted: $1"
-  [[ $out == *"$2"* ]] || fail "$1: message lacks '$2': $out"
-  [[ -e $dir/bad.csv ]] && fail "$1: wrote a CSV"
-}
+refused '[sweep]\nmode = "monte-carlo"\nruns = 4\n[choices]\narrival = ["equal-time"]\n' 'at least two values'
+refused '[sweep]\nmode = "monte-carlo"\nruns = 4\n[choices]\narrival = ["equal-time", "sometimes"]\n' 'sometimes'
+refused '[sweep]\nmode = "monte-carlo"\nruns = 4\n[ranges]\ndx = ["1mm", "2mm"]\n[choices]\ndx = ["1mm", "3mm"]\n' 'in one table'
+refused '[sweep]\nmode = "grid"\n[grid]\ndx = ["1mm"]\n[choices]\narrival = ["equal-time", "equal-space"]\n' 'monte-carlo sweep'
+bad() { refused "[sweep]\\nmode = \"monte-carlo\"\\nruns = 4\\n[ranges]\\n$1\\n" "$2"; }  # a bad [ranges] line
 bad 'fs = ["10kHz", "1MHz", "lin"]' 'or [min, max, "log"]'
 bad 'fs = ["0Hz", "1MHz", "log"]' 'needs min > 0'
 

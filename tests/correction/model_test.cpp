@@ -420,18 +420,24 @@ TEST(Correction, ModelFileKeepsTheProcessing) {
   EXPECT_TRUE(v1.processing == correction::Processing{});
 }
 
+// An extended model over u 1-50 m/s, fs 10 kHz-1 MHz, 20-300 s and 10-1010
+// windows, its velocity target rising with fs.
+CorrectionModel extended_model() {
+  return model_of("extended", 9, [](Features& f, std::mt19937_64& g) {
+    f.velocity = 1 + 49 * uniform(g);
+    f.fs = 1e4 + 1e6 * uniform(g);
+    f.duration = 20 + 280 * uniform(g);
+    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * uniform(g));
+  }, [](const Features& f) { return 1.0 + 1e-7 * f.fs; });
+}
+
 TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   // A model whose ranges are the extended set: a row without fs is not
   // corrected and says which feature is missing; with it, it is corrected
   // exactly as the forests say; the file reads back bit for bit, as version 3.
   const auto names = correction::feature_set_names("extended");
   ASSERT_EQ(names.size(), 10u);
-  auto m = model_of("extended", 9, [](Features& f, std::mt19937_64& g) {
-    f.velocity = 1 + 49 * uniform(g);
-    f.fs = 1e4 + 1e6 * uniform(g);
-    f.duration = 20 + 280 * uniform(g);
-    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * uniform(g));
-  }, [](const Features& f) { return 1.0 + 1e-7 * f.fs; });
+  auto m = extended_model();
   Features f = inside();
   const auto missing = m.correct(f);
   EXPECT_EQ(missing.status, correction::CorrectionStatus::missing_feature);
@@ -470,12 +476,7 @@ TEST(Correction, RowsWithoutTheRecordsFeaturesGoToTheReducedModel) {
   // alone, its forest named and the missing features said; the file holds
   // both and reads back bit for bit; a reduced model that is not of the
   // measured features alone is refused as damaged.
-  auto m = model_of("extended", 9, [](Features& f, std::mt19937_64& g) {
-    f.velocity = 1 + 49 * uniform(g);
-    f.fs = 1e4 + 1e6 * uniform(g);
-    f.duration = 20 + 280 * uniform(g);
-    f.windows_accepted = 10 + static_cast<std::int64_t>(1000 * uniform(g));
-  }, [](const Features& f) { return 1.0 + 1e-7 * f.fs; });
+  auto m = extended_model();
   const auto reduced = std::make_shared<const CorrectionModel>(model_of(
       "measured", 10, [](Features& f, std::mt19937_64& g) { f.velocity = 1 + 49 * uniform(g); },
       [](const Features& f) { return 1.0 + 0.001 * f.velocity; }));
