@@ -761,6 +761,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.message.clear();
   result.velocity = mean;
   result.velocity_rms = rms;
+  result.weighting = options.weighting;
   const auto intervals = moment_intervals95(mean, rms, result.windows_accepted);
   result.turbulence_intensity = intervals.turbulence_intensity;
   if (result.probe_corrected) {

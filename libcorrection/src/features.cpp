@@ -57,6 +57,7 @@ FeatureResult make_features(const Measurement& m) {
   f.fs = m.fs;
   f.duration = m.duration;
   if (m.bubble_count_rate > 0.0) f.chord_time = m.void_fraction / m.bubble_count_rate;
+  if (m.weighting) f.awcc_unweighted = *m.weighting == awcc::Weighting::none ? 1 : 0;
   auto d32_of = [&](double u) {
     return m.bubble_count_rate > 0.0 ? 1.5 * u * m.void_fraction / m.bubble_count_rate : m.d32.value_or(0.0);
   };
@@ -108,17 +109,24 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == "r12_max" && fscc_velocity > 0.0) return r12_max;
   if (name == "fscc_d32" && fscc_d32 > 0.0) return fscc_d32;
   if (name == "chord_time" && chord_time > 0.0) return chord_time;
+  if (name == weighting_name && awcc_unweighted >= 0) return static_cast<double>(awcc_unweighted);
   if (name == "fscc_lag" && fscc_velocity > 0.0) return dx / fscc_velocity;
   return std::nullopt;
 }
 
 std::vector<std::string> feature_set_names(std::string_view set) {
+  constexpr std::string_view weighted = "+weighting";
+  if (set.ends_with(weighted) && !set.starts_with("fscc")) {
+    auto names = feature_set_names(set.substr(0, set.size() - weighted.size()));
+    names.emplace_back(Features::weighting_name);
+    return names;
+  }
   if (set == "fscc") return {Features::fscc_names.begin(), Features::fscc_names.end()};
   if (set == "fscc-2") return {Features::fscc2_names.begin(), Features::fscc2_names.end()};
   if (set != "measured" && set != "extended" && set != "extended-yield") {
     throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7), extended (with "
                                             "fs, duration and accepted windows) or extended-yield (fs, duration and "
-                                            "the data yield)",
+                                            "the data yield), each optionally followed by +weighting",
                                             set));
   }
   std::vector<std::string> out(Features::names.begin(), Features::names.end());
@@ -128,7 +136,8 @@ std::vector<std::string> feature_set_names(std::string_view set) {
 }
 
 std::string feature_set_of(const std::vector<std::string>& names) {
-  for (const char* set : {"measured", "extended", "extended-yield"})
+  for (const char* set : {"measured", "extended", "extended-yield", "measured+weighting", "extended+weighting",
+                          "extended-yield+weighting"})
     if (names == feature_set_names(set)) return set;
   return {};
 }
@@ -151,6 +160,7 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   }
   if (r.awcc) {
     m.np = r.awcc->np;
+    m.weighting = r.awcc->weighting;
     m.windows_accepted = r.awcc->windows_accepted;
     m.windows_total = r.awcc->windows_total;
   }

@@ -551,7 +551,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f);
 Attempt reduced_attempt(const CorrectionModel& m, const Features& f) {
   std::vector<std::string> missing;
   for (const auto& r : m.ranges)
-    if (!f.value(r.name)) missing.push_back(r.name);
+    if (!f.value(r.name) && r.name != Features::weighting_name) missing.push_back(r.name);
   Attempt a = awcc_attempt(*m.reduced, f);
   auto& c = a.correction;
   if (c.velocity) {
@@ -570,12 +570,23 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
                           fmt::format("{} accepted windows; the model was trained on runs with at least {}",
                                       f.windows_accepted, m.min_windows))};
   }
-  const auto x = feature_vector(m.ranges, m.range_margin, f);
+  // A row whose weighting is not known, for a model that takes it: both
+  // answers, equally weighted (correction/features.hpp).
+  const bool mixed = m.takes_weighting() && f.awcc_unweighted < 0;
+  Features known = f;
+  if (mixed) known.awcc_unweighted = 0;
+  const auto x = feature_vector(m.ranges, m.range_margin, known);
   if (x.status == CorrectionStatus::missing_feature && m.reduced) return reduced_attempt(m, f);
   if (!x.ok()) return refused(x, f);
   const auto& cal = m.calibration;
-  const auto velocity_d = m.velocity.distribution(x.x);
-  const auto tu_d = m.turbulence_intensity.distribution(x.x);
+  auto velocity_d = m.velocity.distribution(x.x);
+  auto tu_d = m.turbulence_intensity.distribution(x.x);
+  if (mixed) {
+    auto other = x.x;
+    other[m.weighting_feature()] = 1.0;
+    velocity_d = mixture(velocity_d, m.velocity.distribution(other));
+    tu_d = mixture(tu_d, m.turbulence_intensity.distribution(other));
+  }
   auto velocity_t = quantiles_of(velocity_d);
   auto tu_t = quantiles_of(tu_d);
   // The group's Tu band: the Tu forest's own median, before calibration.
@@ -592,6 +603,10 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   c.velocity = corrected_quantity(u, velocity_t);
   c.turbulence_intensity = corrected_quantity(tu, tu_t);
   c.notes = x.notes;
+  if (mixed) {
+    c.notes.push_back("how AWCC's moments were taken is not known for this row: the answers for duration-weighted "
+                      "and unweighted moments are mixed, equally weighted (state it: pdp correct --weighting)");
+  }
   const std::string runs = cal.envelope_from_training
                                ? "the forest's training runs"
                                : fmt::format("runs the model was not trained on ({})",
@@ -696,8 +711,18 @@ void CorrectionModel::use_training_envelopes() {
 }
 
 std::string CorrectionModel::mismatch(const Processing& results) const {
-  return processing_mismatch(processing, results);
+  Processing compared = results;
+  if (takes_weighting()) compared.weighting = processing.weighting;  // a feature, not a mismatch
+  return processing_mismatch(processing, compared);
 }
+
+std::size_t CorrectionModel::weighting_feature() const {
+  for (std::size_t j = 0; j < ranges.size(); ++j)
+    if (ranges[j].name == Features::weighting_name) return j;
+  return ranges.size();
+}
+
+bool CorrectionModel::takes_weighting() const { return weighting_feature() < ranges.size(); }
 
 std::vector<std::uint8_t> CorrectionModel::serialise() const {
   Writer payload;
@@ -895,7 +920,8 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
       auto reduced = parse(owner, block, name + " (its reduced model)");
       std::vector<std::string> reduced_names;
       for (const auto& fr : reduced.ranges) reduced_names.push_back(fr.name);
-      if (feature_set_of(reduced_names) != "measured" || reduced.fscc || reduced.reduced) {
+      const auto reduced_set = feature_set_of(reduced_names);
+      if ((reduced_set != "measured" && reduced_set != "measured+weighting") || reduced.fscc || reduced.reduced) {
         r.damaged("the reduced model is not one of the measured features alone");
       }
       m.reduced = std::make_shared<const CorrectionModel>(std::move(reduced));

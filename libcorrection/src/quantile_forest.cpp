@@ -198,6 +198,19 @@ double WeightedDistribution::quantile(double alpha) const {
   return values.back();
 }
 
+WeightedDistribution mixture(const WeightedDistribution& a, const WeightedDistribution& b) {
+  WeightedDistribution out;
+  out.values.reserve(a.values.size() + b.values.size());
+  out.weights.reserve(a.values.size() + b.values.size());
+  std::size_t i = 0, j = 0;
+  while (i < a.values.size() || j < b.values.size()) {
+    const bool from_a = j == b.values.size() || (i < a.values.size() && a.values[i] <= b.values[j]);
+    out.values.push_back(from_a ? a.values[i] : b.values[j]);
+    out.weights.push_back(0.5 * (from_a ? a.weights[i++] : b.weights[j++]));
+  }
+  return out;
+}
+
 QuantileForest QuantileForest::train(const TrainingData& data, const ForestOptions& options) {
   if (auto v = options.validate(); !v.ok()) throw awcc::OptionError("forest options: " + v.message, v.quantity);
   const auto n = data.rows();

@@ -145,8 +145,12 @@ Correction correct_row(const CorrectionModel& model, const MeasurementResult& ou
     }
     return model.correct(result);
   }
-  const auto result = measurement();
-  check_processing(model, processing(), where, warnings);
+  auto result = measurement();
+  const auto processed = processing();
+  check_processing(model, processed, where, warnings);
+  // The weighting the file records; a file that records no processing is
+  // assumed processed as the model's training data (check_processing warns).
+  result.measurement.weighting = processed ? processed->weighting : model.processing.weighting;
   return model.correct(result);
 }
 
@@ -195,8 +199,12 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     if (!col.count(name)) throw awcc::InputError(fmt::format("{}: no column '{}'. {}", file, name, kLayouts));
   }
   out.warnings.push_back(fmt::format("{}: the file records neither AWCC's accepted windows nor its processing: "
-                                     "assumed enough windows and the model's processing ({})",
-                                     file, describe(model.processing)));
+                                     "assumed enough windows and the model's processing ({}){}",
+                                     file, describe(model.processing),
+                                     !model.takes_weighting() ? ""
+                                     : d.weighting ? fmt::format(", moments {} as stated", awcc::to_string(*d.weighting))
+                                                   : ", the weighting excepted: not known, both answers mixed "
+                                                     "(state it with --weighting)"));
   out.text = line;
   for (const char* q : {"u", "Tu"}) {
     const char* unit = q[0] == 'u' ? "m/s" : "-";
@@ -229,6 +237,7 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     m.duration = optional("duration").value_or(d.duration.value_or(0.0));
     if (const auto w = optional("awcc_windows_accepted")) m.windows_accepted = whole(*w, where, "awcc_windows_accepted");
     if (const auto w = optional("awcc_windows_total")) m.windows_total = whole(*w, where, "awcc_windows_total");
+    m.weighting = d.weighting;  // not known unless stated
     const auto c = c_value ? model.correct(m)
                            : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
     add_notes(c, where, out.warnings);

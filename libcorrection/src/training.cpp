@@ -196,7 +196,8 @@ const awcc::OptionField<T> kTraining[] = {
      [](const T& o) { return std::string(o.reduced ? "on" : "off"); }},
     {"features-per-split", "-", "features tried per split (1 to the feature count): the values tried",
      [](T& o, std::string_view t) {
-       o.features_per_split_grid = whole_list(t, 1, static_cast<std::int64_t>(Features::names.size() + Features::record_names.size()));
+       o.features_per_split_grid =
+           whole_list(t, 1, static_cast<std::int64_t>(Features::names.size() + Features::record_names.size() + 1));
        o.features_per_split = o.features_per_split_grid.front();
      },
      [](const T& o) { return list_text(o.features_per_split_grid); }},
@@ -394,6 +395,9 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       m.duration = optional_number(Scene::duration).value_or(0.0);
       m.fscc_velocity = optional_number(column_name(C::fscc_velocity));
       m.r12_max = optional_number(column_name(C::fscc_r12_max));
+      // Every row of a set shares one processing (checked above); runs
+      // without the columns were processed with the defaults.
+      m.weighting = has_processing ? set.processing.weighting : awcc::Weighting::duration;
       const auto features = make_features(m);
       if (truth == TruthKind::realised) {
         r.true_velocity = number_of(column_name(C::truth_velocity));
@@ -417,6 +421,16 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         continue;
       }
       r.features = features.features;
+      // The same windows' unweighted moments, where the sweep wrote them.
+      const auto u_unweighted = optional_number(column_name(C::awcc_velocity_unweighted));
+      const auto tu_unweighted = optional_number(column_name(C::awcc_turbulence_intensity_unweighted));
+      if (u_unweighted && tu_unweighted) {
+        Measurement twin = m;
+        twin.velocity = u_unweighted;
+        twin.turbulence_intensity = tu_unweighted;
+        twin.weighting = awcc::Weighting::none;
+        if (const auto t = make_features(twin); t.ok()) r.unweighted = t.features;
+      }
       set.rows.push_back(r);
     }
     for (const auto& s : studies) set.sources.push_back(fmt::format("{} (study {})", path.filename().string(), s));
@@ -847,6 +861,13 @@ void cross_validate(const std::vector<TrainingRow>& training, const TrainOptions
                     const std::function<void(double)>& progress, Hyperparameters& h, TrainResult& result) {
   const std::size_t grid = o.min_leaf_grid.size() * o.features_per_split_grid.size() * 2;
   const auto k = static_cast<std::size_t>(o.folds);
+  // Folds by run: a run's rows (its weighted and unweighted twins, side by
+  // side) fall in one fold, so that no fold is scored on a run it fit.
+  std::vector<std::size_t> run_ordinal(training.size());
+  for (std::size_t i = 0, ordinal = 0; i < training.size(); ++i) {
+    if (i > 0 && (training[i].run != training[i - 1].run || training[i].study != training[i - 1].study)) ++ordinal;
+    run_ordinal[i] = ordinal;
+  }
   std::size_t done = 0;
   for (int target = 0; target < 2; ++target) {
     const bool velocity = target == 0;
@@ -859,7 +880,8 @@ void cross_validate(const std::vector<TrainingRow>& training, const TrainOptions
           double loss = 0.0;
           for (std::size_t fold = 0; fold < k; ++fold) {
             std::vector<TrainingRow> fit, test;
-            for (std::size_t i = 0; i < training.size(); ++i) (i % k == fold ? test : fit).push_back(training[i]);
+            for (std::size_t i = 0; i < training.size(); ++i)
+              (run_ordinal[i] % k == fold ? test : fit).push_back(training[i]);
             ForestOptions fo;
             fo.trees = o.cv_trees;
             fo.min_leaf = leaf;
@@ -976,6 +998,22 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
 
 namespace {
 
+// The rows and, after each that has one, its unweighted twin (the same run's
+// windows with unweighted moments, feature awcc_unweighted 1).
+std::vector<TrainingRow> with_unweighted_twins(const std::vector<TrainingRow>& rows) {
+  std::vector<TrainingRow> out;
+  out.reserve(2 * rows.size());
+  for (const auto& r : rows) {
+    out.push_back(r);
+    if (!r.unweighted) continue;
+    TrainingRow twin = r;
+    twin.features = *r.unweighted;
+    twin.unweighted.reset();
+    out.push_back(std::move(twin));
+  }
+  return out;
+}
+
 // The reduced model (CorrectionModel::reduced): the measured features of the
 // same training runs, the same hyperparameters, its intervals calibrated
 // pooled over the window bands (a peer's row states no windows, so every
@@ -983,7 +1021,7 @@ namespace {
 // held-out runs with their record features removed.
 void train_reduced(const Split& split, const TrainOptions& o, const Hyperparameters& h, const Processing& processing,
                    TrainResult& result) {
-  const auto names = feature_set_names("measured");
+  const auto names = feature_set_names(result.model.takes_weighting() ? "measured+weighting" : "measured");
   const int most = static_cast<int>(names.size());
   ForestOptions velocity = h.velocity, turbulence = h.turbulence;
   velocity.features_per_split = std::min(velocity.features_per_split, most);
@@ -1012,8 +1050,13 @@ void train_reduced(const Split& split, const TrainOptions& o, const Hyperparamet
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
   o.validate().throw_if_failed();
   const auto names = feature_set_names(o.feature_set);
-  const Split split = split_runs(set.rows, o);
+  Split split = split_runs(set.rows, o);
   const std::size_t runs = set.rows.size();
+  const bool twins = names.back() == Features::weighting_name;
+  if (twins) {
+    // Each run measured both ways, its twins side by side in its part.
+    for (auto* part : {&split.held_out, &split.calibration, &split.training}) *part = with_unweighted_twins(*part);
+  }
   if (split.held_out.empty() || split.held_out.size() >= runs) {
     throw awcc::OptionError(fmt::format("{} usable runs cannot be split {:.0f}/{:.0f}; run a larger sweep", runs,
                                         100 * (1 - o.held_out), 100 * o.held_out),
@@ -1352,16 +1395,17 @@ std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const 
 
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
   std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,fs,duration,"
-                    "true_velocity,true_turbulence_intensity,in_range,status";
+                    "awcc_unweighted,true_velocity,true_turbulence_intensity,in_range,status";
   for (const char* q : {"velocity", "turbulence_intensity"}) {
     for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
   out += "\n";
   for (const auto& p : predictions) {
     const auto& f = p.row.features;
-    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{},{}",
+    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{},{:.10g},{:.10g},{},{}",
                        p.row.run, f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np,
-                       f.windows_accepted, f.fs, f.duration, p.row.true_velocity, p.row.true_turbulence_intensity,
+                       f.windows_accepted, f.fs, f.duration, f.awcc_unweighted, p.row.true_velocity,
+                       p.row.true_turbulence_intensity,
                        p.correction.corrected() ? 1 : 0, to_string(p.correction.status));
     for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
       for (std::size_t k = 0; k < correction_levels.size(); ++k) {

@@ -120,6 +120,37 @@ grep -q "not known for this row: corrected by the reduced forest" <<<"$(column "
 grep -q "^Reduced model" "$dir/noreduced.txt" && fail "--reduced off: a reduced model all the same"
 [[ $(stat -c %s "$dir/noreduced.qrf") -lt $(stat -c %s "$dir/x.qrf") ]] || fail "--reduced off: the file is not smaller"
 
+# The AWCC weighting as a feature (issue 33): every run trains twice, its
+# duration-weighted and its unweighted measurement side by side in one part
+# of the split; a recording processed either way is corrected (no refusal for
+# the weighting), as its own; a peer's row of unknown weighting gets both
+# answers mixed, and a note that says how to state it.
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/xw.qrf" --feature-set extended+weighting --min-windows 10 \
+  --trees 20 --folds 2 --cv-trees 5 --min-leaf 5 --features-per-split 3 --predictions "$dir/xw-pred.csv" \
+  >"$dir/xw.txt" || fail "train extended+weighting"
+/usr/bin/python3 - "$dir/xw-pred.csv" <<'PY' || fail "weighting twins: not side by side in the held-out runs"
+import csv, sys, collections
+rows = list(csv.DictReader(open(sys.argv[1])))
+by_run = collections.defaultdict(list)
+for r in rows:
+    by_run[r["run"]].append(r["awcc_unweighted"])
+assert by_run and all(sorted(v) == ["0", "1"] for v in by_run.values()), list(by_run.items())[:5]
+PY
+for w in duration none; do
+  "$pdp" --log-level error process "$dir/rec.flac" --dx 4.5mm --dy 0mm --np 10 --weighting $w --correct "$dir/xw.qrf" \
+    --csv "$dir/w-$w.csv" || fail "process --weighting $w --correct (a model with the weighting feature)"
+  [[ $(column "$dir/w-$w.csv" correction_status) == corrected ]] || fail "weighting $w: $(column "$dir/w-$w.csv" correction_reason)"
+done
+[[ $(column "$dir/w-none.csv" corrected_velocity) != $(column "$dir/w-duration.csv" corrected_velocity) ]] ||
+  fail "the weighting feature made no difference"
+"$pdp" --log-level error correct "$dir/peer.csv" -m "$dir/xw.qrf" --dx 4.5mm --dy 0mm --np 10 \
+  -o "$dir/peer-w.csv" || fail "correct a peer's row, weighting unknown"
+grep -q "answers for duration-weighted and unweighted moments are mixed" <<<"$(column "$dir/peer-w.csv" "correction_notes [-]")" ||
+  fail "unknown weighting: no note"
+"$pdp" --log-level error correct "$dir/peer.csv" -m "$dir/xw.qrf" --dx 4.5mm --dy 0mm --np 10 --weighting none \
+  -o "$dir/peer-none.csv" || fail "correct a peer's row, --weighting none"
+grep -q "mixed" <<<"$(column "$dir/peer-none.csv" "correction_notes [-]")" && fail "--weighting none: mixed all the same"
+
 if ((failures)); then
   echo "$failures failures"
   exit 1

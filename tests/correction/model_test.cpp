@@ -548,6 +548,51 @@ TEST(Correction, FsccFeatureSetTwoTakesTheChordTimeAndTheLag) {
   EXPECT_EQ(correction::feature_value_text("fscc_lag", 2.5e-3), "fscc_lag = 2.5 ms");
 }
 
+TEST(Correction, TheWeightingAsAFeatureCorrectsEitherAndMixesAnUnknownOne) {
+  // A model whose velocity target is 1 for duration-weighted rows and 0.95
+  // for unweighted ones (unweighted moments high by about Tu^2): each
+  // weighting is corrected as its own, a row of unknown weighting by the
+  // mixture of both (its quantiles spanning both answers, with a note), and
+  // the processing check does not refuse the other weighting.
+  auto m = model_of("measured+weighting", 12, [](Features& f, std::mt19937_64& g) {
+    f.velocity = 1 + 49 * uniform(g);
+    f.awcc_unweighted = uniform(g) < 0.5 ? 1 : 0;
+  }, [](const Features& f) { return f.awcc_unweighted == 1 ? 0.95 : 1.0; });
+  ASSERT_TRUE(m.takes_weighting());
+  EXPECT_EQ(m.weighting_feature(), 7u);
+  Features f = inside();
+  f.awcc_unweighted = 0;
+  const auto weighted = m.correct(f);
+  f.awcc_unweighted = 1;
+  const auto unweighted = m.correct(f);
+  f.awcc_unweighted = -1;
+  const auto unknown = m.correct(f);
+  ASSERT_TRUE(weighted.corrected() && unweighted.corrected()) << weighted.message << unweighted.message;
+  EXPECT_DOUBLE_EQ(weighted.velocity->median(), 10.0);
+  EXPECT_DOUBLE_EQ(unweighted.velocity->median(), 9.5);
+  ASSERT_TRUE(unknown.velocity);
+  EXPECT_DOUBLE_EQ(unknown.velocity->quantiles.front(), 9.5);
+  EXPECT_DOUBLE_EQ(unknown.velocity->quantiles.back(), 10.0);
+  ASSERT_FALSE(unknown.notes.empty());
+  EXPECT_NE(unknown.notes.back().find("--weighting"), std::string::npos);
+  correction::Processing none;
+  none.weighting = awcc::Weighting::none;
+  EXPECT_EQ(m.mismatch(none), "");
+  none.filter_a = 0.3;
+  EXPECT_NE(m.mismatch(none).find("filter A"), std::string::npos);
+  EXPECT_EQ(correction::feature_set_of(correction::feature_set_names("extended-yield+weighting")),
+            "extended-yield+weighting");
+  // A measurement says its weighting through the feature.
+  correction::Measurement meas;
+  meas.velocity = 3.0;
+  meas.turbulence_intensity = 0.2;
+  meas.void_fraction = 0.1;
+  meas.bubble_count_rate = 50.0;
+  EXPECT_FALSE(correction::make_features(meas).features.value("awcc_unweighted"));
+  meas.weighting = awcc::Weighting::none;
+  EXPECT_EQ(*correction::make_features(meas).features.value("awcc_unweighted"), 1.0);
+}
+
 TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
   // An extended-yield model (data yield = accepted / formed windows) and the
   // CSV other AWCC tools write: with the columns fs, duration,

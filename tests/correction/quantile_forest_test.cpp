@@ -40,6 +40,30 @@ TrainingData random_data(std::size_t n, int features, std::uint64_t seed) {
   return d;
 }
 
+TEST(QuantileForest, AMixtureHalvesEachWeightAndKeepsTheValuesInOrder) {
+  // The mixture of {1, 2} (1/2 each) and {1.5, 3} (1/4, 3/4): values 1, 1.5,
+  // 2, 3 with weights 1/4, 1/8, 1/4, 3/8; its quantiles are those of the
+  // merged sample, brute-forced here.
+  correction::WeightedDistribution a{{1.0, 2.0}, {0.5, 0.5}}, b{{1.5, 3.0}, {0.25, 0.75}};
+  const auto m = correction::mixture(a, b);
+  EXPECT_EQ(m.values, (std::vector<double>{1.0, 1.5, 2.0, 3.0}));
+  EXPECT_EQ(m.weights, (std::vector<double>{0.25, 0.125, 0.25, 0.375}));
+  for (double alpha : {0.1, 0.25, 0.3, 0.5, 0.625, 0.7, 0.99}) {
+    // P(T <= y) = (P_a(y) + P_b(y)) / 2 at the smallest y reaching alpha.
+    double want = 0.0;
+    for (double y : {1.0, 1.5, 2.0, 3.0}) {
+      const double pa = (y >= 1.0 ? 0.5 : 0.0) + (y >= 2.0 ? 0.5 : 0.0);
+      const double pb = (y >= 1.5 ? 0.25 : 0.0) + (y >= 3.0 ? 0.75 : 0.0);
+      if ((pa + pb) / 2 >= alpha - 1e-12) {
+        want = y;
+        break;
+      }
+    }
+    EXPECT_EQ(m.quantile(alpha), want) << alpha;
+  }
+  EXPECT_EQ(correction::mixture(a, a).quantile(0.5), a.quantile(0.5));
+}
+
 TEST(QuantileForest, SingleTreeWeightsReproduceTheLeafsEmpiricalQuantiles) {
   const auto data = random_data(200, 3, 7);
   ForestOptions o;

@@ -36,6 +36,10 @@ void setup_correct(CLI::App& app, Command& command, CorrectOptions& o) {
   cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(1, 1000));
   cmd->add_option("--fs", o.fs, "sampling rate, Hz (units allowed), where the input has none (extended models)");
   cmd->add_option("--duration", o.duration, "record length, s (units allowed), where the input has none (extended models)");
+  cmd->add_option("--weighting", o.weighting,
+                  "how the input's AWCC moments were taken, where it does not record it: duration | none (a model "
+                  "with the weighting feature; not given: both answers mixed)")
+      ->check(CLI::IsMember({"duration", "none"}));
   o.flow.add(cmd, awcc::profile_flow_option_fields(), awcc::ProfileFlowOptions{},
              "Profile quantities (a profile with positions: Y90, C_mean, discharge, models, with the corrected velocities)");
 }
@@ -65,6 +69,9 @@ int run_correct(const CorrectOptions& o) {
     };
     if (!o.fs.empty()) defaults.fs = positive(o.fs, awcc::Dimension::frequency, "--fs");
     if (!o.duration.empty()) defaults.duration = positive(o.duration, awcc::Dimension::time, "--duration");
+    if (!o.weighting.empty()) {
+      defaults.weighting = o.weighting == "none" ? awcc::Weighting::none : awcc::Weighting::duration;
+    }
     if (!o.output.empty() && std::filesystem::exists(o.output) &&
         (std::filesystem::equivalent(o.output, o.input) || std::filesystem::equivalent(o.output, o.model))) {
       throw std::invalid_argument(fmt::format("{} is an input; choose another output file", o.output));

@@ -22,6 +22,7 @@ struct CorrectOptions {
   int np = 0;           ///< AWCC particles per window where the input lacks it; 0 = not given
   std::string fs;       ///< sampling rate where the input lacks it (units allowed)
   std::string duration; ///< record length where the input lacks it (units allowed)
+  std::string weighting; ///< AWCC's moments where the input does not record them: duration | none; empty = not known
   OptionSet flow;       ///< a profile's flow quantities (awcc/profile_flow.hpp)
 };
 

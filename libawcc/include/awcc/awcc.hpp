@@ -168,6 +168,9 @@ struct AwccResult {
   std::int64_t lag_zero_windows = 0;  ///< windows peaking at lag 0 (delay below one sample)
   std::int64_t negative_lag_windows = 0;  ///< windows peaking at a negative lag
   int roc_iterations = 0;
+  /// How the moments were taken (options.weighting): a correction model
+  /// learns the bias of one weighting, or takes it as a feature.
+  Weighting weighting = Weighting::duration;
   /// Bubble-probe correction: the moments above are of the corrected
   /// velocities; these of the measured ones over the same windows.
   bool probe_corrected = false;

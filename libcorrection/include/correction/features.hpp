@@ -33,6 +33,17 @@
 // the bubbles' size without FSCC's velocity folded in, and the lag says where
 // in the 20 ms searched the peak fell.
 //
+// The AWCC weighting as a feature (issue 33; any set above followed by
+// "+weighting", e.g. "extended-yield+weighting"): awcc_unweighted, 1 when
+// AWCC's moments were taken unweighted and 0 when duration-weighted. Other
+// tools take them unweighted (pdp-uq's published dataset did); when the flow
+// carries more bubbles while it is fast, the unweighted mean is high by about
+// Tu^2 and a model that learnt one weighting leaves that bias in the other's
+// rows (+3.9 % on the foreign test set). A model with the feature learns both
+// from the same runs (each run measured both ways); a row whose weighting is
+// not known (another tool's file, nothing stated) is corrected by the mixture
+// of both answers, equally weighted.
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -82,6 +93,8 @@ struct Measurement {
   double duration = 0.0;                       ///< record duration, s (0: not known)
   std::optional<double> fscc_velocity;         ///< FSCC's velocity, m/s (empty: none)
   std::optional<double> r12_max;               ///< FSCC's correlation peak, -
+  /// How AWCC's moments were taken; empty: not known (another tool's file).
+  std::optional<awcc::Weighting> weighting;
 };
 
 /// How a feature is written in messages: its unit and the factor from SI
@@ -121,6 +134,10 @@ struct Features {
   double fscc_velocity = 0.0, r12_max = 0.0, fscc_d32 = 0.0;
   /// The leading tip's mean air-chord time c / F, s (0: not known).
   double chord_time = 0.0;
+  /// 1: AWCC's moments unweighted, 0: duration-weighted, -1: not known.
+  int awcc_unweighted = -1;
+  /// The name of the weighting feature.
+  static constexpr const char* weighting_name = "awcc_unweighted";
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
@@ -132,9 +149,10 @@ struct Features {
 /// The feature names of a feature set: "measured" (the seven), "extended"
 /// (the seven and the record's three), "extended-yield" (the same with the
 /// data yield for the accepted windows), "fscc" or "fscc-2" (the FSCC
-/// forest's). Throws std::invalid_argument otherwise.
+/// forest's); the first three may end in "+weighting" (the weighting
+/// feature last). Throws std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
-/// "measured" or "extended" for a model's names in order; empty when they are neither.
+/// The set of a model's names in order ("measured", "extended-yield+weighting", ...); empty when they are none.
 std::string feature_set_of(const std::vector<std::string>& names);
 
 /// Features, or the status and message saying why there are none.

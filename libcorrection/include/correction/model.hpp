@@ -283,8 +283,14 @@ struct CorrectionModel {
   /// True when the model has an FSCC forest and a row with this AWCC status may go to it.
   [[nodiscard]] bool falls_back_to_fscc(CorrectionStatus awcc_status) const;
 
+  /// True when the AWCC weighting is one of the features (a "+weighting"
+  /// set): results of either weighting are corrected, each as its own.
+  [[nodiscard]] bool takes_weighting() const;
+  /// The weighting feature's place in `ranges` (ranges.size() when there is none).
+  [[nodiscard]] std::size_t weighting_feature() const;
   /// Empty when results processed this way may be corrected, else the
-  /// differences ("filter A: model 0.4, results 0.3").
+  /// differences ("filter A: model 0.4, results 0.3"); a model that takes the
+  /// weighting as a feature corrects either.
   [[nodiscard]] std::string mismatch(const Processing& results) const;
 
   [[nodiscard]] std::vector<std::uint8_t> serialise() const;

@@ -81,6 +81,10 @@ struct WeightedDistribution {
   [[nodiscard]] double quantile(double alpha) const;
 };
 
+/// The mixture of two distributions, each weighted one half: its quantiles
+/// are those of a truth drawn from either with equal probability.
+WeightedDistribution mixture(const WeightedDistribution& a, const WeightedDistribution& b);
+
 /// A forest held as one block of bytes, read in place (so that a model file
 /// mapped into memory is used as it lies, with nothing built). Little-endian
 /// whatever the machine, every value read by copying its bytes (no alignment):

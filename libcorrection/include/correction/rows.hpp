@@ -22,6 +22,9 @@ struct RowDefaults {
   /// The record's sampling rate (Hz) and length (s), features of the
   /// extended models, for files that do not record them (other tools' CSVs).
   std::optional<double> fs, duration;
+  /// How AWCC's moments were taken, for files that do not record it (a
+  /// model with the weighting feature; empty: not known).
+  std::optional<awcc::Weighting> weighting;
 };
 
 /// What a correction of a file says besides its rows.

@@ -52,6 +52,9 @@ struct TrainingRow {
   /// the AWCC forests take the row. The FSCC forest is applied where this is
   /// false, so that is where it is calibrated and scored.
   bool awcc_served = true;
+  /// The same run's features with AWCC's unweighted moments (the sweep's
+  /// awcc_*_unweighted columns), for a model with the weighting feature.
+  std::optional<Features> unweighted;
 };
 
 struct TrainingSet {
