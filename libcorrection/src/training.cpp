@@ -1287,6 +1287,21 @@ std::vector<Band> held_out_bands() {
     bands.push_back({hi > 1e299 ? fmt::format("fs {:g} kHz+", lo / 1e3) : fmt::format("fs {:g}-{:g} kHz", lo / 1e3, hi / 1e3),
                      [lo, hi](const HeldOutPrediction& p) { return p.row.features.fs > lo && p.row.features.fs <= hi; }});
   }
+  // The record's length (issue 33: the coverage by duration, to 1,800 s and
+  // beyond the training records, where the duration is held).
+  for (const auto& band : std::vector<std::pair<double, double>>{{0, 60}, {60, 300}, {300, 600}, {600, 1800}, {1800, 1e300}}) {
+    const double lo = band.first, hi = band.second;
+    bands.push_back({hi > 1e299 ? fmt::format("duration {:g} s+", lo) : fmt::format("duration {:g}-{:g} s", lo, hi),
+                     [lo, hi](const HeldOutPrediction& p) {
+                       return p.row.features.duration > lo && p.row.features.duration <= hi;
+                     }});
+  }
+  // How AWCC's moments were taken (a model with the weighting feature
+  // scores each run both ways).
+  for (const int unweighted : {0, 1}) {
+    bands.push_back({unweighted ? "unweighted moments" : "duration-weighted moments",
+                     [unweighted](const HeldOutPrediction& p) { return p.row.features.awcc_unweighted == unweighted; }});
+  }
   return bands;
 }
 
