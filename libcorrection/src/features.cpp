@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "correction/features.hpp"
 
 #include <fmt/format.h>
@@ -112,6 +113,10 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == weighting_name && awcc_unweighted >= 0) return static_cast<double>(awcc_unweighted);
   if (name == "fscc_lag" && fscc_velocity > 0.0) return dx / fscc_velocity;
   return std::nullopt;
+}
+
+bool Features::on_log_scale(std::string_view name) {
+  return std::find(log_scale_names.begin(), log_scale_names.end(), name) != log_scale_names.end();
 }
 
 std::vector<std::string> feature_set_names(std::string_view set) {

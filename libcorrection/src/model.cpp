@@ -298,6 +298,21 @@ struct FeatureVector {
   [[nodiscard]] bool ok() const { return status == CorrectionStatus::corrected; }
 };
 
+}  // namespace
+
+FeatureRange accepted_range(const FeatureRange& training, double margin) {
+  FeatureRange r = training;
+  const double pad = margin * (training.max - training.min);
+  r.min = training.min - pad;
+  r.max = training.max + pad;
+  if (Features::on_log_scale(training.name) && training.min > 0.0) {
+    r.min = training.min * std::pow(training.max / training.min, -margin);
+  }
+  return r;
+}
+
+namespace {
+
 FeatureVector feature_vector(const std::vector<FeatureRange>& ranges, double margin, const Features& f) {
   FeatureVector out;
   out.x.resize(ranges.size());
@@ -314,12 +329,12 @@ FeatureVector feature_vector(const std::vector<FeatureRange>& ranges, double mar
   }
   for (std::size_t j = 0; j < ranges.size(); ++j) {
     const auto& r = ranges[j];
-    const double pad = margin * (r.max - r.min);
-    if (r.name == "duration" && out.x[j] > r.max + pad) {
+    const auto accepted = accepted_range(r, margin);
+    if (r.name == "duration" && out.x[j] > accepted.max) {
       out.notes.push_back(fmt::format("duration {} s is beyond the training range ({}): corrected as {:.4g} s",
                                       fmt::format("{:.4g}", out.x[j]), feature_range_text(r.name, r.min, r.max), r.max));
       out.x[j] = r.max;
-    } else if (!(out.x[j] >= r.min - pad && out.x[j] <= r.max + pad)) {
+    } else if (!(out.x[j] >= accepted.min && out.x[j] <= accepted.max)) {
       out.status = CorrectionStatus::outside_training_range;
       out.message = out_of_range_reason(r, out.x[j]);
       out.refused = &r;

@@ -277,17 +277,67 @@ TEST(Correction, RowsOutsideTheTrainingDataAreFlaggedNotCorrected) {
   c = m.correct(f);
   EXPECT_EQ(c.status, correction::CorrectionStatus::too_few_windows);
   EXPECT_NE(c.message.find("99 accepted windows"), std::string::npos) << c.message;
-  // Within the margin of 1 % of the span below the smallest dy: in range;
-  // beyond it: out.
+  // Within the margin below the smallest and above the largest u: in range;
+  // beyond it: out (u spans 1-50 m/s: logarithmic below, linear above).
   f = inside();
-  const auto& dy = m.ranges[5];
-  f.dy = dy.min - 0.5 * m.range_margin * (dy.max - dy.min);
+  const auto& u = m.ranges[0];
+  const auto accepted = correction::accepted_range(u, m.range_margin);
+  ASSERT_LT(accepted.min, u.min);
+  ASSERT_GT(accepted.max, u.max);
+  f.velocity = u.min - 0.5 * (u.min - accepted.min);
   EXPECT_TRUE(m.correct(f).corrected());
-  f.dy = dy.min - 1.5 * m.range_margin * (dy.max - dy.min);
+  f.velocity = u.min - 1.5 * (u.min - accepted.min);
+  EXPECT_FALSE(m.correct(f).corrected());
+  f.velocity = u.max + 0.5 * (accepted.max - u.max);
+  EXPECT_TRUE(m.correct(f).corrected());
+  f.velocity = u.max + 1.5 * (accepted.max - u.max);
   EXPECT_FALSE(m.correct(f).corrected());
   f = inside();
   f.velocity = std::nan("");
   EXPECT_FALSE(m.correct(f).corrected());
+}
+
+TEST(Correction, AFeatureOnALogarithmicScaleGetsALogarithmicMarginAtItsLowEnd) {
+  // c drawn over 0.005-0.6: 1 % of the span (0.00595) would take every
+  // c > -0.00095, the whole lower decade; the logarithmic margin takes
+  // c >= 0.005 / 120^0.01 = 0.0047663 (1 % of ln 120 below ln 0.005).
+  const auto c = correction::accepted_range({"void_fraction", 0.005, 0.6}, 0.01);
+  EXPECT_NEAR(c.min, 0.005 / std::pow(120.0, 0.01), 1e-15);
+  EXPECT_NEAR(c.min, 0.0047663, 1e-7);
+  // At the top, linear (0.60595; the logarithmic one would be 0.6294).
+  EXPECT_DOUBLE_EQ(c.max, 0.6 + 0.01 * 0.595);
+  // Features whose 0 is a value stay linear at both ends, even when their
+  // training minimum is a tiny positive number: an inline probe (dy = 0)
+  // and still water in Tu must stay inside a model trained from 0.0005 mm.
+  const auto dy = correction::accepted_range({"dy", 4.876e-7, 2e-3}, 0.01);
+  EXPECT_LT(dy.min, 0.0);
+  EXPECT_DOUBLE_EQ(dy.min, 4.876e-7 - 0.01 * (2e-3 - 4.876e-7));
+  const auto tu = correction::accepted_range({"turbulence_intensity", 1e-4, 0.45}, 0.01);
+  EXPECT_LT(tu.min, 0.0);
+  const auto np = correction::accepted_range({"np", 3.0, 30.0}, 0.01);
+  EXPECT_DOUBLE_EQ(np.min, 3.0 - 0.27);
+  // Every feature the log scale names, from u to FSCC's lag.
+  for (const char* name : correction::Features::log_scale_names) {
+    const auto r = correction::accepted_range({name, 2.0, 200.0}, 0.01);
+    EXPECT_NEAR(r.min, 2.0 / std::pow(100.0, 0.01), 1e-12) << name;
+    EXPECT_DOUBLE_EQ(r.max, 200.0 + 1.98) << name;
+  }
+
+  // Through the model: the real profile's lowest row (c = 0.0037) against
+  // a model trained from c = 0.005 is refused, naming void_fraction; inside
+  // the logarithmic margin it is corrected.
+  const auto m = model_of("measured", 11,
+                          [](Features& f, std::mt19937_64& g) { f.void_fraction = 0.005 * std::pow(120.0, uniform(g)); },
+                          [](const Features&) { return 1.0; });
+  const auto& range = m.ranges[2];
+  ASSERT_EQ(range.name, "void_fraction");
+  auto f = inside();
+  f.void_fraction = 0.0037 / 0.005 * range.min;
+  const auto refused = m.correct(f);
+  EXPECT_EQ(refused.status, correction::CorrectionStatus::outside_training_range);
+  EXPECT_NE(refused.message.find("void_fraction"), std::string::npos) << refused.message;
+  f.void_fraction = range.min * std::pow(range.max / range.min, -0.005);
+  EXPECT_TRUE(m.correct(f).corrected()) << m.correct(f).why_not();
 }
 
 TEST(Correction, TargetFormsInvert) {

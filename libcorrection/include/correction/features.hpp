@@ -125,6 +125,13 @@ struct Features {
   static constexpr std::array<const char*, 9> fscc2_names{"fscc_velocity", "r12_max", "void_fraction",
                                                           "chord_time",    "fscc_lag", "dx",
                                                           "dy",            "fs",       "duration"};
+  /// The features positive by nature and drawn over decades (0 is not a
+  /// value they take): their range margin is logarithmic at the low end
+  /// (accepted_range). Not dy, Tu or the yield, whose 0 is a real value.
+  static constexpr std::array<const char*, 10> log_scale_names{
+      "velocity", "void_fraction", "d32",       "fs",         "duration",
+      "windows_accepted", "fscc_velocity", "fscc_d32", "chord_time", "fscc_lag"};
+  [[nodiscard]] static bool on_log_scale(std::string_view name);
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
   /// Rows below a model's minimum are not corrected; -1 unknown.
   std::int64_t windows_accepted = -1;

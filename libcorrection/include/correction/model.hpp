@@ -13,9 +13,9 @@
 // which is the quantile of the clipped distribution.
 //
 // A row is corrected only inside the training data: every feature within its
-// training [min, max] widened by `range_margin` of the span on each side
-// (the trees split between training values, so beyond the data they repeat
-// the edge leaf: that is extrapolation), and at least `min_windows` accepted
+// training [min, max] widened by `range_margin` on each side (the trees split
+// between training values, so beyond the data they repeat the edge leaf:
+// that is extrapolation; accepted_range owns the rule), and at least `min_windows` accepted
 // windows (runs with fewer were left out of training). Otherwise the row
 // keeps its measurement, with a status and the reason. A model is applied
 // only to results processed as its training data were (`processing`).
@@ -130,6 +130,17 @@ struct FeatureRange {
   std::string name;
   double min = 0.0, max = 0.0;
 };
+
+/// The values of a feature a model corrects: its training [min, max]
+/// widened by `margin` of the span on each side, except at the low end of a
+/// feature on a logarithmic scale (Features::on_log_scale: c, u, d32, fs,
+/// ...), which is widened by `margin` of the span of its logarithm,
+/// min * (max / min)^-margin. A linear margin of such a range reaches far
+/// below the least training value (1 % of c = 0.005-0.6 is 0.006, the
+/// whole lower decade and more), where the biases differ (METHOD 6); the
+/// logarithmic one is a few per cent of the value. (At the high end the
+/// linear margin is the narrower, and is kept.)
+FeatureRange accepted_range(const FeatureRange& training, double margin);
 
 struct CorrectedQuantity {
   double measured = 0.0;
