@@ -699,6 +699,31 @@ struct Split {
   std::vector<TrainingRow> held_out, calibration, training;
 };
 
+}  // namespace
+
+double duration_cap(const std::vector<TrainingRow>& rows) {
+  std::vector<double> d;
+  d.reserve(rows.size());
+  for (const auto& r : rows)
+    if (r.features.duration > 0.0) d.push_back(r.features.duration);
+  if (d.empty()) return 0.0;
+  std::sort(d.begin(), d.end());
+  const auto above = static_cast<std::size_t>(std::floor(duration_saturation_share * static_cast<double>(d.size())));
+  return d[d.size() - 1 - above];
+}
+
+namespace {
+
+// The rows as the forests see them: durations above the cap at the cap.
+std::vector<TrainingRow> with_saturated_durations(std::vector<TrainingRow> rows) {
+  const double cap = duration_cap(rows);
+  for (auto& r : rows) {
+    r.features.duration = std::min(r.features.duration, cap);
+    if (r.unweighted) r.unweighted->duration = std::min(r.unweighted->duration, cap);
+  }
+  return rows;
+}
+
 Split split_runs(std::vector<TrainingRow> rows, const TrainOptions& o) {
   auto key = [&](const TrainingRow& r) { return mix64(o.seed ^ mix64(static_cast<std::uint64_t>(r.run) ^ mix64(r.study))); };
   std::sort(rows.begin(), rows.end(), [&](const TrainingRow& a, const TrainingRow& b) {
@@ -765,7 +790,7 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
   const Split split = split_runs(set.fscc_rows, o);
   const auto& held_out = split.held_out;
   const auto& calibration_rows = split.calibration;
-  const auto& training = split.training;
+  const auto training = with_saturated_durations(split.training);
   const auto names = feature_set_names(o.fscc_feature_set);
   FsccForest f;
   f.form = TargetForm::ratio;
@@ -1051,6 +1076,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
   o.validate().throw_if_failed();
   const auto names = feature_set_names(o.feature_set);
   Split split = split_runs(set.rows, o);
+  split.training = with_saturated_durations(std::move(split.training));
   const std::size_t runs = set.rows.size();
   const bool twins = names.back() == Features::weighting_name;
   if (twins) {

@@ -424,6 +424,64 @@ std::vector<correction::TrainingRow> runs(int count, std::uint64_t seed, std::in
   return rows;
 }
 
+TEST(Training, TheRecordsDurationSaturatesAtItsLongestPercent) {
+  // duration_cap: of durations 1..1000 s the longest 1 % (991-1000) lie
+  // above the cap, 990; rows without a duration are not counted.
+  std::vector<correction::TrainingRow> rows(1001);
+  for (int i = 0; i < 1000; ++i) rows[static_cast<std::size_t>(i)].features.duration = 1000 - i;
+  EXPECT_DOUBLE_EQ(correction::duration_cap(rows), 990.0);
+  rows.resize(99);  // 1000..902: floor(0.99) = 0 above, the longest itself
+  EXPECT_DOUBLE_EQ(correction::duration_cap(rows), 1000.0);
+  EXPECT_DOUBLE_EQ(correction::duration_cap({}), 0.0);
+
+  // Through training: both forests' duration range ends at the cap of their
+  // training runs, below the longest run, and a row beyond it is held there:
+  // the same quantiles at the cap and at twice the longest record.
+  std::mt19937_64 g(8);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::string csv = kHeader + "\n";
+  for (int i = 0; i < 1000; ++i) {
+    const double measured = 1 + 49 * u(g);
+    auto v = good(measured, measured * (0.9 + 0.2 * u(g)), 10 + std::floor(1000 * u(g)));
+    v["fs"] = "100000";
+    v["duration"] = fmt::format("{:.10g}", 20 * std::pow(15.0, u(g)));
+    v["fscc_velocity"] = fmt::format("{:.10g}", measured);
+    v["fscc_r12_max"] = "0.5";
+    csv += row(i, v);
+  }
+  const auto set = correction::load_training_set({write("saturated.csv", csv)}, 10);
+  double longest = 0.0;
+  for (const auto& r : set.rows) longest = std::max(longest, r.features.duration);
+  correction::TrainOptions o;
+  o.trees = 10;
+  o.folds = 0;
+  o.min_windows = 10;
+  o.feature_set = "extended";
+  const auto r = correction::train_model(set, o);
+  const auto& d = r.model.ranges[8];
+  ASSERT_EQ(d.name, "duration");
+  ASSERT_TRUE(r.model.fscc);
+  const auto& fd = r.model.fscc->ranges[7];
+  ASSERT_EQ(fd.name, "duration");
+  for (double cap : {d.max, fd.max}) {
+    std::size_t above = 0;
+    for (const auto& row : set.rows) above += row.features.duration > cap;
+    // 640 training runs: 6 above the cap; over all 1000 rows about 10.
+    EXPECT_GE(above, 6u) << cap;
+    EXPECT_LE(above, 25u) << cap;
+    EXPECT_LT(cap, longest);
+  }
+  auto f = set.rows[0].features;
+  f.duration = d.max;
+  const auto at_cap = r.model.correct(f);
+  f.duration = 2 * longest;
+  const auto beyond = r.model.correct(f);
+  ASSERT_TRUE(at_cap.corrected() && beyond.corrected()) << at_cap.why_not() << beyond.why_not();
+  EXPECT_EQ(at_cap.velocity->quantiles, beyond.velocity->quantiles);
+  ASSERT_EQ(beyond.notes.size(), 1u);
+  EXPECT_NE(beyond.notes[0].find(fmt::format("corrected as {:.4g} s", d.max)), std::string::npos) << beyond.notes[0];
+}
+
 TEST(Calibration, ConformalOffsetsBringCoverageToNominal) {
   // The forest learnt a spread twice the runs' own: its 80 % interval covers
   // P(|Z| < 2 x 1.2816) = 99 % of them. Calibrated on n = 1000 runs, the
