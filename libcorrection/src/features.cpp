@@ -27,6 +27,7 @@ FeatureUnit unit_of(std::string_view feature) {
   if (feature == "fs") return {"kHz", 1e-3};
   if (feature == "duration") return {"s", 1.0};
   if (feature == "chord_time" || feature == "fscc_lag") return {"ms", 1e3};
+  if (feature == Features::lag_name) return {"samples", 1.0};
   return {"-", 1.0};
 }
 
@@ -112,6 +113,7 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == "chord_time" && chord_time > 0.0) return chord_time;
   if (name == weighting_name && awcc_unweighted >= 0) return static_cast<double>(awcc_unweighted);
   if (name == "fscc_lag" && fscc_velocity > 0.0) return dx / fscc_velocity;
+  if (name == lag_name && fs > 0.0 && velocity > 0.0) return dx * fs / velocity;
   return std::nullopt;
 }
 
@@ -126,12 +128,19 @@ std::vector<std::string> feature_set_names(std::string_view set) {
     names.emplace_back(Features::weighting_name);
     return names;
   }
+  constexpr std::string_view lag = "+lag";
+  if (set == "extended+lag" || set == "extended-yield+lag") {
+    auto names = feature_set_names(set.substr(0, set.size() - lag.size()));
+    names.emplace_back(Features::lag_name);
+    return names;
+  }
   if (set == "fscc") return {Features::fscc_names.begin(), Features::fscc_names.end()};
   if (set == "fscc-2") return {Features::fscc2_names.begin(), Features::fscc2_names.end()};
   if (set != "measured" && set != "extended" && set != "extended-yield") {
     throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7), extended (with "
                                             "fs, duration and accepted windows) or extended-yield (fs, duration and "
-                                            "the data yield), each optionally followed by +weighting",
+                                            "the data yield), the extended two optionally followed by +lag (the lag "
+                                            "in samples), each then optionally by +weighting",
                                             set));
   }
   std::vector<std::string> out(Features::names.begin(), Features::names.end());
@@ -142,7 +151,8 @@ std::vector<std::string> feature_set_names(std::string_view set) {
 
 std::string feature_set_of(const std::vector<std::string>& names) {
   for (const char* set : {"measured", "extended", "extended-yield", "measured+weighting", "extended+weighting",
-                          "extended-yield+weighting"})
+                          "extended-yield+weighting", "extended+lag", "extended-yield+lag", "extended+lag+weighting",
+                          "extended-yield+lag+weighting"})
     if (names == feature_set_names(set)) return set;
   return {};
 }

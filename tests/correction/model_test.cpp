@@ -512,6 +512,28 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   y.windows_total = 120;
   EXPECT_DOUBLE_EQ(*y.value("data_yield"), 0.25);
   EXPECT_EQ(correction::feature_set_names("extended-yield").back(), "data_yield");
+  // The lag in samples: dx fs / u (5 mm at 500 kHz and 2.5 m/s: 1000
+  // samples), unknown without the rate, after the record's features and
+  // before the weighting feature; not a set of the measured features alone
+  // (no rate) nor of FSCC's.
+  Features lag = inside();
+  lag.dx = 0.005;
+  lag.velocity = 2.5;
+  lag.fs = 500e3;
+  EXPECT_DOUBLE_EQ(*lag.value("lag_samples"), 1000.0);
+  lag.fs = 0.0;
+  EXPECT_FALSE(lag.value("lag_samples"));
+  const auto lag_set = correction::feature_set_names("extended-yield+lag+weighting");
+  ASSERT_EQ(lag_set.size(), 12u);
+  EXPECT_EQ(lag_set[9], "data_yield");
+  EXPECT_EQ(lag_set[10], "lag_samples");
+  EXPECT_EQ(lag_set[11], "awcc_unweighted");
+  EXPECT_EQ(correction::feature_set_of(lag_set), "extended-yield+lag+weighting");
+  EXPECT_EQ(correction::feature_set_of(correction::feature_set_names("extended+lag")), "extended+lag");
+  EXPECT_THROW(correction::feature_set_names("measured+lag"), std::invalid_argument);
+  EXPECT_THROW(correction::feature_set_names("fscc+lag"), std::invalid_argument);
+  EXPECT_TRUE(Features::on_log_scale("lag_samples"));
+  EXPECT_EQ(correction::feature_value_text("lag_samples", 12.5), "lag_samples = 12.5 samples");
   // The unknown-record values are not features.
   Features none;
   EXPECT_FALSE(none.value("fs"));

@@ -128,9 +128,9 @@ struct Features {
   /// The features positive by nature and drawn over decades (0 is not a
   /// value they take): their range margin is logarithmic at the low end
   /// (accepted_range). Not dy, Tu or the yield, whose 0 is a real value.
-  static constexpr std::array<const char*, 10> log_scale_names{
-      "velocity", "void_fraction", "d32",       "fs",         "duration",
-      "windows_accepted", "fscc_velocity", "fscc_d32", "chord_time", "fscc_lag"};
+  static constexpr std::array<const char*, 11> log_scale_names{
+      "velocity",      "void_fraction", "d32",        "fs",       "duration",   "windows_accepted",
+      "fscc_velocity", "fscc_d32",      "chord_time", "fscc_lag", "lag_samples"};
   [[nodiscard]] static bool on_log_scale(std::string_view name);
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
   /// Rows below a model's minimum are not corrected; -1 unknown.
@@ -145,6 +145,15 @@ struct Features {
   int awcc_unweighted = -1;
   /// The name of the weighting feature.
   static constexpr const char* weighting_name = "awcc_unweighted";
+  /// The lag feature: AWCC's mean lag in samples, dx fs / u. The lag is
+  /// quantised to whole samples, so a short lag (a close pair of tips, a
+  /// fast flow, a slow sampling rate) inflates the windows' velocity spread
+  /// and biases their mean; the forests otherwise have to find that
+  /// product among dx, fs and u by splits, and a broad campaign (fs over
+  /// two decades) leaves too few runs at any one rate for that: without it,
+  /// the corrected Tu at 300 s and 500 kHz was off by +0.09 below 15
+  /// samples and +0.004 above 120 (docs/validation.md, "The lag in samples").
+  static constexpr const char* lag_name = "lag_samples";
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
@@ -156,8 +165,9 @@ struct Features {
 /// The feature names of a feature set: "measured" (the seven), "extended"
 /// (the seven and the record's three), "extended-yield" (the same with the
 /// data yield for the accepted windows), "fscc" or "fscc-2" (the FSCC
-/// forest's); the first three may end in "+weighting" (the weighting
-/// feature last). Throws std::invalid_argument otherwise.
+/// forest's); the two extended sets may end in "+lag" (the lag in samples
+/// after the record's features), and the first three, after that, in
+/// "+weighting" (the weighting feature last). Throws std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// The set of a model's names in order ("measured", "extended-yield+weighting", ...); empty when they are none.
 std::string feature_set_of(const std::vector<std::string>& names);

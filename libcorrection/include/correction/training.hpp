@@ -128,7 +128,8 @@ struct TrainOptions {
   std::uint64_t seed = 1;
   int threads = 0;
   /// "measured" (the seven features of METHOD 7) or "extended" (also fs,
-  /// duration and accepted windows: records of every length and rate).
+  /// duration and accepted windows: records of every length and rate), and
+  /// their variants (feature_set_names: "+lag", "+weighting").
   std::string feature_set = "measured";
   /// With an extended feature set, also train the reduced model
   /// (CorrectionModel::reduced) for rows without the record's features.
