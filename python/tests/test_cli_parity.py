@@ -53,9 +53,9 @@ def test_a_profile_with_positions_and_the_correction_equals_the_cli(cli, real_fi
     for got, want in zip(r.profile, expected["profile"]):
         assert got == want, got["file"]
     # Every row but file 01 is corrected by the shipped model's AWCC forest;
-    # file 01 (2 accepted windows) goes to its FSCC forest, whose answer has
-    # two modes: untrusted (issue 29, docs/validation.md).
-    assert [row.correction.status for row in r.profile] == ["untrusted"] + ["corrected"] * 9
+    # file 01 (2 accepted windows) by its FSCC forest, with one mode since
+    # issue 33 (two modes, untrusted, before: docs/validation.md).
+    assert [row.correction.status for row in r.profile] == ["corrected"] * 10
     assert [row.correction.forest for row in r.profile] == ["fscc"] + ["awcc"] * 9
 
 

@@ -272,7 +272,7 @@ def test_the_real_profile_has_no_y90_and_says_why_on_figure_and_table(real_profi
 
 def test_each_velocity_has_the_interval_of_its_source(real_files, tmp_path):
     """The corrected real profile: its rows' velocities are the corrected
-    AWCC medians (the FSCC forest's row, untrusted, FSCC's own); each point's
+    AWCC medians (a row without AWCC, FSCC's own: METHOD 12); each point's
     bar is its source's interval: the AWCC forest's 2.5 and 97.5 % quantiles,
     FSCC's 95 % interval."""
     positions = ",".join(f"{p}mm" for p in (2, 8, 14, 20, 26, 32, 38, 44, 50, 54))

@@ -239,9 +239,9 @@ def test_the_real_report_draws_each_position_from_its_recording(real):
 
 def test_an_insufficient_row_is_a_gap_with_its_reason(real):
     """Real file 01 (2 mm) has 2 accepted AWCC windows: its velocity cell is a
-    gap whose note gives AWCC's reason; the FSCC forest's answer for it has two
-    modes, so the correction is untrusted: its corrected velocity is a gap
-    whose note names the rule, and its Tu a gap as well."""
+    gap whose note gives AWCC's reason; the FSCC forest corrects its velocity
+    (one mode since issue 33), so the corrected velocity is a value, the
+    forest's median, and its Tu a gap (that forest corrects no Tu)."""
     page = page_of(real)
     row0 = load(real / "profile.json")["profile"][0]
     assert row0["awcc"]["quality"] == "insufficient"
@@ -249,9 +249,8 @@ def test_an_insufficient_row_is_a_gap_with_its_reason(real):
     assert value is None and gap
     assert "windows accepted" in page.ids[f"gap-{gap}"]
     value, gap = page.columns["corrected_velocity"][0]
-    assert row0["correction"]["status"] == "untrusted" and row0["correction"]["forest"] == "fscc"
-    assert value is None and gap
-    assert "untrusted" in page.ids[f"gap-{gap}"] or "multimodal" in page.ids[f"gap-{gap}"], page.ids[f"gap-{gap}"]
+    assert row0["correction"]["status"] == "corrected" and row0["correction"]["forest"] == "fscc"
+    assert not gap and value == pytest.approx(row0["correction"]["velocity"]["median"], rel=1e-3), value
     _, gap = page.columns["corrected_turbulence_intensity"][0]
     assert gap
     _, gap = page.columns["awcc_velocity_measured"][9]

@@ -2,9 +2,17 @@
 # Issue 29, cases 1 and 6, end to end with the shipped model:
 #  1. the 2 mm row of the real profile (c 0.004, AWCC insufficient, FSCC
 #     2.80 m/s) was corrected by the FSCC forest to 6.62 m/s (95 % 2.37-13.1,
-#     quartiles 2.84 and 10.1), status corrected. Now untrusted: the summary
-#     says "not corrected: untrusted: multimodal: ...", the JSON and the CSV
-#     keep the quantiles but no corrected median.
+#     quartiles 2.84 and 10.1), status corrected; then flagged untrusted
+#     (two modes). Issue 33 fixed the model (its FSCC forest had no runs
+#     below c = 0.004): corrected by the FSCC forest with one mode, within
+#     10 % of FSCC's 2.80 m/s, the summary, the JSON, the CSV and pdp
+#     correct saying so.
+#  1b. An untrusted answer, end to end: tips 0.6 mm apart sampled at 27 kHz
+#     hold a lag of one sample, so AWCC reads dx fs = 16.2 m/s with Tu 0 for
+#     a 12 m/s flow; the AWCC forest's answer moves it by +66 %, outside the
+#     envelope of its held-out runs: the summary says "not corrected:
+#     untrusted: outside the envelope: ...", the JSON and the CSV keep the
+#     quantiles but no corrected median.
 #  6. a 30-minute record (truth 3.00 m/s, Tu 0.30) was refused ("duration =
 #     1800 is outside the training range [20.0007, 299.802]", "FSCC forest:"
 #     twice). Now corrected as a record of the longest training length, with
@@ -26,35 +34,68 @@ data=$src/../shared/data/felder-stepped-spillway
 if [[ -d $data ]]; then
   "$pdp" process "$data/dc157_01.dat" --fs 20kHz --dx 7.15mm --correct "$model" --json "$dir/row2mm.json" \
     >"$dir/row2mm.txt" 2>"$dir/row2mm.err" || fail "case 1: process"
-  grep -q "  correction: not corrected: untrusted: multimodal: the FSCC forest's velocity distribution is" "$dir/row2mm.txt" ||
+  grep -q "correction (quantile regression forest, FSCC forest):" "$dir/row2mm.txt" ||
     fail "case 1: summary: $(grep correction "$dir/row2mm.txt")"
-  grep -q "dc157_01.dat: not corrected: untrusted: multimodal" "$dir/row2mm.err" || fail "case 1: stderr: $(cat "$dir/row2mm.err")"
-  grep -q "m/s median;" "$dir/row2mm.txt" && fail "case 1: the summary still presents a corrected velocity"
+  grep -q "untrusted" "$dir/row2mm.txt" "$dir/row2mm.err" && fail "case 1: still untrusted"
   /usr/bin/python3 - "$dir/row2mm.json" <<'PY' || fail "case 1: the JSON"
 import json, sys
 c = json.load(open(sys.argv[1]))["correction"]
-assert c["status"] == "untrusted" and c["in_range"] is False, c
-assert c["forest"] == "fscc" and c["reason"].startswith("multimodal:"), c
-assert c["velocity"]["median"] is None, c  # no corrected value
-q = c["velocity"]["quantiles"]            # the quantiles, for the report to draw apart
-assert 6.5 < q["0.5"] < 6.7 and q["0.025"] < 2.8 < q["0.975"], q
+assert c["status"] == "corrected" and c["in_range"] is True, c
+assert c["forest"] == "fscc", c
+q = c["velocity"]["quantiles"]
+assert abs(c["velocity"]["median"] - 2.80) < 0.28, c["velocity"]  # one mode at FSCC's value
+assert q["0.75"] - q["0.25"] < 0.5, q                               # the two-mode answer's was 2.84-10.1
 assert c["turbulence_intensity"] is None and c["notes"] == [], c
 PY
   "$pdp" --log-level error process "$data/dc157_01.dat" "$data/dc157_02.dat" --fs 20kHz --dx 7.15mm --positions 2mm,8mm \
     --correct "$model" --csv "$dir/rows.csv" || fail "case 1: profile"
-  [[ $(column "$dir/rows.csv" correction_status | tr '\n' ' ') == "untrusted corrected " ]] ||
+  [[ $(column "$dir/rows.csv" correction_status | tr '\n' ' ') == "corrected corrected " ]] ||
     fail "case 1: CSV statuses: $(column "$dir/rows.csv" correction_status | tr '\n' ' ')"
-  [[ -z $(column "$dir/rows.csv" corrected_velocity | head -1) ]] || fail "case 1: CSV presents a corrected velocity"
-  [[ -n $(column "$dir/rows.csv" corrected_velocity_q0.5 | head -1) ]] || fail "case 1: CSV lost the quantiles"
+  [[ $(column "$dir/rows.csv" correction_forest | tr '\n' ' ') == "fscc awcc " ]] ||
+    fail "case 1: CSV forests: $(column "$dir/rows.csv" correction_forest | tr '\n' ' ')"
   # pdp correct on the written JSON says the same.
   "$pdp" --log-level error process "$data/dc157_01.dat" --fs 20kHz --dx 7.15mm --json "$dir/raw2mm.json" >/dev/null ||
     fail "case 1: process without correction"
   "$pdp" correct "$dir/raw2mm.json" -m "$model" -o "$dir/corrected2mm.json" || fail "case 1: pdp correct"
-  /usr/bin/python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['correction']; sys.exit(c['status'] != 'untrusted')" \
-    "$dir/corrected2mm.json" || fail "case 1: pdp correct did not say untrusted"
+  /usr/bin/python3 - "$dir/corrected2mm.json" "$dir/row2mm.json" <<'PY' || fail "case 1: pdp correct differs"
+import json, sys
+a, b = (json.load(open(p))["correction"] for p in sys.argv[1:])
+assert a["status"] == "corrected" and a["velocity"]["quantiles"] == b["velocity"]["quantiles"], (a, b)
+PY
 else
   echo "skipped case 1: no real recordings at $data"
 fi
+
+# Case 1b.
+"$pdp" --log-level error synth --config "$src/samples/base.toml" --velocity 12m/s --tu 0.1 --void-fraction 0.04 \
+  --bubble-diameter 3mm --duration 30s --fs 27kHz --dx 0.6mm --seed 1 -q -o "$dir/onelag.flac" || fail "case 1b: synth"
+"$pdp" process "$dir/onelag.flac" --dx 0.6mm --dy 1mm --correct "$model" --json "$dir/onelag.json" \
+  >"$dir/onelag.txt" 2>"$dir/onelag.err" || fail "case 1b: process"
+"$pdp" --log-level error process "$dir/onelag.flac" --dx 0.6mm --dy 1mm --correct "$model" --csv "$dir/onelag.csv" ||
+  fail "case 1b: process to CSV"
+grep -q "  correction: not corrected: untrusted: outside the envelope: the AWCC forest's velocity median" "$dir/onelag.txt" ||
+  fail "case 1b: summary: $(grep correction "$dir/onelag.txt")"
+grep -q "onelag.flac: not corrected: untrusted: outside the envelope" "$dir/onelag.err" ||
+  fail "case 1b: stderr: $(cat "$dir/onelag.err")"
+grep -q "m/s median;" "$dir/onelag.txt" && fail "case 1b: the summary presents a corrected velocity"
+/usr/bin/python3 - "$dir/onelag.json" <<'PY' || fail "case 1b: the JSON"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert abs(j["awcc"]["velocity"] - 0.6e-3 * 27e3) < 1e-9, j["awcc"]["velocity"]  # one sample's lag
+c = j["correction"]
+assert c["status"] == "untrusted" and c["in_range"] is False, c
+assert c["forest"] == "awcc" and c["reason"].startswith("outside the envelope:"), c
+assert c["velocity"]["median"] is None, c  # no corrected value
+assert c["velocity"]["quantiles"]["0.5"] > 16.2, c["velocity"]  # the quantiles kept, for the report to draw apart
+PY
+[[ $(column "$dir/onelag.csv" correction_status) == untrusted ]] || fail "case 1b: CSV status"
+[[ -z $(column "$dir/onelag.csv" corrected_velocity) ]] || fail "case 1b: CSV presents a corrected velocity"
+[[ -n $(column "$dir/onelag.csv" corrected_velocity_q0.5) ]] || fail "case 1b: CSV lost the quantiles"
+"$pdp" --log-level error process "$dir/onelag.flac" --dx 0.6mm --dy 1mm --json "$dir/onelag-raw.json" >/dev/null ||
+  fail "case 1b: process without correction"
+"$pdp" correct "$dir/onelag-raw.json" -m "$model" -o "$dir/onelag-corrected.json" 2>/dev/null || fail "case 1b: pdp correct"
+/usr/bin/python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['correction']; sys.exit(c['status'] != 'untrusted')" \
+  "$dir/onelag-corrected.json" || fail "case 1b: pdp correct did not say untrusted"
 
 # Case 6.
 "$pdp" --log-level error synth --config "$src/samples/base.toml" --velocity 3m/s --tu 0.3 --duration 1800s --fs 20kHz \
@@ -62,7 +103,7 @@ fi
 "$pdp" process "$dir/long.flac" --dx 5mm --dy 1mm --correct "$model" --json "$dir/long.json" --csv "$dir/long.csv" \
   2>"$dir/long.err" || fail "case 6: process"
 "$pdp" process "$dir/long.flac" --dx 5mm --dy 1mm --correct "$model" >"$dir/long.txt" 2>/dev/null || fail "case 6: summary"
-note="duration 1800 s is beyond the training range (20-299.8 s): corrected as 299.8 s"
+note="duration 1800 s is beyond the training range (20-1006 s): corrected as 1006 s"
 [[ $(grep -c "note: $note" "$dir/long.txt") == 1 ]] || fail "case 6: the summary's note: $(grep -i note "$dir/long.txt")"
 [[ $(grep -cF "$note" "$dir/long.err") == 1 ]] || fail "case 6: stderr: $(cat "$dir/long.err")"
 grep -q "outside the training range" "$dir/long.err" && fail "case 6: still refused"

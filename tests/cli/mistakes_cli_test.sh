@@ -164,14 +164,14 @@ expect 1 "the CSV other AWCC tools write (columns 'u [m/s]'" "$pdp" correct "$di
 
 # 12. The real profile: quality per row; rows are corrected down to the model's least windows (10 for
 # the shipped model), whatever their quality: the six low rows (10-50 windows) by the AWCC forest; the
-# insufficient one (2 windows) goes to the FSCC forest, whose answer is untrusted (issue 29: multimodal;
-# tests/cli/correction_trust_test.sh); c, F and FSCC velocities as before.
+# insufficient one (2 windows) goes to the FSCC forest, which corrects it with one mode (issue 33; it was
+# untrusted, two modes, before: tests/cli/correction_trust_test.sh); c, F and FSCC velocities as before.
 if [[ -d $data ]]; then
   "$pdp" --log-level error process "$data"/dc157_*.dat --fs 20kHz --dx 7.15mm --dy 0mm \
     --correct "$src/samples/model/awcc.qrf" --csv "$dir/real.csv" || fail "real profile"
   [[ $(column "$dir/real.csv" awcc_quality | tr '\n' ' ') == "insufficient low low low low low low ok ok ok " ]] ||
     fail "real profile quality: $(column "$dir/real.csv" awcc_quality | tr '\n' ' ')"
-  [[ $(column "$dir/real.csv" correction_status | tr '\n' ' ') == "untrusted $(printf 'corrected %.0s' 1 2 3 4 5 6 7 8 9)" ]] ||
+  [[ $(column "$dir/real.csv" correction_status | tr '\n' ' ') == "$(printf 'corrected %.0s' 1 2 3 4 5 6 7 8 9 10)" ]] ||
     fail "real profile corrections: $(column "$dir/real.csv" correction_status | tr '\n' ' ')"
   [[ $(column "$dir/real.csv" correction_forest | tr '\n' ' ') == "fscc $(printf 'awcc %.0s' 1 2 3 4 5 6 7 8 9)" ]] ||
     fail "real profile forests: $(column "$dir/real.csv" correction_forest | tr '\n' ' ')"

@@ -790,17 +790,19 @@ TEST(Correction, Format2FilesStillCorrectAsTheyDid) {
 TEST(Correction, TheShippedModelCorrectsTheRecordsLabsMake) {
   // Issue 18: the data yield as the record feature (chosen by
   // cross-validation, docs/validation.md), rows from 10 accepted windows, an
-  // FSCC forest, calibrated intervals. A 45 s, 20 kHz row with 30 of 300
-  // windows is corrected by the AWCC forest, with quantiles in order.
+  // FSCC forest, calibrated intervals; issue 33: the lag in samples and the
+  // weighting, and a reduced model for peers' rows. A 45 s, 20 kHz row with
+  // 30 of 300 windows is corrected by the AWCC forest, with quantiles in order.
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
   EXPECT_EQ(correction::feature_set_of([&] {
               std::vector<std::string> n;
               for (const auto& r : m.ranges) n.push_back(r.name);
               return n;
             }()),
-            "extended-yield");
+            "extended-yield+lag+weighting");
   EXPECT_EQ(m.min_windows, 10);
   ASSERT_TRUE(m.fscc.has_value());
+  ASSERT_TRUE(m.reduced);
   EXPECT_FALSE(m.calibration.empty());
   Features f = inside();
   f.velocity = 3.0;
