@@ -41,6 +41,24 @@ std::map<std::string, std::string> good(double u, double true_u, double windows 
           {"awcc_windows_total", std::to_string(static_cast<long>(2 * windows))}};
 }
 
+// Training without cross-validation, small and quick: 30 trees, min leaf 3.
+correction::TrainOptions quick_training(int features_per_split) {
+  correction::TrainOptions o;
+  o.trees = 30;
+  o.folds = 0;
+  o.min_windows = 10;
+  o.min_leaf_grid = {3};
+  o.min_leaf = 3;
+  o.features_per_split_grid = {features_per_split};
+  o.features_per_split = features_per_split;
+  return o;
+}
+
+// A sampling rate drawn log-uniformly over 10 kHz-1 MHz, as the campaigns draw it.
+double log_uniform_rate(std::mt19937_64& g) {
+  return std::exp(std::log(1e4) + (std::log(1e6) - std::log(1e4)) * std::uniform_real_distribution<double>(0.0, 1.0)(g));
+}
+
 std::filesystem::path write(const std::string& name, const std::string& text) {
   const auto p = pdp_test::temp_dir() / name;
   std::ofstream(p) << text;
@@ -272,7 +290,7 @@ TEST(Training, TheLagFeatureLearnsABiasOfTheLagInSamples) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::string csv = kHeader + "\n";
   for (int i = 0; i < 1500; ++i) {
-    const double fs = std::exp(std::log(1e4) + (std::log(1e6) - std::log(1e4)) * u(g));
+    const double fs = log_uniform_rate(g);
     const double dx = 0.0005 + 0.0095 * u(g);
     const double measured = 1 + 49 * u(g);
     const double lag = dx * fs / measured;
@@ -282,14 +300,7 @@ TEST(Training, TheLagFeatureLearnsABiasOfTheLagInSamples) {
     csv += row(i, v);
   }
   const auto set = correction::load_training_set({write("lag.csv", csv)}, 10);
-  correction::TrainOptions o;
-  o.trees = 30;
-  o.folds = 0;
-  o.min_windows = 10;
-  o.min_leaf_grid = {3};
-  o.min_leaf = 3;
-  o.features_per_split_grid = {5};
-  o.features_per_split = 5;
+  auto o = quick_training(5);
   o.reduced = false;
   o.feature_set = "extended-yield";
   const auto without = correction::train_model(set, o);
@@ -310,7 +321,7 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::string csv = kHeader + "\n";
   for (int i = 0; i < 1000; ++i) {
-    const double fs = std::exp(std::log(1e4) + (std::log(1e6) - std::log(1e4)) * u(g));
+    const double fs = log_uniform_rate(g);
     const double measured = 1 + 49 * u(g);
     const double truth = measured * (1.0 - 0.2 * (std::log(1e6) - std::log(fs)) / (std::log(1e6) - std::log(1e4)));
     auto v = good(measured, truth, 10 + std::floor(1000 * u(g)));
@@ -327,12 +338,7 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   ASSERT_EQ(set.fscc_rows.size(), 1000u);  // FSCC's forest takes the runs without AWCC too
   EXPECT_GT(set.rows[0].features.fs, 1e4 - 1);
   EXPECT_GT(set.rows[0].features.duration, 19.9);
-  correction::TrainOptions o;
-  o.trees = 30;
-  o.folds = 0;
-  o.min_windows = 10;
-  o.min_leaf_grid = {3};
-  o.min_leaf = 3;
+  auto o = quick_training(3);
   double rmse[3];
   int k = 0;
   for (const char* features : {"measured", "extended", "extended-yield"}) {
