@@ -1,10 +1,13 @@
 #pragma once
 // What the benchmark programs share: a clock, the process's peak memory and medians.
 
+#include <fcntl.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
@@ -20,6 +23,19 @@ inline double peak_mb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+/// Drops a file's pages from the page cache (no privilege needed: the pages
+/// are clean), so that the next read of it comes from the disk. Exits when
+/// the file cannot be opened: a cold measurement that read from the cache
+/// would be silently wrong.
+inline void evict(const char* path) {
+  const int fd = ::open(path, O_RDONLY);
+  if (fd < 0 || ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED) != 0) {
+    std::perror(path);
+    std::exit(2);
+  }
+  ::close(fd);
 }
 
 inline double median(std::vector<double> v) {

@@ -1,6 +1,6 @@
 // Benchmark of reading and binarising recordings (docs/performance.md).
 //
-//   process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES] [--read-only]
+//   process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES] [--read-only] [--cold]
 //
 // Times, on one thread, (a) reading the whole file through libawcc's reader
 // and nothing else (as volts, and as int16 counts where the file has them),
@@ -8,7 +8,10 @@
 // chord and structure statistics (no correlation), and optionally (d) FSCC on
 // the binarised signals. Prints the median of N
 // runs, the samples per second and the peak memory of the process. With
-// --read-only, (a) alone: the floor a whole run is compared with.
+// --read-only, (a) alone: the floor a whole run is compared with. With
+// --cold, the file is dropped from the page cache before every timed read
+// (bench::evict), so each read comes from the disk: a lab's first pass over
+// a recording, where the page cache holds none of it.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -25,17 +28,19 @@ using bench::median;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES] [--read-only]\n");
+    std::fprintf(stderr,
+                 "usage: process_bench FILE [--fs HZ] [--repeat N] [--fscc] [--block FRAMES] [--read-only] [--cold]\n");
     return 2;
   }
   awcc::ProcessOptions options;
   int repeat = 3;
-  bool with_fscc = false, read_only = false;
+  bool with_fscc = false, read_only = false, cold = false;
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--fs") && i + 1 < argc) options.reader.fs = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--fscc")) with_fscc = true;
     else if (!std::strcmp(argv[i], "--read-only")) read_only = true;
+    else if (!std::strcmp(argv[i], "--cold")) cold = true;
     else if (!std::strcmp(argv[i], "--block") && i + 1 < argc) options.block_frames = std::atoll(argv[++i]);
   }
   options.dx = 5e-3;
@@ -46,6 +51,7 @@ int main(int argc, char** argv) {
   int channels = 0;
   for (int r = 0; r < repeat; ++r) {
     {
+      if (cold) bench::evict(argv[1]);
       const double t0 = now();
       auto rec = awcc::open_recording(argv[1], options.reader);
       channels = rec->info().channels;
@@ -60,6 +66,7 @@ int main(int argc, char** argv) {
       }
       read_times.push_back(now() - t0);
       if (rec->has_int16()) {
+        if (cold) bench::evict(argv[1]);
         const double t1 = now();
         auto again = awcc::open_recording(argv[1], options.reader);
         std::vector<std::int16_t> counts(static_cast<std::size_t>(options.block_frames * channels));
@@ -74,6 +81,7 @@ int main(int argc, char** argv) {
     }
     if (read_only) continue;
     {
+      if (cold) bench::evict(argv[1]);
       const double t0 = now();
       const auto binarised = awcc::binarise_recording(argv[1], options);
       binarise_times.push_back(now() - t0);
@@ -93,7 +101,8 @@ int main(int argc, char** argv) {
   }
   const double samples = static_cast<double>(frames) * channels;
   const double t_read = median(read_times);
-  std::printf("%s: %lld frames x %d channels\n", argv[1], static_cast<long long>(frames), channels);
+  std::printf("%s: %lld frames x %d channels%s\n", argv[1], static_cast<long long>(frames), channels,
+              cold ? " (each read from the disk: --cold)" : "");
   std::printf("read only (float volts):   %.3f s  (%.0f M samples/s)\n", t_read, samples / t_read / 1e6);
   if (!read16_times.empty()) {
     const double t16 = median(read16_times);

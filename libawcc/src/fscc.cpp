@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <future>
 #include <iterator>
 #include <optional>
 #include <stdexcept>
@@ -184,7 +185,8 @@ class AirPrefix {
 // `r12_sums`, when given, are R12's lagged products over the whole record
 // (those of window_partition below), else they are computed here.
 void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& lags, FftPlanCache& plans,
-                 CorrelationFunctions& f, const std::vector<double>* r12_sums = nullptr) {
+                 CorrelationFunctions& f, const std::vector<double>* r12_sums = nullptr,
+                 const std::vector<double>* r11_sums = nullptr) {
   const std::int64_t n = x.sample_count;
   const double sx = static_cast<double>(x.air_samples()), sy = static_cast<double>(y.air_samples());
   const double mx = sx / static_cast<double>(n), my = sy / static_cast<double>(n);
@@ -213,7 +215,7 @@ void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& l
     }
     return r;
   };
-  f.r11 = normalised(x, x, px, px, mx, mx, qx, qx, 0, lags.r11_last, nullptr);
+  f.r11 = normalised(x, x, px, px, mx, mx, qx, qx, 0, lags.r11_last, r11_sums);
   f.r12 = normalised(x, y, px, py, mx, my, qx, qy, lags.r12_first, lags.r12_last, r12_sums);
   f.segments_used = 1;
 }
@@ -721,7 +723,8 @@ void add_velocity_interval(FsccResult& result, const CorrelationFunctions& sprea
   result.interval_segments = static_cast<int>(spread.segment_peak_lags.size());
 }
 
-FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options) {
+FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, double dx, const FsccOptions& options,
+                bool second_thread) {
   // The interval reads the segments' R12 peaks and the status only: the
   // segments' R11 is not computed (correlation_functions would).
   const FsccOptions spread_options = interval_options(options);
@@ -739,12 +742,22 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
   // windows and the gaps between them (window_partition): computed so, the
   // segments' products serve the interval too.
   std::optional<WindowPartition> partition;
+  // R11's lagged products, on a second thread while R12's partition runs
+  // here: whole numbers either way, so the thread changes no bit.
+  std::future<std::vector<double>> r11_sums;
+  std::optional<FsccLags> lags;
   if (options.segments == 1) {
     options.validate().throw_if_failed();
-    const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
+    lags = fscc_lags(leading.sample_count, leading.fs, options);
     if (leading.sample_count == trailing.sample_count && leading.fs == trailing.fs && leading.air_samples() > 0 &&
-        trailing.air_samples() > 0 && lags.r12_first == spread_lags.r12_first && lags.r12_last == spread_lags.r12_last) {
-      partition = window_partition(leading, trailing, spread_options.segments, lags, plans);
+        trailing.air_samples() > 0 && lags->r12_first == spread_lags.r12_first && lags->r12_last == spread_lags.r12_last) {
+      if (second_thread) {
+        r11_sums = std::async(std::launch::async, [&leading, last = lags->r11_last] {
+          FftPlanCache own;  // a plan cache is one thread's
+          return lagged_products(leading, leading, 0, leading.sample_count, 0, last, own);
+        });
+      }
+      partition = window_partition(leading, trailing, spread_options.segments, *lags, plans);
     }
   }
   if (!partition) {
@@ -752,9 +765,10 @@ FsccResult fscc(const AirIntervals& leading, const AirIntervals& trailing, doubl
     if (out.ok()) interval(out, nullptr);
     return out;
   }
-  const FsccLags lags = fscc_lags(leading.sample_count, leading.fs, options);
-  CorrelationFunctions f = binary_functions(leading.fs, lags);
-  full_record(leading, trailing, lags, plans, f, &partition->whole);
+  CorrelationFunctions f = binary_functions(leading.fs, *lags);
+  const bool r11_given = r11_sums.valid();
+  const std::vector<double> r11 = r11_given ? r11_sums.get() : std::vector<double>{};
+  full_record(leading, trailing, *lags, plans, f, &partition->whole, r11_given ? &r11 : nullptr);
   auto out = fscc_from_functions(std::move(f), dx, options);
   if (out.ok()) interval(out, &partition->windows);
   return out;

@@ -233,9 +233,14 @@ BinarisationOptions tip_options(const BinarisationOptions& bopt, std::size_t k) 
 
 // Blocks of a recording in order, read one ahead on a second thread where the
 // options allow it and a second core exists (same blocks either way).
+// Whether a second thread can run beside this one without waiting for it.
+bool two_cores() {
+  static const bool two = std::thread::hardware_concurrency() >= 2;
+  return two;
+}
+
 template <class Sample>
 detail::ReadAhead<Sample> blocks(Recording& recording, const ProcessOptions& options, const ChannelSelection& ch) {
-  static const bool two_cores = std::thread::hardware_concurrency() >= 2;
   typename detail::ReadAhead<Sample>::ReadFn read;
   if constexpr (std::is_same_v<Sample, float>) {
     read = [&recording](std::span<float> out, std::int64_t n) { return recording.read(out, n); };
@@ -247,7 +252,7 @@ detail::ReadAhead<Sample> blocks(Recording& recording, const ProcessOptions& opt
   constexpr std::size_t block_budget = std::size_t{4} << 20;
   const auto frames = std::clamp<std::int64_t>(
       static_cast<std::int64_t>(block_budget / (ch.stride * sizeof(Sample))), 1, options.block_frames);
-  return detail::ReadAhead<Sample>(std::move(read), frames, ch.stride, options.read_ahead && two_cores);
+  return detail::ReadAhead<Sample>(std::move(read), frames, ch.stride, options.read_ahead && two_cores());
 }
 
 // Two passes over floating (or non-16-bit) samples: histograms, then thresholds.
@@ -870,7 +875,7 @@ ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOption
   out.dx = options.dx;
   out.dy = options.dy;
   if (options.fscc && options.awcc_options.signal == CorrelationSignal::binary) {
-    out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options);
+    out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options, options.parallel_fscc && two_cores());
   }
   if (options.awcc && options.awcc_options.signal == CorrelationSignal::binary) {
     out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);

@@ -26,6 +26,7 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
   p.structure.enabled = false;
   p.velocity_spectrum = false;
   p.sizes = false;
+  p.parallel_fscc = false;  // a study's rows fill the cores, one row a thread
   return p;
 }
 

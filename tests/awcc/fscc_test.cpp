@@ -175,6 +175,41 @@ TEST(Fscc, FullRecordFromSegmentWindowsEqualsTheWholeRecordsProducts) {
   }
 }
 
+// The auto-correlation summed on a thread of its own (what pdp process does
+// with a second core) against the one-thread run: sums of whole numbers, so
+// every output equals bit for bit. Records long and short (the shortest does
+// not partition into the segments' windows, and the thread's sums are then
+// computed and not used), with chords of tens of samples and of one to three.
+TEST(Fscc, AutoCorrelationOnASecondThreadGivesTheSameBits) {
+  struct Case {
+    std::int64_t n;
+    int max_air, max_water, min_length;
+  };
+  unsigned seed = 40;
+  for (const Case c : {Case{200'000, 10, 40, 2}, Case{200'000, 3, 3, 1}, Case{1'000, 10, 40, 2}, Case{60, 3, 3, 1}}) {
+    const auto x = pdp_test::telegraph(c.n, ++seed, 1000.0, c.max_air, c.max_water, c.min_length);
+    const auto y = shifted(x, 3);
+    awcc::FsccOptions o;
+    o.max_lag = 0.05;
+    const auto one = awcc::fscc(x, y, 1.0, o, false);
+    const auto two = awcc::fscc(x, y, 1.0, o, true);
+    EXPECT_EQ(one.status, two.status) << c.n;
+    EXPECT_EQ(one.r11, two.r11) << c.n;
+    EXPECT_EQ(one.r12, two.r12) << c.n;
+    EXPECT_EQ(one.velocity, two.velocity) << c.n;
+    EXPECT_EQ(one.t05, two.t05) << c.n;
+    EXPECT_EQ(one.txx, two.txx) << c.n;
+    ASSERT_EQ(one.velocity_ci95.has_value(), two.velocity_ci95.has_value()) << c.n;
+    if (one.velocity_ci95) {
+      EXPECT_EQ(one.velocity_ci95->lower, two.velocity_ci95->lower) << c.n;
+    }
+    // And against the whole record's functions, computed apart.
+    if (one.ok()) {
+      EXPECT_EQ(two.r11, awcc::correlation_functions(x, y, o).r11) << c.n;
+    }
+  }
+}
+
 TEST(Fscc, UndefinedResultsCarryAReason) {
   const auto x = telegraph(10'000, 3);
   AirIntervals empty;

@@ -93,6 +93,11 @@ struct ProcessOptions {
   /// second core exists (same result; decoding FLAC or copying from the page
   /// cache then overlaps with the work on the samples).
   bool read_ahead = true;
+  /// Sum FSCC's auto-correlation on a second thread while its
+  /// cross-correlation is summed (awcc::fscc's second_thread), where a
+  /// second core exists: the same result, bit for bit. Off in study runs,
+  /// whose rows fill the cores already (study::processing_options).
+  bool parallel_fscc = true;
   /// Hash the recording's file (SHA-256, ProcessResult::input_sha256) for
   /// the provenance, on the bytes as they are read where the reader allows
   /// (Recording::hash_while_reading). Off unless an output records it: the
