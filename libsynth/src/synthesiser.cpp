@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <deque>
 #include <fmt/format.h>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <tuple>
 #include <unordered_map>
 
 #include "synth/overlap.hpp"
@@ -107,12 +109,12 @@ std::vector<awcc::AirInterval> complement(const std::vector<awcc::AirInterval>& 
   return out;
 }
 
-// What the step loop reads of every candidate (key, t_entry, open_mask,
+// What the pierce walk reads of every step (key, t_entry, entry_step,
 // clear_until) comes first, on one cache line.
 struct ActiveBubble {
   Vec3 key;        // D(t_entry)
   double t_entry;
-  std::uint64_t open_mask = 0;  // tips inside this bubble at the end of the last step (in open_)
+  std::int64_t entry_step = 0;  // the velocity step in which it entered
   // Per tip (the first few): the probe's lateral path length below which
   // the tip cannot reach this bubble (Synthesiser::pierce_tip).
   static constexpr std::size_t cached_tips = 4;
@@ -147,17 +149,9 @@ class BubbleQueue {
   /// answer), found by walking from where the last search with this `hint`
   /// ended: keys move a little from one step to the next, so the walk is a
   /// step or two where a binary search is a dozen unpredictable branches.
-  iterator first_not_below(double key, std::size_t& hint) {
-    std::size_t i = hint >= erased_ ? std::clamp(hint - erased_, head_, items_.size()) : head_;
-    while (i > head_ && items_[i - 1].key.x >= key) --i;
-    // Mostly one bubble or none: that one without a branch, so that the
-    // loop's test is nearly always false (a walk of 0 or 1 was a
-    // mispredicted branch a step).
-    if (i < items_.size()) i += static_cast<std::size_t>(items_[i].key.x < key);
-    while (i < items_.size() && items_[i].key.x < key) ++i;
-    hint = i + erased_;
-    return items_.begin() + static_cast<std::ptrdiff_t>(i);
-  }
+  iterator first_not_below(double key, std::size_t& hint) { return first_after<false>(key, hint); }
+  /// The first bubble whose key.x is above `key`, found so.
+  iterator first_above(double key, std::size_t& hint) { return first_after<true>(key, hint); }
   /// A new bubble at the end, to be filled in, then settle_last().
   ActiveBubble& append() { return items_.emplace_back(); }
   /// Moves the last bubble back to its place in key order (it is there
@@ -170,6 +164,21 @@ class BubbleQueue {
   }
 
  private:
+  // The first bubble whose key.x is not below `key` (above it, if strict).
+  template <bool strict>
+  iterator first_after(double key, std::size_t& hint) {
+    auto before = [key](double k) { return strict ? k <= key : k < key; };
+    std::size_t i = hint >= erased_ ? std::clamp(hint - erased_, head_, items_.size()) : head_;
+    while (i > head_ && !before(items_[i - 1].key.x)) --i;
+    // Mostly one bubble or none: that one without a branch, so that the
+    // loop's test is nearly always false (a walk of 0 or 1 was a
+    // mispredicted branch a step).
+    if (i < items_.size()) i += static_cast<std::size_t>(before(items_[i].key.x));
+    while (i < items_.size() && before(items_[i].key.x)) ++i;
+    hint = i + erased_;
+    return items_.begin() + static_cast<std::ptrdiff_t>(i);
+  }
+
   std::vector<ActiveBubble> items_;
   std::size_t head_ = 0;
   std::size_t erased_ = 0;  // items erased from the front so far: hints survive the compaction
@@ -195,10 +204,57 @@ struct Interface {
   Vec3 normal;        // outward unit normal of the surface at the tip
 };
 
+// One tip's pierce of the bubble being walked, while the tip is inside.
 struct OpenPierce {
+  bool inside = false;
+  double t_in = 0.0;
+  std::int64_t step = 0;  // the step in which it opened
+  Interface front;        // with bubble_truth
+};
+
+// One velocity step as the pierce walk reads it: the common displacement
+// and the lateral path length at its start and end, its velocity, and the
+// steps with u_x < 0 up to it.
+struct Step {
+  Vec3 d;
+  Vec3 u;
+  double path, path_next;
+  std::int64_t backward;  // steps up to and including this one with u_x < 0
+};
+
+// The keys of the bubbles a step can bring within a_x_max of a tip
+// streamwise (Synthesiser::walk).
+struct Reach {
+  double lo, hi;
+};
+
+// Steps [from, to) at which a bubble of key `key` was not yet within reach
+// of a tip: so neither is any bubble of a larger key (Synthesiser::walk).
+struct NotThere {
+  double key = -std::numeric_limits<double>::infinity();
+  std::int64_t from = 0, to = 0;
+};
+
+// What a step's view hands to the pierce test: the step and its start time.
+struct StepView {
+  const Step& h;
+  double t;
+};
+
+// A term of a tip's interfacial-area sum (bubble_truth), kept with the
+// order in which the step loop used to add it: by the step of the pierce's
+// end, then the bubbles' key order; the pierces still open at the record's
+// end last, in the order they opened. Summed in that order at the end, so
+// the sum does not depend on the order in which bubbles are walked.
+struct AreaTerm {
+  bool at_end;
+  std::int64_t step;
+  double key;
   std::uint64_t serial;
-  double t_in;
-  Interface front;  // with bubble_truth
+  double front, rear;  // 0 when the interface is not in the record
+  bool operator<(const AreaTerm& o) const {
+    return std::tie(at_end, step, key, serial) < std::tie(o.at_end, o.step, o.key, o.serial);
+  }
 };
 
 // A pierced bubble's truth while it is still active.
@@ -375,14 +431,14 @@ class Synthesiser {
     t_start_ = -static_cast<double>(pre_steps_) * dt_;
     record_steps_ = static_cast<std::int64_t>(std::ceil(duration_ / dt_));
 
-    open_.resize(tips_.size());
-    pierce_hint_.assign(tips_.size(), 0);
     pierces_.resize(tips_.size());
     pair_counts_.assign(tips_.size() * tips_.size(), 0);
+    not_there_.resize(tips_.size());
+    reach_.resize(tips_.size());
     tip_counts_.assign(tips_.size(), 0);
     if (options.bubble_truth) {
       table_.tip_count = tips_.size();
-      area_sum_.assign(tips_.size(), 0.0);
+      area_terms_.resize(tips_.size());
     }
 
     const bool time_rule = scene.arrival == ArrivalRule::equal_time || scene.arrival == ArrivalRule::poisson_time;
@@ -429,6 +485,7 @@ class Synthesiser {
         const double t = t_start_ + static_cast<double>(step) * dt_;
         if (options_.keep_reference_data) out.reference->velocities.push_back(u);
         if (step == pre_steps_) record_start_x_ = d_.x;
+        step_ = step;
         advance(t, u);
         if (step >= pre_steps_) {
           flow.add(u);
@@ -437,7 +494,9 @@ class Synthesiser {
       }
       if (options_.progress) options_.progress(static_cast<double>(first + n) / static_cast<double>(total));
     }
-    finish_open();
+    // The bubbles still in the control volume: walked to the last step,
+    // a pierce still open ending with the record.
+    for (auto& b : bubbles_) walk(b, total - 1, true);
     for (const auto& b : bubbles_) tally(b);
     if (options_.keep_reference_data) out.reference->bubbles = std::move(records_);
 
@@ -472,7 +531,7 @@ class Synthesiser {
       tip.void_fraction = signal.void_fraction();
       tip.chords = static_cast<std::int64_t>(signal.intervals.size());
       tip.bubbles_pierced = tip_counts_[j];
-      if (options_.bubble_truth) tip.interfacial_area = area_sum_[j] / duration_;
+      if (options_.bubble_truth) tip.interfacial_area = area_sum(j) / duration_;
       truth.tips.push_back(tip);
       out.signals.push_back(std::move(signal));
       for (std::size_t k = j + 1; k < tips_.size(); ++k) {
@@ -492,7 +551,17 @@ class Synthesiser {
     // Most steps have no event: what arrivals' loop finds first, checked
     // here, without the call.
     if (!pending_.empty() || (time_rule_ ? next_time_ - t < dt_ : next_key_ <= d_next.x)) arrivals(t, u, d_next);
-    pierce(t, u, d_next);
+    backward_ += static_cast<std::int64_t>(u.x < 0.0);
+    history_.push_back({d_, u, lateral_path_, lateral_path_next_, backward_});
+    path_next_.push_back(lateral_path_next_);
+    // The keys of the bubbles this step can bring within a_x_max of tip j
+    // streamwise: the bubble's x relative to the tip is entry_x + D_x - key - P_jx.
+    const double d_lo = std::min(d_.x, d_next.x), d_hi = std::max(d_.x, d_next.x);
+    for (std::size_t j = 0; j < tips_.size(); ++j) {
+      reach_[j].push_back({entry_x_ + d_lo - tips_[j].x - a_x_max_, entry_x_ + d_hi - tips_[j].x + a_x_max_});
+    }
+    // A bubble retired may have come back to a tip: counted, not pierced.
+    if (entry_x_ + std::min(d_.x, d_next.x) - tip_x_max_ - a_x_max_ < max_retired_key_) ++reentries_missed_;
     retire(d_next);
     d_ = d_next;
     lateral_path_ = lateral_path_next_;
@@ -578,7 +647,7 @@ class Synthesiser {
     const double reach = 2.0 * a_x_max_;
     const auto lo = bubbles_.first_not_below(key.x - reach, place_hint_lo_);
     // partition_point(o.key.x <= key.x + reach): the first key above it.
-    const auto hi = bubbles_.first_not_below(std::nextafter(key.x + reach, HUGE_VAL), place_hint_hi_);
+    const auto hi = bubbles_.first_above(key.x + reach, place_hint_hi_);
     // What the attempts share, once: each neighbour's disc in the entry
     // plane (synth/placement.hpp).
     auto& near = neighbours_;
@@ -613,6 +682,7 @@ class Synthesiser {
     ActiveBubble& b = bubbles_.append();
     b.key = key;
     b.t_entry = t_entry;
+    b.entry_step = step_;
     b.entry = {entry_x_, placement_.y(chosen), placement_.z(chosen)};
     b.radius = radius;
     b.a_x = radius * sizes_.x_factor;
@@ -625,7 +695,7 @@ class Synthesiser {
     // threshold lower than it could be. Most bubbles pass every tip at a
     // distance and are never looked at again.
     for (std::size_t j = 0; j < std::min(tips_.size(), ActiveBubble::cached_tips); ++j) {
-      b.clear_until[j] = clear_until(b, b.entry.y - tips_[j].y, b.entry.z - tips_[j].z);
+      b.clear_until[j] = clear_until(b, lateral_path_, b.entry.y - tips_[j].y, b.entry.z - tips_[j].z);
     }
     b.serial = serial_++;
     if (t_entry >= 0.0 && t_entry < duration_) ++generated_;
@@ -698,31 +768,71 @@ class Synthesiser {
     }
   }
 
-  void pierce(double t, const Vec3& u, const Vec3& d_next) {
-    const double d_lo = std::min(d_.x, d_next.x);
-    const double d_hi = std::max(d_.x, d_next.x);
-    if (entry_x_ + d_lo - tip_x_max_ - a_x_max_ < max_retired_key_) ++reentries_missed_;
-    // Bubble x relative to tip j is entry_x + D_x - key_x - P_jx, and the tip
-    // can be inside only if |.| < a_x: one contiguous range of keys per tip.
+  // The pierces of bubble b, walked step by step from its entry to step
+  // `last` over the velocity steps kept in history_ (retire() walks a bubble
+  // when it leaves, run() the ones left at the end, with at_end). The steps
+  // tested are the ones at which the step loop once tested it: those whose
+  // range of keys holds it (at most a_x_max from the tip streamwise, the
+  // same expression), and every test is the same arithmetic on the same
+  // step, so the air intervals are the ones the step loop found. Past the
+  // tip with no backward step to come, the walk stops: the displacement
+  // only grows from there.
+  void walk(ActiveBubble& b, std::int64_t last, bool at_end) {
+    const double key = b.key.x;
+    const std::int64_t first = history_first_;
+    const Step* steps = history_.data();  // steps[s - first] is step s, as in every array below
+    const double* path_next = path_next_.data();
+    const std::int64_t backward_to_last = steps[last - first].backward;
     for (std::size_t j = 0; j < tips_.size(); ++j) {
-      const double key_lo = entry_x_ + d_lo - tips_[j].x - a_x_max_;
-      const double key_hi = entry_x_ + d_hi - tips_[j].x + a_x_max_;
-      auto it = bubbles_.first_not_below(key_lo, pierce_hint_[j]);
-      // The candidates that the lateral skip does not pass over, gathered
-      // without a branch a candidate (most are skipped, unpredictably).
+      const Reach* reach = reach_[j].data() - first;  // reach[s]: step s
+      // Not there yet: the steps before the first whose keys reach it.
+      // Bubbles are walked in key order, so the last bubble's steps not
+      // there yet are this one's too (NotThere).
+      NotThere& hint = not_there_[j];
+      std::int64_t s = b.entry_step;
+      if (key >= hint.key && s >= hint.from) s = std::max(s, hint.to);
+      s = first_of(s, last, [&](std::int64_t i) { return key <= reach[i].hi; });
+      hint = {key, b.entry_step, s};
       const bool cached = j < ActiveBubble::cached_tips;
-      // The threshold is read whether or not the tip has one (no branch):
-      // a tip beyond the cached ones reads slot 0 and ignores it.
-      const std::size_t slot = cached ? j : 0;
-      std::size_t due = 0;
-      for (; it != bubbles_.end() && it->key.x <= key_hi; ++it) {
-        if (due == due_.size()) [[unlikely]] due_.resize(2 * due + 8);
-        due_[due] = &*it;
-        const bool skip = cached & !((it->open_mask >> j) & 1u) & (lateral_path_next_ < it->clear_until[slot]);
-        due += static_cast<std::size_t>(!skip);
+      OpenPierce open;
+      std::int64_t end = last + 1;  // the steps [s, end) hold the candidates
+      if (s <= last && steps[s - first].u.x >= 0.0 && steps[s - first].backward == backward_to_last) {
+        // Forward from s to the last step: the keys reached only grow, so
+        // the candidates are the steps up to the first that has passed it.
+        end = first_of(s, last, [&](std::int64_t i) { return key < reach[i].lo; });
+        // The lateral path only grows: if the tip cannot reach the bubble
+        // by the last of them, it reaches it at none (pierce_tip's skip).
+        if (cached && s < end && path_next[end - 1 - first] < b.clear_until[j]) s = end;
       }
-      for (std::size_t k = 0; k < due; ++k) pierce_tip(*due_[k], j, t, std::max(0.0, due_[k]->t_entry - t), u);
+      for (; s < end; ++s) {
+        const Reach& r = reach[s];
+        if (key < r.lo) {
+          if (steps[s - first].backward == backward_to_last) break;  // past the tip for good
+          continue;
+        }
+        if (key > r.hi) continue;  // back upstream
+        // The lateral skip (pierce_tip), before the call.
+        if (cached && !open.inside && path_next[s - first] < b.clear_until[j]) continue;
+        const double t = t_start_ + static_cast<double>(s) * dt_;
+        pierce_tip(b, j, {steps[s - first], t}, std::max(0.0, b.t_entry - t), open, s);
+      }
+      if (at_end && open.inside) emit(j, b, open.t_in, duration_, {true, open.step}, bubble_truth_ ? &open.front : nullptr);
     }
+  }
+
+  // The first step i in [from, last] with found(i), else last + 1: four
+  // steps tested at a time without a branch, so that the loop's exit (most
+  // walks find it within the first four) is the only branch taken on data.
+  template <class Found>
+  static std::int64_t first_of(std::int64_t from, std::int64_t last, Found found) {
+    for (std::int64_t i = from; i <= last; i += 4) {
+      unsigned hits = 0;
+      for (std::int64_t k = 0; k < 4; ++k) {
+        hits |= static_cast<unsigned>(found(std::min(i + k, last)) && i + k <= last) << k;
+      }
+      if (hits) return i + std::countr_zero(hits);
+    }
+    return last + 1;
   }
 
   // Whether the tip stays outside the bubble for the whole step by one
@@ -751,8 +861,8 @@ class Synthesiser {
   // offset, as the bubble's image is chosen before the tip's offset is
   // taken; the other is length - |lateral_y|) less a_lat and the margin.
   // Lateral semi-axes are equal (try_place).
-  [[nodiscard]] double clear_until(const ActiveBubble& b, double lateral_y, double lateral_z) const {
-    return lateral_path_ + std::sqrt(nearest_image2(lateral_y, lateral_z)) - b.clear_reach;
+  [[nodiscard]] double clear_until(const ActiveBubble& b, double path, double lateral_y, double lateral_z) const {
+    return path + std::sqrt(nearest_image2(lateral_y, lateral_z)) - b.clear_reach;
   }
   [[nodiscard]] double nearest_image2(double lateral_y, double lateral_z) const {
     const double ny = std::min(std::fabs(lateral_y), length_[1] - std::fabs(lateral_y));
@@ -760,13 +870,18 @@ class Synthesiser {
     return ny * ny + nz * nz;
   }
 
-  void pierce_tip(ActiveBubble& b, std::size_t j, double t, double s0, const Vec3& u) {
+  // One step of tip j's walk over bubble b (walk): the step starting at
+  // view.t, the bubble there from s0 into it; `open` is the tip's pierce of
+  // this bubble, open while the tip is inside.
+  void pierce_tip(ActiveBubble& b, std::size_t j, const StepView& view, double s0, OpenPierce& open, std::int64_t step) {
     const Vec3& p = tips_[j];
-    const bool was_inside = (b.open_mask >> j) & 1u;
+    const Step& h = view.h;
+    const double t = view.t;
+    const Vec3& u = h.u;
+    const bool was_inside = open.inside;
     const bool cached = j < ActiveBubble::cached_tips;
-    if (cached && !was_inside && lateral_path_next_ < b.clear_until[j]) return;
-    const double lateral_y = wrap(b.entry.y + d_.y - b.key.y, length_[1]) - p.y;
-    const double lateral_z = wrap(b.entry.z + d_.z - b.key.z, length_[2]) - p.z;
+    const double lateral_y = wrap(b.entry.y + h.d.y - b.key.y, length_[1]) - p.y;
+    const double lateral_z = wrap(b.entry.z + h.d.z - b.key.z, length_[2]) - p.z;
     if (cached && !was_inside) {
       // The skip below, before the roots: a bubble further from the tip
       // than a_lat and the step's lateral path cannot hold it during the
@@ -776,11 +891,11 @@ class Synthesiser {
       // positive), so that the branch does not wait for the square root,
       // which only the threshold kept for later steps needs.
       const double d2 = nearest_image2(lateral_y, lateral_z);
-      const double need = lateral_path_next_ - lateral_path_ + b.clear_reach;
-      b.clear_until[j] = lateral_path_ + std::sqrt(d2) - b.clear_reach;
+      const double need = h.path_next - h.path + b.clear_reach;
+      b.clear_until[j] = h.path + std::sqrt(d2) - b.clear_reach;
       if (need * need < d2) return;
     }
-    const double qx = (b.entry.x + d_.x - b.key.x - p.x) * b.inv_axes.x;
+    const double qx = (b.entry.x + h.d.x - b.key.x - p.x) * b.inv_axes.x;
     const double vx = u.x * b.inv_axes.x;
     const double qy = lateral_y * b.inv_axes.y;
     const double vy = u.y * b.inv_axes.y;
@@ -814,39 +929,38 @@ class Synthesiser {
       crosses = true;
     }
 
-    auto& open = open_[j];
     if (was_inside) {
-      auto found = std::find_if(open.begin(), open.end(), [&](const OpenPierce& o) { return o.serial == b.serial; });
       if (crosses && r2 > s0 && r2 >= dt_) return;  // still inside at the step's end
       const double s_out = !crosses || r2 <= s0 ? s0 : r2;
       if (bubble_truth_) {
-        const Interface rear = interface_at(b, j, t, s_out, u);
-        emit(j, b, found->t_in, t + s_out, &found->front, &rear);
+        const Interface rear = interface_at(b, j, view, s_out);
+        emit(j, b, open.t_in, t + s_out, {false, step}, &open.front, &rear);
       } else {
-        emit(j, b, found->t_in, t + s_out);
+        emit(j, b, open.t_in, t + s_out, {false, step});
       }
-      open.erase(found);
-      b.open_mask &= ~(std::uint64_t{1} << j);
+      open.inside = false;
       return;
     }
     if (!crosses || r2 <= s0 || r1 >= dt_) {
-      if (cached) b.clear_until[j] = clear_until(b, lateral_y, lateral_z);
+      if (cached) b.clear_until[j] = clear_until(b, h.path, lateral_y, lateral_z);
       return;
     }
     const double s_in = std::max(r1, s0);
     const double t_in = t + s_in;
     Interface front;
-    if (bubble_truth_) front = interface_at(b, j, t, s_in, u);
+    if (bubble_truth_) front = interface_at(b, j, view, s_in);
     if (r2 < dt_) {
       if (bubble_truth_) {
-        const Interface rear = interface_at(b, j, t, r2, u);
-        emit(j, b, t_in, t + r2, &front, &rear);
+        const Interface rear = interface_at(b, j, view, r2);
+        emit(j, b, t_in, t + r2, {false, step}, &front, &rear);
       } else {
-        emit(j, b, t_in, t + r2);
+        emit(j, b, t_in, t + r2, {false, step});
       }
     } else {
-      open.push_back({b.serial, t_in, front});
-      b.open_mask |= std::uint64_t{1} << j;
+      open.inside = true;
+      open.t_in = t_in;
+      open.step = step;
+      open.front = front;
     }
   }
 
@@ -855,30 +969,40 @@ class Synthesiser {
   // and the outward normal of |r / a|^2 = 1 there is along r / a^2.
   // Out of line, as record_pierce: the truth's code kept off pierce_tip's
   // hot path leaves its inlining as it was (4 % faster with the table off).
-  [[nodiscard]] [[gnu::noinline]] Interface interface_at(const ActiveBubble& b, std::size_t j, double t, double s, const Vec3& u) const {
+  [[nodiscard]] [[gnu::noinline]] Interface interface_at(const ActiveBubble& b, std::size_t j, const StepView& view,
+                                                        double s) const {
     const Vec3& p = tips_[j];
-    const Vec3 r{p.x - (b.entry.x + d_.x - b.key.x + u.x * s),
-                 p.y - (wrap(b.entry.y + d_.y - b.key.y, length_[1]) + u.y * s),
-                 p.z - (wrap(b.entry.z + d_.z - b.key.z, length_[2]) + u.z * s)};
+    const Vec3& d = view.h.d;
+    const Vec3& u = view.h.u;
+    const Vec3 r{p.x - (b.entry.x + d.x - b.key.x + u.x * s),
+                 p.y - (wrap(b.entry.y + d.y - b.key.y, length_[1]) + u.y * s),
+                 p.z - (wrap(b.entry.z + d.z - b.key.z, length_[2]) + u.z * s)};
     const Vec3 g{r.x * b.inv_axes.x * b.inv_axes.x, r.y * b.inv_axes.y * b.inv_axes.y,
                  r.z * b.inv_axes.z * b.inv_axes.z};
     const double norm = std::sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
     Interface out;
-    out.t = t + s;
-    out.displacement = {d_.x + u.x * s, d_.y + u.y * s, d_.z + u.z * s};
+    out.t = view.t + s;
+    out.displacement = {d.x + u.x * s, d.y + u.y * s, d.z + u.z * s};
     out.velocity = u;
     out.normal = {g.x / norm, g.y / norm, g.z / norm};
     return out;
   }
 
+  // Where an emitted pierce's area terms go in the sum (AreaTerm): ended in
+  // `step`, or still open at the record's end, opened in `step`.
+  struct EmitOrder {
+    bool at_end;
+    std::int64_t step;
+  };
+
   // front, rear: the interfaces with bubble_truth (rear null when the record
   // ends with the tip inside).
-  void emit(std::size_t j, ActiveBubble& b, double t_in, double t_out, const Interface* front = nullptr,
-            const Interface* rear = nullptr) {
+  void emit(std::size_t j, ActiveBubble& b, double t_in, double t_out, EmitOrder order,
+            const Interface* front = nullptr, const Interface* rear = nullptr) {
     if (t_out <= 0.0 || t_in >= duration_) return;
     // A rear interface after the record's end is not in it: the pierce is
-    // censored there, as when the record ends with the step (finish_open).
-    if (front) record_pierce(j, b, *front, rear && rear->t < duration_ ? rear : nullptr);
+    // censored there, as when the record ends with the tip inside.
+    if (front) record_pierce(j, b, order, *front, rear && rear->t < duration_ ? rear : nullptr);
     b.pierced_mask |= std::uint64_t{1} << j;
     // Samples strictly inside (t_in, t_out).
     const auto start = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(t_in * fs_)) + 1);
@@ -889,21 +1013,42 @@ class Synthesiser {
   void retire(const Vec3& d_next) {
     const double limit = entry_x_ + std::min(d_.x, d_next.x) - tip_x_max_ - a_x_max_ - reversal_allowance_;
     while (!bubbles_.empty() && bubbles_.front().key.x < limit) {
-      max_retired_key_ = std::max(max_retired_key_, bubbles_.front().key.x);
-      tally(bubbles_.front());
+      ActiveBubble& b = bubbles_.front();
+      walk(b, step_, false);
+      max_retired_key_ = std::max(max_retired_key_, b.key.x);
+      tally(b);
       bubbles_.pop_front();
     }
+    forget_history();
   }
 
-  void finish_open() {
-    for (std::size_t j = 0; j < tips_.size(); ++j) {
-      for (const auto& o : open_[j]) {
-        auto it = std::find_if(bubbles_.begin(), bubbles_.end(),
-                               [&](const ActiveBubble& b) { return b.serial == o.serial; });
-        if (it != bubbles_.end()) emit(j, *it, o.t_in, duration_, bubble_truth_ ? &o.front : nullptr);
-      }
-      open_[j].clear();
+  // Drops the steps before the earliest entry of a bubble still active:
+  // no walk reads them again.
+  void forget_history() {
+    // Seldom, so that the steps kept (a bubble's life, about 2,000 in the
+    // base case) are moved seldom.
+    if (step_ < next_forget_) return;
+    next_forget_ = step_ + 16384;
+    std::int64_t earliest = step_;
+    for (auto it = bubbles_.begin(); it != bubbles_.end(); ++it) earliest = std::min(earliest, it->entry_step);
+    const std::int64_t drop = earliest - history_first_;
+    if (2 * drop < static_cast<std::int64_t>(history_.size())) return;
+    history_.erase(history_.begin(), history_.begin() + static_cast<std::ptrdiff_t>(drop));
+    path_next_.erase(path_next_.begin(), path_next_.begin() + static_cast<std::ptrdiff_t>(drop));
+    for (auto& r : reach_) r.erase(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(drop));
+    history_first_ = earliest;
+  }
+
+  // Tip j's sum of 1 / |u . n| over its interfaces, added in AreaTerm's order.
+  [[nodiscard]] double area_sum(std::size_t j) {
+    auto& terms = area_terms_[j];
+    std::sort(terms.begin(), terms.end());
+    double sum = 0.0;
+    for (const auto& a : terms) {
+      sum += a.front;
+      sum += a.rear;
     }
+    return sum;
   }
 
   void tally(const ActiveBubble& b) {
@@ -920,7 +1065,8 @@ class Synthesiser {
   }
 
   // One piercing of tip j by bubble b that overlaps the record.
-  [[gnu::noinline]] void record_pierce(std::size_t j, const ActiveBubble& b, const Interface& front, const Interface* rear) {
+  [[gnu::noinline]] void record_pierce(std::size_t j, const ActiveBubble& b, EmitOrder order, const Interface& front,
+                                       const Interface* rear) {
     auto [slot, added] = in_progress_.try_emplace(b.serial);
     BubbleInProgress& p = slot->second;
     if (added) {
@@ -939,8 +1085,8 @@ class Synthesiser {
       const double un = i.velocity.x * i.normal.x + i.velocity.y * i.normal.y + i.velocity.z * i.normal.z;
       return 1.0 / std::fabs(un);
     };
-    if (front.t >= 0.0) area_sum_[j] += area(front);
-    if (rear && rear->t < duration_) area_sum_[j] += area(*rear);
+    area_terms_[j].push_back({order.at_end, order.step, b.key.x, b.serial, front.t >= 0.0 ? area(front) : 0.0,
+                              rear && rear->t < duration_ ? area(*rear) : 0.0});
 
     TipPierce& tip = p.tips[j];
     if (tip.pierced()) {
@@ -1053,19 +1199,25 @@ class Synthesiser {
   std::vector<BubbleRecord> records_;
   std::uint64_t serial_ = 0;
   double max_retired_key_ = -std::numeric_limits<double>::infinity();
-  std::vector<std::vector<OpenPierce>> open_;
-  std::vector<std::size_t> pierce_hint_;  // per tip: where the last candidate search ended
-  std::vector<ActiveBubble*> due_;        // scratch of pierce: the candidates of one tip not skipped
+  // The velocity steps from the earliest entry of an active bubble on
+  // (walk), history_[i] being step history_first_ + i.
+  std::vector<Step> history_;
+  std::vector<double> path_next_;        // history_[i].path_next, alone
+  std::vector<std::vector<Reach>> reach_;  // per tip
+  std::int64_t history_first_ = 0, next_forget_ = 0;
+  std::int64_t step_ = 0;      // the step being taken
+  std::vector<NotThere> not_there_;  // per tip (walk)
+  std::int64_t backward_ = 0;  // steps so far with u_x < 0
   std::size_t place_hint_lo_ = 0, place_hint_hi_ = 0;
   std::vector<std::vector<awcc::AirInterval>> pierces_;
   std::vector<std::int64_t> pair_counts_;
   std::vector<std::int64_t> tip_counts_;
   std::int64_t generated_ = 0, overlaps_unresolved_ = 0, reentries_missed_ = 0;
   // With bubble_truth: pierced bubbles still active (by serial), the rows of
-  // those retired, and each tip's sum of 1 / |u . n| over its interfaces.
+  // those retired, and each tip's terms of 1 / |u . n| over its interfaces.
   std::unordered_map<std::uint64_t, BubbleInProgress> in_progress_;
   BubbleTruth table_;
-  std::vector<double> area_sum_;
+  std::vector<std::vector<AreaTerm>> area_terms_;
 };
 
 template <class PerSample>
