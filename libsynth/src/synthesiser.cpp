@@ -226,6 +226,8 @@ struct Step {
 // streamwise (Synthesiser::walk).
 struct Reach {
   double lo, hi;
+  /// Whether a step of these keys can bring a bubble of this key within reach.
+  [[nodiscard]] bool holds(double key) const { return lo <= key && key <= hi; }
 };
 
 // Steps [from, to) at which a bubble of key `key` was not yet within reach
@@ -435,6 +437,7 @@ class Synthesiser {
     pair_counts_.assign(tips_.size() * tips_.size(), 0);
     not_there_.resize(tips_.size());
     reach_.resize(tips_.size());
+    block_reach_.resize(tips_.size());
     tip_counts_.assign(tips_.size(), 0);
     if (options.bubble_truth) {
       table_.tip_count = tips_.size();
@@ -557,8 +560,13 @@ class Synthesiser {
     // The keys of the bubbles this step can bring within a_x_max of tip j
     // streamwise: the bubble's x relative to the tip is entry_x + D_x - key - P_jx.
     const double d_lo = std::min(d_.x, d_next.x), d_hi = std::max(d_.x, d_next.x);
+    const bool new_block = (step_ & (block_steps - 1)) == 0;
     for (std::size_t j = 0; j < tips_.size(); ++j) {
-      reach_[j].push_back({entry_x_ + d_lo - tips_[j].x - a_x_max_, entry_x_ + d_hi - tips_[j].x + a_x_max_});
+      const Reach r{entry_x_ + d_lo - tips_[j].x - a_x_max_, entry_x_ + d_hi - tips_[j].x + a_x_max_};
+      reach_[j].push_back(r);
+      if (new_block) block_reach_[j].push_back(r);
+      Reach& block = block_reach_[j].back();
+      block = {std::min(block.lo, r.lo), std::max(block.hi, r.hi)};
     }
     // A bubble retired may have come back to a tip: counted, not pierced.
     if (entry_x_ + std::min(d_.x, d_next.x) - tip_x_max_ - a_x_max_ < max_retired_key_) ++reentries_missed_;
@@ -784,14 +792,14 @@ class Synthesiser {
     const double* path_next = path_next_.data();
     const std::int64_t backward_to_last = steps[last - first].backward;
     for (std::size_t j = 0; j < tips_.size(); ++j) {
-      const Reach* reach = reach_[j].data() - first;  // reach[s]: step s
+      const Reach* reach = reach_[j].data();
       // Not there yet: the steps before the first whose keys reach it.
       // Bubbles are walked in key order, so the last bubble's steps not
       // there yet are this one's too (NotThere).
       NotThere& hint = not_there_[j];
       std::int64_t s = b.entry_step;
       if (key >= hint.key && s >= hint.from) s = std::max(s, hint.to);
-      s = first_of(s, last, [&](std::int64_t i) { return key <= reach[i].hi; });
+      s = first_of(s, last, [&](std::int64_t i) { return key <= reach[i - first].hi; });
       hint = {key, b.entry_step, s};
       const bool cached = j < ActiveBubble::cached_tips;
       OpenPierce open;
@@ -799,18 +807,25 @@ class Synthesiser {
       if (s <= last && steps[s - first].u.x >= 0.0 && steps[s - first].backward == backward_to_last) {
         // Forward from s to the last step: the keys reached only grow, so
         // the candidates are the steps up to the first that has passed it.
-        end = first_of(s, last, [&](std::int64_t i) { return key < reach[i].lo; });
+        end = first_of(s, last, [&](std::int64_t i) { return key < reach[i - first].lo; });
         // The lateral path only grows: if the tip cannot reach the bubble
         // by the last of them, it reaches it at none (pierce_tip's skip).
         if (cached && s < end && path_next[end - 1 - first] < b.clear_until[j]) s = end;
       }
+      const Reach* block = block_reach_[j].data();  // block[(s >> block_shift) - first_block]: s's block
+      const std::int64_t first_block = first >> block_shift;
       for (; s < end; ++s) {
-        const Reach& r = reach[s];
-        if (key < r.lo) {
-          if (steps[s - first].backward == backward_to_last) break;  // past the tip for good
+        const Reach& r = reach[s - first];
+        if (key < r.lo || key > r.hi) {
+          if (key < r.lo && steps[s - first].backward == backward_to_last) break;  // past the tip for good
+          // The flow reversed somewhere ahead: on to the next step that can
+          // bring it within reach, whole blocks at a time.
+          while (((s + 1) & (block_steps - 1)) == 0 && s + 1 < end &&
+                 !block[((s + 1) >> block_shift) - first_block].holds(key)) {
+            s += block_steps;
+          }
           continue;
         }
-        if (key > r.hi) continue;  // back upstream
         // The lateral skip (pierce_tip), before the call.
         if (cached && !open.inside && path_next[s - first] < b.clear_until[j]) continue;
         const double t = t_start_ + static_cast<double>(s) * dt_;
@@ -1031,11 +1046,13 @@ class Synthesiser {
     next_forget_ = step_ + 16384;
     std::int64_t earliest = step_;
     for (auto it = bubbles_.begin(); it != bubbles_.end(); ++it) earliest = std::min(earliest, it->entry_step);
+    earliest &= ~(block_steps - 1);  // whole blocks
     const std::int64_t drop = earliest - history_first_;
     if (2 * drop < static_cast<std::int64_t>(history_.size())) return;
     history_.erase(history_.begin(), history_.begin() + static_cast<std::ptrdiff_t>(drop));
     path_next_.erase(path_next_.begin(), path_next_.begin() + static_cast<std::ptrdiff_t>(drop));
     for (auto& r : reach_) r.erase(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(drop));
+    for (auto& r : block_reach_) r.erase(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(drop >> block_shift));
     history_first_ = earliest;
   }
 
@@ -1204,6 +1221,11 @@ class Synthesiser {
   std::vector<Step> history_;
   std::vector<double> path_next_;        // history_[i].path_next, alone
   std::vector<std::vector<Reach>> reach_;  // per tip
+  // Per tip and block of block_steps steps: the least lo and greatest hi of
+  // its steps, so that a walk passes over blocks that cannot reach a key.
+  static constexpr int block_shift = 6;
+  static constexpr std::int64_t block_steps = std::int64_t{1} << block_shift;
+  std::vector<std::vector<Reach>> block_reach_;
   std::int64_t history_first_ = 0, next_forget_ = 0;
   std::int64_t step_ = 0;      // the step being taken
   std::vector<NotThere> not_there_;  // per tip (walk)
