@@ -808,9 +808,17 @@ class Synthesiser {
         // Forward from s to the last step: the keys reached only grow, so
         // the candidates are the steps up to the first that has passed it.
         end = first_of(s, last, [&](std::int64_t i) { return key < reach[i - first].lo; });
-        // The lateral path only grows: if the tip cannot reach the bubble
-        // by the last of them, it reaches it at none (pierce_tip's skip).
-        if (cached && s < end && path_next[end - 1 - first] < b.clear_until[j]) s = end;
+        // pierce_tip's lateral skip over all of them at once: a bubble
+        // further from the tip at the first than a_lat and the lateral path
+        // to the end of the last cannot hold it at any (most pass at a
+        // distance, and are then never tested step by step).
+        if (cached && s < end) {
+          const Step& h = steps[s - first];
+          const double d2 = nearest_image2(wrap(b.entry.y + h.d.y - b.key.y, length_[1]) - tips_[j].y,
+                                           wrap(b.entry.z + h.d.z - b.key.z, length_[2]) - tips_[j].z);
+          const double need = path_next[end - 1 - first] - h.path + b.clear_reach;
+          if (need * need < d2) s = end;
+        }
       }
       const Reach* block = block_reach_[j].data();  // block[(s >> block_shift) - first_block]: s's block
       const std::int64_t first_block = first >> block_shift;
