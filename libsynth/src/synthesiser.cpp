@@ -129,8 +129,9 @@ struct ActiveBubble {
 };
 
 // Active bubbles sorted by key.x: a vector with a moving head, so that the
-// candidate searches run on contiguous memory (a std::deque's iterators made
-// them the hot spot). Appends dominate; retirement advances the head.
+// neighbour searches of the placement run on contiguous memory (a
+// std::deque's iterators made them the hot spot). Appends dominate;
+// retirement advances the head.
 class BubbleQueue {
  public:
   using iterator = std::vector<ActiveBubble>::iterator;
