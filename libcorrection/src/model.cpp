@@ -660,7 +660,16 @@ Attempt fscc_attempt(const CorrectionModel& m, const Features& f) {
 // reasons, each said once (a feature both forests refuse is named once).
 Correction after_awcc(const Attempt& first, const Attempt& fscc) {
   const auto& c = fscc.correction;
-  if (c.corrected() || c.status == CorrectionStatus::untrusted) return c;
+  if (c.corrected() || c.status == CorrectionStatus::untrusted) {
+    // Why the AWCC forest did not answer, first: a row the AWCC forest
+    // refuses for a feature (a dx or fs typed wrong puts the lag outside its
+    // range) is corrected from FSCC's velocity, and says so.
+    Correction out = c;
+    out.notes.insert(out.notes.begin(),
+                     fmt::format("AWCC forest: {}; corrected from FSCC's velocity by the FSCC forest, which gives no Tu",
+                                 first.correction.message));
+    return out;
+  }
   Correction awcc = first.correction;
   const auto* a = first.refused;
   const auto* b = fscc.refused;

@@ -45,7 +45,10 @@ assert c["forest"] == "fscc", c
 q = c["velocity"]["quantiles"]
 assert abs(c["velocity"]["median"] - 2.80) < 0.28, c["velocity"]  # one mode at FSCC's value
 assert q["0.75"] - q["0.25"] < 0.5, q                               # the two-mode answer's was 2.84-10.1
-assert c["turbulence_intensity"] is None and c["notes"] == [], c
+assert c["turbulence_intensity"] is None, c
+# Why the AWCC forest did not answer, once.
+assert len(c["notes"]) == 1 and c["notes"][0].startswith("AWCC forest: AWCC gave no velocity: 2 of 72 windows "), c
+assert c["notes"][0].endswith("; corrected from FSCC's velocity by the FSCC forest, which gives no Tu"), c
 PY
   "$pdp" --log-level error process "$data/dc157_01.dat" "$data/dc157_02.dat" --fs 20kHz --dx 7.15mm --positions 2mm,8mm \
     --correct "$model" --csv "$dir/rows.csv" || fail "case 1: profile"

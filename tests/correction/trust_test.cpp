@@ -422,8 +422,46 @@ TEST(LongRecords, TheFsccForestHoldsTheDurationToo) {
   const auto c = m.correct(r);
   ASSERT_TRUE(c.velocity) << c.message;
   EXPECT_EQ(c.forest, "fscc");
-  ASSERT_EQ(c.notes.size(), 1u);
-  EXPECT_NE(c.notes[0].find("duration 1800 s is beyond the training range"), std::string::npos);
+  // Why not the AWCC forest, then the FSCC forest's own note.
+  ASSERT_EQ(c.notes.size(), 2u);
+  EXPECT_EQ(c.notes[0], "AWCC forest: 5 accepted windows; the model was trained on runs with at least 10; corrected "
+                        "from FSCC's velocity by the FSCC forest, which gives no Tu");
+  EXPECT_NE(c.notes[1].find("duration 1800 s is beyond the training range"), std::string::npos);
+}
+
+// The lag in samples, dx fs / u, is a feature of the AWCC forest (not of the
+// FSCC forest): a row whose lag lies outside its training range, with every
+// other feature inside, is refused by the AWCC forest by name and in
+// samples, and corrected from FSCC's velocity by the FSCC forest, which says
+// so. Below the range: dx typed as 0.6 mm for 6 mm at 20 kHz and 20 m/s (0.6
+// samples; a real AWCC lag is at least one). Above it: 1 m/s past tips 9.9 mm
+// apart sampled at 990 kHz (9,801 samples).
+TEST(Messages, ALagOutsideTheAwccForestsRangeIsNamedInSamples) {
+  const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
+  const auto& lag = *std::find_if(m.ranges.begin(), m.ranges.end(), [](const auto& x) { return x.name == "lag_samples"; });
+  struct Case {
+    double u, dx, fs, lag;
+  };
+  for (const Case k : {Case{20.0, 0.6e-3, 20e3, 0.6}, Case{1.0, 9.9e-3, 990e3, 9801.0}}) {
+    auto r = row(k.u, 0.2, 0.2, 300.0, k.dx, {500, 1000}, {k.fs, 100.0}, {k.u, 0.3});
+    r.dy = 1e-3;
+    // Every other feature of the AWCC forest is inside its range.
+    const auto features = correction::make_features(r).features;
+    for (const auto& range : m.ranges) {
+      const auto v = features.value(range.name);
+      if (range.name == "lag_samples" || !v) continue;
+      EXPECT_TRUE(*v >= range.min && *v <= range.max) << range.name << " = " << *v;
+    }
+    ASSERT_NEAR(*features.value("lag_samples"), k.lag, 1e-9 * k.lag);
+    const auto c = m.correct(r);
+    EXPECT_EQ(c.status, CorrectionStatus::corrected) << c.message;
+    EXPECT_EQ(c.forest, "fscc");
+    ASSERT_FALSE(c.notes.empty());
+    EXPECT_EQ(c.notes[0], fmt::format("AWCC forest: lag_samples = {} samples is outside the training range {}; "
+                                      "corrected from FSCC's velocity by the FSCC forest, which gives no Tu",
+                                      k.lag, correction::feature_range_text("lag_samples", lag.min, lag.max)))
+        << c.notes[0];
+  }
 }
 
 TEST(Messages, AFeatureBothForestsRefuseIsNamedOnceWithUnits) {
