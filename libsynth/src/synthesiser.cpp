@@ -244,11 +244,11 @@ struct StepView {
   double t;
 };
 
-// A term of a tip's interfacial-area sum (bubble_truth), kept with the
-// order in which the step loop used to add it: by the step of the pierce's
-// end, then the bubbles' key order; the pierces still open at the record's
-// end last, in the order they opened. Summed in that order at the end, so
-// the sum does not depend on the order in which bubbles are walked.
+// A term of a tip's interfacial-area sum (bubble_truth), kept with its
+// place in time: the step of the pierce's end, then the bubbles' key order;
+// the pierces still open at the record's end last, in the order they
+// opened. Summed in that order at the end, so that the sum does not depend
+// on the order in which bubbles are walked.
 struct AreaTerm {
   bool at_end;
   std::int64_t step;
@@ -570,7 +570,7 @@ class Synthesiser {
       block = {std::min(block.lo, r.lo), std::max(block.hi, r.hi)};
     }
     // A bubble retired may have come back to a tip: counted, not pierced.
-    if (entry_x_ + std::min(d_.x, d_next.x) - tip_x_max_ - a_x_max_ < max_retired_key_) ++reentries_missed_;
+    if (entry_x_ + d_lo - tip_x_max_ - a_x_max_ < max_retired_key_) ++reentries_missed_;
     retire(d_next);
     d_ = d_next;
     lateral_path_ = lateral_path_next_;
@@ -780,12 +780,12 @@ class Synthesiser {
   // The pierces of bubble b, walked step by step from its entry to step
   // `last` over the velocity steps kept in history_ (retire() walks a bubble
   // when it leaves, run() the ones left at the end, with at_end). The steps
-  // tested are the ones at which the step loop once tested it: those whose
-  // range of keys holds it (at most a_x_max from the tip streamwise, the
-  // same expression), and every test is the same arithmetic on the same
-  // step, so the air intervals are the ones the step loop found. Past the
-  // tip with no backward step to come, the walk stops: the displacement
-  // only grows from there.
+  // tested are those whose range of keys holds it (at most a_x_max from the
+  // tip streamwise), less the ones the lateral skip proves empty; every
+  // test is pierce_tip's exact arithmetic on that step, so the air
+  // intervals do not depend on how the steps are found. Past the tip with
+  // no backward step to come, the walk stops: the displacement only grows
+  // from there.
   void walk(ActiveBubble& b, std::int64_t last, bool at_end) {
     const double key = b.key.x;
     const std::int64_t first = history_first_;
