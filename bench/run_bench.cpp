@@ -3,8 +3,14 @@
 // the base case (METHOD 5) as pdp sweep runs it, on one thread.
 //
 //   run_bench [--scene FILE.toml] [--duration SECONDS] [--repeat N] [--seed S]
+//             [--allocator-defaults]
 //
-// Prints the median (and range) of each stage over N runs, and a fingerprint
+// The allocator keeps freed memory for the next run, as in pdp
+// (awcc::keep_freed_memory); --allocator-defaults measures glibc's defaults,
+// under which every run faults its pages in again.
+//
+// Prints the median (and range) of each stage over N runs, the first run
+// alone (the only one that faults its pages in), and a fingerprint
 // of the results: every estimate and the truth written with 17 significant
 // digits, then a hash of them, so that a faster build can be checked to give
 // bit-identical numbers for the same seed.
@@ -17,6 +23,7 @@
 
 #include <fmt/format.h>
 
+#include "awcc/memory.hpp"
 #include "awcc/sha256.hpp"
 #include "bench_util.hpp"
 #include "study/run.hpp"
@@ -55,12 +62,15 @@ int main(int argc, char** argv) {
   int repeat = 5;
   std::uint64_t seed = 1;
   const char* scene_file = nullptr;
+  bool allocator_defaults = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--scene") && i + 1 < argc) scene_file = argv[++i];
     else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--allocator-defaults")) allocator_defaults = true;
   }
+  const bool kept = !allocator_defaults && awcc::keep_freed_memory();
   synth::Scene scene;
   if (scene_file) synth::load_scene_toml(scene_file, scene);
   scene.duration = duration;
@@ -85,6 +95,8 @@ int main(int argc, char** argv) {
               duration, scene.fs / 1e3,
               static_cast<unsigned long long>(seed), repeat);
   for (const auto* s : {&synth, &process, &total}) show(*s);
+  std::printf("  first run  %.3f s; freed memory %s\n", total.seconds.front(),
+              kept ? "kept for the next run" : "returned (glibc's defaults)");
   awcc::Sha256 hash;
   hash.update({reinterpret_cast<const std::uint8_t*>(first.data()), first.size()});
   std::printf("results:\n%sfingerprint %s\n", first.c_str(), hash.hex().substr(0, 16).c_str());

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "awcc/memory.hpp"
 #include "awcc/version.hpp"
 #include "bench_command.hpp"
 #include "command.hpp"
@@ -30,6 +31,9 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("pdp"));
   spdlog::set_pattern("%^[%l]%$ %v");
   pdp::set_command_line(argc, argv);
+  // A sweep's worker threads run scene after scene: their freed memory is
+  // reused rather than faulted in again each run.
+  awcc::keep_freed_memory();
 
   CLI::App app{"pdp: dual-tip phase-detection probe toolkit (AWCC processing, synthetic probe)"};
 #ifdef PDP_WITH_MPI
