@@ -463,11 +463,8 @@ class Synthesiser {
     Synthesis out;
     VelocityProcess velocity(scene_, dt_);
     FlowAccumulator flow(scene_, dt_);
-    std::vector<double> history;
-    if (options_.keep_velocity_history) {
-      history.reserve(static_cast<std::size_t>(record_steps_) + 1);
-      history.push_back(0.0);
-    }
+    std::optional<VelocityHistory> history;
+    if (options_.keep_velocity_history) history.emplace(dt_);
     if (options_.keep_reference_data) {
       out.reference.emplace();
       out.reference->t_start = t_start_;
@@ -493,7 +490,7 @@ class Synthesiser {
         advance(t, u);
         if (step >= pre_steps_) {
           flow.add(u);
-          if (options_.keep_velocity_history) history.push_back(history.back() + u.x * dt_);
+          if (history) history->push_back(history->back() + u.x * dt_);
         }
       }
       if (options_.progress) options_.progress(static_cast<double>(first + n) / static_cast<double>(total));
@@ -542,7 +539,7 @@ class Synthesiser {
         truth.pairs.push_back({static_cast<int>(j), static_cast<int>(k), pair_counts_[j * tips_.size() + k]});
       }
     }
-    if (options_.keep_velocity_history) out.history.emplace(dt_, std::move(history));
+    out.history = std::move(history);
     if (options_.bubble_truth) out.bubbles = finish_table();
     return out;
   }

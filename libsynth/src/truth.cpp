@@ -7,20 +7,20 @@
 namespace synth {
 
 double VelocityHistory::displacement(double t) const {
-  if (displacement_.size() < 2) return 0.0;
-  const double position = std::clamp(t / step_, 0.0, static_cast<double>(displacement_.size() - 1));
+  if (size_ < 2) return 0.0;
+  const double position = std::clamp(t / step_, 0.0, static_cast<double>(size_ - 1));
   auto k = static_cast<std::size_t>(position);
-  k = std::min(k, displacement_.size() - 2);
+  k = std::min(k, size_ - 2);
   const double frac = position - static_cast<double>(k);
-  return displacement_[k] + (displacement_[k + 1] - displacement_[k]) * frac;
+  return at(k) + (at(k + 1) - at(k)) * frac;
 }
 
 double VelocityHistory::mean_velocity(double t0, double t1) const {
-  if (displacement_.size() < 2) return 0.0;
+  if (size_ < 2) return 0.0;
   if (t1 > t0) return (displacement(t1) - displacement(t0)) / (t1 - t0);
-  const double position = std::clamp(t0 / step_, 0.0, static_cast<double>(displacement_.size() - 2));
-  const auto k = std::min(static_cast<std::size_t>(position), displacement_.size() - 2);
-  return (displacement_[k + 1] - displacement_[k]) / step_;
+  const double position = std::clamp(t0 / step_, 0.0, static_cast<double>(size_ - 2));
+  const auto k = std::min(static_cast<std::size_t>(position), size_ - 2);
+  return (at(k + 1) - at(k)) / step_;
 }
 
 namespace {

@@ -244,6 +244,38 @@ TEST(VelocityHistory, WindowAveragesEqualTheIntegralOfTheSteps) {
   EXPECT_NEAR(out.history->mean_velocity(0.0, s.duration), out.truth.realised.mean_velocity[0], 1e-9);
 }
 
+// The history is kept in blocks of 2^20 steps; a window across a block's
+// end must read the same displacements as one array would. X_k = k^2 / 8 is
+// exact in double up to 2^26 steps, so every answer below is exact: the
+// interpolated displacement at t = (k + f) step is X_k + (X_{k+1} - X_k) f,
+// and the mean over [k, m) steps is (X_m - X_k) / ((m - k) step).
+TEST(VelocityHistory, AWindowAcrossABlocksEndReadsBothBlocks) {
+  const std::size_t block = std::size_t{1} << 20;
+  const std::size_t n = 2 * block + 5;
+  auto x = [](std::size_t k) { return static_cast<double>(k) * static_cast<double>(k) / 8.0; };
+  std::vector<double> all(n);
+  synth::VelocityHistory stepwise(0.5);  // X_0 = 0 pushed by the constructor
+  for (std::size_t k = 0; k < n; ++k) {
+    all[k] = x(k);
+    if (k > 0) stepwise.push_back(x(k));
+  }
+  const synth::VelocityHistory whole(0.5, all);
+  for (const synth::VelocityHistory* h : {static_cast<const synth::VelocityHistory*>(&stepwise), &whole}) {
+    EXPECT_DOUBLE_EQ(h->end_time(), 0.5 * static_cast<double>(n - 1));
+    EXPECT_EQ(h->back(), x(n - 1));
+    for (const std::size_t k : {block - 2, block - 1, block, block + 1, 2 * block - 1, 2 * block, n - 2}) {
+      const double t = 0.5 * static_cast<double>(k);
+      EXPECT_EQ(h->displacement(t), x(k)) << k;
+      EXPECT_EQ(h->displacement(t + 0.25), x(k) + (x(k + 1) - x(k)) * 0.5) << k;
+      // The velocity at a step: (X_{k+1} - X_k) / step.
+      EXPECT_EQ(h->mean_velocity(t, t), (x(k + 1) - x(k)) / 0.5) << k;
+    }
+    // A window from one block into the next.
+    const double t0 = 0.5 * static_cast<double>(block - 3), t1 = 0.5 * static_cast<double>(block + 4);
+    EXPECT_EQ(h->mean_velocity(t0, t1), (x(block + 4) - x(block - 3)) / (t1 - t0));
+  }
+}
+
 // Extreme corners of METHOD 5's ranges: each must run and give sane truth.
 // Bounds: the realised mean is within 5 standard errors sigma sqrt(2T/D) of
 // the imposed one (D >> T); the pierce count of each tip within 5 binomial

@@ -105,8 +105,20 @@ struct Truth {
 class VelocityHistory {
  public:
   VelocityHistory() = default;
-  VelocityHistory(double step, std::vector<double> cumulative_displacement)
-      : step_(step), displacement_(std::move(cumulative_displacement)) {}
+  /// An empty history with X_0 = 0 at t = 0, to be extended step by step.
+  explicit VelocityHistory(double step) : step_(step) { push_back(0.0); }
+  VelocityHistory(double step, const std::vector<double>& cumulative_displacement) : step_(step) {
+    for (const double x : cumulative_displacement) push_back(x);
+  }
+
+  /// Appends X at the next velocity step.
+  void push_back(double x) {
+    if ((size_ & block_mask) == 0) blocks_.emplace_back().reserve(block_size);
+    blocks_.back().push_back(x);
+    ++size_;
+  }
+  /// X at the last step kept, m.
+  [[nodiscard]] double back() const { return blocks_.back().back(); }
 
   /// Mean of u_x over [t0, t1), m/s; t0 < t1 within the record. For t0 == t1
   /// the velocity at t0.
@@ -114,11 +126,21 @@ class VelocityHistory {
   /// Streamwise displacement since t = 0, m.
   [[nodiscard]] double displacement(double t) const;
   [[nodiscard]] double step() const { return step_; }
-  [[nodiscard]] double end_time() const { return step_ * static_cast<double>(displacement_.size() - 1); }
+  [[nodiscard]] double end_time() const { return step_ * static_cast<double>(size_ - 1); }
 
  private:
+  // Blocks of 2^20 steps (8 MB), not one array: a 300 s record holds 6
+  // million steps, 47 MB, above the largest block glibc keeps in the heap
+  // (32 MB), so one array went to mmap and was faulted in again by every
+  // run of a sweep; blocks are reused (awcc::keep_freed_memory).
+  static constexpr std::size_t block_shift = 20;
+  static constexpr std::size_t block_size = std::size_t{1} << block_shift;
+  static constexpr std::size_t block_mask = block_size - 1;
+  [[nodiscard]] double at(std::size_t k) const { return blocks_[k >> block_shift][k & block_mask]; }
+
   double step_ = 0.0;
-  std::vector<double> displacement_;  // X_k at t = k step, X_0 = 0
+  std::size_t size_ = 0;                     // steps kept: X_k at t = k step, X_0 = 0
+  std::vector<std::vector<double>> blocks_;  // X_k in blocks_[k >> block_shift][k & block_mask]
 };
 
 }  // namespace synth
