@@ -435,6 +435,16 @@ class Synthesiser {
     record_steps_ = static_cast<std::int64_t>(std::ceil(duration_ / dt_));
 
     pierces_.resize(tips_.size());
+    {
+      // Room for the pierces expected (the equal-time rate, more by about
+      // 1 + Tu^2 for the fast flow's extra particles) and 5 % more, so that
+      // the arrays are not grown by doubling: each doubling leaves the old
+      // array behind as a hole in the heap that a sweep's next run keeps
+      // (awcc::keep_freed_memory). At most one pierce every two samples.
+      const double expected = expected_pierce_rate_ * duration_ * (1.0 + scene.tu * scene.tu) * 1.05 + 256.0;
+      const auto room = static_cast<std::size_t>(std::min(expected, 0.5 * static_cast<double>(samples_) + 1.0));
+      for (auto& p : pierces_) p.reserve(room);
+    }
     pair_counts_.assign(tips_.size() * tips_.size(), 0);
     not_there_.resize(tips_.size());
     reach_.resize(tips_.size());
