@@ -106,8 +106,9 @@ done
 
 # Many kills of one sweep, resuming each time into the same file: each kill
 # comes after at least one new row and must land before the end; only when
-# at most two runs are left (two threads finish them together) may the
-# sweep end first. Then a final resume: still exactly the uninterrupted rows.
+# at most two runs are left once the row it waits for is written (two
+# threads finish them together) may the sweep end first. Then a final
+# resume: still exactly the uninterrupted rows.
 rm -f "$dir/many.csv"
 landed=0
 for attempt in $(seq 1 "$total"); do
@@ -118,7 +119,7 @@ for attempt in $(seq 1 "$total"); do
   case $kill_status in
     landed) landed=$((landed + 1)) ;;
     late | ended)
-      ((before >= total - 2)) || fail "kill $attempt (after row $((before + 1))) missed the sweep: $kill_status at $after rows"
+      ((before + 1 >= total - 2)) || fail "kill $attempt (after row $((before + 1))) missed the sweep: $kill_status at $after rows"
       ;;
     *) fail "kill $attempt: no new row within 60 s ($after rows)" ;;
   esac
