@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
@@ -75,6 +76,55 @@ SampleKind kind_of(const py::array& a, std::size_t k) {
                           "channels");
 }
 
+// A channel's samples where numpy keeps them: the first byte, the stride
+// between samples in bytes, the dtype (kind and size, native byte order).
+struct ChannelView {
+  const char* data;
+  py::ssize_t stride;
+  char kind;
+  py::ssize_t size;
+  double scale;  // volts per count for counts, 1 for volts
+
+  // Kinds and sizes read in place; others (float16, long double) are first
+  // converted by numpy.
+  static bool readable(char kind, py::ssize_t size) {
+    if (kind == 'f') return size == 4 || size == 8;
+    if (kind == 'b') return size == 1;
+    return (kind == 'i' || kind == 'u') && (size == 1 || size == 2 || size == 4 || size == 8);
+  }
+
+  // Calls f(sample) with sample(i) the i-th sample as the dtype's C type.
+  template <class F>
+  void visit(F&& f) const {
+    auto as = [&](auto zero) {
+      using T = decltype(zero);
+      // memcpy: numpy does not promise alignment (a view into a record array).
+      f([this](std::size_t i) {
+        T v;
+        std::memcpy(&v, data + static_cast<py::ssize_t>(i) * stride, sizeof v);
+        return v;
+      });
+    };
+    if (kind == 'f') {
+      if (size == 4) return as(float{});
+      if (size == 8) return as(double{});
+    } else if (kind == 'b') {
+      return as(bool{});
+    } else if (kind == 'i') {
+      if (size == 1) return as(std::int8_t{});
+      if (size == 2) return as(std::int16_t{});
+      if (size == 4) return as(std::int32_t{});
+      if (size == 8) return as(std::int64_t{});
+    } else if (kind == 'u') {
+      if (size == 1) return as(std::uint8_t{});
+      if (size == 2) return as(std::uint16_t{});
+      if (size == 4) return as(std::uint32_t{});
+      if (size == 8) return as(std::uint64_t{});
+    }
+    throw awcc::OptionError(fmt::format("samples of kind '{}' and {} bytes cannot be read", kind, size), "channels");
+  }
+};
+
 // The channels (1-D arrays of one length) as an in-memory recording.
 // Integer counts are volts x volts_per_count when it is given, else counts of
 // unknown scale (a 0/1 binary signal).
@@ -106,22 +156,43 @@ std::unique_ptr<awcc::Recording> recording_of(const std::vector<py::array>& chan
   const bool any_counts = std::any_of(kinds.begin(), kinds.end(), [](SampleKind k) { return k != SampleKind::volts; });
   const double quantum = volts_per_count.value_or(1.0);
   const bool volts_known = volts_per_count.has_value() || !any_counts;
+  // Each channel read where it lies (any stride, a column of a 2-D array
+  // too) in its own dtype; only a foreign byte order is converted first, by
+  // numpy, under the GIL. The interleaving then runs without the GIL: for a
+  // long record it is hundreds of MB written, and a fresh page faulted in
+  // per 4 kB held every other Python thread for a third of a second.
+  std::vector<py::array> kept;  // the converted copies, alive until the copy is done
+  std::vector<ChannelView> views;
+  for (std::size_t k = 0; k < c; ++k) {
+    py::array a = channels[k];
+    if (!a.dtype().attr("isnative").cast<bool>() || !ChannelView::readable(a.dtype().kind(), a.dtype().itemsize())) {
+      a = a.dtype().kind() == 'f' ? py::array(py::array_t<double, py::array::forcecast>::ensure(a))
+                                  : py::array(py::array_t<std::int64_t, py::array::forcecast>::ensure(a));
+      kept.push_back(a);
+    }
+    views.push_back({static_cast<const char*>(a.data()), a.strides(0), a.dtype().kind(), a.dtype().itemsize(),
+                     kinds[k] == SampleKind::volts ? 1.0 : quantum});
+  }
+  py::gil_scoped_release unlocked;
   if (all16) {
     std::vector<std::int16_t> interleaved(n * c);
     for (std::size_t k = 0; k < c; ++k) {
-      // forcecast copies a slice or another dtype into a contiguous int16 array.
-      const auto a = py::array_t<std::int16_t, py::array::c_style | py::array::forcecast>::ensure(channels[k]);
-      const auto* p = a.data();
-      for (std::size_t i = 0; i < n; ++i) interleaved[i * c + k] = p[i];
+      views[k].visit([&](auto sample) {
+        for (std::size_t i = 0; i < n; ++i) interleaved[i * c + k] = static_cast<std::int16_t>(sample(i));
+      });
     }
     return awcc::memory_recording(std::move(interleaved), static_cast<int>(c), fs, quantum, volts_known);
   }
   std::vector<float> interleaved(n * c);
   for (std::size_t k = 0; k < c; ++k) {
-    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(channels[k]);
-    const auto* p = a.data();
-    const double scale = kinds[k] == SampleKind::volts ? 1.0 : quantum;
-    for (std::size_t i = 0; i < n; ++i) interleaved[i * c + k] = static_cast<float>(p[i] * scale);
+    const double scale = views[k].scale;
+    views[k].visit([&](auto sample) {
+      // As numpy's cast to float64, then the scale, then float: the numbers
+      // of the earlier forcecast copy.
+      for (std::size_t i = 0; i < n; ++i) {
+        interleaved[i * c + k] = static_cast<float>(static_cast<double>(sample(i)) * scale);
+      }
+    });
   }
   return awcc::memory_recording(std::move(interleaved), static_cast<int>(c), fs);
 }

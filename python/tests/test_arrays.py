@@ -51,15 +51,21 @@ def test_dtypes_and_slices_give_the_same_result():
     for x, y in [(volts(lead).astype(np.float32), volts(trail).astype(np.float32)),
                  (np.stack([volts(lead), volts(trail)], axis=1), None),               # 2-D samples x channels
                  (np.stack([volts(lead), volts(trail)])[:, :].T, None),              # a transposed view
-                 (np.repeat(volts(lead), 2)[::2], np.repeat(volts(trail), 2)[::2])]:  # strided slices
+                 (np.repeat(volts(lead), 2)[::2], np.repeat(volts(trail), 2)[::2]),  # strided slices
+                 (volts(lead).astype(">f8"), volts(trail).astype(">f8"))]:            # big-endian
         r = pdp.process(x, y, fs=FS, dx=DX)
         assert r.tips == reference.tips
         assert r.awcc.velocity == reference.awcc.velocity
     # Integer counts: 0/1 of any integer dtype, or bool, binarise to the same intervals.
-    for dtype in (np.uint8, np.int8, np.int16, np.int32, np.uint16, np.int64, bool):
+    for dtype in (np.uint8, np.int8, np.int16, np.int32, np.uint16, np.int64, np.uint32, np.uint64, ">i2", ">u4", bool):
         r = pdp.process(lead.astype(dtype), trail.astype(dtype), fs=FS, dx=DX)
         assert [t.void_fraction for t in r.tips] == [t.void_fraction for t in reference.tips], dtype
         assert r.awcc.velocity == reference.awcc.velocity, dtype
+    # float16 volts (converted by numpy first): the same as the same values in float64.
+    half = volts(lead).astype(np.float16), volts(trail).astype(np.float16)
+    r = pdp.process(*half, fs=FS, dx=DX)
+    wide = pdp.process(*(h.astype(np.float64) for h in half), fs=FS, dx=DX)
+    assert r.tips == wide.tips and r.awcc.velocity == wide.awcc.velocity
 
 
 def test_counts_with_a_scale_are_volts():
