@@ -4,6 +4,12 @@
 #include <openssl/evp.h>
 
 #include <algorithm>
+#if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
 #include <fstream>
 #include <system_error>
 #include <new>
@@ -97,9 +103,10 @@ FileSha256::FileSha256(std::filesystem::path path, std::size_t in_flight)
 
 FileSha256::~FileSha256() {
   if (!worker_.joinable()) return;
+  stop_ = true;
   {
     std::lock_guard lock(mutex_);
-    finishing_ = abandon_ = true;
+    finishing_ = true;
   }
   changed_.notify_all();
   worker_.join();
@@ -110,16 +117,29 @@ void FileSha256::saw(std::uint64_t offset, std::span<const std::uint8_t> bytes) 
   if (end <= queued_) return;  // seen before (a second pass)
   // A long gap ahead of the cursor (a trailing chunk parsed before the data):
   // left for the reading to reach, or for hex().
-  if (offset > queued_ && offset - queued_ > gap_read_now) return;
-  const std::uint64_t from = std::max(offset, queued_);
-  const auto fresh = bytes.subspan(static_cast<std::size_t>(from - offset));
+  const std::uint64_t claimed = claimed_.load(std::memory_order_acquire);
+  if (offset > queued_ && offset - queued_ > gap_read_now && offset > claimed) return;
+  const std::uint64_t from = std::max({offset, queued_, claimed});
   queued_ = end;
+  if (from >= end) return;  // hashed already, or being read ahead
+  const auto fresh = bytes.subspan(static_cast<std::size_t>(from - offset));
   // Small reads (a FLAC decoder's) gather into one piece, so that handing
   // pieces over costs little against hashing them.
   if (!filling_.bytes.empty() && filling_.offset + filling_.bytes.size() != from) hand_on();
   {
-    std::lock_guard lock(mutex_);
-    if (done_ || in_flight_ + fresh.size() > in_flight_limit_) return;  // the hashing thread reads them itself
+    std::unique_lock lock(mutex_);
+    if (done_ || in_flight_ + fresh.size() > in_flight_limit_) {
+      // Not copied: the hashing thread reads them itself, as soon as it is
+      // free (the piece being filled first, so that it is queued before).
+      lock.unlock();
+      hand_on();
+      lock.lock();
+      not_copied_to_ = end;
+      const bool wake = waiting_;
+      lock.unlock();
+      if (wake) changed_.notify_all();
+      return;
+    }
     in_flight_ += fresh.size();
     if (filling_.bytes.empty() && !spare_.empty()) {
       filling_.bytes = std::move(spare_.back());
@@ -141,20 +161,26 @@ void FileSha256::hand_on() {
   changed_.notify_all();
 }
 
-void FileSha256::hash_file(std::uint64_t from, std::uint64_t to) {
+bool FileSha256::hash_file(std::uint64_t to, FileRead how) {
+  const std::uint64_t from = hashed_;
   std::ifstream in(path_, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot read the file to hash it", path_.string()));
   std::error_code ec;
   const auto size = std::filesystem::file_size(path_, ec);
   // Bytes seen by the reader that the file no longer holds: it changed while being read.
-  if (ec || size < from || (to != std::uint64_t(-1) && size < to)) {
+  if (ec || size < from || (how != FileRead::ahead && to != std::uint64_t(-1) && size < to)) {
     throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
                                  path_.string()));
   }
   in.seekg(static_cast<std::streamoff>(from));
-  std::vector<char> buffer(std::size_t{1} << 20);
+  std::vector<char> buffer(chunk_bytes);
   std::uint64_t at = from;
+  bool stopped = false;
   while (in && at < to) {
+    if (how != FileRead::to_the_end && stop_.load(std::memory_order_relaxed)) {
+      stopped = true;
+      break;
+    }
     const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(buffer.size(), to - at));
     in.read(buffer.data(), want);
     const auto n = static_cast<std::size_t>(in.gcount());
@@ -162,30 +188,78 @@ void FileSha256::hash_file(std::uint64_t from, std::uint64_t to) {
     digest_.update({reinterpret_cast<const std::uint8_t*>(buffer.data()), n});
     at += n;
   }
+  read_again_ += at - from;
+  hashed_ = at;
+  if (stopped) return false;
   if (in.bad()) throw InputError(fmt::format("{}: a read error while hashing the file", path_.string()));
   if (to != std::uint64_t(-1) && at != to) {
+    if (how == FileRead::ahead) return false;  // the file's end
     throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
                                  path_.string()));
   }
-  read_again_ += at - from;
-  hashed_ = at;
+  return true;
+}
+
+void FileSha256::hash_piece(const Piece& piece) {
+  const std::uint64_t end = piece.offset + piece.bytes.size();
+  if (end <= hashed_) return;  // read from the file already
+  if (piece.offset > hashed_) hash_file(piece.offset, FileRead::to_the_end);  // a gap, or bytes not copied
+  digest_.update(std::span<const std::uint8_t>(piece.bytes).subspan(static_cast<std::size_t>(hashed_ - piece.offset)));
+  hashed_ = end;
 }
 
 void FileSha256::work() {
+#if defined(__linux__)
+  // The lowest priority, for this thread alone (class comment). SCHED_IDLE
+  // rather than nice 19: the scheduler counts a core that runs only
+  // SCHED_IDLE threads as idle, so the reader thread, woken, goes there at
+  // once; at nice 19 it was woken onto the processing's core and the two
+  // took turns on it. Neither needs a privilege; if both fail the hash runs
+  // at the caller's priority.
+  const sched_param lowest{};
+  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &lowest) != 0) {
+    (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+  }
+#endif
   try {
     for (;;) {
       Piece piece;
+      std::uint64_t to = 0;
+      FileRead how = FileRead::stoppable;
       {
         std::unique_lock lock(mutex_);
-        changed_.wait(lock, [&] { return !queue_.empty() || finishing_; });
-        if (abandon_) return;
-        if (queue_.empty()) break;  // finishing, everything handed on is hashed
-        piece = std::move(queue_.front());
-        queue_.pop_front();
+        // Reading ahead of the reader only once it has stopped copying (a
+        // file larger than the bytes in flight): a small file is hashed
+        // from the reader's copies alone.
+        const auto ahead = [&] { return not_copied_to_ > 0 && !at_end_; };
+        waiting_ = true;
+        changed_.wait(lock, [&] { return finishing_ || !queue_.empty() || not_copied_to_ > hashed_ || ahead(); });
+        waiting_ = false;
+        if (finishing_) break;  // hex() hashes the rest
+        if (!queue_.empty() && queue_.front().offset <= hashed_) {
+          piece = std::move(queue_.front());
+          queue_.pop_front();
+        } else if (!queue_.empty() || not_copied_to_ > hashed_) {
+          // Bytes no piece holds, up to the next piece or to the last byte not copied.
+          to = queue_.empty() ? not_copied_to_ : queue_.front().offset;
+        } else {
+          how = FileRead::ahead;
+          to = hashed_ + chunk_bytes;
+          claimed_.store(to, std::memory_order_release);  // before the bytes are read: saw() copies none of them
+        }
       }
-      if (piece.offset > hashed_) hash_file(hashed_, piece.offset);  // a gap, or bytes not copied
-      digest_.update(piece.bytes);
-      hashed_ = piece.offset + piece.bytes.size();
+      if (piece.bytes.empty()) {
+        const bool whole = hash_file(to, how);
+        claimed_.store(std::max(claimed_.load(std::memory_order_relaxed), hashed_), std::memory_order_release);
+        if (!whole) {
+          if (how != FileRead::ahead || stop_) break;
+          std::lock_guard lock(mutex_);
+          at_end_ = true;
+        }
+        continue;
+      }
+      hash_piece(piece);
+      claimed_.store(std::max(claimed_.load(std::memory_order_relaxed), hashed_), std::memory_order_release);
       {
         std::lock_guard lock(mutex_);
         in_flight_ -= piece.bytes.size();
@@ -193,7 +267,6 @@ void FileSha256::work() {
         spare_.push_back(std::move(piece.bytes));
       }
     }
-    hash_file(hashed_, std::uint64_t(-1));
   } catch (...) {
     std::lock_guard lock(mutex_);
     error_ = std::current_exception();
@@ -205,6 +278,7 @@ void FileSha256::work() {
 std::string FileSha256::hex() {
   if (worker_.joinable()) {
     hand_on();
+    stop_ = true;
     {
       std::lock_guard lock(mutex_);
       finishing_ = true;
@@ -212,8 +286,18 @@ std::string FileSha256::hex() {
     changed_.notify_all();
     worker_.join();
     if (error_) std::rethrow_exception(error_);
-  } else {
-    hash_file(0, std::uint64_t(-1));  // no hashing thread: the whole file now
+  }
+  // What the hashing thread did not reach, here: the pieces still queued
+  // (in file order: each continues the cursor), then the rest of the file.
+  hashed_in_background_ = hashed_;
+  for (const auto& piece : queue_) hash_piece(piece);
+  queue_.clear();
+  hash_file(std::uint64_t(-1), FileRead::to_the_end);
+  // Read ahead to a file's end that the reader later found further on: the
+  // file was cut while being read.
+  if (hashed_ < queued_) {
+    throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
+                                 path_.string()));
   }
   return digest_.hex();
 }

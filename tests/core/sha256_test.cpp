@@ -133,4 +133,43 @@ TEST(Sha256, FileCutWhileReadIsRefused) {
   EXPECT_THROW(h.hex(), awcc::InputError);
 }
 
+// A file cut before the hashing thread reaches the bytes the reader saw
+// beyond its in-flight room (so it reads them from the file, or hex() does)
+// is refused, whichever of the two finds the end first.
+TEST(Sha256, FileCutBeforeTheBytesNotCopiedAreReadIsRefused) {
+  const auto path = pdp_test::temp_dir() / "sha256_cut_uncopied.bin";
+  const std::string text(50000, 'z');
+  for (int trial = 0; trial < 20; ++trial) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+    awcc::FileSha256 h(path, 100);
+    std::filesystem::resize_file(path, 1000);
+    h.saw(0, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    EXPECT_THROW(h.hex(), awcc::InputError) << "trial " << trial;
+  }
+}
+
+// A large file read front to back with little room in flight: the hashing
+// thread reads the bytes not copied, and ahead of the reader, and hex()
+// finishes whatever it has not reached; every byte is hashed once, in
+// order, whoever hashed it (an overlap or a hole changes the digest).
+TEST(Sha256, ReadingAheadAndTakingOverGiveTheWholeDigest) {
+  std::mt19937 random(11);
+  std::vector<std::uint8_t> bytes(3 << 20);
+  for (auto& b : bytes) b = static_cast<std::uint8_t>(random());
+  const auto path = pdp_test::temp_dir() / "sha256_ahead.bin";
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                              static_cast<std::streamsize>(bytes.size()));
+  const std::string whole = awcc::sha256_of_file(path);
+  for (int trial = 0; trial < 12; ++trial) {
+    awcc::FileSha256 h(path, std::size_t{1} << (12 + trial % 6));
+    // Stop anywhere: after no read at all, halfway, or at the end.
+    const std::size_t stop = trial % 3 == 0 ? 0 : (trial % 3 == 1 ? bytes.size() / 2 : bytes.size());
+    for (std::size_t i = 0; i < stop; i += 65536) {
+      h.saw(i, std::span<const std::uint8_t>(bytes).subspan(i, std::min<std::size_t>(65536, stop - i)));
+    }
+    EXPECT_EQ(h.hex(), whole) << "trial " << trial;
+    EXPECT_LE(h.hashed_in_background(), bytes.size());
+  }
+}
+
 }  // namespace

@@ -3,6 +3,7 @@
 // it was made from. Computed by the system's libcrypto (OpenSSL), which uses
 // the CPU's SHA instructions where there are some (docs/performance.md).
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -43,11 +44,20 @@ std::string sha256_of_file(const std::filesystem::path& path);
 /// copied into at most `in_flight` bytes of buffers for the hashing thread;
 /// beyond that the reader is not held up: the hashing thread reads those
 /// bytes from the file itself, as it does a short gap (at most gap_read_now:
-/// a header the reader skips) and everything after the last bytes seen.
-/// Bytes seen further ahead of the cursor (a trailing chunk parsed before the
-/// data) are left for the reading to reach. So the digest is always
-/// sha256_of_file's. saw() is called from one thread at a time; hex() after
-/// the reading.
+/// a header the reader skips). Bytes seen further ahead of the cursor (a
+/// trailing chunk parsed before the data) are left for the reading to reach.
+///
+/// The hashing thread runs at the lowest priority (on Linux, where a thread
+/// has a scheduling policy of its own): it uses a core only when the reading
+/// and the processing leave one idle, never takes one from them. Once the
+/// reader has gone beyond the bytes in flight (a large file), the hashing
+/// thread also reads ahead of the reader, so that an idle core is never left
+/// waiting for the reading; the reader then copies nothing it has reached.
+/// hex() stops the thread and hashes what it has not reached on the calling
+/// thread, so a busy machine (a sweep on every core) costs no more than
+/// hashing after the processing. The digest is always sha256_of_file's (a
+/// file found shorter than the bytes read is refused). saw() is called from
+/// one thread at a time; hex() after the reading.
 class FileSha256 {
  public:
   static constexpr std::uint64_t gap_read_now = std::uint64_t{1} << 16;       // bytes
@@ -64,9 +74,12 @@ class FileSha256 {
   /// The whole file's digest once the hashing thread is done; spent. Throws
   /// InputError when the file cannot be read (or became shorter).
   std::string hex();
-  /// After hex(): the bytes the hashing thread read from the file itself
-  /// rather than from the reader's copies.
+  /// After hex(): the bytes read from the file itself rather than taken
+  /// from the reader's copies.
   [[nodiscard]] std::uint64_t read_again() const { return read_again_; }
+  /// After hex(): the bytes the hashing thread hashed before hex() (the rest
+  /// was hashed by hex()'s caller).
+  [[nodiscard]] std::uint64_t hashed_in_background() const { return hashed_in_background_; }
 
  private:
   struct Piece {
@@ -74,23 +87,40 @@ class FileSha256 {
     std::vector<std::uint8_t> bytes;
   };
   static constexpr std::size_t piece_bytes = std::size_t{1} << 20;  // reads gathered before handing on
+  // Bytes hashed between two looks at stop_: a stop waits for at most one
+  // such chunk (0.1 ms at 2 GB/s).
+  static constexpr std::size_t chunk_bytes = std::size_t{1} << 18;
   void hand_on();  // the piece being filled, to the hashing thread
   void work();
-  void hash_file(std::uint64_t from, std::uint64_t to);  // on the hashing thread; to = -1: the end
+  enum class FileRead { to_the_end, stoppable, ahead };
+  // Hashes the file's bytes [hashed_, to) (to = -1: to the end), read from
+  // the file. Returns false when stop_ ends it early (stoppable, ahead) or
+  // the file ends before `to` (ahead: not an error there).
+  bool hash_file(std::uint64_t to, FileRead how);
+  void hash_piece(const Piece& piece);  // the bytes of a piece not hashed yet (a gap before it from the file)
 
   std::filesystem::path path_;
   std::size_t in_flight_limit_;
   Sha256 digest_;                       // the hashing thread's
   std::uint64_t hashed_ = 0;            // the hashing thread's
   std::uint64_t read_again_ = 0;        // the hashing thread's
+  std::uint64_t hashed_in_background_ = 0;
   std::uint64_t queued_ = 0;            // the reader's cursor
+  // Below this offset every byte the reader saw is handed on or will not be
+  // copied: the hashing thread may read from the file what no piece holds.
+  std::uint64_t not_copied_to_ = 0;
+  bool at_end_ = false;                 // the hashing thread read ahead to the file's end
+  // Bytes below this offset are hashed, or being read ahead from the file:
+  // saw() copies none of them.
+  std::atomic<std::uint64_t> claimed_{0};
+  std::atomic<bool> stop_{false};       // hex() or the destructor: the hashing thread stops
   Piece filling_;                       // the reader's: copies not yet handed on
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Piece> queue_;
   std::vector<std::vector<std::uint8_t>> spare_;  // buffers to reuse
   std::size_t in_flight_ = 0;
-  bool finishing_ = false, abandon_ = false, done_ = false;
+  bool finishing_ = false, done_ = false, waiting_ = false;
   std::exception_ptr error_;
   std::thread worker_;
 };
