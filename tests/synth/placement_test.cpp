@@ -10,11 +10,13 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <ostream>
 #include <vector>
 
+#include "synth/random.hpp"
 #include "synth/synthesiser.hpp"
 
 namespace {
@@ -60,6 +62,44 @@ struct TwoDiscs {
     return torus_distance2(y, z, cy[0], cz[0]) < rho2 || torus_distance2(y, z, cy[1], cz[1]) < rho2;
   }
 };
+
+// The AVX2 lanes against SSE2's: for random discs (none to 40, some
+// covering most of the cross-section, centres anywhere) and attempt counts
+// (1 to 40, across batch ends), the same outcome, the same positions to the
+// bit, and the same draws consumed (the next draw of both streams equal).
+TEST(LateralPlacement, AvxAndSseGiveTheSameBits) {
+  LateralPlacement wide(ly, lz), narrow(ly, lz);
+  if (!wide.allow_avx2(true)) GTEST_SKIP() << "this CPU has no AVX2: only the SSE2 lanes run here";
+  ASSERT_FALSE(narrow.allow_avx2(false));
+  awcc::Rng shape(2026, synth::Stream::bubbles);
+  int placed = 0, failed = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    wide.clear();
+    narrow.clear();
+    const int discs = static_cast<int>(shape.next() % 41);
+    for (int k = 0; k < discs; ++k) {
+      const double y = (shape.uniform() - 0.5) * 3.0 * ly, z = (shape.uniform() - 0.5) * 3.0 * lz;
+      const double rho2 = shape.uniform() * shape.uniform() * 0.3 * ly * lz;
+      wide.add_disc(y, z, rho2);
+      narrow.add_disc(y, z, rho2);
+    }
+    const int n = 1 + static_cast<int>(shape.next() % 40);
+    awcc::Rng a(static_cast<std::uint64_t>(trial), synth::Stream::bubbles);
+    awcc::Rng b(static_cast<std::uint64_t>(trial), synth::Stream::bubbles);
+    const auto x = wide.place(a, n), y = narrow.place(b, n);
+    ASSERT_EQ(x.placed, y.placed) << "trial " << trial;
+    ASSERT_EQ(x.attempts, y.attempts) << "trial " << trial;
+    for (int i = 0; i < x.attempts; ++i) {
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(wide.y(i)), std::bit_cast<std::uint64_t>(narrow.y(i))) << trial;
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(wide.z(i)), std::bit_cast<std::uint64_t>(narrow.z(i))) << trial;
+    }
+    ASSERT_EQ(a.next(), b.next()) << "trial " << trial;
+    (x.placed ? placed : failed) += 1;
+  }
+  // Both outcomes were compared many times.
+  EXPECT_GT(placed, 300);
+  EXPECT_GT(failed, 300);
+}
 
 // N calls of n = 4 attempts on the two discs. The outcome of a call is a
 // category: placed at attempt k (probability p (1 - p)^(k - 1), k = 1..4)

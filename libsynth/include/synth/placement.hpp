@@ -34,6 +34,10 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define SYNTH_PLACEMENT_AVX2 1
+#endif
 
 #include "awcc/random.hpp"
 
@@ -52,7 +56,19 @@ class LateralPlacement {
     int attempts = 0;
   };
 
-  LateralPlacement(double length_y, double length_z) : ly_(length_y), lz_(length_z) {}
+  LateralPlacement(double length_y, double length_z) : ly_(length_y), lz_(length_z) { allow_avx2(true); }
+
+  /// Whether the attempts may be tested with AVX2 where the CPU has it (the
+  /// default); off, with SSE2. The same bits either way: this exists for
+  /// the test that shows it. Returns whether AVX2 is used.
+  bool allow_avx2(bool allowed) {
+#if defined(SYNTH_PLACEMENT_AVX2)
+    avx2_ = allowed && __builtin_cpu_supports("avx2");
+#else
+    avx2_ = false && allowed;
+#endif
+    return avx2_;
+  }
 
   void clear() {
     cy_.clear();
@@ -110,6 +126,9 @@ class LateralPlacement {
   // The same operations in the same order either way: the same bits.
   unsigned draw_batch(awcc::Rng& rng, double* y, double* z) const {
     const std::size_t count = cy_.size();
+#if defined(SYNTH_PLACEMENT_AVX2)
+    if (avx2_) return draw_batch_avx2(rng, y, z);
+#endif
 #if defined(__SSE2__)
     const __m128d sign = _mm_set1_pd(-0.0), ly = _mm_set1_pd(ly_), lz = _mm_set1_pd(lz_);
     const __m128d one = _mm_set1_pd(1.0), half = _mm_set1_pd(0.5);
@@ -166,6 +185,52 @@ class LateralPlacement {
 #endif
   }
 
+#if defined(SYNTH_PLACEMENT_AVX2)
+  // draw_batch four lanes at a time, where the CPU has AVX2 (checked once,
+  // at run time): half the instructions a disc. The same operations on each
+  // lane in the same order (AVX2 alone brings no fused multiply-add, so
+  // none is contracted): the same bits as the SSE2 and scalar loops
+  // (LateralPlacement.AvxAndSseGiveTheSameBits).
+  __attribute__((target("avx2"))) unsigned draw_batch_avx2(awcc::Rng& rng, double* y, double* z) const {
+    const std::size_t count = cy_.size();
+    const __m256d sign = _mm256_set1_pd(-0.0), ly = _mm256_set1_pd(ly_), lz = _mm256_set1_pd(lz_);
+    const __m256d one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);
+    const __m256i exponent = _mm256_set1_epi64x(0x3ff0000000000000ll);
+    __m256d yv[batch / 4], zv[batch / 4], m[batch / 4];
+    for (int h = 0; h < batch / 4; ++h) {
+      const std::uint64_t r0 = rng.next(), r1 = rng.next(), r2 = rng.next(), r3 = rng.next();
+      const __m256i r = _mm256_set_epi64x(static_cast<long long>(r3), static_cast<long long>(r2),
+                                          static_cast<long long>(r1), static_cast<long long>(r0));
+      const __m256i high = _mm256_srli_epi64(r, 32);
+      const __m256i low = _mm256_srli_epi64(_mm256_slli_epi64(r, 32), 32);
+      const __m256d fy = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(_mm256_slli_epi64(high, 20), exponent)), one);
+      const __m256d fz = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(_mm256_slli_epi64(low, 20), exponent)), one);
+      yv[h] = _mm256_mul_pd(_mm256_sub_pd(fy, half), ly);
+      zv[h] = _mm256_mul_pd(_mm256_sub_pd(fz, half), lz);
+      _mm256_storeu_pd(y + 4 * h, yv[h]);
+      _mm256_storeu_pd(z + 4 * h, zv[h]);
+      m[h] = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+      const __m256d cy = _mm256_set1_pd(cy_[k]), cz = _mm256_set1_pd(cz_[k]), rho2 = _mm256_set1_pd(rho2_[k]);
+      for (int h = 0; h < batch / 4; ++h) {
+        __m256d dy = _mm256_andnot_pd(sign, _mm256_sub_pd(yv[h], cy));
+        __m256d dz = _mm256_andnot_pd(sign, _mm256_sub_pd(zv[h], cz));
+        dy = _mm256_min_pd(_mm256_sub_pd(ly, dy), dy);
+        dz = _mm256_min_pd(_mm256_sub_pd(lz, dz), dz);
+        const __m256d d2 = _mm256_add_pd(_mm256_mul_pd(dy, dy), _mm256_mul_pd(dz, dz));
+        m[h] = _mm256_min_pd(_mm256_sub_pd(d2, rho2), m[h]);
+      }
+    }
+    unsigned covered = 0;
+    for (int h = 0; h < batch / 4; ++h) {
+      covered |= static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(m[h], _mm256_setzero_pd(), _CMP_LT_OQ)))
+                 << (4 * h);
+    }
+    return covered;
+  }
+#endif
+
   // v reduced to [-L/2, L/2] by whole periods. A centre is an entry in the
   // tile plus the drift since, rarely a period: one shift each way without
   // a branch, and a division only beyond that.
@@ -185,6 +250,7 @@ class LateralPlacement {
   }
 
   double ly_, lz_;
+  bool avx2_ = false;  // draw_batch_avx2
   std::vector<double> cy_, cz_, rho2_;
   std::vector<double> ys_, zs_;
 };
