@@ -133,28 +133,6 @@ void clip(const AirIntervals& s, std::int64_t start, std::int64_t length, std::v
 
 namespace {
 
-// Air samples of intervals `iv` (sorted, relative) in [0, m), for a sweep
-// whose m moves a little at a time: the first interval ending after m is
-// found by walking from where the last call left off (the same interval a
-// binary search finds, without its dozen unpredictable branches per call).
-class AirBelow {
- public:
-  AirBelow(const std::vector<AirInterval>& iv, const std::vector<double>& cumulative)
-      : iv_(iv), cumulative_(cumulative) {}
-  double operator()(std::int64_t m) {
-    while (i_ > 0 && iv_[i_ - 1].stop > m) --i_;
-    while (i_ < iv_.size() && iv_[i_].stop <= m) ++i_;
-    double total = cumulative_[i_];
-    if (i_ < iv_.size() && iv_[i_].start < m) total += static_cast<double>(m - iv_[i_].start);
-    return total;
-  }
-
- private:
-  const std::vector<AirInterval>& iv_;
-  const std::vector<double>& cumulative_;
-  std::size_t i_ = 0;
-};
-
 // std::popcount without the popcnt instruction (the build targets plain
 // x86-64) is a call into libgcc per word; this is inline and vectorises.
 inline std::size_t bits_set(std::uint64_t w) {
@@ -203,76 +181,73 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   auto& scratch = workspace.scratch();
   auto& a = scratch.clipped_x;
   auto& b = scratch.clipped_y;
-  auto& ca = scratch.air_x;
-  auto& cb = scratch.air_y;
   out.lags.clear();
   out.values.clear();
   clip(x, start, length, a);
   clip(y, start, length, b);
   const double L = static_cast<double>(length);
-  ca.assign(a.size() + 1, 0.0);
-  cb.assign(b.size() + 1, 0.0);
-  for (std::size_t i = 0; i < a.size(); ++i) ca[i + 1] = ca[i] + static_cast<double>(a[i].stop - a[i].start);
-  for (std::size_t i = 0; i < b.size(); ++i) cb[i + 1] = cb[i] + static_cast<double>(b[i].stop - b[i].start);
-  const double ax = ca.back(), ay = cb.back();
+  std::int64_t air_x = 0, air_y = 0;
+  for (const auto& iv : a) air_x += iv.stop - iv.start;
+  for (const auto& iv : b) air_y += iv.stop - iv.start;
+  const double ax = static_cast<double>(air_x), ay = static_cast<double>(air_y);
   const double mx = ax / L, my = ay / L;
   const double qx = L * mx * (1 - mx), qy = L * my * (1 - my);
   if (!(qx > 0.0) || !(qy > 0.0) || k_max < k_min) return;
 
-  // Overlap sums from the pairs of air intervals (overlap_impulses.hpp).
-  // Impulses and every other kink (the mean terms' kinks at the edges of
-  // intervals entering or leaving the overlapping ranges, and lag 0 where
-  // n = L - |k| turns) are marked on a bit per lag: cheaper than sorting
-  // them. The impulses go to an array that is zero between windows: the
-  // sweep visits every lag holding one and clears it (no 4 bytes per lag to
-  // zero per window).
+  // Overlap sums from the pairs of air intervals (overlap_impulses.hpp). The
+  // mean terms need each tip's air in the range the lag overlaps,
+  //   sx(k) = sum_t x(t) W(t + k),  sy(k) = sum_t W(t) y(t + k),
+  // W the window's indicator on [0, L): overlap sums too, of each tip's
+  // intervals with the window as one interval, so they come from the same
+  // impulses, exactly and in integers (two lookups into the prefix sums per
+  // breakpoint, with their unpredictable walks, were a third of the sweep).
+  // Impulses and every other kink (lag 0, where n = L - |k| turns, and the
+  // range's ends) are marked on a bit per lag: cheaper than sorting them.
+  // The impulses go to arrays that are zero between windows: the sweep
+  // visits every lag holding one and clears it (no 4 bytes per lag to zero
+  // per window).
   const auto lags = static_cast<std::size_t>(k_max - k_min + 1);
   auto& impulse = scratch.impulse;
+  auto& impulse_x = scratch.impulse_x;
+  auto& impulse_y = scratch.impulse_y;
   auto& mark = scratch.mark;
-  if (impulse.size() < lags) impulse.resize(lags, 0);
+  if (impulse.size() < lags) {
+    impulse.resize(lags, 0);
+    impulse_x.resize(lags, 0);
+    impulse_y.resize(lags, 0);
+  }
   mark.assign((lags + 63) / 64, 0);
-  // Should the sweep not finish (an allocation failing), the array is
+  // Should the sweep not finish (an allocation failing), the arrays are
   // cleared whole, so that the workspace stays usable.
   struct Clear {
-    std::vector<std::int32_t>& impulse;
+    std::vector<std::int32_t>* arrays[3];
     bool swept = false;
     ~Clear() {
-      if (!swept) std::fill(impulse.begin(), impulse.end(), 0);
+      if (swept) return;
+      for (auto* v : arrays) std::fill(v->begin(), v->end(), 0);
     }
-  } clear{impulse};
+  } clear{{&impulse, &impulse_x, &impulse_y}};
   detail::OverlapImpulses<std::int32_t> sum{k_min, k_max, impulse, mark.data()};
+  detail::OverlapImpulses<std::int32_t> sum_x{k_min, k_max, impulse_x, mark.data()};
+  detail::OverlapImpulses<std::int32_t> sum_y{k_min, k_max, impulse_y, mark.data()};
+  for (const auto& ia : a) {
+    for (const auto& ib : b) sum.add_pair(ia.start, ia.stop, ib.start, ib.stop);
+    sum_x.add_pair(ia.start, ia.stop, 0, length);
+  }
+  for (const auto& ib : b) sum_y.add_pair(0, length, ib.start, ib.stop);
   auto add_break = [&](std::int64_t k) {
     if (k >= k_min && k <= k_max) {
       const auto i = static_cast<std::size_t>(k - k_min);
       mark[i >> 6] |= std::uint64_t{1} << (i & 63);
     }
   };
-  for (const auto& ia : a) {
-    for (const auto& ib : b) sum.add_pair(ia.start, ia.stop, ib.start, ib.stop);
-  }
-  std::int64_t slope = sum.slope, value = sum.value;
   add_break(k_min);
   add_break(k_max);
   add_break(0);
-  for (const auto& iv : a) {
-    for (std::int64_t e : {iv.start, iv.stop}) {
-      add_break(length - e);
-      add_break(-e);
-    }
-  }
-  for (const auto& iv : b) {
-    for (std::int64_t e : {iv.start, iv.stop}) {
-      add_break(e);
-      add_break(e - length);
-    }
-  }
 
-  // Sweep the breaks in lag order: f(k) from the slope, which is constant
-  // between breaks; the mean terms from the prefix sums,
-  //   k >= 0: sx = air of x in [0, L - k), sy = air of y in [k, L);
-  //   k <  0: sx = air of x in [-k, L),    sy = air of y in [0, L + k).
+  // Sweep the breaks in lag order: each sum from its slope, which is
+  // constant between breaks.
   const double norm = 1.0 / std::sqrt(qx * qy);
-  AirBelow air_a(a, ca), air_b(b, cb);
   // The outputs sized once (a bit per breakpoint) and written through
   // pointers: push_back's capacity checks and its stores of the vectors' ends
   // kept the sweep's sums in memory.
@@ -283,28 +258,34 @@ void window_correlation_piecewise(const AirIntervals& x, const AirIntervals& y, 
   std::int64_t* lag_out = out.lags.data();
   double* value_out = out.values.data();
   std::int32_t* const impulses = impulse.data();
+  std::int32_t* const impulses_x = impulse_x.data();
+  std::int32_t* const impulses_y = impulse_y.data();
   const std::uint64_t* const marks = mark.data();
   const std::size_t words = mark.size();
+  std::int64_t slope = sum.slope, value = sum.value;
+  std::int64_t slope_x = sum_x.slope, sx = sum_x.value;
+  std::int64_t slope_y = sum_y.slope, sy = sum_y.value;
   std::int64_t at = k_min;
   for (std::size_t word = 0; word < words; ++word) {
     for (std::uint64_t bits = marks[word]; bits != 0; bits &= bits - 1) {
       const std::size_t i = word * 64 + static_cast<std::size_t>(std::countr_zero(bits));
       const std::int64_t k = k_min + static_cast<std::int64_t>(i);
-      value += slope * (k - at);  // slope is constant on [at, k)
+      const std::int64_t step = k - at;  // every slope is constant on [at, k)
+      value += slope * step;
+      sx += slope_x * step;
+      sy += slope_y * step;
       at = k;
-      double sx, sy;
-      if (k >= 0) {
-        sx = air_a(length - k);
-        sy = ay - air_b(k);
-      } else {
-        sx = ax - air_a(-k);
-        sy = air_b(length + k);
-      }
       const double n = static_cast<double>(length - (k >= 0 ? k : -k));
       *lag_out++ = k;
-      *value_out++ = (static_cast<double>(value) - mx * sy - my * sx + n * mx * my) * norm;
+      *value_out++ = (static_cast<double>(value) - mx * static_cast<double>(sy) - my * static_cast<double>(sx) +
+                      n * mx * my) *
+                     norm;
       slope += impulses[i];
+      slope_x += impulses_x[i];
+      slope_y += impulses_y[i];
       impulses[i] = 0;
+      impulses_x[i] = 0;
+      impulses_y[i] = 0;
     }
   }
   clear.swept = true;

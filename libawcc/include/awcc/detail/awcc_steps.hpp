@@ -159,8 +159,8 @@ struct AwccScratch {
   std::vector<double> samples_x, samples_y;     // a window's samples as the FFT path takes them
   PiecewiseCorrelation piecewise;               // the interval path's correlation of the window
   std::vector<AirInterval> clipped_x, clipped_y;
-  std::vector<double> air_x, air_y;             // cumulative air of the clipped intervals
   std::vector<std::int32_t> impulse;            // per lag; all zero between windows (the sweep clears what it used)
+  std::vector<std::int32_t> impulse_x, impulse_y;  // the same for each tip's air in the overlapping range
   std::vector<std::uint64_t> mark;              // a bit per lag: a kink of the window's correlation there
   std::vector<std::complex<double>> spectrum;
   std::vector<double> turns, left, right, prominence;
