@@ -163,8 +163,13 @@ void FileSha256::hand_on() {
 
 bool FileSha256::hash_file(std::uint64_t to, FileRead how) {
   const std::uint64_t from = hashed_;
-  std::ifstream in(path_, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot read the file to hash it", path_.string()));
+  // One stream for every call (the read-ahead calls this every chunk_bytes):
+  // opened once, by the hashing thread or, after it, by hex()'s caller.
+  if (!file_.is_open()) {
+    file_.open(path_, std::ios::binary);
+    if (!file_) throw InputError(fmt::format("{}: cannot read the file to hash it", path_.string()));
+    buffer_.resize(chunk_bytes);
+  }
   std::error_code ec;
   const auto size = std::filesystem::file_size(path_, ec);
   // Bytes seen by the reader that the file no longer holds: it changed while being read.
@@ -172,26 +177,26 @@ bool FileSha256::hash_file(std::uint64_t to, FileRead how) {
     throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",
                                  path_.string()));
   }
-  in.seekg(static_cast<std::streamoff>(from));
-  std::vector<char> buffer(chunk_bytes);
+  file_.clear();  // an earlier call may have read to the end
+  file_.seekg(static_cast<std::streamoff>(from));
   std::uint64_t at = from;
   bool stopped = false;
-  while (in && at < to) {
+  while (file_ && at < to) {
     if (how != FileRead::to_the_end && stop_.load(std::memory_order_relaxed)) {
       stopped = true;
       break;
     }
-    const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(buffer.size(), to - at));
-    in.read(buffer.data(), want);
-    const auto n = static_cast<std::size_t>(in.gcount());
+    const auto want = static_cast<std::streamsize>(std::min<std::uint64_t>(buffer_.size(), to - at));
+    file_.read(buffer_.data(), want);
+    const auto n = static_cast<std::size_t>(file_.gcount());
     if (n == 0) break;
-    digest_.update({reinterpret_cast<const std::uint8_t*>(buffer.data()), n});
+    digest_.update({reinterpret_cast<const std::uint8_t*>(buffer_.data()), n});
     at += n;
   }
   read_again_ += at - from;
   hashed_ = at;
   if (stopped) return false;
-  if (in.bad()) throw InputError(fmt::format("{}: a read error while hashing the file", path_.string()));
+  if (file_.bad()) throw InputError(fmt::format("{}: a read error while hashing the file", path_.string()));
   if (to != std::uint64_t(-1) && at != to) {
     if (how == FileRead::ahead) return false;  // the file's end
     throw InputError(fmt::format("{}: the file became shorter while being read; read it again when it is complete",

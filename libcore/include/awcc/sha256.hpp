@@ -9,6 +9,7 @@
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -122,6 +123,8 @@ class FileSha256 {
   std::size_t in_flight_ = 0;
   bool finishing_ = false, done_ = false, waiting_ = false;
   std::exception_ptr error_;
+  std::ifstream file_;                  // hash_file's: the hashing thread's, then hex()'s caller's
+  std::vector<char> buffer_;            // hash_file's
   std::thread worker_;
 };
 

@@ -65,7 +65,8 @@ class LateralPlacement {
 #if defined(SYNTH_PLACEMENT_AVX2)
     avx2_ = allowed && __builtin_cpu_supports("avx2");
 #else
-    avx2_ = false && allowed;
+    (void)allowed;
+    avx2_ = false;
 #endif
     return avx2_;
   }
