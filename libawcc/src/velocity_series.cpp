@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <limits>
 #include <numbers>
 
 #include "awcc/fft.hpp"
@@ -140,6 +141,94 @@ std::optional<double> integral_to_first_zero(std::span<const double> r, double d
   return std::nullopt;
 }
 
+SlottedIntegral slotted_integral_to_first_zero(std::span<const double> times, std::span<const double> values,
+                                               double slot, std::size_t slots, double stop_at) {
+  SlottedIntegral out;
+  const std::size_t n = values.size();
+  if (n < 2 || !(slot > 0.0) || slots == 0) return out;
+  double mean = 0.0;
+  for (double v : values) mean += v;
+  mean /= static_cast<double>(n);
+  double variance = 0.0;
+  for (double v : values) variance += (v - mean) * (v - mean);
+  variance /= static_cast<double>(n);
+  std::vector<double> sum(slots + 1, 0.0), r(slots + 1, 0.0);
+  std::vector<std::int64_t> count(slots + 1, 0);
+  const double reach = (static_cast<double>(slots) + 0.5) * slot;
+  r[0] = 1.0;
+  double area = 0.0;  // trapezoids so far, in slots (integral_to_first_zero's sum)
+  std::size_t done = 0;
+  for (std::size_t band_end = std::min<std::size_t>(slots, 16);; band_end = std::min(slots, 2 * band_end)) {
+    // The pairs of slots (done, band_end]: for each i from the first j past
+    // slot `done` (nondecreasing in i, as the times ascend) while in the band.
+    const bool last_band = band_end == slots;
+    std::size_t from = 1;
+    for (std::size_t i = 0; i < n; ++i) {
+      from = std::max(from, i + 1);
+      while (from < n && std::ceil((times[from] - times[i]) / slot - 0.5) <= static_cast<double>(done)) ++from;
+      for (std::size_t j = from; j < n; ++j) {
+        const double separation = times[j] - times[i];
+        const double k = std::ceil(separation / slot - 0.5);
+        if (k > static_cast<double>(band_end) || (last_band && separation > reach)) break;
+        const auto slot_index = static_cast<std::size_t>(k);
+        sum[slot_index] += (values[i] - mean) * (values[j] - mean);
+        ++count[slot_index];
+      }
+    }
+    for (std::size_t k = done + 1; k <= band_end; ++k) {
+      r[k] = count[k] > 0 && variance > 0.0 ? sum[k] / static_cast<double>(count[k]) / variance : r[k - 1];
+    }
+    for (std::size_t i = done; i < band_end; ++i) {
+      if (r[i + 1] <= 0.0) {
+        out.integral = (area + 0.5 * r[i] * r[i] / (r[i] - r[i + 1])) * slot;
+        out.zero_reached = true;
+        return out;
+      }
+      area += 0.5 * (r[i] + r[i + 1]);
+      if (area * slot >= stop_at) {
+        out.integral = area * slot;
+        out.stopped = true;
+        return out;
+      }
+    }
+    done = band_end;
+    if (last_band) break;
+  }
+  out.integral = area * slot;
+  return out;
+}
+
+namespace {
+
+// The accepted windows' centres and velocities, and their mean duration T_W.
+struct AcceptedSeries {
+  std::vector<double> times, values;
+  double mean_window_duration = 0.0;
+};
+AcceptedSeries accepted_series(const AwccResult& awcc) {
+  AcceptedSeries s;
+  double total = 0.0;
+  for (const auto& w : awcc.windows) {
+    if (w.fate != WindowFate::accepted) continue;
+    s.times.push_back(w.start_time + 0.5 * w.duration);
+    s.values.push_back(w.velocity);
+    total += w.duration;
+  }
+  if (!s.times.empty()) s.mean_window_duration = total / static_cast<double>(s.times.size());
+  return s;
+}
+
+// velocity_spectrum's slots: half a window, out to a quarter of the record
+// (at most 4096 slots).
+std::pair<double, std::size_t> slots_of(const AcceptedSeries& s) {
+  const double slot = 0.5 * s.mean_window_duration;
+  const auto slots =
+      static_cast<std::size_t>(std::clamp((s.times.back() - s.times.front()) / 4.0 / slot, 1.0, 4096.0));
+  return {slot, slots};
+}
+
+}  // namespace
+
 namespace detail {
 
 std::string windows_too_long(const AwccResult& awcc, double ratio) {
@@ -181,15 +270,10 @@ VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, cons
     out.message = "AWCC gave no velocity series";
     return out;
   }
-  std::vector<double> times, values;
-  double total = 0.0;
-  for (const auto& w : awcc.windows) {
-    if (w.fate != WindowFate::accepted) continue;
-    times.push_back(w.start_time + 0.5 * w.duration);
-    values.push_back(w.velocity);
-    total += w.duration;
-  }
-  out.mean_window_duration = total / static_cast<double>(times.size());
+  const auto accepted = accepted_series(awcc);
+  const auto& times = accepted.times;
+  const auto& values = accepted.values;
+  out.mean_window_duration = accepted.mean_window_duration;
   out.resample_rate = 1.0 / out.mean_window_duration;
   out.resolvable_frequency = 0.5 * out.resample_rate;
   const auto series = sample_and_hold(times, values, out.resample_rate, times.front(), std::min(times.back(), duration));
@@ -204,11 +288,10 @@ VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, cons
   out.psd = welch_psd(series.values, series.rate, options.segment_length);
   out.autocorrelation = autocorrelation(series.values, series.values.size() / 2);
   out.integral_time_scale_held = integral_to_first_zero(out.autocorrelation, 1.0 / series.rate);
-  // Slots of half a window, out to a quarter of the record (at most 4096 slots).
-  const double slot = 0.5 * out.mean_window_duration;
-  const auto slots = static_cast<std::size_t>(
-      std::clamp((times.back() - times.front()) / 4.0 / slot, 1.0, 4096.0));
-  out.integral_time_scale = integral_to_first_zero(slotted_autocorrelation(times, values, slot, slots), slot);
+  const auto [slot, slots] = slots_of(accepted);
+  const auto slotted = slotted_integral_to_first_zero(times, values, slot, slots,
+                                                      std::numeric_limits<double>::infinity());
+  if (slotted.zero_reached) out.integral_time_scale = slotted.integral;
   if (out.integral_time_scale) {
     out.time_scale_ratio = *out.integral_time_scale / out.mean_window_duration;
     if (*out.time_scale_ratio < time_scale_ratio_min) out.warning = detail::windows_too_long(awcc, *out.time_scale_ratio);
@@ -216,6 +299,16 @@ VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, cons
     out.warning = "the velocity's autocorrelation does not reach zero within half the record: no integral time scale";
   }
   return out;
+}
+
+std::optional<double> capped_time_scale_ratio(const AwccResult& awcc, double cap) {
+  if (!awcc.ok() || !(cap > 0.0)) return std::nullopt;
+  const auto accepted = accepted_series(awcc);
+  if (accepted.times.size() < 2 || !(accepted.mean_window_duration > 0.0)) return std::nullopt;
+  const auto [slot, slots] = slots_of(accepted);
+  const double t_w = accepted.mean_window_duration;
+  const auto slotted = slotted_integral_to_first_zero(accepted.times, accepted.values, slot, slots, cap * t_w);
+  return std::min(slotted.integral / t_w, cap);
 }
 
 }  // namespace awcc

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -133,6 +135,133 @@ TEST(VelocitySpectrum, NeedsAnAwccSeriesLongerThanASegment) {
   EXPECT_EQ(ok.status, awcc::SpectrumStatus::ok);
   EXPECT_NEAR(ok.resample_rate, 100.0, 1e-9);
   EXPECT_NEAR(ok.resolvable_frequency, 50.0, 1e-9);
+}
+
+// An Ornstein-Uhlenbeck velocity of scale t_scale at Poisson instants of
+// rate nu over `duration` s (exact updates between instants).
+struct IrregularSeries {
+  std::vector<double> times, values;
+};
+IrregularSeries ou_at_poisson_instants(double t_scale, double nu, double duration, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::exponential_distribution<double> gap(nu);
+  std::normal_distribution<double> e(0.0, 1.0);
+  IrregularSeries s;
+  double t = 0.0, u = 0.0;
+  while (t < duration) {
+    const double dt = gap(rng);
+    t += dt;
+    const double a = std::exp(-dt / t_scale);
+    u = a * u + std::sqrt(1.0 - a * a) * e(rng);
+    s.times.push_back(t);
+    s.values.push_back(3.0 + 0.5 * u);
+  }
+  return s;
+}
+
+TEST(SlottedIntegral, EqualsTheIntegralOfTheWholeSlottedAutocorrelationBitForBit) {
+  // Band by band or all slots at once, each slot's sum takes the same pairs
+  // in the same order: the same doubles. Scales from a fraction of a slot
+  // (zero in the first band) to beyond every slot (no zero: the integral so
+  // far), and slot counts that end inside a band and on its edge.
+  int reached = 0, not_reached = 0;
+  for (const double t_scale : {0.002, 0.05, 0.4, 30.0}) {
+    const auto s = ou_at_poisson_instants(t_scale, 20.0, 400.0, 11);
+    for (const std::size_t slots : {1u, 16u, 17u, 100u, 1000u}) {
+      const double slot = 0.01;
+      const auto r = awcc::slotted_autocorrelation(s.times, s.values, slot, slots);
+      const auto whole = awcc::integral_to_first_zero(r, slot);
+      const auto banded = awcc::slotted_integral_to_first_zero(s.times, s.values, slot, slots,
+                                                               std::numeric_limits<double>::infinity());
+      EXPECT_FALSE(banded.stopped);
+      ASSERT_EQ(banded.zero_reached, whole.has_value()) << t_scale << " " << slots;
+      if (whole) {
+        EXPECT_EQ(banded.integral, *whole) << t_scale << " " << slots;
+        ++reached;
+      } else {
+        // The trapezoids over every slot, as integral_to_first_zero sums them.
+        double area = 0.0;
+        for (std::size_t i = 0; i < slots; ++i) area += 0.5 * (r[i] + r[i + 1]);
+        EXPECT_EQ(banded.integral, area * slot) << t_scale << " " << slots;
+        ++not_reached;
+      }
+    }
+  }
+  EXPECT_GT(reached, 5);
+  EXPECT_GT(not_reached, 3);
+}
+
+TEST(SlottedIntegral, StopsAtTheFirstTrapezoidThatReachesTheLimit) {
+  const auto s = ou_at_poisson_instants(0.3, 20.0, 400.0, 12);
+  const double slot = 0.01;
+  const std::size_t slots = 1000;
+  const auto r = awcc::slotted_autocorrelation(s.times, s.values, slot, slots);
+  const auto whole = awcc::integral_to_first_zero(r, slot);
+  ASSERT_TRUE(whole);
+  ASSERT_GT(*whole, 0.2);
+  // The partial integral after each trapezoid, from the whole r.
+  std::vector<double> partial{0.0};
+  for (std::size_t i = 0; r[i + 1] > 0.0; ++i) partial.push_back(partial.back() + 0.5 * (r[i] + r[i + 1]));
+  const std::size_t m = partial.size() / 2;
+  const double limit = partial[m] * slot;
+  // At the limit (the trapezoid that reaches it exactly) and just above it.
+  const auto at = awcc::slotted_integral_to_first_zero(s.times, s.values, slot, slots, limit);
+  EXPECT_TRUE(at.stopped);
+  EXPECT_EQ(at.integral, limit);
+  const auto above = awcc::slotted_integral_to_first_zero(s.times, s.values, slot, slots, std::nextafter(limit, 1.0));
+  EXPECT_TRUE(above.stopped);
+  EXPECT_EQ(above.integral, partial[m + 1] * slot);
+  // A limit beyond the whole integral: the zero first.
+  const auto beyond = awcc::slotted_integral_to_first_zero(s.times, s.values, slot, slots, *whole * 1.01);
+  EXPECT_FALSE(beyond.stopped);
+  EXPECT_TRUE(beyond.zero_reached);
+  EXPECT_EQ(beyond.integral, *whole);
+}
+
+// An AWCC result whose accepted windows are the series' points (each a
+// window of duration t_w centred there); every fourth window rejected.
+awcc::AwccResult windows_of(const IrregularSeries& s, double t_w) {
+  awcc::AwccResult a;
+  a.status = awcc::AwccStatus::ok;
+  for (std::size_t i = 0; i < s.times.size(); ++i) {
+    awcc::AwccWindow w;
+    w.start_time = s.times[i] - 0.5 * t_w;
+    w.duration = t_w;
+    w.velocity = s.values[i];
+    if (i % 4 == 3) w.fate = awcc::WindowFate::correlation;
+    a.windows.push_back(w);
+  }
+  return a;
+}
+
+TEST(CappedTimeScaleRatio, IsTheSpectrumsRatioBelowTheCapAndTheCapAtOrAboveIt) {
+  const auto s = ou_at_poisson_instants(0.1, 40.0, 300.0, 13);
+  const auto a = windows_of(s, 0.02);
+  awcc::SpectrumOptions o;
+  o.segment_length = 64;
+  const auto spectrum = awcc::velocity_spectrum(a, 300.0, o);
+  ASSERT_EQ(spectrum.status, awcc::SpectrumStatus::ok);
+  ASSERT_TRUE(spectrum.time_scale_ratio);
+  const double ratio = *spectrum.time_scale_ratio;
+  // T_u about 0.1 s over T_W = 0.02 s: about 5 (the slotted estimate's
+  // sampling error at D = 300 s is a few percent).
+  EXPECT_NEAR(ratio, 5.0, 1.0);
+  EXPECT_EQ(awcc::capped_time_scale_ratio(a, 1e9), ratio);
+  EXPECT_EQ(awcc::capped_time_scale_ratio(a, std::nextafter(ratio, 1e9)), ratio);
+  EXPECT_EQ(awcc::capped_time_scale_ratio(a, ratio), ratio);
+  EXPECT_EQ(awcc::capped_time_scale_ratio(a, std::nextafter(ratio, 0.0)), std::nextafter(ratio, 0.0));
+  EXPECT_EQ(awcc::capped_time_scale_ratio(a, 2.0), 2.0);
+}
+
+TEST(CappedTimeScaleRatio, NeedsTwoAcceptedWindowsOfAnAwccVelocity) {
+  awcc::AwccResult failed;
+  EXPECT_FALSE(awcc::capped_time_scale_ratio(failed, 20.0));
+  IrregularSeries two{{1.0, 1.5}, {3.0, 3.2}};
+  auto a = windows_of(two, 0.1);
+  EXPECT_TRUE(awcc::capped_time_scale_ratio(a, 20.0));
+  a.windows[1].fate = awcc::WindowFate::correlation;
+  EXPECT_FALSE(awcc::capped_time_scale_ratio(a, 20.0));
+  EXPECT_FALSE(awcc::capped_time_scale_ratio(windows_of(two, 0.1), 0.0));
 }
 
 }  // namespace

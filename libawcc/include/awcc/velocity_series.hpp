@@ -93,6 +93,22 @@ std::vector<double> slotted_autocorrelation(std::span<const double> times, std::
 /// stays positive.
 std::optional<double> integral_to_first_zero(std::span<const double> r, double dt);
 
+/// The integral from 0 to the first zero of the slotted autocorrelation
+/// (slotted_autocorrelation's r over `slots` slots of width `slot`),
+/// formed a band of slots at a time (16, 32, 64, ...), so that pairs beyond
+/// the band holding the first zero are never formed, and stopped once the
+/// integral reaches `stop_at` (s). Its cost therefore grows with
+/// min(T_u, stop_at), not with the record or the slots. Each slot's sum has
+/// slotted_autocorrelation's pairs in its order, and the trapezoids are
+/// integral_to_first_zero's: the same value, bit for bit.
+struct SlottedIntegral {
+  double integral = 0.0;      ///< s: to the first zero, or as far as it went
+  bool zero_reached = false;  ///< the autocorrelation reached 0 (integral complete)
+  bool stopped = false;       ///< the integral reached stop_at first
+};
+SlottedIntegral slotted_integral_to_first_zero(std::span<const double> times, std::span<const double> values,
+                                               double slot, std::size_t slots, double stop_at);
+
 enum class SpectrumStatus { ok, no_awcc_velocity, too_few_points };
 std::string_view to_string(SpectrumStatus status);
 
@@ -127,5 +143,17 @@ std::string windows_too_long(const AwccResult& awcc, double ratio);
 /// The spectrum and time scale of AWCC's accepted windows over a record of
 /// `duration` s.
 VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, const SpectrumOptions& options);
+
+/// T_u / T_W as the bias correction reads it (correction/features.hpp,
+/// feature time_scale_ratio): velocity_spectrum's slotted ratio, capped at
+/// `cap` (> 0). The integral stops once it reaches cap T_W, so the cost is
+/// a few cap pairs per accepted window whatever T_u and the record's length
+/// (a study computes it on every run; the spectrum's full integral can take
+/// thousands of pairs per window where T_u is long). Where the slotted
+/// autocorrelation stays positive over every slot (a quarter of the
+/// record), the integral so far: a lower bound. Equal to
+/// min(velocity_spectrum's time_scale_ratio, cap) wherever that exists.
+/// Empty when AWCC gave no velocity or accepted fewer than two windows.
+std::optional<double> capped_time_scale_ratio(const AwccResult& awcc, double cap);
 
 }  // namespace awcc
