@@ -3,6 +3,9 @@
 
 #include <fmt/format.h>
 #include <stdexcept>
+#include <tuple>
+
+#include "awcc/velocity_series.hpp"
 
 namespace correction {
 
@@ -60,6 +63,7 @@ FeatureResult make_features(const Measurement& m) {
   f.duration = m.duration;
   if (m.bubble_count_rate > 0.0) f.chord_time = m.void_fraction / m.bubble_count_rate;
   if (m.weighting) f.awcc_unweighted = *m.weighting == awcc::Weighting::none ? 1 : 0;
+  if (m.time_scale_ratio && *m.time_scale_ratio > 0.0) f.time_scale_ratio = *m.time_scale_ratio;
   auto d32_of = [&](double u) {
     return m.bubble_count_rate > 0.0 ? 1.5 * u * m.void_fraction / m.bubble_count_rate : m.d32.value_or(0.0);
   };
@@ -114,6 +118,7 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == weighting_name && awcc_unweighted >= 0) return static_cast<double>(awcc_unweighted);
   if (name == "fscc_lag" && fscc_velocity > 0.0) return dx / fscc_velocity;
   if (name == lag_name && fs > 0.0 && velocity > 0.0) return dx * fs / velocity;
+  if (name == scale_name && time_scale_ratio > 0.0) return time_scale_ratio;
   return std::nullopt;
 }
 
@@ -122,38 +127,51 @@ bool Features::on_log_scale(std::string_view name) {
 }
 
 std::vector<std::string> feature_set_names(std::string_view set) {
-  constexpr std::string_view weighted = "+weighting";
-  if (set.ends_with(weighted) && !set.starts_with("fscc")) {
-    auto names = feature_set_names(set.substr(0, set.size() - weighted.size()));
-    names.emplace_back(Features::weighting_name);
-    return names;
-  }
-  constexpr std::string_view lag = "+lag";
-  if (set == "extended+lag" || set == "extended-yield+lag") {
-    auto names = feature_set_names(set.substr(0, set.size() - lag.size()));
-    names.emplace_back(Features::lag_name);
-    return names;
-  }
   if (set == "fscc") return {Features::fscc_names.begin(), Features::fscc_names.end()};
   if (set == "fscc-2") return {Features::fscc2_names.begin(), Features::fscc2_names.end()};
-  if (set != "measured" && set != "extended" && set != "extended-yield") {
-    throw std::invalid_argument(fmt::format("feature set '{}': use measured (the seven of METHOD 7), extended (with "
-                                            "fs, duration and accepted windows) or extended-yield (fs, duration and "
-                                            "the data yield), the extended two optionally followed by +lag (the lag "
-                                            "in samples), each then optionally by +weighting",
-                                            set));
-  }
+  auto bad = [&] {
+    return std::invalid_argument(fmt::format(
+        "feature set '{}': use measured (the seven of METHOD 7), extended (with fs, duration and accepted windows) "
+        "or extended-yield (fs, duration and the data yield), the extended two optionally followed by +lag (the lag "
+        "in samples) and then +scale (the time-scale ratio T_u / T_W), each then optionally by +weighting",
+        set));
+  };
+  const auto plus = set.find('+');
+  const std::string_view base = set.substr(0, plus);
+  std::string_view rest = plus == std::string_view::npos ? std::string_view() : set.substr(plus);
+  if (base != "measured" && base != "extended" && base != "extended-yield") throw bad();
   std::vector<std::string> out(Features::names.begin(), Features::names.end());
-  if (set != "measured") out.insert(out.end(), Features::record_names.begin(), Features::record_names.end());
-  if (set == "extended-yield") out.back() = "data_yield";
+  if (base != "measured") out.insert(out.end(), Features::record_names.begin(), Features::record_names.end());
+  if (base == "extended-yield") out.back() = "data_yield";
+  // The suffixes, each at most once and in this order.
+  auto take = [&](std::string_view suffix) {
+    if (!rest.starts_with(suffix) || (rest.size() > suffix.size() && rest[suffix.size()] != '+')) return false;
+    rest.remove_prefix(suffix.size());
+    return true;
+  };
+  for (const auto& [suffix, name, extended_only] :
+       {std::tuple{"+lag", Features::lag_name, true}, std::tuple{"+scale", Features::scale_name, true},
+        std::tuple{"+weighting", Features::weighting_name, false}}) {
+    if (!take(suffix)) continue;
+    if (extended_only && base == "measured") throw bad();
+    out.emplace_back(name);
+  }
+  if (!rest.empty()) throw bad();
   return out;
 }
 
 std::string feature_set_of(const std::vector<std::string>& names) {
-  for (const char* set : {"measured", "extended", "extended-yield", "measured+weighting", "extended+weighting",
-                          "extended-yield+weighting", "extended+lag", "extended-yield+lag", "extended+lag+weighting",
-                          "extended-yield+lag+weighting"})
-    if (names == feature_set_names(set)) return set;
+  for (const char* base : {"measured", "extended", "extended-yield"}) {
+    for (const char* lag : {"", "+lag"}) {
+      for (const char* scale : {"", "+scale"}) {
+        for (const char* weighting : {"", "+weighting"}) {
+          const std::string set = std::string(base) + lag + scale + weighting;
+          if (std::string_view(base) == "measured" && (*lag || *scale)) continue;
+          if (names == feature_set_names(set)) return set;
+        }
+      }
+    }
+  }
   return {};
 }
 
@@ -194,6 +212,7 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   } else {
     m.velocity = r.awcc->velocity;
     m.turbulence_intensity = r.awcc->turbulence_intensity;
+    m.time_scale_ratio = awcc::capped_time_scale_ratio(*r.awcc, Features::time_scale_ratio_cap);
   }
   return out;
 }

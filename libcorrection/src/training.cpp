@@ -396,6 +396,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       m.duration = optional_number(Scene::duration).value_or(0.0);
       m.fscc_velocity = optional_number(column_name(C::fscc_velocity));
       m.r12_max = optional_number(column_name(C::fscc_r12_max));
+      m.time_scale_ratio = optional_number(column_name(C::awcc_time_scale_ratio));
       // Every row of a set shares one processing (checked above); runs
       // without the columns were processed with the defaults.
       m.weighting = has_processing ? set.processing.weighting : awcc::Weighting::duration;

@@ -390,6 +390,7 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
     cell(SweepColumn::awcc_velocity_unweighted) = num(mean);
     cell(SweepColumn::awcc_turbulence_intensity_unweighted) = num(rms / mean);
   }
+  cell(SweepColumn::awcc_time_scale_ratio) = num(m.time_scale_ratio);
   cell(SweepColumn::seconds_synth) = fmt::format("{:.4f}", r->seconds_synth);
   cell(SweepColumn::seconds_process) = fmt::format("{:.4f}", r->seconds_process);
   cell(SweepColumn::reason) = clean(reason);
@@ -422,14 +423,21 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
   const auto first_newline = content.find('\n');
   const std::string_view first_line =
       first_newline == std::string::npos ? std::string_view(content) : std::string_view(content).substr(0, first_newline);
-  const std::string version_column = "," + std::string(correction::column_name(correction::SweepColumn::generator_version));
-  if (first_line.size() + version_column.size() == header.size() && header.ends_with(version_column) &&
-      header.starts_with(first_line)) {
+  // A sweep of an earlier pdp: its header is a beginning of this one (columns
+  // are only ever added at the end, sweep_columns.hpp).
+  if (first_line.size() < header.size() && header.starts_with(first_line) && header[first_line.size()] == ',') {
+    const std::string_view missing = std::string_view(header).substr(first_line.size() + 1);
+    if (missing.starts_with(correction::column_name(correction::SweepColumn::generator_version))) {
+      throw awcc::InputError(fmt::format(
+          "{}: written by pdp's generator version 1 (before the column generator_version); this pdp's generator is "
+          "version {}, whose streams give other scenes for the same seeds; refusing to resume it: write the study to "
+          "another file",
+          csv.string(), awcc::generator_version));
+    }
     throw awcc::InputError(fmt::format(
-        "{}: written by pdp's generator version 1 (before the column generator_version); this pdp's generator is "
-        "version {}, whose streams give other scenes for the same seeds; refusing to resume it: write the study to "
-        "another file",
-        csv.string(), awcc::generator_version));
+        "{}: written by an earlier pdp, whose rows end before the columns {}; refusing to resume it (its rows would "
+        "lack them): write the study to another file",
+        csv.string(), missing));
   }
   if (first_newline == std::string::npos || first_line != header) {
     throw awcc::InputError(fmt::format(
@@ -470,8 +478,14 @@ std::set<std::int64_t> finished_runs(const std::filesystem::path& csv, std::uint
                                          "write this study to another file",
                                          csv.string(), line));
     }
-    // The last cell: the generator version of the row's streams.
-    const std::string_view version = row.substr(row.rfind(',') + 1);
+    // The generator version of the row's streams, `after` cells from the end
+    // (no cell holds a comma: sweep_row cleans them).
+    constexpr auto after = correction::sweep_result_column_count - 1 -
+                           static_cast<std::size_t>(correction::SweepColumn::generator_version);
+    std::size_t version_end = row.size();
+    for (std::size_t k = 0; k < after; ++k) version_end = row.rfind(',', version_end - 1);
+    const std::size_t version_start = row.rfind(',', version_end - 1) + 1;
+    const std::string_view version = row.substr(version_start, version_end - version_start);
     if (version != std::to_string(awcc::generator_version)) {
       throw awcc::InputError(fmt::format("{}:{}: the run was made by generator version '{}', this pdp's is {}: the same "
                                          "seeds give other scenes; refusing to mix them: write the study to another file",

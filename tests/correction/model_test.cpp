@@ -13,6 +13,7 @@
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
+#include "awcc/velocity_series.hpp"
 #include "correction/rows.hpp"
 #include "test_paths.hpp"
 
@@ -424,6 +425,24 @@ TEST(Correction, MeasurementOfAProcessedRecording) {
   EXPECT_EQ(f.features.np, 12.0);
   EXPECT_EQ(f.features.windows_accepted, 321);
   EXPECT_EQ(f.features.dy, 1e-3);
+  // No accepted windows in this result: the time-scale ratio is not known.
+  EXPECT_FALSE(m.measurement.time_scale_ratio);
+  EXPECT_FALSE(f.features.value("time_scale_ratio"));
+  // With them, AWCC's capped ratio (awcc::capped_time_scale_ratio, tested
+  // against the spectrum's in velocity_series_test): windows of 10 ms whose
+  // velocity alternates every other window have uncorrelated neighbours.
+  for (int i = 0; i < 400; ++i) {
+    awcc::AwccWindow w;
+    w.start_time = 0.01 * i;
+    w.duration = 0.01;
+    w.velocity = 10.0 + ((i / 2) % 2 ? 1.0 : -1.0);
+    r.awcc->windows.push_back(w);
+  }
+  m = correction::measurement_of(r);
+  ASSERT_TRUE(m.measurement.time_scale_ratio);
+  EXPECT_EQ(*m.measurement.time_scale_ratio, *awcc::capped_time_scale_ratio(*r.awcc, Features::time_scale_ratio_cap));
+  EXPECT_GT(*m.measurement.time_scale_ratio, 0.0);
+  EXPECT_LT(*m.measurement.time_scale_ratio, 2.0);
 }
 
 // The feature contract refuses what has no features, each with its status.
@@ -534,6 +553,34 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   EXPECT_THROW(correction::feature_set_names("fscc+lag"), std::invalid_argument);
   EXPECT_TRUE(Features::on_log_scale("lag_samples"));
   EXPECT_EQ(correction::feature_value_text("lag_samples", 12.5), "lag_samples = 12.5 samples");
+  // The time-scale ratio: after the lag, before the weighting; unknown until
+  // a measurement gives it; extended sets only, each suffix once and in order.
+  Features scale = inside();
+  EXPECT_FALSE(scale.value("time_scale_ratio"));
+  scale.time_scale_ratio = 2.5;
+  EXPECT_DOUBLE_EQ(*scale.value("time_scale_ratio"), 2.5);
+  const auto scale_set = correction::feature_set_names("extended-yield+lag+scale+weighting");
+  ASSERT_EQ(scale_set.size(), 13u);
+  EXPECT_EQ(scale_set[10], "lag_samples");
+  EXPECT_EQ(scale_set[11], "time_scale_ratio");
+  EXPECT_EQ(scale_set[12], "awcc_unweighted");
+  for (const char* set : {"extended+scale", "extended-yield+scale+weighting", "extended+lag+scale",
+                          "extended-yield+lag+scale+weighting"}) {
+    EXPECT_EQ(correction::feature_set_of(correction::feature_set_names(set)), set);
+  }
+  for (const char* set : {"measured+scale", "extended+scale+lag", "extended+lag+lag", "extended+scales",
+                          "extended+weighting+scale", "extended+", "fscc+scale"}) {
+    EXPECT_THROW(correction::feature_set_names(set), std::invalid_argument) << set;
+  }
+  EXPECT_TRUE(Features::on_log_scale("time_scale_ratio"));
+  EXPECT_EQ(correction::feature_value_text("time_scale_ratio", 20.0), "time_scale_ratio = 20");
+  correction::Measurement stated;
+  stated.velocity = 3.0;
+  stated.turbulence_intensity = 0.2;
+  stated.void_fraction = 0.1;
+  stated.bubble_count_rate = 100.0;
+  stated.time_scale_ratio = 7.5;
+  EXPECT_EQ(*correction::make_features(stated).features.value("time_scale_ratio"), 7.5);
   // The unknown-record values are not features.
   Features none;
   EXPECT_FALSE(none.value("fs"));

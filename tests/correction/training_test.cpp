@@ -313,6 +313,48 @@ TEST(Training, TheLagFeatureLearnsABiasOfTheLagInSamples) {
   EXPECT_EQ(again.serialise(), with.model.serialise());
 }
 
+TEST(Training, TheScaleFeatureLearnsABiasOfTheTimeScaleRatio) {
+  // AWCC's Tu falls short by a factor that depends on T_u / T_W only (the
+  // windows average the velocity over their length, error E4: Tu_true =
+  // Tu (1 + 1 / ratio)), with the ratio drawn log-uniformly over 0.2-20 and
+  // independent of every other feature: without the feature no split can
+  // find it, with it one does. A sweep CSV without the column cannot train
+  // a +scale set, and says which feature is missing.
+  std::mt19937_64 g(8);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::string header = kHeader + ",awcc_time_scale_ratio";
+  std::string csv = header + "\n", without_column = kHeader + "\n";
+  for (int i = 0; i < 1500; ++i) {
+    const double ratio = std::exp(std::log(0.2) + (std::log(20.0) - std::log(0.2)) * u(g));
+    const double measured = 1 + 49 * u(g), tu = 0.05 + 0.3 * u(g);
+    auto v = good(measured, measured, 500);
+    v["awcc_turbulence_intensity"] = fmt::format("{:.10g}", tu);
+    v["truth_turbulence_intensity"] = fmt::format("{:.10g}", tu * (1.0 + 1.0 / ratio));
+    without_column += row(i, v);
+    csv += row(i, v);
+    csv.back() = ',';
+    csv += fmt::format("{:.10g}\n", ratio);
+  }
+  const auto set = correction::load_training_set({write("scale.csv", csv)}, 10);
+  auto o = quick_training(5);
+  o.reduced = false;
+  o.feature_set = "extended-yield";
+  const auto without = correction::train_model(set, o);
+  o.feature_set = "extended-yield+scale";
+  const auto with = correction::train_model(set, o);
+  EXPECT_EQ(with.model.ranges.back().name, "time_scale_ratio");
+  EXPECT_LT(with.held_out.tu_rmse_corrected, 0.5 * without.held_out.tu_rmse_corrected)
+      << with.held_out.tu_rmse_corrected << " against "
+      << without.held_out.tu_rmse_corrected;
+  const auto no_column = correction::load_training_set({write("no-scale.csv", without_column)}, 10);
+  try {
+    (void)correction::train_model(no_column, o);
+    ADD_FAILURE() << "a sweep without the ratio trained a +scale model";
+  } catch (const awcc::OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("time_scale_ratio"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   // The bias depends on the sampling rate only (true u = measured u at
   // 1 MHz, 20 % below it at 10 kHz): a forest that sees fs removes it, one

@@ -61,6 +61,7 @@ enum class SweepColumn : std::size_t {
   multi_tip_interfacial_area, multi_tip_quality, multi_tip_bubbles_accepted,
   awcc_velocity_unweighted, awcc_turbulence_intensity_unweighted,
   generator_version,
+  awcc_time_scale_ratio,
   count
 };
 
@@ -123,6 +124,9 @@ inline constexpr std::array<SweepColumnInfo, sweep_result_column_count> sweep_re
     {"generator_version", "-",
      "the version of the seeded streams that made the run (awcc::generator_version; sweeps written before the "
      "column existed are version 1)"},
+    {"awcc_time_scale_ratio", "-",
+     "T_u / T_W of AWCC's accepted windows, capped at 20 (correction::Features::time_scale_ratio; the feature of the "
+     "+scale sets)"},
 }};
 
 [[nodiscard]] constexpr std::string_view column_name(SweepColumn c) {
