@@ -1,4 +1,5 @@
 #include "awcc/awcc.hpp"
+#include "awcc/velocity_series.hpp"
 
 #include "awcc/detail/awcc_driver.hpp"
 #include "awcc/detail/awcc_steps.hpp"
@@ -696,6 +697,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.quality = AwccQuality::insufficient;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
+  result.time_scale_ratio.reset();
   auto insufficient = [&result] { result.quality_reason = result.message; };
   if (result.windows_total == 0) {
     result.status = AwccStatus::too_few_particles;
@@ -758,6 +760,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   std::tie(result.quality, result.quality_reason) =
       reported_quality(result.windows_accepted, result.windows_total, options.windows_ok, options.yield_ok, intervals,
                        {"accepted windows", "data yield", "windows accepted", "the accepted windows"});
+  result.time_scale_ratio = capped_time_scale_ratio(result, time_scale_ratio_cap);
 }
 
 }  // namespace detail
@@ -859,6 +862,7 @@ void detail::no_tip_separation(AwccResult& result) {
   result.quality_reason = result.message;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
+  result.time_scale_ratio.reset();
 }
 
 void detail::tips_swapped(AwccResult& result, const std::string& why) {
@@ -868,6 +872,7 @@ void detail::tips_swapped(AwccResult& result, const std::string& why) {
   result.quality_reason = why;
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
+  result.time_scale_ratio.reset();
 }
 
 }  // namespace awcc

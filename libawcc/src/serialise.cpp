@@ -564,6 +564,7 @@ json awcc_json(const AwccResult& a) {
       {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
       {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
       {"windows_not_bubbly", a.windows_not_bubbly},
+      {process_key::time_scale_ratio, a.time_scale_ratio ? json(*a.time_scale_ratio) : json(nullptr)},
       {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
                                             static_cast<double>(a.windows_total))
                                       : json(nullptr)},
@@ -929,6 +930,8 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {"interfacial_area_ci95_upper", "1/m", "/interfacial_area/ci95/1", "interfacial area, 95 % interval, upper"},
       {profile_column::interfacial_area_source, "", "/interfacial_area/source",
        "which estimate interfacial_area is: dual_tip (4 F / u = 6 c / d32) or multi_tip"},
+      {profile_column::awcc_time_scale_ratio, "-", "/awcc/time_scale_ratio",
+       "AWCC's T_u / T_W capped at 20: the bias correction's time-scale feature"},
   };
   return columns;
 }
@@ -1023,6 +1026,7 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
                      csv_number(area_ci ? std::optional(area_ci->lower) : std::nullopt),
                      csv_number(area_ci ? std::optional(area_ci->upper) : std::nullopt),
                      area.source ? to_string(*area.source) : "");
+  out += "," + csv_number(awcc_ok ? a->time_scale_ratio : std::nullopt);
   return out;
 }
 

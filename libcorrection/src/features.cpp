@@ -212,7 +212,7 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   } else {
     m.velocity = r.awcc->velocity;
     m.turbulence_intensity = r.awcc->turbulence_intensity;
-    m.time_scale_ratio = awcc::capped_time_scale_ratio(*r.awcc, Features::time_scale_ratio_cap);
+    m.time_scale_ratio = r.awcc->time_scale_ratio;
   }
   return out;
 }

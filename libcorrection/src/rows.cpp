@@ -280,6 +280,7 @@ MeasurementResult measurement_of_json(const nlohmann::json& r, const RowDefaults
     if (const auto w = number(a, key::windows_accepted)) p.awcc->windows_accepted = whole(*w, file, "awcc.windows_accepted");
     if (const auto w = number(a, key::windows_total)) p.awcc->windows_total = whole(*w, file, "awcc.windows_total");
     p.awcc->np = static_cast<int>(number(a, key::np).value_or(d.np.value_or(0)));
+    p.awcc->time_scale_ratio = number(a, key::time_scale_ratio);  // a JSON of an earlier pdp: not known
   }
   p.dx = need(number(r, key::dx), d.dx, file, "dx", "streamwise tip separation");
   p.dy = need(number(r, key::dy), d.dy, file, "dy", "lateral tip separation");
@@ -409,6 +410,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       if (p.awcc) {
         if (accepted) p.awcc->windows_accepted = whole(*accepted, where, "awcc_windows_accepted");
         if (total) p.awcc->windows_total = whole(*total, where, "awcc_windows_total");
+        p.awcc->time_scale_ratio = value(column::awcc_time_scale_ratio);  // a CSV of an earlier pdp: not known
         if (outcome.status == CorrectionStatus::corrected) {
           p.awcc->velocity = *value(column::awcc_velocity);
           p.awcc->turbulence_intensity = *value(column::awcc_turbulence_intensity);

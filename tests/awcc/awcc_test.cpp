@@ -1,5 +1,6 @@
 #include "awcc/detail/awcc_steps.hpp"
 #include "awcc/awcc.hpp"
+#include "awcc/velocity_series.hpp"
 #include "awcc/detail/awcc_driver.hpp"
 #include "awcc/process.hpp"
 
@@ -240,6 +241,16 @@ TEST(AwccDriver, FatesAreCountedOncePerWindowAndSumToTheTotal) {
   awcc::detail::awcc_summarise(mixed, o);
   for (std::size_t i = 0; i < awcc::window_fate_count; ++i) EXPECT_GT(mixed.windows_by_fate[i], 50) << i;
   expect_fates_counted(mixed);
+  // An ok result carries its capped time-scale ratio (the correction's
+  // feature), the accepted windows' own; a result that is not ok carries none.
+  ASSERT_TRUE(mixed.ok()) << mixed.message;
+  ASSERT_TRUE(mixed.time_scale_ratio);
+  EXPECT_EQ(*mixed.time_scale_ratio, *awcc::capped_time_scale_ratio(mixed, awcc::time_scale_ratio_cap));
+  awcc::AwccResult few = mixed;
+  few.windows.resize(3);
+  awcc::detail::awcc_summarise(few, o);
+  EXPECT_FALSE(few.ok());
+  EXPECT_FALSE(few.time_scale_ratio);
   // The driver's own fates: a planted delay in the first half of the windows,
   // an unrelated trailing signal in the second (filter and lag rejections),
   // the outlier cutoff, and windows too short for a stated velocity range.

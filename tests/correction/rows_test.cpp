@@ -6,6 +6,8 @@
 // (only "defined") still reads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
@@ -104,6 +106,19 @@ TEST(Rows, FilesAreCorrectedAsTheResultsInMemory) {
     EXPECT_EQ(read.measurement.velocity, in_memory.measurement.velocity) << i;
     EXPECT_EQ(read.measurement.fscc_velocity, in_memory.measurement.fscc_velocity) << i;
     EXPECT_EQ(read.measurement.windows_total, in_memory.measurement.windows_total) << i;
+    // The time-scale feature too: the JSON's awcc.time_scale_ratio, and the
+    // CSV's awcc_time_scale_ratio cell that the CSV reader takes.
+    EXPECT_EQ(read.measurement.time_scale_ratio, in_memory.measurement.time_scale_ratio) << i;
+    EXPECT_EQ(in_memory.measurement.time_scale_ratio.has_value(), in_memory.measurement.velocity.has_value()) << i;
+    const auto names = awcc::split_cells(awcc::profile_csv_header());
+    const auto cells = awcc::split_cells(awcc::profile_csv_row(rs[i], 0.01));
+    const auto at = std::find(names.begin(), names.end(), "awcc_time_scale_ratio") - names.begin();
+    ASSERT_LT(static_cast<std::size_t>(at), names.size());
+    const auto cell = awcc::cell_number(cells[static_cast<std::size_t>(at)]);
+    ASSERT_EQ(cell.has_value(), rs[i].awcc && rs[i].awcc->time_scale_ratio.has_value()) << i;
+    if (cell) {
+      EXPECT_NEAR(*cell, *rs[i].awcc->time_scale_ratio, 1e-9 * *cell) << i;
+    }
   }
   // The rows cover what the correction tells apart: the probe-corrected row
   // is refused (a profile CSV's "on" was once not read as corrected).

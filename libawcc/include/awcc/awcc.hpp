@@ -176,6 +176,10 @@ struct AwccResult {
   bool probe_corrected = false;
   double velocity_measured = 0.0, velocity_rms_measured = 0.0, turbulence_intensity_measured = 0.0;
   std::int64_t windows_not_bubbly = 0;    ///< accepted windows above the bubbly void fraction: as measured
+  /// T_u / T_W of the accepted windows, capped at time_scale_ratio_cap
+  /// (awcc/velocity_series.hpp, capped_time_scale_ratio): the bias
+  /// correction's feature time_scale_ratio; empty unless ok.
+  std::optional<double> time_scale_ratio;
   std::vector<AwccWindow> windows;
 };
 

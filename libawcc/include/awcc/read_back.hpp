@@ -109,6 +109,7 @@ inline constexpr std::string_view r12_max = "r12_max";
 inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
 inline constexpr std::string_view windows_accepted = "windows_accepted";
 inline constexpr std::string_view windows_total = "windows_total";
+inline constexpr std::string_view time_scale_ratio = "time_scale_ratio";  ///< AWCC's, capped (AwccResult)
 inline constexpr std::string_view np = "np";
 inline constexpr std::string_view probe_corrected = "probe_corrected";
 inline constexpr std::string_view options = "options";
@@ -184,6 +185,7 @@ inline constexpr std::string_view warnings = "warnings";  ///< the texts, joined
 inline constexpr std::string_view flags = "flags";        ///< the codes, joined by "; "
 inline constexpr std::string_view sizes_status = "sizes_status";
 inline constexpr std::string_view interfacial_area_source = "interfacial_area_source";
+inline constexpr std::string_view awcc_time_scale_ratio = "awcc_time_scale_ratio";
 }  // namespace profile_column
 
 }  // namespace awcc

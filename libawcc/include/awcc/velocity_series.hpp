@@ -144,6 +144,13 @@ std::string windows_too_long(const AwccResult& awcc, double ratio);
 /// `duration` s.
 VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, const SpectrumOptions& options);
 
+/// Where AWCC's T_u / T_W is capped (AwccResult::time_scale_ratio, the bias
+/// correction's feature): an oracle test (the true T / T_W clipped to
+/// 0.5-20 as a feature, docs/validation.md "The time scale") kept most of the
+/// unclipped ratio's gain, and windows 20 times shorter than T_u follow the
+/// velocity; the cap also bounds the cost (below).
+inline constexpr double time_scale_ratio_cap = 20.0;
+
 /// T_u / T_W as the bias correction reads it (correction/features.hpp,
 /// feature time_scale_ratio): velocity_spectrum's slotted ratio, capped at
 /// `cap` (> 0). The integral stops once it reaches cap T_W, so the cost is

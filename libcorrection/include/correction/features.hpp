@@ -75,6 +75,7 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/process.hpp"
+#include "awcc/velocity_series.hpp"
 
 namespace correction {
 
@@ -173,10 +174,8 @@ struct Features {
   /// The time-scale feature (T_u / T_W, see the file's comment); 0: not known.
   double time_scale_ratio = 0.0;
   static constexpr const char* scale_name = "time_scale_ratio";
-  /// Where the ratio is capped: the oracle test of validation.md ("The time
-  /// scale") kept most of the true ratio's gain clipped at 20, and the
-  /// computation stops there.
-  static constexpr double time_scale_ratio_cap = 20.0;
+  /// Where the ratio is capped (AWCC's result holds it capped, and says why).
+  static constexpr double time_scale_ratio_cap = awcc::time_scale_ratio_cap;
   [[nodiscard]] std::array<double, 7> vector() const {
     return {velocity, turbulence_intensity, void_fraction, d32, dx, dy, np};
   }
