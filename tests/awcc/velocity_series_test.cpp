@@ -262,6 +262,13 @@ TEST(CappedTimeScaleRatio, NeedsTwoAcceptedWindowsOfAnAwccVelocity) {
   a.windows[1].fate = awcc::WindowFate::correlation;
   EXPECT_FALSE(awcc::capped_time_scale_ratio(a, 20.0));
   EXPECT_FALSE(awcc::capped_time_scale_ratio(windows_of(two, 0.1), 0.0));
+  // Every window at one velocity (one lag): no variance, r = 1 throughout: the cap.
+  IrregularSeries flat;
+  for (int i = 0; i < 200; ++i) {
+    flat.times.push_back(0.1 * i);
+    flat.values.push_back(4.0);
+  }
+  EXPECT_EQ(awcc::capped_time_scale_ratio(windows_of(flat, 0.1), 20.0), 20.0);
 }
 
 }  // namespace

@@ -158,7 +158,10 @@ inline constexpr double time_scale_ratio_cap = 20.0;
 /// (a study computes it on every run; the spectrum's full integral can take
 /// thousands of pairs per window where T_u is long). Where the slotted
 /// autocorrelation stays positive over every slot (a quarter of the
-/// record), the integral so far: a lower bound. Equal to
+/// record), the integral so far: a lower bound. A series without variance
+/// (every accepted window at one lag, AWCC's Tu 0) has r = 1 at every slot
+/// (slotted_autocorrelation's rule) and gives the cap: it has no scale, and
+/// the cap keeps the feature defined for every result AWCC gives. Equal to
 /// min(velocity_spectrum's time_scale_ratio, cap) wherever that exists.
 /// Empty when AWCC gave no velocity or accepted fewer than two windows.
 std::optional<double> capped_time_scale_ratio(const AwccResult& awcc, double cap);
