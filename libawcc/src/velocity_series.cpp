@@ -103,17 +103,26 @@ std::vector<double> autocorrelation(std::span<const double> x, std::size_t max_l
   return out;
 }
 
+namespace {
+// The mean and the (biased) variance of the values, as the slotted
+// correlations normalise by them.
+std::pair<double, double> mean_and_variance(std::span<const double> values) {
+  const auto n = static_cast<double>(values.size());
+  double mean = 0.0;
+  for (double v : values) mean += v;
+  mean /= n;
+  double variance = 0.0;
+  for (double v : values) variance += (v - mean) * (v - mean);
+  return {mean, variance / n};
+}
+}  // namespace
+
 std::vector<double> slotted_autocorrelation(std::span<const double> times, std::span<const double> values, double slot,
                                             std::size_t slots) {
   const std::size_t n = values.size();
   std::vector<double> r(slots + 1, 0.0);
   if (n < 2 || !(slot > 0.0)) return r;
-  double mean = 0.0;
-  for (double v : values) mean += v;
-  mean /= static_cast<double>(n);
-  double variance = 0.0;
-  for (double v : values) variance += (v - mean) * (v - mean);
-  variance /= static_cast<double>(n);
+  const auto [mean, variance] = mean_and_variance(values);
   std::vector<double> sum(slots + 1, 0.0);
   std::vector<std::int64_t> count(slots + 1, 0);
   const double reach = (static_cast<double>(slots) + 0.5) * slot;
@@ -146,12 +155,7 @@ SlottedIntegral slotted_integral_to_first_zero(std::span<const double> times, st
   SlottedIntegral out;
   const std::size_t n = values.size();
   if (n < 2 || !(slot > 0.0) || slots == 0) return out;
-  double mean = 0.0;
-  for (double v : values) mean += v;
-  mean /= static_cast<double>(n);
-  double variance = 0.0;
-  for (double v : values) variance += (v - mean) * (v - mean);
-  variance /= static_cast<double>(n);
+  const auto [mean, variance] = mean_and_variance(values);
   std::vector<double> sum(slots + 1, 0.0), r(slots + 1, 0.0);
   std::vector<std::int64_t> count(slots + 1, 0);
   const double reach = (static_cast<double>(slots) + 0.5) * slot;

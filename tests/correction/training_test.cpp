@@ -281,6 +281,19 @@ TEST(Training, ModelDoesNotDependOnRowOrder) {
   EXPECT_EQ(first.cv.size(), 2u * 2u * 2u * 2u);
 }
 
+// Two quick models of the same runs (no reduced model), of a feature set
+// without and with a feature.
+std::pair<correction::TrainResult, correction::TrainResult> without_and_with(const correction::TrainingSet& set,
+                                                                             const std::string& without,
+                                                                             const std::string& with) {
+  auto o = quick_training(5);
+  o.reduced = false;
+  o.feature_set = without;
+  auto first = correction::train_model(set, o);
+  o.feature_set = with;
+  return {std::move(first), correction::train_model(set, o)};
+}
+
 TEST(Training, TheLagFeatureLearnsABiasOfTheLagInSamples) {
   // The bias depends on the lag in samples L = dx fs / u only (AWCC's lag
   // quantisation: 30 % at L -> 0, 1.5 % at L = 100): the lag feature makes it
@@ -299,13 +312,8 @@ TEST(Training, TheLagFeatureLearnsABiasOfTheLagInSamples) {
     v["dx"] = fmt::format("{:.10g}", dx);
     csv += row(i, v);
   }
-  const auto set = correction::load_training_set({write("lag.csv", csv)}, 10);
-  auto o = quick_training(5);
-  o.reduced = false;
-  o.feature_set = "extended-yield";
-  const auto without = correction::train_model(set, o);
-  o.feature_set = "extended-yield+lag";
-  const auto with = correction::train_model(set, o);
+  const auto [without, with] = without_and_with(correction::load_training_set({write("lag.csv", csv)}, 10),
+                                                 "extended-yield", "extended-yield+lag");
   EXPECT_EQ(with.model.ranges.back().name, "lag_samples");
   EXPECT_LT(with.held_out.velocity_rmse_corrected, 0.5 * without.held_out.velocity_rmse_corrected)
       << with.held_out.velocity_rmse_corrected << " against " << without.held_out.velocity_rmse_corrected;
@@ -335,19 +343,17 @@ TEST(Training, TheScaleFeatureLearnsABiasOfTheTimeScaleRatio) {
     csv.back() = ',';
     csv += fmt::format("{:.10g}\n", ratio);
   }
-  const auto set = correction::load_training_set({write("scale.csv", csv)}, 10);
-  auto o = quick_training(5);
-  o.reduced = false;
-  o.feature_set = "extended-yield";
-  const auto without = correction::train_model(set, o);
-  o.feature_set = "extended-yield+scale";
-  const auto with = correction::train_model(set, o);
+  const auto [without, with] = without_and_with(correction::load_training_set({write("scale.csv", csv)}, 10),
+                                                 "extended-yield", "extended-yield+scale");
   EXPECT_EQ(with.model.ranges.back().name, "time_scale_ratio");
   EXPECT_LT(with.held_out.tu_rmse_corrected, 0.5 * without.held_out.tu_rmse_corrected)
       << with.held_out.tu_rmse_corrected << " against "
       << without.held_out.tu_rmse_corrected;
   const auto no_column = correction::load_training_set({write("no-scale.csv", without_column)}, 10);
   try {
+    auto o = quick_training(5);
+    o.reduced = false;
+    o.feature_set = "extended-yield+scale";
     (void)correction::train_model(no_column, o);
     ADD_FAILURE() << "a sweep without the ratio trained a +scale model";
   } catch (const awcc::OptionError& e) {
