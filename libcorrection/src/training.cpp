@@ -173,7 +173,8 @@ const awcc::OptionField<T> kTraining[] = {
     {"feature-set", "-",
      "features of the model: measured (u, Tu, c, d32, dx, dy, Np), extended (also fs, duration and accepted "
      "windows) or extended-yield (fs, duration and the data yield); an extended set may end in +lag (AWCC's lag "
-     "in samples, dx fs / u), any in +weighting (how AWCC's moments were taken)",
+     "in samples, dx fs / u), then +scale (AWCC's T_u / T_W, capped at 20), any in +weighting (how AWCC's moments "
+     "were taken)",
      [](T& o, std::string_view t) {
        feature_set_names(t);  // refuses an unknown set
        o.feature_set = std::string(t);
