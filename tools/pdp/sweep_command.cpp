@@ -22,6 +22,14 @@ void setup_sweep(CLI::App& app, Command& command, SweepOptions& o) {
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 4096))
       ->capture_default_str();
   cmd->add_option("--shard", o.shard, "i/n: run only the runs whose index is i modulo n (cluster job arrays)");
+  // A Monte Carlo sweep's first N runs are a random sample of it, and which
+  // runs they are does not depend on when the sweep was stopped: a campaign
+  // that needs only part of a sweep asks for it, and a later call with a
+  // larger N (or without it) resumes the rest into the same file.
+  cmd->add_option("--first-runs", o.first_runs,
+                  "run only the runs whose index is below N (0 = every run); a later call resumes the rest")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40))
+      ->capture_default_str();
   add_method_options(cmd, o.methods);
 }
 
@@ -76,11 +84,13 @@ int run_sweep(const SweepOptions& o) {
   std::vector<std::int64_t> pending;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     if (runs[i].index % shards != shard || done.count(runs[i].index)) continue;
+    if (o.first_runs > 0 && runs[i].index >= o.first_runs) continue;
     pending.push_back(static_cast<std::int64_t>(i));
   }
   if (mpi.rank() == 0) {
-    spdlog::info("{}: {} runs in the study, {} already in {}, {} to run{}", o.study, runs.size(), done.size(),
-                 o.output, pending.size(), shards > 1 ? fmt::format(" (shard {}/{})", shard, shards) : "");
+    spdlog::info("{}: {} runs in the study, {} already in {}, {} to run{}{}", o.study, runs.size(), done.size(),
+                 o.output, pending.size(), shards > 1 ? fmt::format(" (shard {}/{})", shard, shards) : "",
+                 o.first_runs > 0 ? fmt::format(" (runs below {})", o.first_runs) : "");
   }
   auto compute_row = [&](std::int64_t i) {
     return study::run_sweep_row(runs[static_cast<std::size_t>(i)], options, id);

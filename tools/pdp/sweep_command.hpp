@@ -3,6 +3,7 @@
 // into an append-only CSV that an interrupted sweep resumes.
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <string>
 
 #include "command.hpp"
@@ -15,6 +16,7 @@ struct SweepOptions {
   std::string output;         ///< CSV (appended; resumed when it holds rows of this study)
   int threads = 0;            ///< 0 = all cores
   std::string shard;          ///< "i/n": this process runs the runs with index % n == i
+  std::int64_t first_runs = 0;  ///< run only the runs with index below this; 0 = every run
   OptionSet methods;          ///< AWCC/FSCC settings for every run (np: unless the study sets it)
 };
 
