@@ -571,10 +571,16 @@ Attempt reduced_attempt(const CorrectionModel& m, const Features& f) {
   auto& c = a.correction;
   if (c.velocity) {
     c.forest = "awcc-reduced";
+    // A file of an earlier pdp lacks only the time scale: the recording,
+    // processed again, gives it and the full forest.
+    const bool only_scale = missing.size() == 1 && missing.front() == Features::scale_name;
     c.notes.insert(c.notes.begin(),
                    fmt::format("{} not known for this row: corrected by the reduced forest (u, Tu, c, d32, dx, dy, "
-                               "Np), trained over every record length and rate, whose intervals are wider",
-                               fmt::join(missing, ", ")));
+                               "Np), trained over every record length and rate, whose intervals are wider{}",
+                               fmt::join(missing, ", "),
+                               only_scale ? " (pdp process writes it as awcc.time_scale_ratio: process the "
+                                            "recording again for the full forest)"
+                                          : ""));
   }
   return a;
 }

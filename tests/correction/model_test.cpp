@@ -631,6 +631,61 @@ TEST(Correction, RowsWithoutTheRecordsFeaturesGoToTheReducedModel) {
   }
 }
 
+TEST(Correction, ARowWithoutTheTimeScaleGoesToTheReducedModelNamingIt) {
+  // A "+scale" model (issue 33) corrects a row that states fs, duration and
+  // windows but not T_u / T_W (a file of an earlier pdp, or another tool's)
+  // with its reduced model, exactly as that model alone, and the note names
+  // the time scale as the one feature missing; the same row with the ratio is
+  // the full forest's, whose target here depends on the ratio alone.
+  auto m = model_of(
+      "extended-yield+lag+scale", 21,
+      [](Features& f, std::mt19937_64& g) {
+        f.velocity = 1 + 49 * uniform(g);
+        f.fs = 1e4 + 1e6 * uniform(g);
+        f.duration = 20 + 280 * uniform(g);
+        f.windows_total = 1000;
+        f.windows_accepted = 10 + static_cast<std::int64_t>(900 * uniform(g));
+        f.time_scale_ratio = 0.5 + 19.5 * uniform(g);
+      },
+      [](const Features& f) { return 1.0 + 0.01 * f.time_scale_ratio; });
+  const auto reduced = std::make_shared<const CorrectionModel>(model_of(
+      "measured", 10, [](Features& f, std::mt19937_64& g) { f.velocity = 1 + 49 * uniform(g); },
+      [](const Features& f) { return 1.0 + 0.001 * f.velocity; }));
+  m.reduced = reduced;
+  Features full = inside();
+  full.fs = 5e5;
+  full.duration = 100;
+  full.windows_total = 1000;
+  full.time_scale_ratio = 10.0;
+  const auto with = m.correct(full);
+  ASSERT_TRUE(with.corrected()) << with.message;
+  EXPECT_EQ(with.forest, "awcc");
+  Features without = full;
+  without.time_scale_ratio = 0.0;
+  ASSERT_FALSE(without.value("time_scale_ratio"));
+  const auto c = m.correct(without);
+  ASSERT_TRUE(c.corrected()) << c.message;
+  EXPECT_EQ(c.forest, "awcc-reduced");
+  const auto alone = reduced->correct(without);
+  ASSERT_TRUE(alone.corrected());
+  EXPECT_EQ(c.velocity->quantiles, alone.velocity->quantiles);
+  ASSERT_FALSE(c.notes.empty());
+  EXPECT_EQ(c.notes.front().rfind("time_scale_ratio not known for this row: corrected by the reduced forest", 0), 0u)
+      << c.notes.front();
+  EXPECT_NE(c.notes.front().find("process the recording again for the full forest"), std::string::npos);
+  // A row missing fs as well is a peer's: no advice to process it again.
+  Features peer = without;
+  peer.fs = 0;
+  const auto p = m.correct(peer);
+  ASSERT_TRUE(p.corrected());
+  EXPECT_EQ(p.notes.front().find("process the recording again"), std::string::npos) << p.notes.front();
+  // Without a reduced model the row is refused, naming the feature.
+  m.reduced = nullptr;
+  const auto refused = m.correct(without);
+  EXPECT_EQ(refused.status, correction::CorrectionStatus::missing_feature);
+  EXPECT_NE(refused.message.find("time_scale_ratio"), std::string::npos) << refused.message;
+}
+
 TEST(Correction, FsccFeatureSetTwoTakesTheChordTimeAndTheLag) {
   // Set 2 replaces the Sauter diameter from FSCC's velocity by c / F and
   // adds FSCC's lag dx / u_FSCC: both from the measurement, exactly.
