@@ -10,7 +10,13 @@ and 95 % intervals. Standard errors by the bootstrap (2,000 resamples of the
 rows, seed 0); coverage's is also sqrt(p (1 - p) / n). The two sets are
 independent, so z = (b - a) / sqrt(se_a^2 + se_b^2).
 
-Usage: score_comparison.py NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv
+With --paired the two files are two models' predictions of the same runs
+(candidate models, docs/validation.md "The time scale"): only the rows both
+corrected are scored (a row is a run and its weighting), and the standard
+error is that of the difference, from resampling the rows as pairs, so the
+runs' own spread cancels.
+
+Usage: score_comparison.py [--paired] NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv
 """
 import csv
 import math
@@ -27,6 +33,7 @@ def rows(path):
         q = lambda name: float(r[name])
         u, tu = q("true_velocity"), q("true_turbulence_intensity")
         out.append({
+            "key": (r["run"], r.get("awcc_unweighted", "")),
             "u_err": q("corrected_velocity_q0.5") / u - 1.0,
             "tu_err": q("corrected_turbulence_intensity_q0.5") - tu,
             "u80": q("corrected_velocity_q0.1") <= u <= q("corrected_velocity_q0.9"),
@@ -54,8 +61,34 @@ def bootstrap_se(rs, f, rng, n=2000):
     return statistics.stdev(values)
 
 
+def paired(a_name, a, b_name, b):
+    a_by = {r["key"]: r for r in a}
+    b_by = {r["key"]: r for r in b}
+    keys = sorted(set(a_by) & set(b_by))
+    pa, pb = [a_by[k] for k in keys], [b_by[k] for k in keys]
+    rng = random.Random(0)
+    print(f"rows both corrected: {len(keys)} (of {len(a)} and {len(b)})\n")
+    print(f"| score | {a_name} | {b_name} | difference +- se | z |")
+    print("|---|---|---|---|---|")
+    for name, f in SCORES:
+        va, vb = f(pa), f(pb)
+        diffs = []
+        for _ in range(2000):
+            idx = [rng.randrange(len(keys)) for _ in keys]
+            diffs.append(f([pb[i] for i in idx]) - f([pa[i] for i in idx]))
+        se = statistics.stdev(diffs)
+        digits = 4 if name.startswith("Tu m") else 2
+        z = (vb - va) / se if se > 0 else float("nan")
+        print(f"| {name} | {va:.{digits}f} | {vb:.{digits}f} | {vb - va:+.{digits}f} +- {se:.{digits}f} | {z:+.2f} |")
+
+
 def main():
-    a_name, a_path, b_name, b_path = sys.argv[1:5]
+    args = sys.argv[1:]
+    if args and args[0] == "--paired":
+        a_name, a_path, b_name, b_path = args[1:5]
+        paired(a_name, rows(a_path), b_name, rows(b_path))
+        return
+    a_name, a_path, b_name, b_path = args[0:4]
     a, b = rows(a_path), rows(b_path)
     rng = random.Random(0)
     print(f"| score | {a_name} ({len(a)} rows) | {b_name} ({len(b)} rows) | z |")
