@@ -577,6 +577,13 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   EXPECT_FALSE(none.value("colour"));
 }
 
+// A reduced model (the measured features alone) over u 1-50 m/s.
+CorrectionModel reduced_model() {
+  return model_of(
+      "measured", 10, [](Features& f, std::mt19937_64& g) { f.velocity = 1 + 49 * uniform(g); },
+      [](const Features& f) { return 1.0 + 0.001 * f.velocity; });
+}
+
 TEST(Correction, RowsWithoutTheRecordsFeaturesGoToTheReducedModel) {
   // An extended model with a reduced one (issue 33, peers' rows): a row that
   // states fs, duration and windows is the extended model's; a row without
@@ -585,9 +592,7 @@ TEST(Correction, RowsWithoutTheRecordsFeaturesGoToTheReducedModel) {
   // both and reads back bit for bit; a reduced model that is not of the
   // measured features alone is refused as damaged.
   auto m = extended_model();
-  const auto reduced = std::make_shared<const CorrectionModel>(model_of(
-      "measured", 10, [](Features& f, std::mt19937_64& g) { f.velocity = 1 + 49 * uniform(g); },
-      [](const Features& f) { return 1.0 + 0.001 * f.velocity; }));
+  const auto reduced = std::make_shared<const CorrectionModel>(reduced_model());
   m.reduced = reduced;
   Features full = inside();
   full.fs = 5e5;
@@ -648,9 +653,7 @@ TEST(Correction, ARowWithoutTheTimeScaleGoesToTheReducedModelNamingIt) {
         f.time_scale_ratio = 0.5 + 19.5 * uniform(g);
       },
       [](const Features& f) { return 1.0 + 0.01 * f.time_scale_ratio; });
-  const auto reduced = std::make_shared<const CorrectionModel>(model_of(
-      "measured", 10, [](Features& f, std::mt19937_64& g) { f.velocity = 1 + 49 * uniform(g); },
-      [](const Features& f) { return 1.0 + 0.001 * f.velocity; }));
+  const auto reduced = std::make_shared<const CorrectionModel>(reduced_model());
   m.reduced = reduced;
   Features full = inside();
   full.fs = 5e5;
