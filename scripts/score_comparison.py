@@ -27,13 +27,20 @@ import sys
 
 def rows(path):
     out = []
+    seen = {}
     for r in csv.DictReader(open(path)):
+        # A row's key: its run, its weighting and which of the rows with
+        # those it is (held-out runs of several sweeps share run numbers;
+        # two models trained on the same sweeps list them in one order).
+        run = (r["run"], r.get("awcc_unweighted", ""))
+        seen[run] = seen.get(run, 0) + 1
         if r["status"] != "corrected":
             continue
         q = lambda name: float(r[name])
         u, tu = q("true_velocity"), q("true_turbulence_intensity")
         out.append({
-            "key": (r["run"], r.get("awcc_unweighted", "")),
+            "key": run + (seen[run],),
+            "truth": (r["true_velocity"], r["true_turbulence_intensity"]),
             "u_err": q("corrected_velocity_q0.5") / u - 1.0,
             "tu_err": q("corrected_turbulence_intensity_q0.5") - tu,
             "u80": q("corrected_velocity_q0.1") <= u <= q("corrected_velocity_q0.9"),
@@ -65,6 +72,8 @@ def paired(a_name, a, b_name, b):
     a_by = {r["key"]: r for r in a}
     b_by = {r["key"]: r for r in b}
     keys = sorted(set(a_by) & set(b_by))
+    if any(a_by[k]["truth"] != b_by[k]["truth"] for k in keys):
+        sys.exit("--paired: the two files' rows are not the same runs (their truths differ)")
     pa, pb = [a_by[k] for k in keys], [b_by[k] for k in keys]
     rng = random.Random(0)
     print(f"rows both corrected: {len(keys)} (of {len(a)} and {len(b)})\n")
