@@ -61,13 +61,32 @@ std::vector<double> lagged_products_by_intervals(const AirIntervals& x, const Ai
   std::vector<std::int64_t> impulse(lags, 0);
   detail::OverlapImpulses<std::int64_t> sum{k_min, k_max, impulse};
   const auto& yi = y.intervals;
+  const std::size_t ny = yi.size();
+  std::int64_t* const counts = impulse.data();
   std::size_t first = 0;
   for (const auto& iv : x.intervals) {
     const std::int64_t a0 = std::max(iv.start, t0), a1 = std::min(iv.stop, t1);
     if (a0 >= a1) continue;
     // y intervals that can overlap a shifted by a lag in range: b1 > a0 + k_min, b0 <= a1 + k_max.
-    while (first < yi.size() && yi[first].stop <= a0 + k_min) ++first;
-    for (std::size_t j = first; j < yi.size() && yi[j].start <= a1 + k_max; ++j) {
+    while (first < ny && yi[first].stop <= a0 + k_min) ++first;
+    // A pair's impulses lie between b0 - a1 and b1 - a0. y's intervals are
+    // sorted and disjoint, so along j the pairs whose lowest impulse falls
+    // below k_min come first, then those with all four in range, then those
+    // whose highest falls beyond k_max: the middle run, most pairs at a high
+    // count rate, adds its impulses without add_pair's range tests (the same
+    // integers, so the same sums).
+    std::size_t j = first;
+    for (; j < ny && yi[j].start <= a1 + k_max && yi[j].start - a1 < k_min; ++j) {
+      sum.add_pair(a0, a1, yi[j].start, yi[j].stop);
+    }
+    for (; j < ny && yi[j].stop - a0 <= k_max; ++j) {
+      const std::int64_t b0 = yi[j].start - k_min, b1 = yi[j].stop - k_min;
+      ++counts[b0 - a1];
+      --counts[b0 - a0];
+      --counts[b1 - a1];
+      ++counts[b1 - a0];
+    }
+    for (; j < ny && yi[j].start <= a1 + k_max; ++j) {
       sum.add_pair(a0, a1, yi[j].start, yi[j].stop);
     }
   }
