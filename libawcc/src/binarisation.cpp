@@ -325,7 +325,7 @@ Threshold choose_threshold(const VoltageHistogram& h, const BinarisationOptions&
   return t;
 }
 
-Binariser::Binariser(const Threshold& threshold, double fs) : t_(threshold), fs_(fs) { out_.fs = fs; }
+Binariser::Binariser(const Threshold& threshold, double fs) : t_(threshold) { out_.fs = fs; }
 
 void Binariser::feed(std::span<const float> values, std::size_t first, std::size_t stride) {
   const bool binary = t_.binary_input;

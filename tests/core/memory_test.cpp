@@ -12,7 +12,16 @@
 
 namespace {
 
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+// A sanitizer replaces the allocator: GCC says so by __SANITIZE_*__, clang by __has_feature.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define PDP_SANITIZED_ALLOCATOR 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define PDP_SANITIZED_ALLOCATOR 1
+#endif
+#endif
+
+#if defined(__GLIBC__) && !defined(PDP_SANITIZED_ALLOCATOR)
 // A 20 MB block, freed and asked for again, must come from the heap both
 // times and stay there in between. glibc's defaults fail both: the first
 // block of this test process is above the initial 128 kB mmap threshold

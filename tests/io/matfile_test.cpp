@@ -121,7 +121,7 @@ struct Bytes {
 
 constexpr std::uint32_t miINT8 = 1, miUINT8 = 2, miINT16 = 3, miUINT16 = 4, miINT32 = 5, miUINT32 = 6, miDOUBLE = 9,
                         miMATRIX = 14, miCOMPRESSED = 15;
-constexpr std::uint32_t mxCHAR = 4, mxDOUBLE = 6;
+constexpr std::uint32_t mxDOUBLE = 6;  // the array class of every variable written here
 
 // A data element: the small format (type and size packed into one uint32,
 // data in the next four bytes) when it holds 1 to 4 bytes, else a tag and

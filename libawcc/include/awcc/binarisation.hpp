@@ -129,7 +129,6 @@ class Binariser {
 
  private:
   Threshold t_;
-  double fs_;
   std::int64_t position_ = 0;
   bool in_air_ = false;
   bool started_ = false;
