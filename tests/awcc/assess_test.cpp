@@ -23,7 +23,7 @@
 
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool mentions(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 TEST(Flags, TableIsInEnumOrderWithDistinctCodesAndTheProfileColumnListsThem) {
   std::set<std::string_view> codes;
@@ -50,7 +50,7 @@ TEST(Flags, CellOfCodesParsesBackAndAnUnknownCodeIsRefused) {
     awcc::parse_flags_cell("reader_note; E4", at);
     ADD_FAILURE() << "an unknown code accepted";
   } catch (const awcc::InputError& e) {
-    EXPECT_TRUE(contains(e.what(), "profile.csv") && contains(e.what(), "line 3") && contains(e.what(), "'E4'"))
+    EXPECT_TRUE(mentions(e.what(), "profile.csv") && mentions(e.what(), "line 3") && mentions(e.what(), "'E4'"))
         << e.what();
   }
 }
@@ -148,15 +148,15 @@ TEST(MethodsDisagree, TheWarningGivesBothValuesBothIntervalsAndTheRelativeDiffer
   for (const char* part : {"1.600 m/s", "1.550-1.650", "2.000 m/s", "1.900-2.200", "differ by 0.400 m/s",
                            "AWCC 20 % below FSCC", "(0.112 m/s)", "lags 4.00-4.50 ms", "FSCC's whole record at 3.00 ms",
                            "12 accepted windows of 500 (quality low)", "chord lengths and d32 use FSCC's velocity"}) {
-    EXPECT_TRUE(contains(t, part)) << "'" << part << "' not in: " << t;
+    EXPECT_TRUE(mentions(t, part)) << "'" << part << "' not in: " << t;
   }
   // Quality ok: the advice is the correction's, not the windows'.
   const auto ok = awcc::assess(row(fscc_at_2(), awcc_at(2.4)));
   ASSERT_EQ(ok.size(), 1u);
-  EXPECT_TRUE(contains(ok[0].text, "AWCC 20 % above FSCC")) << ok[0].text;
-  EXPECT_TRUE(contains(ok[0].text, "bias correction")) << ok[0].text;
-  EXPECT_FALSE(contains(ok[0].text, "quality low")) << ok[0].text;
-  EXPECT_FALSE(contains(ok[0].text, "accepted windows peak at")) << ok[0].text;  // many windows: no lag range
+  EXPECT_TRUE(mentions(ok[0].text, "AWCC 20 % above FSCC")) << ok[0].text;
+  EXPECT_TRUE(mentions(ok[0].text, "bias correction")) << ok[0].text;
+  EXPECT_FALSE(mentions(ok[0].text, "quality low")) << ok[0].text;
+  EXPECT_FALSE(mentions(ok[0].text, "accepted windows peak at")) << ok[0].text;  // many windows: no lag range
   // Within the limit: no warning.
   EXPECT_TRUE(awcc::assess(row(fscc_at_2(), awcc_at(2.1))).empty());
 }
@@ -240,19 +240,19 @@ TEST(E4Advice, NamesTheNpThatWouldDoOrSaysNoneWouldAndWhetherTheWindowsAreFew) {
   a.np = 10;
   a.windows_accepted = 23;  // file 04: ratio 1.27
   const auto few = awcc::detail::windows_too_long(a, 1.27);
-  EXPECT_TRUE(contains(few, "1.27 mean window durations")) << few;
-  EXPECT_TRUE(contains(few, "np = 6 particles or fewer (now 10)")) << few;  // 10 x 1.27 / 2 = 6.35
-  EXPECT_TRUE(contains(few, "rests on 23 accepted windows (quality ok needs 100)")) << few;
-  EXPECT_FALSE(contains(few, "not resolved")) << few;
+  EXPECT_TRUE(mentions(few, "1.27 mean window durations")) << few;
+  EXPECT_TRUE(mentions(few, "np = 6 particles or fewer (now 10)")) << few;  // 10 x 1.27 / 2 = 6.35
+  EXPECT_TRUE(mentions(few, "rests on 23 accepted windows (quality ok needs 100)")) << few;
+  EXPECT_FALSE(mentions(few, "not resolved")) << few;
   a.windows_accepted = 355;  // file 10: ratio 0.24
   const auto unresolved = awcc::detail::windows_too_long(a, 0.24);
-  EXPECT_TRUE(contains(unresolved, "not resolved")) << unresolved;
-  EXPECT_TRUE(contains(unresolved, "np = 1.2 or fewer (now 10), under the 3 particles")) << unresolved;
-  EXPECT_FALSE(contains(unresolved, "rests on")) << unresolved;
-  EXPECT_FALSE(contains(unresolved, "particles or fewer")) << unresolved;
+  EXPECT_TRUE(mentions(unresolved, "not resolved")) << unresolved;
+  EXPECT_TRUE(mentions(unresolved, "np = 1.2 or fewer (now 10), under the 3 particles")) << unresolved;
+  EXPECT_FALSE(mentions(unresolved, "rests on")) << unresolved;
+  EXPECT_FALSE(mentions(unresolved, "particles or fewer")) << unresolved;
   // Around the least np, 3: ratio 0.61 allows np = 3.05, so 3; 0.58 allows 2.9, so none.
-  EXPECT_TRUE(contains(awcc::detail::windows_too_long(a, 0.61), "np = 3 particles or fewer"));
-  EXPECT_TRUE(contains(awcc::detail::windows_too_long(a, 0.58), "np = 2.9 or fewer (now 10), under"));
+  EXPECT_TRUE(mentions(awcc::detail::windows_too_long(a, 0.61), "np = 3 particles or fewer"));
+  EXPECT_TRUE(mentions(awcc::detail::windows_too_long(a, 0.58), "np = 2.9 or fewer (now 10), under"));
 }
 
 // A recording of four channels, the tips on two of them.
@@ -290,7 +290,7 @@ TEST(ChannelsIgnored, AFourChannelRecordingNamesTheChannelsNotProcessed) {
   const auto ignored = std::find_if(other.warnings.begin(), other.warnings.end(),
                                     [](const awcc::Warning& x) { return x.flag == awcc::Flag::channels_ignored; });
   ASSERT_NE(ignored, other.warnings.end());
-  EXPECT_TRUE(contains(ignored->text, "channels 1 and 2 of 4 are not processed"));
+  EXPECT_TRUE(mentions(ignored->text, "channels 1 and 2 of 4 are not processed"));
   // Two channels: nothing ignored.
   o.trailing_channel = 1;
   std::vector<float> two;

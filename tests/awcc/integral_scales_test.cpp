@@ -57,12 +57,12 @@ std::vector<long double> naive_correlation(const AirIntervals& xs, const AirInte
 // crossing lies at z - 1 + r[z-1] / (r[z-1] - r[z]), z the first index after
 // `from` with r[z] <= 0; the area is that of trapezoids [i, i + 1] up to z - 1
 // plus the triangle of height r[z-1] from z - 1 to the crossing.
-struct Crossing {
+struct ZeroCrossing {
   long double area;
   long double zero;   // fractional index of the zero
   long double gap;    // |r| of the two values bracketing it: how clear the crossing is
 };
-std::optional<Crossing> area_to_first_zero(const std::vector<long double>& r, std::size_t from) {
+std::optional<ZeroCrossing> area_to_first_zero(const std::vector<long double>& r, std::size_t from) {
   std::size_t z = from + 1;
   while (z < r.size() && r[z] > 0) ++z;
   if (z >= r.size()) return std::nullopt;
@@ -70,7 +70,7 @@ std::optional<Crossing> area_to_first_zero(const std::vector<long double>& r, st
   for (std::size_t i = from; i + 1 < z; ++i) area += (r[i] + r[i + 1]) / 2;
   const long double width = r[z - 1] / (r[z - 1] - r[z]);
   area += r[z - 1] * width / 2;
-  return Crossing{area, static_cast<long double>(z - 1) + width, std::min(std::fabs(r[z - 1]), std::fabs(r[z]))};
+  return ZeroCrossing{area, static_cast<long double>(z - 1) + width, std::min(std::fabs(r[z - 1]), std::fabs(r[z]))};
 }
 
 void expect_relative(double got, long double want, const char* what) {

@@ -19,7 +19,7 @@ using awcc::AirIntervals;
 //   Var(c) = ((1 - c)^2 Var(a) + c^2 Var(w)) / (n m^2), m = E[a] + E[w];
 //   Var(F) / F^2 = (Var(a) + Var(w)) / (m^2 n);
 // sample variances with n - 1; bounds c -/+ 1.96 se and F -/+ 1.96 se.
-struct Expected {
+struct ExpectedPhases {
   long double c, c_lower, c_upper;  // unclamped
   long double f, f_lower, f_upper;  // unclamped
 };
@@ -38,7 +38,7 @@ long double sample_variance(const std::vector<long double>& v) {
 }
 
 // air, water: complete chords in samples; air_total: air samples of the record.
-Expected expected(const std::vector<long double>& air_samples, const std::vector<long double>& water_samples,
+ExpectedPhases expected(const std::vector<long double>& air_samples, const std::vector<long double>& water_samples,
                   long double air_total, long double sample_count, long double fs) {
   std::vector<long double> a, w;
   for (auto x : air_samples) a.push_back(x / fs);

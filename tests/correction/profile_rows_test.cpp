@@ -32,7 +32,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-fs::path data_dir() { return pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway"; }
+fs::path spillway_dir() { return pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway"; }
 
 // The real profile's rows 01 (AWCC insufficient), 04, 07 and 10, and 10 by
 // FSCC alone, at positions not in increasing order.
@@ -48,11 +48,11 @@ const Profile& profile() {
     o.reader.fs = 20e3;
     o.dx = 7.15e-3;
     for (const int i : {1, 4, 7, 10}) {
-      out.results.push_back(awcc::process_recording(data_dir() / fmt::format("dc157_{:02d}.dat", i), o));
+      out.results.push_back(awcc::process_recording(spillway_dir() / fmt::format("dc157_{:02d}.dat", i), o));
     }
     auto fscc_only = o;
     fscc_only.awcc = false;
-    out.results.push_back(awcc::process_recording(data_dir() / "dc157_10.dat", fscc_only));
+    out.results.push_back(awcc::process_recording(spillway_dir() / "dc157_10.dat", fscc_only));
     return out;
   }();
   return p;
@@ -108,7 +108,7 @@ void same_json(const json& got, const json& expected, double relative, const std
 }
 
 TEST(ProfileRows, RowsReadBackFromJsonAndCsvAreTheResultsRows) {
-  if (!fs::exists(data_dir())) GTEST_SKIP() << "the real recordings are not at " << data_dir();
+  if (!fs::exists(spillway_dir())) GTEST_SKIP() << "the real recordings are not at " << spillway_dir();
   const auto& p = profile();
   const auto model = correction::CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
   std::set<awcc::FlowVelocitySource> sources;
@@ -153,7 +153,7 @@ TEST(ProfileRows, RowsReadBackFromJsonAndCsvAreTheResultsRows) {
 }
 
 TEST(ProfileRows, AFileWithoutEveryPositionHasNoFlowAndSaysWhy) {
-  if (!fs::exists(data_dir())) GTEST_SKIP() << "the real recordings are not at " << data_dir();
+  if (!fs::exists(spillway_dir())) GTEST_SKIP() << "the real recordings are not at " << spillway_dir();
   const auto& p = profile();
   json j{{"profile", {awcc::to_json(p.results[1]), awcc::to_json(p.results[2])}}};
   j["profile"][0]["position"] = 0.01;

@@ -24,7 +24,7 @@ using synth::SynthesisOptions;
 using synth::TipPierce;
 using synth::Vec3;
 
-Synthesis run(const Scene& s, bool bubble_truth = true, bool reference = false, std::int64_t chunk = 1 << 16) {
+Synthesis run_truth(const Scene& s, bool bubble_truth = true, bool reference = false, std::int64_t chunk = 1 << 16) {
   SynthesisOptions o;
   o.bubble_truth = bubble_truth;
   o.keep_reference_data = reference;
@@ -140,7 +140,7 @@ void expect_counts_match(const Synthesis& out) {
 
 TEST(BubbleTruth, StraightPathsMatchRaySphereIntersections) {
   const Scene s = straight_scene();
-  const Synthesis out = run(s, true, true);
+  const Synthesis out = run_truth(s, true, true);
   ASSERT_TRUE(out.bubbles && out.reference);
   const auto& ref = *out.reference;
   for (const auto& u : ref.velocities) ASSERT_TRUE(u == (Vec3{s.velocity, 0.0, 0.0})) << "the path must be straight";
@@ -225,7 +225,7 @@ double periodic(double x, double length) { return x - length * std::nearbyint(x 
 
 TEST(BubbleTruth, TurbulentPathsGiveSurfacePointsNormalsAndTheInteractionMeanVelocity) {
   const Scene s = turbulent_scene();
-  const Synthesis out = run(s, true, true);
+  const Synthesis out = run_truth(s, true, true);
   ASSERT_TRUE(out.bubbles && out.reference);
   const auto& ref = *out.reference;
   const BubbleTruth& t = *out.bubbles;
@@ -299,7 +299,7 @@ TEST(BubbleTruth, TurbulentRecordingAgreesWithTheTableWithinHalfASample) {
   Scene s = turbulent_scene();
   s.tu = 0.25;  // no reversal: the table's passes are all the recording holds
   s.void_fraction = 0.25;
-  const Synthesis out = run(s);
+  const Synthesis out = run_truth(s);
   ASSERT_TRUE(out.bubbles);
   expect_counts_match(out);
   expect_recording_matches_table(out, s);
@@ -327,14 +327,14 @@ void expect_same(const BubbleTruth& a, const BubbleTruth& b) {
 
 TEST(BubbleTruth, SameSeedSameTableWhateverTheChunksAndThreads) {
   const Scene s = turbulent_scene();
-  const Synthesis one = run(s);
-  const Synthesis chunked = run(s, true, false, 977);
+  const Synthesis one = run_truth(s);
+  const Synthesis chunked = run_truth(s, true, false, 977);
   ASSERT_TRUE(one.bubbles && chunked.bubbles);
   ASSERT_GT(one.bubbles->size(), 100u);
   expect_same(*one.bubbles, *chunked.bubbles);
   Synthesis a, b;
-  std::thread first([&] { a = run(s, true, false, 977); });
-  std::thread second([&] { b = run(s); });
+  std::thread first([&] { a = run_truth(s, true, false, 977); });
+  std::thread second([&] { b = run_truth(s); });
   first.join();
   second.join();
   expect_same(*one.bubbles, *a.bubbles);
@@ -348,8 +348,8 @@ TEST(BubbleTruth, SameSeedSameTableWhateverTheChunksAndThreads) {
 TEST(BubbleTruth, OffByDefaultAndChangesNothingElse) {
   const Scene s = turbulent_scene();
   EXPECT_FALSE(SynthesisOptions{}.bubble_truth);
-  const Synthesis off = run(s, false);
-  const Synthesis on = run(s, true);
+  const Synthesis off = run_truth(s, false);
+  const Synthesis on = run_truth(s, true);
   EXPECT_FALSE(off.bubbles);
   ASSERT_TRUE(on.bubbles);
   ASSERT_EQ(off.signals.size(), on.signals.size());
@@ -392,7 +392,7 @@ TEST(BubbleTruth, InterfacialAreaOfOneSphereSizeIsSixCOverD) {
   s.realisation_step = 1e-3;  // the path is exact at any step without turbulence
   const double rate = 1.5 * s.void_fraction * s.velocity / s.bubble_diameter;
   s.duration = std::ceil(60'000.0 / rate);
-  const Synthesis out = run(s);
+  const Synthesis out = run_truth(s);
   ASSERT_TRUE(out.bubbles);
   const BubbleTruth& t = *out.bubbles;
   const double expected = 6.0 * s.void_fraction / s.bubble_diameter;
@@ -428,7 +428,7 @@ TEST(BubbleTruth, InterfacialAreaOfOneSphereSizeIsSixCOverD) {
 TEST(BubbleTruth, ExpectedAreaOfSpheroidsAgainstThomsensApproximation) {
   Scene s = straight_scene();
   s.duration = 0.01;
-  const double sphere = run(s, false).truth.expected_interfacial_area;
+  const double sphere = run_truth(s, false).truth.expected_interfacial_area;
   EXPECT_NEAR(sphere, 6.0 * s.void_fraction / s.bubble_diameter, 1e-12 * sphere);
   for (const double aspect : {0.4, 0.7, 1.5, 3.0}) {
     s.aspect_ratio = aspect;
@@ -436,13 +436,13 @@ TEST(BubbleTruth, ExpectedAreaOfSpheroidsAgainstThomsensApproximation) {
     const double a = std::cbrt(aspect * aspect), b = 1.0 / std::cbrt(aspect), p = 1.6075;
     const double ab = std::pow(a * b, p), bb = std::pow(b * b, p);
     const double ratio = std::pow((2.0 * ab + bb) / 3.0, 1.0 / p);  // over the unit sphere's 4 pi
-    EXPECT_NEAR(run(s, false).truth.expected_interfacial_area / sphere / ratio, 1.0, 0.0107) << "aspect " << aspect;
+    EXPECT_NEAR(run_truth(s, false).truth.expected_interfacial_area / sphere / ratio, 1.0, 0.0107) << "aspect " << aspect;
     EXPECT_GT(ratio, 1.0) << "a spheroid has more surface than the sphere of its volume";
   }
 }
 
 TEST(BubbleTruth, CsvRoundTripsExactlyAndRefusesWhatItDoesNotWrite) {
-  const Synthesis out = run(turbulent_scene());
+  const Synthesis out = run_truth(turbulent_scene());
   ASSERT_TRUE(out.bubbles);
   const auto path = pdp_test::test_file("bubbles.csv");
   synth::write_bubble_truth_csv(path, *out.bubbles);
