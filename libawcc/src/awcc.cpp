@@ -761,6 +761,29 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       reported_quality(result.windows_accepted, result.windows_total, options.windows_ok, options.yield_ok, intervals,
                        {"accepted windows", "data yield", "windows accepted", "the accepted windows"});
   result.time_scale_ratio = capped_time_scale_ratio(result, time_scale_ratio_cap);
+  result.mean_lag_samples = mean_lag_samples(windows, options.weighting);
+}
+
+double mean_lag_samples(std::span<const AwccWindow> windows, Weighting weighting) {
+  double weights = 0.0, inverse = 0.0;
+  for (const auto& w : windows) {
+    if (w.fate != WindowFate::accepted || w.lag_samples <= 0) continue;
+    const double weight = weighting == Weighting::duration ? w.duration : 1.0;
+    weights += weight;
+    inverse += weight / static_cast<double>(w.lag_samples);
+  }
+  return inverse > 0.0 ? weights / inverse : 0.0;
+}
+
+void flag_unresolved_lag(AwccResult& result, double dx, double fs) {
+  if (!result.ok() || !(result.mean_lag_samples > 0.0) || result.mean_lag_samples >= least_resolved_lag_samples) return;
+  const auto [lo, hi] = one_sample_velocity_bounds(dx, fs);
+  result.quality = AwccQuality::low;
+  result.quality_reason = fmt::format(
+      "a lag of one sample: the accepted windows peak at a mean lag of {:.2f} samples (below {:g}), and every "
+      "delay of 0.5-1.5 samples reads as one, so the velocity is bounded ({:.4g}-{:.4g} m/s), not measured, and "
+      "Tu is not resolved (sample faster or move the tips apart)",
+      result.mean_lag_samples, least_resolved_lag_samples, lo, hi);
 }
 
 }  // namespace detail
@@ -850,6 +873,7 @@ AwccResult run_awcc(const AirIntervals& leading, double dx, const AwccOptions& o
   correct_windows(result, dx, options);
   awcc_summarise(result, options);
   if (!(dx > 0.0) && result.ok()) no_tip_separation(result);
+  flag_unresolved_lag(result, dx, fs);
   return result;
 }
 

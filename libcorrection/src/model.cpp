@@ -21,6 +21,7 @@
 #include <zlib.h>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/awcc.hpp"
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/read_back.hpp"
@@ -390,12 +391,29 @@ std::string value_text(const Quantity& q, double v) {
 // What the trust rules find, rule by rule, each quantity's clause apart so
 // that a rule both quantities break is named once.
 struct Verdict {
-  std::vector<std::string> envelope, modes;
+  std::vector<std::string> envelope, modes, lag;
   void add(const Verdict& v) {
     envelope.insert(envelope.end(), v.envelope.begin(), v.envelope.end());
     modes.insert(modes.end(), v.modes.begin(), v.modes.end());
+    lag.insert(lag.end(), v.lag.begin(), v.lag.end());
   }
 };
+
+// Rule (c) (the model's header): the measurement's lag in samples, from
+// `source`'s velocity; silent when fs is not known.
+Verdict unresolved_lag(const char* source, double velocity, double dx, double fs) {
+  Verdict verdict;
+  if (!(fs > 0.0) || !(dx > 0.0) || !(velocity > 0.0)) return verdict;
+  const double lag = dx * fs / velocity;
+  if (lag >= awcc::least_resolved_lag_samples) return verdict;
+  const auto [lo, hi] = awcc::one_sample_velocity_bounds(dx, fs);
+  verdict.lag.push_back(fmt::format(
+      "{} velocity {:.3g} m/s is a lag of {:.2f} samples (dx fs / u, below {:g}), and every delay of 0.5-1.5 samples "
+      "reads as one, so the record bounds the velocity ({:.4g}-{:.4g} m/s) and no forest's median measures it "
+      "(sample faster or move the tips apart)",
+      source, velocity, lag, awcc::least_resolved_lag_samples, lo, hi));
+  return verdict;
+}
 
 Verdict untrusted_reasons(const Quantity& q, const WeightedDistribution& d,
                           const std::optional<std::array<double, 2>>& envelope, const std::string& envelope_runs) {
@@ -447,9 +465,11 @@ std::vector<double> quantiles_of(const WeightedDistribution& d) {
 void judge(Correction& c, const Verdict& v) {
   c.outside_envelope = !v.envelope.empty();
   c.multimodal = !v.modes.empty();
-  if (!c.outside_envelope && !c.multimodal) return;
+  c.one_sample_lag = !v.lag.empty();
+  if (!c.outside_envelope && !c.multimodal && !c.one_sample_lag) return;
   c.status = CorrectionStatus::untrusted;
   std::vector<std::string> rules;
+  if (c.one_sample_lag) rules.push_back(fmt::format("a lag of one sample: {}", fmt::join(v.lag, "; ")));
   if (c.outside_envelope) rules.push_back(fmt::format("outside the envelope: {}", fmt::join(v.envelope, "; ")));
   if (c.multimodal) rules.push_back(fmt::format("multimodal: {}", fmt::join(v.modes, "; ")));
   c.message = fmt::format("{}", fmt::join(rules, "; "));
@@ -635,6 +655,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   auto verdict =
       untrusted_reasons(u, velocity_d, cal.envelope(cal.velocity_envelope, f.windows_accepted, tu_median), runs);
   verdict.add(untrusted_reasons(tu, tu_d, cal.envelope(cal.turbulence_envelope, f.windows_accepted, tu_median), runs));
+  verdict.add(unresolved_lag("AWCC's", f.velocity, f.dx, f.fs));
   judge(c, verdict);
   return {c};
 }
@@ -655,9 +676,11 @@ Attempt fscc_attempt(const CorrectionModel& m, const Features& f) {
   c.forest = "fscc";
   c.velocity = corrected_quantity(u, t);
   c.notes = x.notes;
-  judge(c, untrusted_reasons(u, d, cal.envelope(cal.velocity_envelope, -1, 0.0),
-                             cal.envelope_from_training ? "the FSCC forest's training runs"
-                                                        : "the FSCC forest's calibration runs"));
+  auto verdict = untrusted_reasons(u, d, cal.envelope(cal.velocity_envelope, -1, 0.0),
+                                   cal.envelope_from_training ? "the FSCC forest's training runs"
+                                                              : "the FSCC forest's calibration runs");
+  verdict.add(unresolved_lag("FSCC's", f.fscc_velocity, f.dx, f.fs));
+  judge(c, verdict);
   return {c};
 }
 

@@ -530,6 +530,7 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
     s.untrusted += c[i].status == CorrectionStatus::untrusted;
     s.outside_envelope += c[i].outside_envelope;
     s.multimodal += c[i].multimodal;
+    s.one_sample_lag += c[i].one_sample_lag;
     const auto& u = *c[i].velocity;
     const auto& t = *c[i].turbulence_intensity;
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
@@ -756,6 +757,7 @@ FsccScores score_fscc(const CorrectionModel& scorer, const std::vector<TrainingR
     sc.untrusted += c.status == CorrectionStatus::untrusted;
     sc.outside_envelope += c.outside_envelope;
     sc.multimodal += c.multimodal;
+    sc.one_sample_lag += c.one_sample_lag;
     const double raw = r.features.fscc_velocity / r.true_velocity - 1.0;
     const double corrected = c.velocity->median() / r.true_velocity - 1.0;
     sq_raw += raw * raw;
@@ -1012,12 +1014,13 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
   }
   if (!result.fscc_note.empty()) provenance += " " + result.fscc_note + ".";
   provenance += fmt::format(" Trust rules (model.hpp): {} of the {} scored held-out runs untrusted by the AWCC forests "
-                            "({} outside the envelope, {} multimodal)",
-                            h.untrusted, h.rows, h.outside_envelope, h.multimodal);
+                            "({} outside the envelope, {} multimodal, {} at a lag of one sample)",
+                            h.untrusted, h.rows, h.outside_envelope, h.multimodal, h.one_sample_lag);
   if (result.model.fscc) {
     const auto& u = result.fscc_held_out_unserved;
-    provenance += fmt::format(", {} of {} by the FSCC forest ({} outside the envelope, {} multimodal)", u.untrusted,
-                              u.rows, u.outside_envelope, u.multimodal);
+    provenance += fmt::format(", {} of {} by the FSCC forest ({} outside the envelope, {} multimodal, {} at a lag of "
+                              "one sample)",
+                              u.untrusted, u.rows, u.outside_envelope, u.multimodal, u.one_sample_lag);
   }
   return provenance + ".";
 }
@@ -1190,14 +1193,15 @@ TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const T
   result.summary = fmt::format(
       "Trust envelopes (rule (a), model.hpp) measured by pdp train {} on runs the model was not trained on ({}): the "
       "AWCC forests' on {} runs{}, {}; the FSCC forest's on {} runs it takes that AWCC cannot serve{}. Held out of "
-      "those runs: {} of {} untrusted by the AWCC forests ({} outside the envelope, {} multimodal), {} of {} by the "
-      "FSCC forest ({} outside the envelope, {} multimodal).",
+      "those runs: {} of {} untrusted by the AWCC forests ({} outside the envelope, {} multimodal, {} at a lag of one "
+      "sample), {} of {} by the FSCC forest ({} outside the envelope, {} multimodal, {} at a lag of one sample).",
       awcc::version, sources, measuring.size(),
       c.envelope_from_training ? " (too few: the training targets' kept)" : "",
       c.envelope_from_training ? "pooled" : "per window and Tu band where a band has 399 runs",
       fscc_split.training.size(),
       model.fscc && model.fscc->calibration.envelope_from_training ? " (too few: the training targets' kept)" : "",
-      h.untrusted, h.rows, h.outside_envelope, h.multimodal, u.untrusted, u.rows, u.outside_envelope, u.multimodal);
+      h.untrusted, h.rows, h.outside_envelope, h.multimodal, h.one_sample_lag, u.untrusted, u.rows,
+      u.outside_envelope, u.multimodal, u.one_sample_lag);
   model.provenance += " " + result.summary;
   result.model = std::move(model);
   return result;
@@ -1247,8 +1251,10 @@ std::string TrainResult::report() const {
   }
   const auto& h = held_out;
   line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored; {} of the scored untrusted by the "
-                   "trust rules: {} outside the envelope, {} multimodal); training {} runs in {:.2f} s",
-                   h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, training_rows, seconds_train));
+                   "trust rules: {} outside the envelope, {} multimodal, {} at a lag of one sample); training {} "
+                   "runs in {:.2f} s",
+                   h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, h.one_sample_lag,
+                   training_rows, seconds_train));
   out += scores_report(h, predictions);
   if (model.reduced) {
     const auto& r = reduced_held_out;

@@ -261,6 +261,79 @@ TEST(WindowTooShortForTheVelocityRange, HasItsOwnFateCountAndReason) {
 
 
 // ---------------------------------------------------------------------------
+// A lag of one sample (awcc.hpp, least_resolved_lag_samples): an ok result
+// whose accepted windows' mean lag sum w / sum (w / k_i) is below 1.5
+// samples is quality low, with the velocity's bounds dx fs / 1.5 - dx fs / 0.5.
+
+awcc::AwccWindow accepted_at(std::int64_t lag, double duration) {
+  awcc::AwccWindow w;
+  w.fate = WindowFate::accepted;
+  w.lag_samples = lag;
+  w.duration = duration;
+  return w;
+}
+
+TEST(OneSampleLag, MeanLagIsTheWeightedHarmonicMeanOfTheAcceptedWindowsLags) {
+  // Lags 1 (0.3 s), 2 (0.1 s) and 4 (0.6 s) accepted, one rejected at lag 1:
+  // duration-weighted 1 / (0.3 / 1 + 0.1 / 2 + 0.6 / 4) = 1 / 0.5 = 2;
+  // unweighted 3 / (1 + 1 / 2 + 1 / 4) = 12 / 7.
+  std::vector<awcc::AwccWindow> w{accepted_at(1, 0.3), accepted_at(2, 0.1), accepted_at(4, 0.6), accepted_at(1, 5.0)};
+  w.back().fate = WindowFate::roc;
+  EXPECT_DOUBLE_EQ(awcc::detail::mean_lag_samples(w, awcc::Weighting::duration), 2.0);
+  EXPECT_DOUBLE_EQ(awcc::detail::mean_lag_samples(w, awcc::Weighting::none), 12.0 / 7.0);
+  // Equal weights at lags 1 and 2: 2 / (1 + 1 / 2) = 4 / 3, below the limit.
+  const std::vector<awcc::AwccWindow> half{accepted_at(1, 1.0), accepted_at(2, 1.0)};
+  EXPECT_DOUBLE_EQ(awcc::detail::mean_lag_samples(half, awcc::Weighting::none), 4.0 / 3.0);
+  EXPECT_EQ(awcc::detail::mean_lag_samples(std::vector<awcc::AwccWindow>{}, awcc::Weighting::none), 0.0);
+}
+
+TEST(OneSampleLag, AMeanLagAtTheLimitIsMeasuredJustBelowIsBounded) {
+  const auto judged_at = [](double lag) {
+    awcc::AwccResult r;
+    r.status = awcc::AwccStatus::ok;
+    r.quality = awcc::AwccQuality::ok;
+    r.velocity = 10.0;
+    r.mean_lag_samples = lag;
+    awcc::detail::flag_unresolved_lag(r, 0.6e-3, 27e3);  // dx fs = 16.2 m/s
+    return r;
+  };
+  EXPECT_EQ(judged_at(awcc::least_resolved_lag_samples).quality, awcc::AwccQuality::ok);
+  EXPECT_EQ(judged_at(3.0).quality, awcc::AwccQuality::ok);
+  const auto r = judged_at(std::nextafter(awcc::least_resolved_lag_samples, 0.0));
+  EXPECT_EQ(r.quality, awcc::AwccQuality::low);
+  EXPECT_TRUE(r.ok());  // reported, flagged: the bound is worth having
+  EXPECT_EQ(r.quality_reason.find("a lag of one sample: the accepted windows peak at a mean lag of 1.50 samples"), 0u)
+      << r.quality_reason;
+  EXPECT_NE(r.quality_reason.find("the velocity is bounded (10.8-32.4 m/s), not measured"), std::string::npos)
+      << r.quality_reason;
+  // A result with no velocity keeps its own status and reason.
+  awcc::AwccResult none;
+  none.mean_lag_samples = 1.0;
+  none.quality_reason = "too few";
+  awcc::detail::flag_unresolved_lag(none, 0.6e-3, 27e3);
+  EXPECT_EQ(none.quality, awcc::AwccQuality::insufficient);
+  EXPECT_EQ(none.quality_reason, "too few");
+}
+
+TEST(OneSampleLag, ATrailingTipOneSampleBehindIsBoundedTwoSamplesBehindIsNot) {
+  // The trailing tip is the leading one delayed by 1 sample: every window
+  // peaks at lag 1, u = dx fs = 1000 m/s with Tu 0, and all the record says
+  // is that u lies in 667-2000 m/s. Delayed by 2 samples the mean lag is 2.
+  const auto x = pdp_test::telegraph(200'000, 41, 1000.0);
+  const auto one = awcc::awcc(x, pdp_test::shifted(x, 1), 1.0, awcc::AwccOptions{});
+  ASSERT_TRUE(one.ok()) << one.message;
+  EXPECT_DOUBLE_EQ(one.mean_lag_samples, 1.0);
+  EXPECT_DOUBLE_EQ(one.velocity, 1000.0);
+  EXPECT_EQ(one.quality, awcc::AwccQuality::low);
+  EXPECT_NE(one.quality_reason.find("bounded (666.7-2000 m/s)"), std::string::npos) << one.quality_reason;
+  const auto two = awcc::awcc(x, pdp_test::shifted(x, 2), 1.0, awcc::AwccOptions{});
+  ASSERT_TRUE(two.ok()) << two.message;
+  EXPECT_DOUBLE_EQ(two.mean_lag_samples, 2.0);
+  EXPECT_EQ(two.quality_reason.find("a lag of one sample"), std::string::npos) << two.quality_reason;
+}
+
+
+// ---------------------------------------------------------------------------
 // Binarisation at its thresholds. Convention (binarisation.cpp): with a single
 // threshold T, a conductivity sample is air when V < T, an optical one when
 // V > T; a sample exactly at T is water for both.

@@ -314,6 +314,34 @@ TEST(TrustRules, AMultimodalDistributionIsUntrustedWithItsQuantilesKept) {
   EXPECT_TRUE(one.correct(middle()).corrected()) << one.correct(middle()).message;
 }
 
+TEST(TrustRules, ALagOfOneSampleIsUntrustedBelowTheLimitAndWithoutFsIsNotJudged) {
+  // Rule (c): the lag in samples dx fs / u. Every target 1.0 (the forest
+  // returns the measurement), so rules (a) and (b) hold and only the lag
+  // decides. u 2 m/s, dx 0.5 m: fs 6 Hz is a lag of exactly 1.5 samples.
+  const auto m = model_of([](int) { return 1.0; }, [](int) { return 0.0; });
+  auto f = middle();
+  ASSERT_TRUE(m.correct(f).corrected()) << "fs not known (a peer's row): not judged";
+  f.fs = 6.0;
+  EXPECT_TRUE(m.correct(f).corrected()) << m.correct(f).message;
+  f.fs = std::nextafter(6.0, 0.0);
+  auto c = m.correct(f);
+  EXPECT_EQ(c.status, CorrectionStatus::untrusted);
+  EXPECT_TRUE(c.one_sample_lag);
+  EXPECT_FALSE(c.outside_envelope);
+  EXPECT_FALSE(c.multimodal);
+  // At one sample (fs 4 Hz: dx fs = 2 m/s) the bounds are 2 / 1.5 and 2 / 0.5.
+  f.fs = 4.0;
+  c = m.correct(f);
+  EXPECT_EQ(c.message.find("a lag of one sample: AWCC's velocity 2 m/s is a lag of 1.00 samples (dx fs / u, below 1.5)"),
+            0u)
+      << c.message;
+  EXPECT_NE(c.message.find("so the record bounds the velocity (1.333-4 m/s)"), std::string::npos) << c.message;
+  EXPECT_EQ(c.why_not(), "untrusted: " + c.message);
+  ASSERT_TRUE(c.velocity);  // the quantiles kept, as for the other rules
+  EXPECT_DOUBLE_EQ(c.velocity->median(), 2.0);
+  EXPECT_TRUE(correction::to_json(c)["velocity"]["median"].is_null());
+}
+
 // A row as pdp process measures it: AWCC's u (m/s) and Tu, the leading
 // tip's c and F (1/s), dx (m), AWCC's {accepted, formed} windows, the
 // record's {fs (Hz), duration (s)}, FSCC's {u (m/s), R12max}; Np 10, dy 0.
@@ -454,7 +482,10 @@ TEST(Messages, ALagOutsideTheAwccForestsRangeIsNamedInSamples) {
     }
     ASSERT_NEAR(*features.value("lag_samples"), k.lag, 1e-9 * k.lag);
     const auto c = m.correct(r);
-    EXPECT_EQ(c.status, CorrectionStatus::corrected) << c.message;
+    // FSCC's velocity at 0.6 samples is no measurement either (trust rule
+    // (c)): its quantiles stay, untrusted, with the same note.
+    EXPECT_EQ(c.status, k.lag < 1.5 ? CorrectionStatus::untrusted : CorrectionStatus::corrected) << c.message;
+    EXPECT_EQ(c.one_sample_lag, k.lag < 1.5) << c.message;
     EXPECT_EQ(c.forest, "fscc");
     ASSERT_FALSE(c.notes.empty());
     EXPECT_EQ(c.notes[0], fmt::format("AWCC forest: lag_samples = {} samples is outside the training range {}; "

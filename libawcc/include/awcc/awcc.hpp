@@ -39,7 +39,9 @@
 //    velocity or Tu, the reason instead; low below `windows_ok` (100: 0.14)
 //    or a data yield (accepted / total windows) below `yield_ok` (5 %):
 //    reported and flagged; ok otherwise. Windows that mostly peak at negative
-//    lags mean swapped tips (or a dx of the wrong sign): no velocity.
+//    lags mean swapped tips (or a dx of the wrong sign): no velocity. A mean
+//    lag below least_resolved_lag_samples (a lag of one sample) is `low`
+//    too: the velocity is bounded, not measured.
 
 #include <array>
 #include <cstdint>
@@ -47,6 +49,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <memory>
@@ -146,6 +149,26 @@ std::string_view to_string(AwccStatus status);
 enum class AwccQuality { ok, low, insufficient };
 std::string_view to_string(AwccQuality quality);
 
+/// The least mean lag, in samples, at which AWCC's velocity is a
+/// measurement. The mean lag is dx fs / u = sum w / sum (w / k_i) over the
+/// accepted windows' whole-sample peak lags k_i (w their weights). A peak
+/// lag is the tip-to-tip delay rounded to a whole sample, so every delay of
+/// 0.5-1.5 samples reads as one: windows that peak at one sample bound the
+/// velocity between dx fs / 1.5 and dx fs / 0.5 and read Tu 0, whatever the
+/// flow. 1.5 is where the mean stops being a lag of one sample (half the
+/// windows at two samples give 1.33, all at two give 2). Measured on the
+/// conventions campaign's runs with at least 10 accepted windows: of the 929
+/// that read one sample, the true velocity lay between 0.63 and 3.0 times
+/// the reading for 95 % (median 1.00); of the 935 at two samples, 0.68-1.32;
+/// above ten samples, 0.74-1.06 (docs/validation.md). Not an option: it is
+/// the quantisation's, not a tuning choice. The AWCC quality (`low`) and the
+/// correction's trust rule (c) (correction/model.hpp) read it.
+inline constexpr double least_resolved_lag_samples = 1.5;
+/// The velocities a delay of one sample allows, {dx fs / 1.5, dx fs / 0.5}, m/s.
+[[nodiscard]] inline std::pair<double, double> one_sample_velocity_bounds(double dx, double fs) {
+  return {dx * fs / 1.5, dx * fs / 0.5};
+}
+
 struct AwccResult {
   AwccStatus status = AwccStatus::too_few_particles;
   std::string message;          ///< why not ok (empty when ok)
@@ -167,6 +190,9 @@ struct AwccResult {
   [[nodiscard]] std::int64_t count(WindowFate fate) const { return windows_by_fate[static_cast<std::size_t>(fate)]; }
   std::int64_t lag_zero_windows = 0;  ///< windows peaking at lag 0 (delay below one sample)
   std::int64_t negative_lag_windows = 0;  ///< windows peaking at a negative lag
+  /// The accepted windows' mean whole-sample lag, sum w / sum (w / k_i)
+  /// (least_resolved_lag_samples); 0 unless ok.
+  double mean_lag_samples = 0.0;
   int roc_iterations = 0;
   /// How the moments were taken (options.weighting): a correction model
   /// learns the bias of one weighting, or takes it as a feature.

@@ -51,7 +51,18 @@
 //     no features; `pdp train --envelope-of` measures a group's on fresh runs.
 // (b) one mode: the forest's predictive distribution (before calibration)
 //     must not dip (correction/modality.hpp) below multimodal_dip_limit.
-// Either rule, on the velocity or on Tu, makes the row untrusted.
+// (c) a resolved lag: the measurement's lag in samples, dx fs / u (AWCC's
+//     velocity for the AWCC forests, FSCC's for the FSCC forest), must be
+//     at least awcc::least_resolved_lag_samples (1.5). Below it the delay
+//     reads as one sample whatever it was (0.5-1.5 samples), so the record
+//     bounds the velocity (dx fs / 1.5 to dx fs / 0.5) and no forest's
+//     median is a measurement of it: the forest can only return where such
+//     records' truths lay in its training runs (0.63-3.0 times the reading
+//     for 95 % of the campaign's), which says nothing of this flow's. Rule
+//     (a) does not catch it once the calibration runs hold such records
+//     (their shifts widen the envelope). A row without fs (a peer's) has
+//     no lag in samples and is not judged by it.
+// Any rule, on the velocity or on Tu, makes the row untrusted.
 //
 // Model file (".qrf"), all numbers little-endian whatever the machine:
 //   "pdp-qrf\n" (8 bytes), u32 format version, u64 payload bytes, payload,
@@ -162,8 +173,8 @@ struct Correction {
   /// What the user should know of a correction that stands (a feature held
   /// at its range's end), each said once.
   std::vector<std::string> notes;
-  /// Which trust rules an untrusted row breaks: (a) and (b) of the model's header.
-  bool outside_envelope = false, multimodal = false;
+  /// Which trust rules an untrusted row breaks: (a), (b) and (c) of the model's header.
+  bool outside_envelope = false, multimodal = false, one_sample_lag = false;
   [[nodiscard]] bool corrected() const { return status == CorrectionStatus::corrected; }
   /// Empty when corrected; "untrusted: " and the reason, or the reason.
   [[nodiscard]] std::string why_not() const;

@@ -169,8 +169,8 @@ struct CvEntry {
 struct HeldOutScores {
   std::int64_t rows = 0, out_of_range = 0;
   /// Of the scored rows, those the trust rules leave untrusted, and by rule
-  /// (a row may break both).
-  std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0;
+  /// (a row may break several).
+  std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0, one_sample_lag = 0;
   double velocity_rmse_raw = 0.0, velocity_rmse_corrected = 0.0;  ///< relative (u/u_true - 1)
   double velocity_bias_raw = 0.0, velocity_bias_corrected = 0.0;  ///< mean relative error
   double velocity_median_abs_raw = 0.0, velocity_median_abs_corrected = 0.0;  ///< median |relative error|
@@ -201,7 +201,7 @@ struct HeldOutPrediction {
 /// Held-out scores of the FSCC forest (velocity only, relative errors).
 struct FsccScores {
   std::int64_t rows = 0, out_of_range = 0;
-  std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0;  ///< as HeldOutScores
+  std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0, one_sample_lag = 0;  ///< as HeldOutScores
   double rmse_raw = 0.0, rmse_corrected = 0.0;
   double median_abs_raw = 0.0, median_abs_corrected = 0.0;
   double coverage80 = 0.0, coverage95 = 0.0;

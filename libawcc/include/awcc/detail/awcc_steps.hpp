@@ -141,6 +141,14 @@ void analyse_window(AwccWindow& window, const CorrelationPeak& peak, bool consta
 /// moments, intervals, counts, the status and its message.
 void awcc_summarise(AwccResult& result, const AwccOptions& options);
 
+/// The accepted windows' mean whole-sample lag, sum w / sum (w / k_i)
+/// (awcc/awcc.hpp, least_resolved_lag_samples); 0 without an accepted window.
+[[nodiscard]] double mean_lag_samples(std::span<const AwccWindow> windows, Weighting weighting);
+
+/// Quality `low`, with the bounds, when an ok result's mean lag is below
+/// least_resolved_lag_samples: its velocity is bounded, not measured.
+void flag_unresolved_lag(AwccResult& result, double dx, double fs);
+
 /// The bubble-probe correction of every accepted window (when the options
 /// ask for it): velocity becomes u0, measured_velocity keeps dx / lag; a
 /// failure rejects the window (fate correction). Run before awcc_summarise.
