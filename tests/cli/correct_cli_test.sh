@@ -96,6 +96,45 @@ PY
   fail "score --other-processing"
 grep -q "^processed otherwise than the model's training data: .*filter A" "$dir/score-a03.out" ||
   fail "the report does not name the other processing: $(cat "$dir/score-a03.out")"
+# As peers' rows (issue 33): the shipped model's reduced forest scores the
+# runs with fs, duration, windows and the time-scale ratio removed, the report
+# says so, and the predictions are those pdp correct gives the same rows in
+# pdp-uq's layout (u, u_rms, c, d_32a with dx, dy and Np stated).
+"$pdp" --log-level warn score -m "$src/samples/model/awcc.qrf" "$dir/mc.csv" --as-peer-rows --other-processing \
+  --predictions "$dir/score-peer.csv" >"$dir/score-peer.out" || fail "score --as-peer-rows"
+grep -q "^as peers' rows: fs, duration, windows and the time-scale ratio removed" "$dir/score-peer.out" ||
+  fail "the report does not say the rows are peers': $(head -3 "$dir/score-peer.out")"
+/usr/bin/python3 - "$dir/score-peer.csv" "$dir/peer-rows.csv" <<'PY' || fail "score --as-peer-rows: the rows"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert rows, "no rows"
+for r in rows:
+    assert float(r["fs"]) == 0 and float(r["duration"]) == 0 and int(r["windows_accepted"]) == -1, r
+# One (dx, dy, Np) group in pdp-uq's layout for pdp correct.
+key = lambda r: (r["dx"], r["dy"], r["np"], r["awcc_unweighted"])
+first = key(rows[0])
+with open(sys.argv[2], "w") as f:
+    f.write("dx,dy,np,run,u [m/s],u_rms [m/s],c [-],d_32a [m]\n")
+    for r in rows:
+        if key(r) == first:
+            u, tu = float(r["velocity"]), float(r["turbulence_intensity"])
+            f.write(f"{r['dx']},{r['dy']},{r['np']},{r['run']},{r['velocity']},{u * tu!r},{r['void_fraction']},{r['d32']}\n")
+PY
+read -r pdx pdy pnp < <(/usr/bin/python3 -c "import csv,sys; r=next(csv.DictReader(open(sys.argv[1]))); print(r['dx'], r['dy'], r['np'])" "$dir/peer-rows.csv")
+"$pdp" --log-level error correct "$dir/peer-rows.csv" -m "$src/samples/model/awcc.qrf" --dx "${pdx}m" --dy "${pdy}m" --np "$pnp" \
+  --weighting duration -o "$dir/peer-corrected.csv" || fail "pdp correct of the peer rows"
+/usr/bin/python3 - "$dir/score-peer.csv" "$dir/peer-corrected.csv" <<'PY' || fail "score --as-peer-rows differs from pdp correct"
+import csv, sys
+scored = {r["run"]: r for r in csv.DictReader(open(sys.argv[1]))}
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert rows
+for r in rows:
+    assert r["correction_forest [-]"] == "awcc-reduced", r["correction_forest [-]"]
+    s = scored[r["run"]]
+    for q in ("0.025", "0.5", "0.975"):
+        a, b = float(r[f"u_q{q} [m/s]"]), float(s[f"corrected_velocity_q{q}"])
+        assert abs(a / b - 1) < 1e-9, (r["run"], q, a, b)
+PY
 # Calibrating intervals (the default) needs 100 calibration runs: a small sweep is told so, and no model is written.
 out=$("$pdp" train "$dir/mc.csv" -o "$dir/c.qrf" --trees 5 --folds 0 --min-windows 20 2>&1) && fail "calibrated on a few runs"
 [[ $out == *"calibration runs are too few"*"set calibration to 0"* ]] || fail "calibration message: $out"

@@ -112,7 +112,7 @@ PY
 "$pdp" process "$dir/long.flac" --dx 5mm --dy 1mm --correct "$model" --json "$dir/long.json" --csv "$dir/long.csv" \
   2>"$dir/long.err" || fail "case 6: process"
 "$pdp" process "$dir/long.flac" --dx 5mm --dy 1mm --correct "$model" >"$dir/long.txt" 2>/dev/null || fail "case 6: summary"
-note="duration 1800 s is beyond the training range (20-1006 s): corrected as 1006 s"
+note="duration 1800 s is beyond the training range (20-932.2 s): corrected as 932.2 s"
 [[ $(grep -c "note: $note" "$dir/long.txt") == 1 ]] || fail "case 6: the summary's note: $(grep -i note "$dir/long.txt")"
 [[ $(grep -cF "$note" "$dir/long.err") == 1 ]] || fail "case 6: stderr: $(cat "$dir/long.err")"
 grep -q "outside the training range" "$dir/long.err" && fail "case 6: still refused"

@@ -885,15 +885,16 @@ TEST(Correction, TheShippedModelCorrectsTheRecordsLabsMake) {
   // Issue 18: the data yield as the record feature (chosen by
   // cross-validation, docs/validation.md), rows from 10 accepted windows, an
   // FSCC forest, calibrated intervals; issue 33: the lag in samples and the
-  // weighting, and a reduced model for peers' rows. A 45 s, 20 kHz row with
-  // 30 of 300 windows is corrected by the AWCC forest, with quantiles in order.
+  // weighting, and a reduced model for peers' rows; the time-scale ratio
+  // (the campaign's complete candidate). A 45 s, 20 kHz row with 30 of 300
+  // windows is corrected by the AWCC forest, with quantiles in order.
   const auto m = CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
   EXPECT_EQ(correction::feature_set_of([&] {
               std::vector<std::string> n;
               for (const auto& r : m.ranges) n.push_back(r.name);
               return n;
             }()),
-            "extended-yield+lag+weighting");
+            "extended-yield+lag+scale+weighting");
   EXPECT_EQ(m.min_windows, 10);
   ASSERT_TRUE(m.fscc.has_value());
   ASSERT_TRUE(m.reduced);
@@ -904,6 +905,7 @@ TEST(Correction, TheShippedModelCorrectsTheRecordsLabsMake) {
   f.duration = 45;
   f.windows_accepted = 30;
   f.windows_total = 300;
+  f.time_scale_ratio = 2.0;
   const auto c = m.correct(f);
   ASSERT_TRUE(c.corrected()) << c.message;
   EXPECT_EQ(c.forest, "awcc");

@@ -344,7 +344,8 @@ TEST(TrustRules, ALagOfOneSampleIsUntrustedBelowTheLimitAndWithoutFsIsNotJudged)
 
 // A row as pdp process measures it: AWCC's u (m/s) and Tu, the leading
 // tip's c and F (1/s), dx (m), AWCC's {accepted, formed} windows, the
-// record's {fs (Hz), duration (s)}, FSCC's {u (m/s), R12max}; Np 10, dy 0.
+// record's {fs (Hz), duration (s)}, FSCC's {u (m/s), R12max}; Np 10, dy 0,
+// a time-scale ratio T_u / T_W of 2 (inside the shipped model's range).
 correction::Measurement row(double u, double tu, double c, double rate, double dx, std::array<std::int64_t, 2> windows,
                             std::array<double, 2> record, std::array<double, 2> fscc) {
   correction::Measurement m;
@@ -361,6 +362,7 @@ correction::Measurement row(double u, double tu, double c, double rate, double d
   m.fscc_velocity = fscc[0];
   m.r12_max = fscc[1];
   m.weighting = awcc::Weighting::duration;  // pdp process's default, which it states
+  m.time_scale_ratio = 2.0;
   return m;
 }
 
@@ -413,7 +415,7 @@ TEST(LongRecords, DurationBeyondTheRangeIsHeldAtItsEndWithANote) {
                                     range.min, range.max, range.max));
   // The shipped model (issue 33) was trained on records to 1,800 s; its
   // forests hold every record beyond the longest 1 % of them at that length.
-  EXPECT_EQ(c.notes[0], "duration 1800 s is beyond the training range (20-1006 s): corrected as 1006 s");
+  EXPECT_EQ(c.notes[0], "duration 1800 s is beyond the training range (20-932.2 s): corrected as 932.2 s");
   // The same quantiles as a record of exactly the longest training length, which has no note.
   f.duration = range.max;
   const auto held = m.correct(f);

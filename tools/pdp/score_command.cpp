@@ -33,6 +33,9 @@ void setup_score(CLI::App& app, Command& command, ScoreOptions& o) {
   cmd->add_flag("--other-processing", o.other_processing,
                 "score runs processed otherwise than the model's training data (another AWCC convention); the "
                 "report names the difference");
+  cmd->add_flag("--as-peer-rows", o.as_peer_rows,
+                "score the runs as a peer's file states them (u, u_rms, c, d32, dx, dy, Np: fs, duration, windows "
+                "and the time-scale ratio removed), so that the model's reduced forest corrects them");
 }
 
 int run_score(const ScoreOptions& o) {
@@ -40,7 +43,8 @@ int run_score(const ScoreOptions& o) {
     const auto model = correction::CorrectionModel::load(o.model);
     const std::vector<std::filesystem::path> csvs(o.sweeps.begin(), o.sweeps.end());
     const auto truth = correction::truth_kind_of(o.truth).value_or(correction::TruthKind::realised);
-    const auto set = correction::load_training_set(csvs, model.min_windows, truth);
+    auto set = correction::load_training_set(csvs, model.min_windows, truth);
+    if (o.as_peer_rows) set.rows = correction::as_peer_rows(std::move(set.rows));
     std::string processed_otherwise;
     if (o.other_processing) {
       processed_otherwise = model.mismatch(set.processing);
@@ -69,6 +73,7 @@ int run_score(const ScoreOptions& o) {
     if (!processed_otherwise.empty()) {
       report += fmt::format("processed otherwise than the model's training data: {}\n", processed_otherwise);
     }
+    if (o.as_peer_rows) report += "as peers' rows: fs, duration, windows and the time-scale ratio removed\n";
     report += correction::scores_report(scores, predictions);
     if (!o.predictions.empty()) awcc::check_output_folder(o.predictions);
     if (!o.report.empty()) awcc::check_output_folder(o.report);

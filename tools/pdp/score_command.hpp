@@ -23,6 +23,9 @@ struct ScoreOptions {
   /// Score runs processed otherwise than the model's training data (another
   /// tool's AWCC conventions, issue 33); the report names the difference.
   bool other_processing = false;
+  /// Score the runs as a peer's file states them (correction::as_peer_rows):
+  /// the reduced forest's scores.
+  bool as_peer_rows = false;
 };
 
 void setup_score(CLI::App& app, Command& command, ScoreOptions& options);

@@ -259,6 +259,11 @@ TrustResult measure_trust(CorrectionModel model, const TrainingSet& runs, const 
 /// a model scored or measured on them would describe other estimates.
 void require_model_processing(const CorrectionModel& model, const TrainingSet& runs);
 
+/// The rows as a peer's file states them (pdp-uq's layout: u, u_rms, c,
+/// d32, dx, dy, Np): fs, the duration, the windows and the time-scale ratio
+/// removed, so that a model corrects them by its reduced forest.
+std::vector<TrainingRow> as_peer_rows(std::vector<TrainingRow> rows);
+
 /// Scores a model on rows.
 HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                     std::vector<HeldOutPrediction>* predictions = nullptr, int threads = 0);
