@@ -63,8 +63,21 @@ std::vector<double> lagged_products_by_intervals(const AirIntervals& x, const Ai
   const auto& yi = y.intervals;
   const std::size_t ny = yi.size();
   std::int64_t* const counts = impulse.data();
+  // Only x's intervals that meet [t0, t1) add pairs, and y's first candidate
+  // only moves forward: both are found by binary search rather than walked
+  // to from the record's start (FSCC calls this for each of its segments'
+  // windows and the gaps between them; the sums are the same integers).
+  const auto& xi = x.intervals;
+  auto ix = std::partition_point(xi.begin(), xi.end(), [t0](const AirInterval& a) { return a.stop <= t0; });
   std::size_t first = 0;
-  for (const auto& iv : x.intervals) {
+  if (ix != xi.end()) {
+    const std::int64_t reach = std::max(ix->start, t0) + k_min;
+    first = static_cast<std::size_t>(
+        std::partition_point(yi.begin(), yi.end(), [reach](const AirInterval& b) { return b.stop <= reach; }) -
+        yi.begin());
+  }
+  for (; ix != xi.end() && ix->start < t1; ++ix) {
+    const auto& iv = *ix;
     const std::int64_t a0 = std::max(iv.start, t0), a1 = std::min(iv.stop, t1);
     if (a0 >= a1) continue;
     // y intervals that can overlap a shifted by a lag in range: b1 > a0 + k_min, b0 <= a1 + k_max.
@@ -184,18 +197,50 @@ class AirPrefix {
   std::int64_t below(std::int64_t t) const {
     const auto& iv = s_.intervals;
     const auto it = std::partition_point(iv.begin(), iv.end(), [t](const AirInterval& a) { return a.stop <= t; });
-    const auto i = static_cast<std::size_t>(it - iv.begin());
-    std::int64_t total = cumulative_[i];
-    if (it != iv.end() && it->start < t) total += t - it->start;
-    return total;
+    return below_at(t, static_cast<std::size_t>(it - iv.begin()));
   }
   std::int64_t in(std::int64_t a, std::int64_t b) const {
     a = std::clamp<std::int64_t>(a, 0, s_.sample_count);
     b = std::clamp<std::int64_t>(b, 0, s_.sample_count);
     return b > a ? below(b) - below(a) : 0;
   }
+  /// Where the last lookups of a sweep ended: the index of the first
+  /// interval that stops after each end (none yet: a binary search).
+  struct Hint {
+    static constexpr std::size_t none = static_cast<std::size_t>(-1);
+    std::size_t a = none, b = none;
+  };
+  /// in(a, b) for a sweep of windows that move a sample or so from one
+  /// call to the next (a lag sweep): each end's interval is found by
+  /// walking from the last call's instead of a binary search over the whole
+  /// record (a 300 s record holds 400,000 intervals, and FSCC's lag range
+  /// 20,000 lags per segment). The intervals are sorted and disjoint, so the
+  /// walk ends at the index partition_point finds: the same count.
+  std::int64_t in(std::int64_t a, std::int64_t b, Hint& hint) const {
+    a = std::clamp<std::int64_t>(a, 0, s_.sample_count);
+    b = std::clamp<std::int64_t>(b, 0, s_.sample_count);
+    return b > a ? below(b, hint.b) - below(a, hint.a) : 0;
+  }
 
  private:
+  std::int64_t below_at(std::int64_t t, std::size_t i) const {
+    const auto& iv = s_.intervals;
+    std::int64_t total = cumulative_[i];
+    if (i < iv.size() && iv[i].start < t) total += t - iv[i].start;
+    return total;
+  }
+  std::int64_t below(std::int64_t t, std::size_t& at) const {
+    const auto& iv = s_.intervals;
+    if (at == Hint::none) {
+      at = static_cast<std::size_t>(
+          std::partition_point(iv.begin(), iv.end(), [t](const AirInterval& x) { return x.stop <= t; }) - iv.begin());
+    } else {
+      while (at > 0 && iv[at - 1].stop > t) --at;
+      while (at < iv.size() && iv[at].stop <= t) ++at;
+    }
+    return below_at(t, at);
+  }
+
   const AirIntervals& s_;
   std::vector<std::int64_t> cumulative_;
 };
@@ -222,13 +267,14 @@ void full_record(const AirIntervals& x, const AirIntervals& y, const FsccLags& l
                         const std::vector<double>* given) {
     const auto sums = given ? *given : lagged_products(a, b, 0, n, kmin, kmax, plans);
     std::vector<double> r(sums.size());
+    AirPrefix::Hint ha, hb;
     for (std::size_t j = 0; j < sums.size(); ++j) {
       const std::int64_t k = kmin + static_cast<std::int64_t>(j);
       // t in [max(0, -k), min(n, n - k)) and t + k in range.
       const std::int64_t t0 = std::max<std::int64_t>(0, -k), t1 = std::min(n, n - k);
       const double count = static_cast<double>(std::max<std::int64_t>(0, t1 - t0));
-      const double sa = static_cast<double>(pa.in(t0, t1));
-      const double sb = static_cast<double>(pb.in(t0 + k, t1 + k));
+      const double sa = static_cast<double>(pa.in(t0, t1, ha));
+      const double sb = static_cast<double>(pb.in(t0 + k, t1 + k, hb));
       const double centred = sums[j] - ma * sb - mb * sa + count * ma * mb;
       r[j] = centred / std::sqrt(qa * qb);
     }
@@ -319,9 +365,10 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
     if (!(va > 0.0)) return r;
     const auto sums = given ? *given : lagged_products(a, b, t0, t1, kmin, kmax, plans);
     r.resize(sums.size());
+    AirPrefix::Hint hint;
     for (std::size_t j = 0; j < sums.size(); ++j) {
       const std::int64_t k = kmin + static_cast<std::int64_t>(j);
-      const double mb = static_cast<double>(pb.in(t0 + k, t1 + k)) / wd;
+      const double mb = static_cast<double>(pb.in(t0 + k, t1 + k, hint)) / wd;
       const double vb = mb * (1 - mb);
       if (!(vb > 0.0)) return std::vector<double>();
       r[j] = (sums[j] / wd - ma * mb) / std::sqrt(va * vb);
@@ -337,9 +384,14 @@ void segmented(const AirIntervals& x, const AirIntervals& y, int segments, const
     const double wd = static_cast<double>(w);
     const double ma = static_cast<double>(pa.in(t0, t1)) / wd;
     if (!(ma * (1 - ma) > 0.0)) return false;
+    // pearson()'s test mb (1 - mb) > 0 with mb = count / w, in integers:
+    // for 0 < count < w (w far below 2^52) the quotient lies in (0, 1) and
+    // the product of two positive doubles of that size is positive, while
+    // count 0 or w gives 0. The same answer without a division per lag.
+    AirPrefix::Hint hint;
     for (std::int64_t k = kmin; k <= kmax; ++k) {
-      const double mb = static_cast<double>(pb.in(t0 + k, t1 + k)) / wd;
-      if (!(mb * (1 - mb) > 0.0)) return false;
+      const std::int64_t count = pb.in(t0 + k, t1 + k, hint);
+      if (count <= 0 || count >= w) return false;
     }
     return true;
   };
