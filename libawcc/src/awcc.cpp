@@ -698,6 +698,8 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
   result.time_scale_ratio.reset();
+  result.mean_lag_samples = 0.0;
+  result.one_sample_lag = result.chance_yield = false;
   auto insufficient = [&result] { result.quality_reason = result.message; };
   if (result.windows_total == 0) {
     result.status = AwccStatus::too_few_particles;
@@ -762,6 +764,16 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
                        {"accepted windows", "data yield", "windows accepted", "the accepted windows"});
   result.time_scale_ratio = capped_time_scale_ratio(result, time_scale_ratio_cap);
   result.mean_lag_samples = mean_lag_samples(windows, options.weighting);
+  const double yield = static_cast<double>(result.windows_accepted) / static_cast<double>(result.windows_total);
+  if (yield < chance_data_yield) {
+    result.chance_yield = true;
+    result.quality = AwccQuality::low;
+    result.quality_reason = fmt::format(
+        "a chance yield: {} of {} windows accepted ({:.3g} %, below {:g} %), about what signals that share no bubble "
+        "give by chance, so the accepted windows may be chance peaks rather than the flow's (check that the tips "
+        "are aligned with the flow and the lateral separation dy is small against the bubbles)",
+        result.windows_accepted, result.windows_total, 100.0 * yield, 100.0 * chance_data_yield);
+  }
 }
 
 double mean_lag_samples(std::span<const AwccWindow> windows, Weighting weighting) {
@@ -778,12 +790,15 @@ double mean_lag_samples(std::span<const AwccWindow> windows, Weighting weighting
 void flag_unresolved_lag(AwccResult& result, double dx, double fs) {
   if (!result.ok() || !(result.mean_lag_samples > 0.0) || result.mean_lag_samples >= least_resolved_lag_samples) return;
   const auto [lo, hi] = one_sample_velocity_bounds(dx, fs);
-  result.quality = AwccQuality::low;
-  result.quality_reason = fmt::format(
+  const std::string why = fmt::format(
       "a lag of one sample: the accepted windows peak at a mean lag of {:.2f} samples (below {:g}), and every "
       "delay of 0.5-1.5 samples reads as one, so the velocity is bounded ({:.4g}-{:.4g} m/s), not measured, and "
       "Tu is not resolved (sample faster or move the tips apart)",
       result.mean_lag_samples, least_resolved_lag_samples, lo, hi);
+  result.one_sample_lag = true;
+  result.quality = AwccQuality::low;
+  // After a chance yield's reason, both; in place of the generic ones.
+  result.quality_reason = result.chance_yield ? result.quality_reason + "; " + why : why;
 }
 
 }  // namespace detail
@@ -887,6 +902,7 @@ void detail::no_tip_separation(AwccResult& result) {
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
   result.time_scale_ratio.reset();
+  result.one_sample_lag = result.chance_yield = false;
 }
 
 void detail::tips_swapped(AwccResult& result, const std::string& why) {
@@ -897,6 +913,7 @@ void detail::tips_swapped(AwccResult& result, const std::string& why) {
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
   result.time_scale_ratio.reset();
+  result.one_sample_lag = result.chance_yield = false;
 }
 
 }  // namespace awcc

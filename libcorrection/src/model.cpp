@@ -391,13 +391,28 @@ std::string value_text(const Quantity& q, double v) {
 // What the trust rules find, rule by rule, each quantity's clause apart so
 // that a rule both quantities break is named once.
 struct Verdict {
-  std::vector<std::string> envelope, modes, lag;
+  std::vector<std::string> envelope, modes, lag, yield;
   void add(const Verdict& v) {
     envelope.insert(envelope.end(), v.envelope.begin(), v.envelope.end());
     modes.insert(modes.end(), v.modes.begin(), v.modes.end());
     lag.insert(lag.end(), v.lag.begin(), v.lag.end());
+    yield.insert(yield.end(), v.yield.begin(), v.yield.end());
   }
 };
+
+// Rule (d) (the model's header): AWCC's data yield; silent when the windows
+// are not known.
+Verdict chance_yield(const Features& f) {
+  Verdict verdict;
+  if (f.windows_accepted < 0 || f.windows_total <= 0) return verdict;
+  const double yield = static_cast<double>(f.windows_accepted) / static_cast<double>(f.windows_total);
+  if (yield >= awcc::chance_data_yield) return verdict;
+  verdict.yield.push_back(fmt::format(
+      "AWCC accepted {} of {} windows ({:.3g} %, below {:g} %), about what signals that share no bubble give by "
+      "chance, so the measurement corrected may be chance peaks rather than the flow's",
+      f.windows_accepted, f.windows_total, 100.0 * yield, 100.0 * awcc::chance_data_yield));
+  return verdict;
+}
 
 // Rule (c) (the model's header): the measurement's lag in samples, from
 // `source`'s velocity; silent when fs is not known.
@@ -466,9 +481,11 @@ void judge(Correction& c, const Verdict& v) {
   c.outside_envelope = !v.envelope.empty();
   c.multimodal = !v.modes.empty();
   c.one_sample_lag = !v.lag.empty();
-  if (!c.outside_envelope && !c.multimodal && !c.one_sample_lag) return;
+  c.chance_yield = !v.yield.empty();
+  if (!c.outside_envelope && !c.multimodal && !c.one_sample_lag && !c.chance_yield) return;
   c.status = CorrectionStatus::untrusted;
   std::vector<std::string> rules;
+  if (c.chance_yield) rules.push_back(fmt::format("a chance yield: {}", fmt::join(v.yield, "; ")));
   if (c.one_sample_lag) rules.push_back(fmt::format("a lag of one sample: {}", fmt::join(v.lag, "; ")));
   if (c.outside_envelope) rules.push_back(fmt::format("outside the envelope: {}", fmt::join(v.envelope, "; ")));
   if (c.multimodal) rules.push_back(fmt::format("multimodal: {}", fmt::join(v.modes, "; ")));
@@ -656,6 +673,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
       untrusted_reasons(u, velocity_d, cal.envelope(cal.velocity_envelope, f.windows_accepted, tu_median), runs);
   verdict.add(untrusted_reasons(tu, tu_d, cal.envelope(cal.turbulence_envelope, f.windows_accepted, tu_median), runs));
   verdict.add(unresolved_lag("AWCC's", f.velocity, f.dx, f.fs));
+  verdict.add(chance_yield(f));
   judge(c, verdict);
   return {c};
 }

@@ -531,6 +531,7 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
     s.outside_envelope += c[i].outside_envelope;
     s.multimodal += c[i].multimodal;
     s.one_sample_lag += c[i].one_sample_lag;
+    s.chance_yield += c[i].chance_yield;
     const auto& u = *c[i].velocity;
     const auto& t = *c[i].turbulence_intensity;
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
@@ -1014,8 +1015,9 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
   }
   if (!result.fscc_note.empty()) provenance += " " + result.fscc_note + ".";
   provenance += fmt::format(" Trust rules (model.hpp): {} of the {} scored held-out runs untrusted by the AWCC forests "
-                            "({} outside the envelope, {} multimodal, {} at a lag of one sample)",
-                            h.untrusted, h.rows, h.outside_envelope, h.multimodal, h.one_sample_lag);
+                            "({} outside the envelope, {} multimodal, {} at a lag of one sample, {} at a chance "
+                            "yield)",
+                            h.untrusted, h.rows, h.outside_envelope, h.multimodal, h.one_sample_lag, h.chance_yield);
   if (result.model.fscc) {
     const auto& u = result.fscc_held_out_unserved;
     provenance += fmt::format(", {} of {} by the FSCC forest ({} outside the envelope, {} multimodal, {} at a lag of "
@@ -1211,13 +1213,14 @@ TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const T
       "Trust envelopes (rule (a), model.hpp) measured by pdp train {} on runs the model was not trained on ({}): the "
       "AWCC forests' on {} runs{}, {}; the FSCC forest's on {} runs it takes that AWCC cannot serve{}. Held out of "
       "those runs: {} of {} untrusted by the AWCC forests ({} outside the envelope, {} multimodal, {} at a lag of one "
-      "sample), {} of {} by the FSCC forest ({} outside the envelope, {} multimodal, {} at a lag of one sample).",
+      "sample, {} at a chance yield), {} of {} by the FSCC forest ({} outside the envelope, {} multimodal, {} at a "
+      "lag of one sample).",
       awcc::version, sources, measuring.size(),
       c.envelope_from_training ? " (too few: the training targets' kept)" : "",
       c.envelope_from_training ? "pooled" : "per window and Tu band where a band has 399 runs",
       fscc_split.training.size(),
       model.fscc && model.fscc->calibration.envelope_from_training ? " (too few: the training targets' kept)" : "",
-      h.untrusted, h.rows, h.outside_envelope, h.multimodal, h.one_sample_lag, u.untrusted, u.rows,
+      h.untrusted, h.rows, h.outside_envelope, h.multimodal, h.one_sample_lag, h.chance_yield, u.untrusted, u.rows,
       u.outside_envelope, u.multimodal, u.one_sample_lag);
   model.provenance += " " + result.summary;
   result.model = std::move(model);
@@ -1268,10 +1271,10 @@ std::string TrainResult::report() const {
   }
   const auto& h = held_out;
   line(fmt::format("Held out: {} runs ({} outside the training ranges, not scored; {} of the scored untrusted by the "
-                   "trust rules: {} outside the envelope, {} multimodal, {} at a lag of one sample); training {} "
-                   "runs in {:.2f} s",
+                   "trust rules: {} outside the envelope, {} multimodal, {} at a lag of one sample, {} at a chance "
+                   "yield); training {} runs in {:.2f} s",
                    h.rows, h.out_of_range, h.untrusted, h.outside_envelope, h.multimodal, h.one_sample_lag,
-                   training_rows, seconds_train));
+                   h.chance_yield, training_rows, seconds_train));
   out += scores_report(h, predictions);
   if (model.reduced) {
     const auto& r = reduced_held_out;

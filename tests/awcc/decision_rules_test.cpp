@@ -334,6 +334,70 @@ TEST(OneSampleLag, ATrailingTipOneSampleBehindIsBoundedTwoSamplesBehindIsNot) {
 
 
 // ---------------------------------------------------------------------------
+// A chance yield (awcc.hpp, chance_data_yield): an ok result whose accepted
+// windows are fewer than 0.1 % of those formed is quality low, saying the
+// accepted windows may be chance peaks.
+
+awcc::AwccResult summarised(std::int64_t accepted, std::int64_t total) {
+  awcc::AwccResult r;
+  for (std::int64_t i = 0; i < total; ++i) {
+    awcc::AwccWindow w;
+    w.duration = 0.01;
+    w.lag_samples = 5;
+    w.velocity = w.measured_velocity = 2.0 + 0.01 * static_cast<double>(i % 7);
+    w.r12_max = 0.9;
+    w.fate = i < accepted ? WindowFate::accepted : WindowFate::correlation;
+    r.windows.push_back(w);
+  }
+  awcc::AwccOptions o;
+  o.roc = false;
+  awcc::detail::awcc_summarise(r, o);
+  return r;
+}
+
+TEST(ChanceYield, TenOfTenThousandIsAtTheLimitOneMoreWindowFormedIsChance) {
+  const auto at = summarised(10, 10'000);  // 0.1 % exactly
+  ASSERT_TRUE(at.ok()) << at.message;
+  EXPECT_FALSE(at.chance_yield);
+  EXPECT_EQ(at.quality_reason.find("a chance yield"), std::string::npos) << at.quality_reason;
+  const auto below = summarised(10, 10'001);
+  ASSERT_TRUE(below.ok()) << below.message;
+  EXPECT_TRUE(below.chance_yield);
+  EXPECT_EQ(below.quality, awcc::AwccQuality::low);
+  EXPECT_EQ(below.quality_reason.find("a chance yield: 10 of 10001 windows accepted (0.1 %, below 0.1 %)"), 0u)
+      << below.quality_reason;
+  // A yield far above chance keeps the generic reasons (here: fewer than 100 windows).
+  const auto fine = summarised(50, 1'000);
+  EXPECT_FALSE(fine.chance_yield);
+  EXPECT_EQ(fine.quality_reason.find("50 accepted windows (fewer than 100)"), 0u) << fine.quality_reason;
+  // Both rules: both reasons, the yield's first.
+  auto both = summarised(10, 10'001);
+  both.mean_lag_samples = 1.0;
+  awcc::detail::flag_unresolved_lag(both, 0.6e-3, 27e3);
+  EXPECT_TRUE(both.one_sample_lag && both.chance_yield);
+  EXPECT_EQ(both.quality_reason.find("a chance yield: "), 0u) << both.quality_reason;
+  EXPECT_NE(both.quality_reason.find("; a lag of one sample: "), std::string::npos) << both.quality_reason;
+}
+
+TEST(ChanceYield, SignalsThatShareNoBubbleAreFlaggedAndTheirOwnPairIsNot) {
+  // The trailing tip of an unrelated record: whatever AWCC accepts is
+  // chance. Reported from two windows (windows_reported 2), so that the
+  // rule, not the window count, decides.
+  const auto x = pdp_test::telegraph(1'600'000, 41, 1000.0);
+  const auto unrelated = pdp_test::telegraph(1'600'000, 97, 1000.0);
+  awcc::AwccOptions o;
+  o.windows_reported = 2;
+  const auto r = awcc::awcc(x, unrelated, 1.0, o);
+  ASSERT_TRUE(r.ok()) << r.message;
+  ASSERT_LT(static_cast<double>(r.windows_accepted), awcc::chance_data_yield * static_cast<double>(r.windows_total));
+  EXPECT_TRUE(r.chance_yield) << r.quality_reason;
+  const auto own = awcc::awcc(x, pdp_test::shifted(x, 3), 1.0, o);
+  ASSERT_TRUE(own.ok());
+  EXPECT_FALSE(own.chance_yield);
+}
+
+
+// ---------------------------------------------------------------------------
 // Binarisation at its thresholds. Convention (binarisation.cpp): with a single
 // threshold T, a conductivity sample is air when V < T, an optical one when
 // V > T; a sample exactly at T is water for both.

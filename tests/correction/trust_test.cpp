@@ -342,6 +342,26 @@ TEST(TrustRules, ALagOfOneSampleIsUntrustedBelowTheLimitAndWithoutFsIsNotJudged)
   EXPECT_TRUE(correction::to_json(c)["velocity"]["median"].is_null());
 }
 
+TEST(TrustRules, AYieldBelowChanceIsUntrustedAtTheLimitItIsNotAndUnknownWindowsAreNotJudged) {
+  // Rule (d): accepted / formed windows below 0.1 %. Targets 1.0, so rules
+  // (a) and (b) hold; no fs, so rule (c) is silent.
+  const auto m = model_of([](int) { return 1.0; }, [](int) { return 0.0; });
+  auto f = middle();
+  f.windows_accepted = 10;
+  f.windows_total = -1;
+  EXPECT_TRUE(m.correct(f).corrected()) << "windows formed not known: not judged";
+  f.windows_total = 10'000;  // 0.1 % exactly
+  EXPECT_TRUE(m.correct(f).corrected()) << m.correct(f).message;
+  f.windows_total = 10'001;
+  const auto c = m.correct(f);
+  EXPECT_EQ(c.status, CorrectionStatus::untrusted);
+  EXPECT_TRUE(c.chance_yield);
+  EXPECT_FALSE(c.one_sample_lag || c.outside_envelope || c.multimodal);
+  EXPECT_EQ(c.message.find("a chance yield: AWCC accepted 10 of 10001 windows (0.1 %, below 0.1 %)"), 0u) << c.message;
+  ASSERT_TRUE(c.velocity);
+  EXPECT_DOUBLE_EQ(c.velocity->median(), 2.0);  // the quantiles kept
+}
+
 // A row as pdp process measures it: AWCC's u (m/s) and Tu, the leading
 // tip's c and F (1/s), dx (m), AWCC's {accepted, formed} windows, the
 // record's {fs (Hz), duration (s)}, FSCC's {u (m/s), R12max}; Np 10, dy 0,

@@ -64,10 +64,10 @@ int run_score(const ScoreOptions& o) {
     std::string report = fmt::format(
         "pdp score {}: {} (generator version {}); {} runs read, {} with at least {} accepted windows; scored {} "
         "({} outside the training ranges, not scored; {} of the scored untrusted by the trust rules: {} outside the "
-        "envelope, {} multimodal, {} at a lag of one sample)\n",
+        "envelope, {} multimodal, {} at a lag of one sample, {} at a chance yield)\n",
         std::filesystem::path(o.model).filename().string(), sources, fmt::join(set.generator_versions, " and "),
         set.total, set.rows.size(), model.min_windows, scores.rows, scores.out_of_range, scores.untrusted,
-        scores.outside_envelope, scores.multimodal, scores.one_sample_lag);
+        scores.outside_envelope, scores.multimodal, scores.one_sample_lag, scores.chance_yield);
     report += fmt::format("truth: {}{}\n", o.truth,
                           truth == correction::TruthKind::imposed ? " (the scene's velocity and tu)" : " (the run's realised statistics)");
     if (!processed_otherwise.empty()) {

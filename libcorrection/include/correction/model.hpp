@@ -62,6 +62,14 @@
 //     (a) does not catch it once the calibration runs hold such records
 //     (their shifts widen the envelope). A row without fs (a peer's) has
 //     no lag in samples and is not judged by it.
+// (d) a yield above chance (the AWCC forests): the data yield, accepted
+//     over formed windows, must be at least awcc::chance_data_yield (0.1 %).
+//     Signals that share no bubble pass AWCC's filter in 0.03-0.08 % of
+//     their windows, so below it the accepted windows may be chance peaks,
+//     and the measurement the forest corrects may not be the flow's (raw
+//     AWCC off by a median 58 % there on the campaign's runs, corrected by
+//     20 %, its 95 % intervals covering 90 %). A row whose
+//     windows are not known (a peer's) is not judged by it.
 // Any rule, on the velocity or on Tu, makes the row untrusted.
 //
 // Model file (".qrf"), all numbers little-endian whatever the machine:
@@ -173,8 +181,8 @@ struct Correction {
   /// What the user should know of a correction that stands (a feature held
   /// at its range's end), each said once.
   std::vector<std::string> notes;
-  /// Which trust rules an untrusted row breaks: (a), (b) and (c) of the model's header.
-  bool outside_envelope = false, multimodal = false, one_sample_lag = false;
+  /// Which trust rules an untrusted row breaks: (a)-(d) of the model's header.
+  bool outside_envelope = false, multimodal = false, one_sample_lag = false, chance_yield = false;
   [[nodiscard]] bool corrected() const { return status == CorrectionStatus::corrected; }
   /// Empty when corrected; "untrusted: " and the reason, or the reason.
   [[nodiscard]] std::string why_not() const;
