@@ -119,6 +119,7 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == "fscc_lag" && fscc_velocity > 0.0) return dx / fscc_velocity;
   if (name == lag_name && fs > 0.0 && velocity > 0.0) return dx * fs / velocity;
   if (name == scale_name && time_scale_ratio > 0.0) return time_scale_ratio;
+  if (name == size_name && d32 > 0.0 && dx > 0.0) return d32 / dx;
   return std::nullopt;
 }
 
@@ -133,7 +134,8 @@ std::vector<std::string> feature_set_names(std::string_view set) {
     return std::invalid_argument(fmt::format(
         "feature set '{}': use measured (the seven of METHOD 7), extended (with fs, duration and accepted windows) "
         "or extended-yield (fs, duration and the data yield), the extended two optionally followed by +lag (the lag "
-        "in samples) and then +scale (the time-scale ratio T_u / T_W), each then optionally by +weighting",
+        "in samples), then +scale (the time-scale ratio T_u / T_W), then +size (d32 / dx), each then optionally by "
+        "+weighting",
         set));
   };
   const auto plus = set.find('+');
@@ -151,7 +153,7 @@ std::vector<std::string> feature_set_names(std::string_view set) {
   };
   for (const auto& [suffix, name, extended_only] :
        {std::tuple{"+lag", Features::lag_name, true}, std::tuple{"+scale", Features::scale_name, true},
-        std::tuple{"+weighting", Features::weighting_name, false}}) {
+        std::tuple{"+size", Features::size_name, true}, std::tuple{"+weighting", Features::weighting_name, false}}) {
     if (!take(suffix)) continue;
     if (extended_only && base == "measured") throw bad();
     out.emplace_back(name);
@@ -164,10 +166,12 @@ std::string feature_set_of(const std::vector<std::string>& names) {
   for (const char* base : {"measured", "extended", "extended-yield"}) {
     for (const char* lag : {"", "+lag"}) {
       for (const char* scale : {"", "+scale"}) {
-        for (const char* weighting : {"", "+weighting"}) {
-          const std::string set = std::string(base) + lag + scale + weighting;
-          if (std::string_view(base) == "measured" && (*lag || *scale)) continue;
-          if (names == feature_set_names(set)) return set;
+        for (const char* size : {"", "+size"}) {
+          for (const char* weighting : {"", "+weighting"}) {
+            const std::string set = std::string(base) + lag + scale + size + weighting;
+            if (std::string_view(base) == "measured" && (*lag || *scale || *size)) continue;
+            if (names == feature_set_names(set)) return set;
+          }
         }
       }
     }

@@ -563,6 +563,23 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   }
   EXPECT_TRUE(Features::on_log_scale("time_scale_ratio"));
   EXPECT_EQ(correction::feature_value_text("time_scale_ratio", 20.0), "time_scale_ratio = 20");
+  // The size ratio d32 / dx: after the time scale, before the weighting;
+  // known whenever d32 and dx are.
+  Features size = inside();
+  size.d32 = 6e-3;
+  size.dx = 4e-3;
+  EXPECT_DOUBLE_EQ(*size.value("size_ratio"), 1.5);
+  size.d32 = 0.0;
+  EXPECT_FALSE(size.value("size_ratio"));
+  const auto size_set = correction::feature_set_names("extended-yield+lag+scale+size+weighting");
+  ASSERT_EQ(size_set.size(), 14u);
+  EXPECT_EQ(size_set[12], "size_ratio");
+  EXPECT_EQ(size_set[13], "awcc_unweighted");
+  for (const char* set : {"extended+size", "extended-yield+lag+size+weighting", "extended-yield+lag+scale+size+weighting"})
+    EXPECT_EQ(correction::feature_set_of(correction::feature_set_names(set)), set);
+  for (const char* set : {"measured+size", "extended+size+scale", "extended+weighting+size"})
+    EXPECT_THROW(correction::feature_set_names(set), std::invalid_argument) << set;
+  EXPECT_TRUE(Features::on_log_scale("size_ratio"));
   correction::Measurement stated;
   stated.velocity = 3.0;
   stated.turbulence_intensity = 0.2;

@@ -58,6 +58,17 @@
 // follow the velocity and the ratio no longer matters. A file that does not
 // give it (another tool's) is corrected by the reduced model.
 //
+// The size ratio as a feature (issue 33; the extended sets followed by
+// "+size", after "+scale"): size_ratio, d32 / dx, the measured Sauter
+// diameter over the streamwise tip separation. Tips much closer than the
+// bubbles meet each interface almost together, so a window's delay follows
+// the interface's tilt more than the flow and AWCC's Tu reads high: on the
+// corrected rows of the conventions campaign's test sets, above d32 / dx =
+// 10 the corrected Tu was off by +0.027 on average and its intervals covered
+// 70 / 93 %, against -0.002 to -0.004 and 86.5 / 98 % below
+// (docs/validation.md). The forests see d32 and dx, but a ratio takes them
+// many splits to find.
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -145,9 +156,9 @@ struct Features {
   /// The features positive by nature and drawn over decades (0 is not a
   /// value they take): their range margin is logarithmic at the low end
   /// (accepted_range). Not dy, Tu or the yield, whose 0 is a real value.
-  static constexpr std::array<const char*, 12> log_scale_names{
-      "velocity",      "void_fraction", "d32",        "fs",       "duration",   "windows_accepted",
-      "fscc_velocity", "fscc_d32",      "chord_time", "fscc_lag", "lag_samples", "time_scale_ratio"};
+  static constexpr std::array<const char*, 13> log_scale_names{
+      "velocity",      "void_fraction", "d32",        "fs",       "duration",    "windows_accepted", "fscc_velocity",
+      "fscc_d32",      "chord_time",    "fscc_lag",   "lag_samples", "time_scale_ratio", "size_ratio"};
   [[nodiscard]] static bool on_log_scale(std::string_view name);
   double velocity = 0.0, turbulence_intensity = 0.0, void_fraction = 0.0, d32 = 0.0, dx = 0.0, dy = 0.0, np = 0.0;
   /// Rows below a model's minimum are not corrected; -1 unknown.
@@ -174,6 +185,8 @@ struct Features {
   /// The time-scale feature (T_u / T_W, see the file's comment); 0: not known.
   double time_scale_ratio = 0.0;
   static constexpr const char* scale_name = "time_scale_ratio";
+  /// The size-ratio feature, d32 / dx (the file's comment).
+  static constexpr const char* size_name = "size_ratio";
   /// Where the ratio is capped (AWCC's result holds it capped, and says why).
   static constexpr double time_scale_ratio_cap = awcc::time_scale_ratio_cap;
   [[nodiscard]] std::array<double, 7> vector() const {
@@ -189,8 +202,8 @@ struct Features {
 /// data yield for the accepted windows), "fscc" or "fscc-2" (the FSCC
 /// forest's); the two extended sets may end in "+lag" (the lag in samples
 /// after the record's features), then in "+scale" (the time-scale ratio),
-/// and the first three, after those, in "+weighting" (the weighting feature
-/// last). Throws std::invalid_argument otherwise.
+/// then in "+size" (d32 / dx), and the first three, after those, in
+/// "+weighting" (the weighting feature last). Throws std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// The set of a model's names in order ("measured", "extended-yield+weighting", ...); empty when they are none.
 std::string feature_set_of(const std::vector<std::string>& names);
