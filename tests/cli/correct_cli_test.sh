@@ -135,6 +135,16 @@ for r in rows:
         a, b = float(r[f"u_q{q} [m/s]"]), float(s[f"corrected_velocity_q{q}"])
         assert abs(a / b - 1) < 1e-9, (r["run"], q, a, b)
 PY
+# A model without a reduced forest scores no peers' rows: refused (exit 1),
+# naming why, with no predictions written, not a report of zeros.
+"$pdp" --log-level warn train "$dir/mc.csv" -o "$dir/noreduced.qrf" --feature-set extended-yield --reduced off \
+  --trees 5 --folds 0 --calibration 0 --min-windows 20 >/dev/null || fail "train without a reduced forest"
+out=$("$pdp" score -m "$dir/noreduced.qrf" "$dir/mc.csv" --as-peer-rows --predictions "$dir/score-noreduced.csv" 2>&1)
+code=$?
+[[ $code == 1 ]] || fail "score --as-peer-rows without a reduced forest: exit $code"
+[[ $out == *"none of the"*"could be scored"*"this model has no reduced forest"* ]] ||
+  fail "score --as-peer-rows without a reduced forest: $out"
+[[ -e $dir/score-noreduced.csv ]] && fail "score wrote predictions of no run"
 # Calibrating intervals (the default) needs 100 calibration runs: a small sweep is told so, and no model is written.
 out=$("$pdp" train "$dir/mc.csv" -o "$dir/c.qrf" --trees 5 --folds 0 --min-windows 20 2>&1) && fail "calibrated on a few runs"
 [[ $out == *"calibration runs are too few"*"set calibration to 0"* ]] || fail "calibration message: $out"

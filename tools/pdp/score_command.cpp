@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/errors.hpp"
 #include "correction/model.hpp"
 #include "correction/training.hpp"
 
@@ -59,6 +60,17 @@ int run_score(const ScoreOptions& o) {
     }
     std::vector<correction::HeldOutPrediction> predictions;
     const auto scores = correction::score(model, set.rows, &predictions, o.threads);
+    if (scores.rows == 0) {
+      // Scores of no run are no scores: refused, not printed as zeros.
+      throw awcc::InputError(fmt::format(
+          "{}: none of the {} runs with at least {} accepted windows could be scored by {}: each is outside the "
+          "model's training ranges or lacks a feature it takes{}",
+          fmt::join(o.sweeps, ", "), set.rows.size(), model.min_windows, std::filesystem::path(o.model).filename().string(),
+          o.as_peer_rows && !model.reduced
+              ? " (--as-peer-rows removes fs, duration and the windows, and this model has no reduced forest for such "
+                "rows: train it with --reduced on)"
+              : ""));
+    }
     std::string sources;
     for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
     std::string report = fmt::format(
