@@ -12,8 +12,10 @@ foreign sets:
     corrected and raw u median |error| against the others' (rule (c));
   - u's errors and coverage by data yield (accepted / formed windows), and
     the rows below 0.1 % against the others (rule (d));
-  - each foreign set's scores on its corrected rows only;
-  - Tu's errors and coverage by d32 / dx on the corrected rows.
+  - each foreign set's scores on its corrected rows only (Tu on the rows
+    whose Tu is corrected too: not those of rule (e));
+  - Tu's errors and coverage by d32 / dx on the corrected rows, and the
+    rows rule (e) holds back (d32 / dx above 10) per set.
 
 Usage: trust_tables.py MODEL_OUT_DIR CAMPAIGN_DIR
   (MODEL_OUT_DIR: scripts/train-conventions-model's OUT_DIR; CAMPAIGN_DIR:
@@ -29,6 +31,7 @@ FOREIGN = ["control", "poisson-time", "equal-space", "poisson-space", "euler", "
            "unweighted", "all", "lab-corners"]
 LEAST_RESOLVED_LAG = 1.5  # awcc::least_resolved_lag_samples
 CHANCE_YIELD = 0.001      # awcc::chance_data_yield
+LARGEST_TU_SIZE_RATIO = 10.0  # correction::largest_tu_size_ratio
 
 
 def load(out, campaign):
@@ -45,6 +48,9 @@ def load(out, campaign):
         rows.append(m)
     d = pd.concat(rows, ignore_index=True)
     d["yield"] = d.windows_accepted / d.awcc_windows_total
+    # Rule (e): written by pdp score since the rule; before it, the same test on d32 / dx.
+    if "turbulence_corrected" not in d:
+        d["turbulence_corrected"] = ((d.status == "corrected") & ~(d.d32 / d.dx > LARGEST_TU_SIZE_RATIO)).astype(int)
     d["lag"] = d.dx * d.fs / d.velocity
     d["u_err"] = d["corrected_velocity_q0.5"] / d.true_velocity - 1
     d["u_raw"] = d.velocity / d.true_velocity - 1
@@ -92,16 +98,28 @@ def main():
     for name in FOREIGN:
         s = d[d.set == f"foreign-{name}"]
         c = s[s.status == "corrected"]
-        print(f"{name} | {100 * c.u_err.abs().median():.2f} % | {100 * c.u_err.mean():+.2f} % | {c.tu_err.abs().median():.4f} | "
-              f"{c.tu_err.mean():+.4f} | {100 * c.u80.mean():.1f} / {100 * c.u95.mean():.1f} | "
-              f"{100 * c.tu80.mean():.1f} / {100 * c.tu95.mean():.1f} | {len(c)} of {len(s)}")
+        t = s[s.turbulence_corrected == 1]
+        print(f"{name} | {100 * c.u_err.abs().median():.2f} % | {100 * c.u_err.mean():+.2f} % | {t.tu_err.abs().median():.4f} | "
+              f"{t.tu_err.mean():+.4f} | {100 * c.u80.mean():.1f} / {100 * c.u95.mean():.1f} | "
+              f"{100 * t.tu80.mean():.1f} / {100 * t.tu95.mean():.1f} | {len(c)} of {len(s)} | Tu {len(t)}")
 
     print("\n## Tu by d32 / dx, corrected rows")
     c = d[d.status == "corrected"]
-    for band, s in c.groupby(pd.cut(c.d32 / c.dx, [0, 0.3, 1, 3, 10, np.inf]), observed=True):
+    for band, s in c.groupby(pd.cut(c.d32 / c.dx, [0, 0.3, 1, 3, 5, 7, 10, 14, 20, 30, np.inf]), observed=True):
         print(f"{band}: {len(s)} rows; Tu mean {s.tu_err.mean():+.4f}, median {s.tu_err.median():+.4f}, "
               f"median abs {s.tu_err.abs().median():.4f}; coverage {pct(s.tu80.mean())} / {pct(s.tu95.mean())}; "
-              f"u median abs {pct(s.u_err.abs().median())}")
+              f"u median abs {pct(s.u_err.abs().median())}, u coverage {pct(s.u80.mean())} / {pct(s.u95.mean())}")
+
+    print("\n## Rule (e): corrected rows whose Tu is held back (d32 / dx above 10), by set")
+    for name, s in c.groupby("set"):
+        held = s.turbulence_corrected == 0
+        print(f"{name}: {held.sum()} of {len(s)}")
+    held = c[c.turbulence_corrected == 0]
+    kept = c[c.turbulence_corrected == 1]
+    for label, s in [("held back", held), ("the others", kept)]:
+        print(f"{label}: {len(s)} rows; Tu mean {s.tu_err.mean():+.4f}, median abs {s.tu_err.abs().median():.4f}, "
+              f"coverage {pct(s.tu80.mean())} / {pct(s.tu95.mean())}; u median abs {pct(s.u_err.abs().median())}, "
+              f"coverage {pct(s.u80.mean())} / {pct(s.u95.mean())}")
 
 
 if __name__ == "__main__":

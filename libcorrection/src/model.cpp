@@ -430,6 +430,21 @@ Verdict unresolved_lag(const char* source, double velocity, double dx, double fs
   return verdict;
 }
 
+// Rule (e) (the model's header): Tu of bubbles far larger than the tip
+// separation; silent when d32 or dx is not known.
+void judge_turbulence(Correction& c, const Features& f) {
+  if (!c.turbulence_intensity || !(f.d32 > 0.0) || !(f.dx > 0.0)) return;
+  const double ratio = f.d32 / f.dx;
+  if (ratio <= largest_tu_size_ratio) return;
+  c.large_bubbles = true;
+  c.turbulence_message = fmt::format(
+      "Tu not corrected: the Sauter diameter d32 {:.4g} mm is {:.3g} times the tip separation dx {:.4g} mm (above "
+      "{:g}), so the tips meet each interface almost together and a window's delay follows the interface's tilt "
+      "more than the flow; AWCC's Tu reads high there by more than the forest corrects, and its intervals do not "
+      "hold (the quantiles are kept, the median is not a corrected value; move the tips apart to measure Tu)",
+      1e3 * f.d32, ratio, 1e3 * f.dx, largest_tu_size_ratio);
+}
+
 Verdict untrusted_reasons(const Quantity& q, const WeightedDistribution& d,
                           const std::optional<std::array<double, 2>>& envelope, const std::string& envelope_runs) {
   Verdict verdict;
@@ -675,6 +690,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   verdict.add(unresolved_lag("AWCC's", f.velocity, f.dx, f.fs));
   verdict.add(chance_yield(f));
   judge(c, verdict);
+  judge_turbulence(c, f);
   return {c};
 }
 
@@ -1077,6 +1093,9 @@ std::span<const awcc::ProfileColumn> correction_csv_columns() {
     out.push_back({"correction_notes", "", "/correction/notes",
                    "what to know of the correction (a record longer than the training records, held at their "
                    "length), joined by '; '"});
+    out.push_back({correction_column::turbulence_reason, "", "/correction/turbulence_intensity/reason",
+                   "why the corrected Tu is empty on a row whose velocity stands (trust rule (e): bubbles far larger "
+                   "than the tip separation); empty otherwise"});
     return out;
   }();
   return columns;
@@ -1092,8 +1111,10 @@ std::string quantile_cells(const Correction& c) {
   std::string out;
   for (const auto* q : {&c.velocity, &c.turbulence_intensity}) {
     if (*q) {
-      // An untrusted row's median is not a corrected value: its quantiles only.
-      out += c.corrected() ? fmt::format(",{:.10g}", (*q)->median()) : ",";
+      // An untrusted row's median is not a corrected value: its quantiles
+      // only; nor is a Tu that rule (e) leaves uncorrected.
+      const bool stands = q == &c.velocity ? c.corrected() : c.turbulence_corrected();
+      out += stands ? fmt::format(",{:.10g}", (*q)->median()) : ",";
       for (double v : (*q)->quantiles) out += fmt::format(",{:.10g}", v);
     } else {
       out += std::string(1 + correction_levels.size(), ',');
@@ -1109,27 +1130,33 @@ std::string notes_text(const Correction& c) {
 }
 
 std::string correction_csv_cells(const Correction& c) {
-  return fmt::format("{},{},{}{},{},{}", c.corrected() ? 1 : 0, awcc::csv_cell(c.corrected() ? std::string() : c.message),
-                     c.forest, quantile_cells(c), to_string(c.status), awcc::csv_cell(notes_text(c)));
+  return fmt::format("{},{},{}{},{},{},{}", c.corrected() ? 1 : 0,
+                     awcc::csv_cell(c.corrected() ? std::string() : c.message), c.forest, quantile_cells(c),
+                     to_string(c.status), awcc::csv_cell(notes_text(c)), awcc::csv_cell(c.turbulence_message));
 }
 
 nlohmann::json to_json(const Correction& c) {
   using nlohmann::json;
   // An untrusted row's median is not a corrected value: null, its quantiles kept.
-  auto quantity = [&c](const std::optional<CorrectedQuantity>& q) {
+  // So is a Tu that rule (e) leaves uncorrected, its reason given.
+  auto quantity = [](const std::optional<CorrectedQuantity>& q, bool stands) {
     if (!q) return json(nullptr);
     json levels = json::object();
     for (std::size_t k = 0; k < correction_levels.size(); ++k) levels[correction_level_names[k]] = q->quantiles[k];
-    return json{{"measured", q->measured}, {"median", c.corrected() ? json(q->median()) : json(nullptr)},
+    return json{{"measured", q->measured}, {"median", stands ? json(q->median()) : json(nullptr)},
                 {correction_key::quantiles, levels}};
   };
+  json tu = quantity(c.turbulence_intensity, c.turbulence_corrected());
+  if (tu.is_object()) {
+    tu[correction_key::reason] = c.turbulence_message.empty() ? json(nullptr) : json(c.turbulence_message);
+  }
   return json{{correction_key::status, to_string(c.status)},
               {"in_range", c.corrected()},
               {correction_key::forest, c.forest.empty() ? json(nullptr) : json(c.forest)},
               {"reason", c.corrected() ? json(nullptr) : json(c.message)},
               {"notes", c.notes},
-              {correction_key::velocity, quantity(c.velocity)},
-              {"turbulence_intensity", quantity(c.turbulence_intensity)}};
+              {correction_key::velocity, quantity(c.velocity, c.corrected())},
+              {correction_key::turbulence_intensity, tu}};
 }
 
 }  // namespace correction

@@ -158,6 +158,7 @@ Correction correct_row(const CorrectionModel& model, const MeasurementResult& ou
 // stderr), named by the row.
 void add_notes(const Correction& c, const std::string& where, std::vector<std::string>& warnings) {
   for (const auto& n : c.notes) warnings.push_back(fmt::format("{}: {}", where, n));
+  if (!c.turbulence_message.empty()) warnings.push_back(fmt::format("{}: {}", where, c.turbulence_message));
 }
 
 // Calls fn(line, cells, "FILE:LINE") for every non-empty row after the
@@ -211,7 +212,8 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     out.text += fmt::format(",{}_corrected [{}]", q, unit);
     for (const char* l : correction_level_names) out.text += fmt::format(",{}_q{} [{}]", q, l, unit);
   }
-  out.text += ",correction_status [-],correction_forest [-],correction_reason [-],correction_notes [-]\n";
+  out.text += ",correction_status [-],correction_forest [-],correction_reason [-],correction_notes [-],"
+              "correction_turbulence_reason [-]\n";
   for_each_row(in, file, header.names.size(), [&](const std::string& row, const std::vector<std::string>& cells,
                                             const std::string& where) {
     auto value = [&](const char* name) -> std::optional<double> {
@@ -241,8 +243,9 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
     const auto c = c_value ? model.correct(m)
                            : not_corrected(CorrectionStatus::no_bubbles, "no void fraction in the row");
     add_notes(c, where, out.warnings);
-    out.text += fmt::format("{}{},{},{},{},{}\n", row, quantile_cells(c), to_string(c.status), c.forest,
-                            awcc::csv_cell(c.message), awcc::csv_cell(notes_text(c)));
+    out.text += fmt::format("{}{},{},{},{},{},{}\n", row, quantile_cells(c), to_string(c.status), c.forest,
+                            awcc::csv_cell(c.message), awcc::csv_cell(notes_text(c)),
+                            awcc::csv_cell(c.turbulence_message));
   });
   return out;
 }

@@ -532,6 +532,7 @@ HeldOutScores score(const CorrectionModel& model, const std::vector<TrainingRow>
     s.multimodal += c[i].multimodal;
     s.one_sample_lag += c[i].one_sample_lag;
     s.chance_yield += c[i].chance_yield;
+    s.large_bubbles += c[i].large_bubbles;
     const auto& u = *c[i].velocity;
     const auto& t = *c[i].turbulence_intensity;
     const std::vector<double> uq(u.quantiles.begin(), u.quantiles.end()), tq(t.quantiles.begin(), t.quantiles.end());
@@ -1465,18 +1466,19 @@ std::string comparison_report(const std::vector<HeldOutPrediction>& mine, const 
 
 std::string predictions_csv(const std::vector<HeldOutPrediction>& predictions) {
   std::string out = "run,velocity,turbulence_intensity,void_fraction,d32,dx,dy,np,windows_accepted,fs,duration,"
-                    "awcc_unweighted,true_velocity,true_turbulence_intensity,in_range,status";
+                    "awcc_unweighted,true_velocity,true_turbulence_intensity,in_range,status,turbulence_corrected";
   for (const char* q : {"velocity", "turbulence_intensity"}) {
     for (const char* l : correction_level_names) out += fmt::format(",corrected_{}_q{}", q, l);
   }
   out += "\n";
   for (const auto& p : predictions) {
     const auto& f = p.row.features;
-    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{},{:.10g},{:.10g},{},{}",
+    out += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.10g},{:.10g},{},{:.10g},{:.10g},{},{},{}",
                        p.row.run, f.velocity, f.turbulence_intensity, f.void_fraction, f.d32, f.dx, f.dy, f.np,
                        f.windows_accepted, f.fs, f.duration, f.awcc_unweighted, p.row.true_velocity,
                        p.row.true_turbulence_intensity,
-                       p.correction.corrected() ? 1 : 0, to_string(p.correction.status));
+                       p.correction.corrected() ? 1 : 0, to_string(p.correction.status),
+                       p.correction.turbulence_corrected() ? 1 : 0);
     for (const auto* q : {&p.correction.velocity, &p.correction.turbulence_intensity}) {
       for (std::size_t k = 0; k < correction_levels.size(); ++k) {
         out += *q ? fmt::format(",{:.10g}", (*q)->quantiles[k]) : std::string(",");

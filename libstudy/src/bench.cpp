@@ -119,7 +119,7 @@ std::vector<BenchRow> bench_one(const std::string& name, std::uint64_t seed, con
         c.windows = a.windows_accepted;
         if (k.corrected()) {
           c.velocity = k.velocity->median();
-          c.tu = k.turbulence_intensity->median();
+          if (k.turbulence_corrected()) c.tu = k.turbulence_intensity->median();
           c.status = "ok";
         } else {
           c.status = std::string(correction::to_string(k.status));

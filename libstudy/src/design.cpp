@@ -379,7 +379,8 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
         if (c.corrected()) {
           r.correction_forest = c.forest;
           if (c.velocity) r.corrected_velocity = c.velocity->median();
-          if (c.turbulence_intensity) r.corrected_turbulence_intensity = c.turbulence_intensity->median();
+          // Not a Tu that trust rule (e) holds back (correction/model.hpp).
+          if (c.turbulence_corrected()) r.corrected_turbulence_intensity = c.turbulence_intensity->median();
         }
       }
       rows.push_back(std::move(r));

@@ -413,7 +413,7 @@ def _awcc_and_corrected(ax, y, rows, quantity, measured_label):
     for forest, colour, mark, what in (("awcc", VERMILION, "^", "corrected"),
                                        ("fscc", PURPLE, "s", "corrected from FSCC (no usable AWCC)")):
         def corrected(r, forest=forest):
-            if (get(r, "correction", "forest") or "awcc") != forest or _untrusted(r):
+            if (get(r, "correction", "forest") or "awcc") != forest or _untrusted(r, quantity):
                 return None
             return get(r, "correction", quantity, "median")
         for low, high, marker, width, label in (("0.025", "0.975", None, 1.0, f"{what}, 95 % band"),
@@ -429,9 +429,14 @@ def _quantiles(r, q, a, b):
     return (qs.get(a), qs.get(b)) if qs else None
 
 
-def _untrusted(r):
-    """A correction whose quantiles are kept but not presented as corrected."""
-    return get(r, "correction", "status") == "untrusted"
+def _untrusted(r, quantity=None):
+    """A correction whose quantiles are kept but not presented as corrected:
+    an untrusted row, or (of `quantity`) a quantity whose median the trust
+    rules hold back on a corrected row (a reason in its object: Tu, rule (e)
+    of correction/model.hpp)."""
+    if get(r, "correction", "status") == "untrusted":
+        return True
+    return quantity is not None and get(r, "correction", quantity, "reason") is not None
 
 
 def _untrusted_medians(ax, y, rows, quantity, unit):
@@ -440,7 +445,7 @@ def _untrusted_medians(ax, y, rows, quantity, unit):
     them is drawn at the edge, pointing out, with its value."""
     # An untrusted row's median is null: the forest's answer is its 0.5 quantile.
     points = [(y[i], number(get(r, "correction", quantity, "quantiles", "0.5"))) for i, r in enumerate(rows)
-              if _untrusted(r)]
+              if _untrusted(r, quantity)]
     points = [(yi, v) for yi, v in points if v is not None]
     if not points:
         return

@@ -362,6 +362,64 @@ TEST(TrustRules, AYieldBelowChanceIsUntrustedAtTheLimitItIsNotAndUnknownWindowsA
   EXPECT_DOUBLE_EQ(c.velocity->median(), 2.0);  // the quantiles kept
 }
 
+TEST(TrustRules, TuOfBubblesFarLargerThanTheTipSeparationIsNotCorrectedAboveTheLimitAndTheVelocityStands) {
+  // Rule (e): d32 / dx above 10 holds back Tu's median, not the velocity's.
+  // Targets 1.0 and 0.0 (the forest returns the measurement), so rules
+  // (a)-(d) hold and only the ratio decides. dx 0.5 m: d32 5 m is 10 exactly.
+  const auto m = model_of([](int) { return 1.0; }, [](int) { return 0.0; });
+  auto f = middle();
+  f.d32 = 5.0;
+  auto c = m.correct(f);
+  EXPECT_TRUE(c.turbulence_corrected()) << c.turbulence_message;
+  EXPECT_FALSE(c.large_bubbles);
+  EXPECT_TRUE(c.turbulence_message.empty());
+  f.d32 = std::nextafter(5.0, 10.0);
+  c = m.correct(f);
+  EXPECT_TRUE(c.corrected()) << c.message;
+  EXPECT_TRUE(c.large_bubbles);
+  EXPECT_FALSE(c.turbulence_corrected());
+  EXPECT_FALSE(c.outside_envelope || c.multimodal || c.one_sample_lag || c.chance_yield);
+  EXPECT_EQ(c.turbulence_message.find("Tu not corrected: the Sauter diameter d32 5000 mm is 10 times the tip "
+                                      "separation dx 500 mm (above 10)"),
+            0u)
+      << c.turbulence_message;
+  ASSERT_TRUE(c.velocity && c.turbulence_intensity);
+  EXPECT_DOUBLE_EQ(c.turbulence_intensity->median(), 0.2);  // the quantiles kept
+  // JSON: the velocity's median stands, Tu's is null with the reason.
+  const auto j = correction::to_json(c);
+  EXPECT_EQ(j["status"], "corrected");
+  EXPECT_DOUBLE_EQ(j["velocity"]["median"].get<double>(), 2.0);
+  EXPECT_TRUE(j["velocity"].find("reason") == j["velocity"].end());
+  EXPECT_TRUE(j["turbulence_intensity"]["median"].is_null());
+  EXPECT_DOUBLE_EQ(j["turbulence_intensity"]["quantiles"]["0.5"].get<double>(), 0.2);
+  EXPECT_EQ(j["turbulence_intensity"]["reason"].get<std::string>(), c.turbulence_message);
+  // CSV: the same, the reason in its column.
+  const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
+  const auto columns = correction::correction_csv_columns();
+  ASSERT_EQ(cells.size(), columns.size());
+  std::map<std::string, std::string, std::less<>> cell;
+  for (std::size_t k = 0; k < columns.size(); ++k) cell[std::string(columns[k].name)] = cells[k];
+  EXPECT_EQ(cell["corrected_velocity"], "2");
+  EXPECT_EQ(cell["corrected_turbulence_intensity"], "");
+  EXPECT_EQ(cell["corrected_turbulence_intensity_q0.5"], "0.2");
+  EXPECT_EQ(cell[std::string(correction::correction_column::turbulence_reason)], c.turbulence_message);
+  // A corrected Tu has a null reason; a row without d32 (0: not known) or dx is not judged.
+  EXPECT_TRUE(correction::to_json(m.correct(middle()))["turbulence_intensity"]["reason"].is_null());
+  f.dx = 0.0;
+  EXPECT_FALSE(m.correct(f).large_bubbles);
+  f = middle();
+  f.d32 = 0.0;
+  EXPECT_FALSE(m.correct(f).large_bubbles);
+  // An untrusted row is judged too: its Tu reason is given beside the row's.
+  f = middle();
+  f.d32 = 6.0;
+  f.fs = 4.0;  // rule (c)
+  c = m.correct(f);
+  EXPECT_EQ(c.status, CorrectionStatus::untrusted);
+  EXPECT_TRUE(c.one_sample_lag && c.large_bubbles);
+  EXPECT_EQ(c.message.find("a lag of one sample"), 0u) << c.message;
+}
+
 // A row as pdp process measures it: AWCC's u (m/s) and Tu, the leading
 // tip's c and F (1/s), dx (m), AWCC's {accepted, formed} windows, the
 // record's {fs (Hz), duration (s)}, FSCC's {u (m/s), R12max}; Np 10, dy 0,

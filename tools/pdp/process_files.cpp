@@ -66,6 +66,7 @@ std::vector<correction::Correction> corrections_of(const Plan& plan, const Proce
     const auto& c = corrections.back();
     if (!c.corrected()) spdlog::warn("{}: not corrected: {}", r.info.path.string(), c.why_not());
     for (const auto& n : c.notes) spdlog::warn("{}: {}", r.info.path.string(), n);
+    if (c.large_bubbles) spdlog::warn("{}: {}", r.info.path.string(), c.turbulence_message);
   }
   return corrections;
 }

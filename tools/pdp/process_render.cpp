@@ -29,6 +29,7 @@ std::string correction_report(const correction::Correction& c) {
   std::string out;
   if (!c.corrected()) {
     out = fmt::format("  correction: not corrected: {}\n", c.why_not());
+    if (c.large_bubbles) out += fmt::format("    turbulence intensity: {}\n", c.turbulence_message);
   } else {
     const auto& u = *c.velocity;
     out = fmt::format(
@@ -36,7 +37,10 @@ std::string correction_report(const correction::Correction& c) {
         "    velocity             {:.4f} m/s median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
         c.forest == "fscc" ? "FSCC" : "AWCC", u.median(), u.quantiles[1], u.quantiles[5], u.quantiles[0],
         u.quantiles[6], u.measured);
-    if (const auto& t = c.turbulence_intensity) {
+    if (const auto& t = c.turbulence_intensity; t && c.large_bubbles) {
+      out += fmt::format("    turbulence intensity: {} (forest's median {:.4f}, measured {:.4f})\n", c.turbulence_message,
+                         t->median(), t->measured);
+    } else if (t) {
       out += fmt::format(
           "    turbulence intensity {:.4f} median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
           t->median(), t->quantiles[1], t->quantiles[5], t->quantiles[0], t->quantiles[6], t->measured);

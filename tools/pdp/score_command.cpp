@@ -76,10 +76,11 @@ int run_score(const ScoreOptions& o) {
     std::string report = fmt::format(
         "pdp score {}: {} (generator version {}); {} runs read, {} with at least {} accepted windows; scored {} "
         "({} outside the training ranges, not scored; {} of the scored untrusted by the trust rules: {} outside the "
-        "envelope, {} multimodal, {} at a lag of one sample, {} at a chance yield)\n",
+        "envelope, {} multimodal, {} at a lag of one sample, {} at a chance yield; the Tu of {} not corrected: "
+        "bubbles far larger than dx)\n",
         std::filesystem::path(o.model).filename().string(), sources, fmt::join(set.generator_versions, " and "),
         set.total, set.rows.size(), model.min_windows, scores.rows, scores.out_of_range, scores.untrusted,
-        scores.outside_envelope, scores.multimodal, scores.one_sample_lag, scores.chance_yield);
+        scores.outside_envelope, scores.multimodal, scores.one_sample_lag, scores.chance_yield, scores.large_bubbles);
     report += fmt::format("truth: {}{}\n", o.truth,
                           truth == correction::TruthKind::imposed ? " (the scene's velocity and tu)" : " (the run's realised statistics)");
     if (!processed_otherwise.empty()) {

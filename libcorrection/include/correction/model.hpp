@@ -71,6 +71,20 @@
 //     20 %, its 95 % intervals covering 90 %). A row whose
 //     windows are not known (a peer's) is not judged by it.
 // Any rule, on the velocity or on Tu, makes the row untrusted.
+// (e) Tu of tips far closer than the bubbles (the AWCC forests' Tu only):
+//     the measured d32 / dx must be at most largest_tu_size_ratio (10).
+//     Tips a tenth of a bubble apart meet each interface almost together,
+//     so a window's delay follows the interface's tilt more than the flow
+//     and AWCC's Tu reads high by an amount no feature carries (the ratio
+//     itself, as a feature, took a sixth of it). On the conventions
+//     campaign's corrected test rows the corrected Tu's mean error is
+//     -0.001 to -0.004 and its 80 % intervals cover 86-89 % in every band
+//     of d32 / dx up to 10; above it +0.011 (10-14), +0.023 (14-20) and
+//     +0.06-0.07 (beyond 20), covering 61-80 % (docs/validation.md). Such
+//     a row's Tu is not corrected (its median not reported, its quantiles
+//     kept, Correction::turbulence_message says why); its velocity, whose
+//     error there is 2-4 % with intervals that hold, stands. A row without
+//     d32 or dx is not judged by it.
 //
 // Model file (".qrf"), all numbers little-endian whatever the machine:
 //   "pdp-qrf\n" (8 bytes), u32 format version, u64 payload bytes, payload,
@@ -133,6 +147,10 @@ inline constexpr std::string_view status = "status";
 inline constexpr std::string_view forest = "forest";
 inline constexpr std::string_view velocity = "velocity";
 inline constexpr std::string_view quantiles = "quantiles";  ///< by correction_level_names
+inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
+/// In turbulence_intensity: why its median is null on a row whose velocity
+/// stands (rule (e)), null otherwise.
+inline constexpr std::string_view reason = "reason";
 }  // namespace correction_key
 /// The correction's CSV columns read back (correction_csv_columns declares them).
 namespace correction_column {
@@ -140,6 +158,8 @@ inline constexpr std::string_view status = "correction_status";
 inline constexpr std::string_view forest = "correction_forest";
 /// Followed by a level's name: the velocity's quantile at that level.
 inline constexpr std::string_view velocity_quantile = "corrected_velocity_q";
+/// Why the corrected Tu is empty on a row whose velocity stands (rule (e)).
+inline constexpr std::string_view turbulence_reason = "correction_turbulence_reason";
 }  // namespace correction_column
 
 enum class TargetForm : std::uint8_t { value = 0, ratio = 1, difference = 2 };
@@ -183,7 +203,16 @@ struct Correction {
   std::vector<std::string> notes;
   /// Which trust rules an untrusted row breaks: (a)-(d) of the model's header.
   bool outside_envelope = false, multimodal = false, one_sample_lag = false, chance_yield = false;
+  /// Rule (e) of the model's header: bubbles far larger than the tip
+  /// separation, so that Tu is not corrected whatever the velocity's status;
+  /// `turbulence_message` says why (empty when the rule holds).
+  bool large_bubbles = false;
+  std::string turbulence_message;
   [[nodiscard]] bool corrected() const { return status == CorrectionStatus::corrected; }
+  /// The row is corrected and its Tu too (not an FSCC forest's row, rule (e) holds).
+  [[nodiscard]] bool turbulence_corrected() const {
+    return corrected() && turbulence_intensity.has_value() && !large_bubbles;
+  }
   /// Empty when corrected; "untrusted: " and the reason, or the reason.
   [[nodiscard]] std::string why_not() const;
 };
@@ -197,6 +226,11 @@ struct Correction {
 /// off by 1.8-2.8 times the others' (docs/validation.md); the 2 mm row of the
 /// real profile (issue 29) is at 0.31.
 inline constexpr double multimodal_dip_limit = 0.4;
+/// The limit of rule (e) (the trust rules above): above this measured
+/// d32 / dx the AWCC forests' Tu is not corrected. The bands of d32 / dx
+/// measured in docs/validation.md change behaviour between 7-10 (Tu mean
+/// error -0.001, 80 % coverage 89 %) and 10-14 (+0.011, 69 %).
+inline constexpr double largest_tu_size_ratio = 10.0;
 /// The share of the calibration runs' truths the envelope of rule (a) holds:
 /// a median beyond it is farther from the measurement than all but 0.25 % of
 /// the truths on that side. At 99 % the rule fired on 1.9 % of held-out runs,
@@ -343,14 +377,16 @@ double from_target(TargetForm form, double target, double measured);
 /// Profile CSV columns of a correction (no leading comma): correction_in_range,
 /// correction_reason, correction_forest, corrected_velocity (median; empty
 /// unless corrected), corrected_velocity_q0.025 .. _q0.975 (of untrusted rows
-/// too), the same for turbulence_intensity, correction_status and
-/// correction_notes.
+/// too), the same for turbulence_intensity (its median empty too where rule
+/// (e) holds it back), correction_status, correction_notes and
+/// correction_turbulence_reason.
 std::string correction_csv_header();
 /// The same columns declared as the profile CSV's (awcc::ProfileColumn).
 std::span<const awcc::ProfileColumn> correction_csv_columns();
 std::string correction_csv_cells(const Correction& c);
 /// The velocity's and Tu's cells of a row, each with a leading comma: the
-/// median (empty unless corrected) and the seven quantiles, or empty cells.
+/// median (empty unless corrected; Tu's also when rule (e) holds it back)
+/// and the seven quantiles, or empty cells.
 std::string quantile_cells(const Correction& c);
 /// The notes joined by "; " (one CSV cell).
 std::string notes_text(const Correction& c);

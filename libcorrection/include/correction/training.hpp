@@ -171,6 +171,9 @@ struct HeldOutScores {
   /// Of the scored rows, those the trust rules leave untrusted, and by rule
   /// (a row may break several).
   std::int64_t untrusted = 0, outside_envelope = 0, multimodal = 0, one_sample_lag = 0, chance_yield = 0;
+  /// Of the scored rows, those whose Tu rule (e) holds back (any status);
+  /// their Tu is scored with the others' (its quantiles).
+  std::int64_t large_bubbles = 0;
   double velocity_rmse_raw = 0.0, velocity_rmse_corrected = 0.0;  ///< relative (u/u_true - 1)
   double velocity_bias_raw = 0.0, velocity_bias_corrected = 0.0;  ///< mean relative error
   double velocity_median_abs_raw = 0.0, velocity_median_abs_corrected = 0.0;  ///< median |relative error|
