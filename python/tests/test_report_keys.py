@@ -33,6 +33,10 @@ def edited(rows, index, status="untrusted"):
         out[index]["correction"] = None
         return out
     c = out[index]["correction"]
+    if status == "tu-held-back":  # trust rule (e): the row corrected, its Tu's median null with a reason
+        c["turbulence_intensity"]["median"] = None
+        c["turbulence_intensity"]["reason"] = "Tu not corrected: the Sauter diameter d32 ..."
+        return out
     c["status"] = status
     for quantity in ("velocity", "turbulence_intensity"):
         if c.get(quantity):
@@ -48,14 +52,15 @@ def drawn_xs(ax):
     return xs
 
 
-@pytest.mark.parametrize("figure, quantity, index", [
-    (plotting.profile_velocity, "velocity", 0),  # the 2 mm row: corrected by the FSCC forest to 6.62 m/s
-    (plotting.profile_velocity, "velocity", 5),  # a median inside the axis
-    (plotting.profile_turbulence, "turbulence_intensity", 5),
+@pytest.mark.parametrize("figure, quantity, index, status", [
+    (plotting.profile_velocity, "velocity", 0, "untrusted"),  # the 2 mm row: corrected by the FSCC forest to 6.62 m/s
+    (plotting.profile_velocity, "velocity", 5, "untrusted"),  # a median inside the axis
+    (plotting.profile_turbulence, "turbulence_intensity", 5, "untrusted"),
+    (plotting.profile_turbulence, "turbulence_intensity", 5, "tu-held-back"),
 ])
-def test_an_untrusted_correction_is_drawn_apart_and_sets_no_limit(rows, figure, quantity, index):
+def test_an_untrusted_correction_is_drawn_apart_and_sets_no_limit(rows, figure, quantity, index, status):
     median = rows[index]["correction"][quantity]["quantiles"]["0.5"]
-    fig = figure(edited(rows, index))
+    fig = figure(edited(rows, index, status))
     ax = fig.axes[0]
     # The axis is the one drawn without that row's correction at all: an exact identity.
     assert ax.get_xlim() == figure(edited(rows, index, None)).axes[0].get_xlim()
@@ -75,6 +80,17 @@ def test_an_untrusted_correction_is_drawn_apart_and_sets_no_limit(rows, figure, 
     assert not {q["0.025"], q["0.975"], q["0.1"], q["0.9"]} & set(drawn_xs(ax))
     assert UNTRUSTED in [t.get_text() for t in ax.get_legend().get_texts()]
     check_legends(fig, f"untrusted {quantity} {index}")
+
+
+def test_a_tu_held_back_leaves_the_rows_velocity_drawn_as_corrected(rows):
+    """Rule (e) holds back Tu only: the velocity figure is the one drawn
+    from the row as pdp wrote it, its corrected median among the points."""
+    held = edited(rows, 5, "tu-held-back")
+    median = rows[5]["correction"]["velocity"]["median"]
+    ax = plotting.profile_velocity(held).axes[0]
+    assert ax.get_xlim() == plotting.profile_velocity(rows).axes[0].get_xlim()
+    assert median in drawn_xs(ax)
+    assert UNTRUSTED not in [t.get_text() for t in ax.get_legend().get_texts()]
 
 
 def test_an_untrusted_2mm_correction_does_not_stretch_the_velocity_axis(rows):
