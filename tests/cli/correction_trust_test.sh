@@ -23,6 +23,9 @@
 #     record is synthesised at 20 kHz (the scene allows it: a lag of 5 mm at
 #     3 m/s is 33 samples), 8 s of CPU instead of a minute at 500 kHz.
 # A row the FSCC forest corrects says its Tu is not corrected (it printed 0.0000).
+# Rule (e), end to end: 9 mm bubbles on tips 0.8 mm apart (measured d32 /
+# dx 12.4) read Tu 0.32 for a flow of 0.2; the velocity is corrected, Tu is
+# not (summary, stderr and the JSON say why; its median null, quantiles kept).
 # Usage: correction_trust_test.sh PDP SCRATCH_DIR SOURCE_DIR
 set -u
 pdp=$1
@@ -140,6 +143,26 @@ grep -q "correction (quantile regression forest, FSCC forest):" "$dir/sparse.txt
 grep -q "    turbulence intensity not corrected (the FSCC forest corrects the velocity only)" "$dir/sparse.txt" ||
   fail "FSCC row: Tu line: $(grep 'turbulence intensity' "$dir/sparse.txt" | tail -1)"
 grep -q "0.0000 median" "$dir/sparse.txt" && fail "FSCC row: a Tu of 0 printed as corrected"
+
+# Rule (e): the velocity stands, Tu is held back.
+"$pdp" --log-level error synth --config "$src/samples/base.toml" --bubble-diameter 9mm --dx 0.8mm --duration 20s \
+  --fs 200kHz --seed 4 -q -o "$dir/large.flac" || fail "rule (e): synth"
+"$pdp" process "$dir/large.flac" --dx 0.8mm --dy 0mm --correct "$model" --json "$dir/large.json" >"$dir/large.txt" \
+  2>"$dir/large.err" || fail "rule (e): process"
+grep -q "correction (quantile regression forest, AWCC forest):" "$dir/large.txt" || fail "rule (e): velocity not corrected"
+grep -q "    turbulence intensity: Tu not corrected: the Sauter diameter d32 9.9.. mm is 12.. times the tip separation dx 0.8 mm (above 10)" \
+  "$dir/large.txt" || fail "rule (e): summary: $(grep 'turbulence intensity' "$dir/large.txt" | tail -1)"
+grep -q "large.flac: Tu not corrected: the Sauter diameter" "$dir/large.err" || fail "rule (e): stderr says nothing"
+/usr/bin/python3 - "$dir/large.json" <<'PY' || fail "rule (e): JSON"
+import json, sys
+c = json.load(open(sys.argv[1]))["correction"]
+assert c["status"] == "corrected" and c["forest"] == "awcc", c
+assert c["velocity"]["median"] is not None and c["velocity"].get("reason") is None, c["velocity"]
+t = c["turbulence_intensity"]
+assert t["median"] is None, t
+assert t["reason"].startswith("Tu not corrected: the Sauter diameter d32"), t["reason"]
+assert t["quantiles"]["0.025"] <= t["quantiles"]["0.5"] <= t["quantiles"]["0.975"], t
+PY
 
 if ((failures)); then
   echo "$failures failures"
