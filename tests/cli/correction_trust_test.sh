@@ -24,7 +24,7 @@
 #     3 m/s is 33 samples), 8 s of CPU instead of a minute at 500 kHz.
 # A row the FSCC forest corrects says its Tu is not corrected (it printed 0.0000).
 # Rule (e), end to end: 9 mm bubbles on tips 0.8 mm apart (measured d32 /
-# dx 12.4) read Tu 0.32 for a flow of 0.2; the velocity is corrected, Tu is
+# dx 12.4) read Tu 0.32 for a flow of 0.25; the velocity is corrected, Tu is
 # not (summary, stderr and the JSON say why; its median null, quantiles kept).
 # Usage: correction_trust_test.sh PDP SCRATCH_DIR SOURCE_DIR
 set -u
