@@ -150,6 +150,17 @@ CorrectionModel model_of(const std::function<double(int)>& velocity_target,
   return m;
 }
 
+// A correction's profile CSV cells by column name (empty when the cells
+// and the declared columns differ in number: the caller checks the size).
+std::map<std::string, std::string, std::less<>> csv_cells_by_column(const correction::Correction& c) {
+  const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
+  const auto columns = correction::correction_csv_columns();
+  std::map<std::string, std::string, std::less<>> out;
+  if (cells.size() != columns.size()) return out;
+  for (std::size_t k = 0; k < columns.size(); ++k) out[std::string(columns[k].name)] = cells[k];
+  return out;
+}
+
 Features middle() {
   Features f;
   f.velocity = 2.0;
@@ -191,11 +202,8 @@ TEST(TrustRules, EnvelopeHoldsAtItsLimitAndBreaksJustBeyond) {
   EXPECT_FALSE(j["in_range"].get<bool>());
   EXPECT_TRUE(j["velocity"]["median"].is_null());
   EXPECT_DOUBLE_EQ(j["velocity"]["quantiles"]["0.5"].get<double>(), 2.4);
-  const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
-  const auto columns = correction::correction_csv_columns();
-  ASSERT_EQ(cells.size(), columns.size());
-  std::map<std::string, std::string, std::less<>> cell;
-  for (std::size_t k = 0; k < columns.size(); ++k) cell[std::string(columns[k].name)] = cells[k];
+  auto cell = csv_cells_by_column(c);
+  ASSERT_EQ(cell.size(), correction::correction_csv_columns().size());
   EXPECT_EQ(cell["corrected_velocity"], "");
   EXPECT_EQ(cell["corrected_velocity_q0.5"], "2.4");
   EXPECT_EQ(cell["correction_status"], "untrusted");
@@ -394,11 +402,8 @@ TEST(TrustRules, TuOfBubblesFarLargerThanTheTipSeparationIsNotCorrectedAboveTheL
   EXPECT_DOUBLE_EQ(j["turbulence_intensity"]["quantiles"]["0.5"].get<double>(), 0.2);
   EXPECT_EQ(j["turbulence_intensity"]["reason"].get<std::string>(), c.turbulence_message);
   // CSV: the same, the reason in its column.
-  const auto cells = awcc::split_cells(correction::correction_csv_cells(c));
-  const auto columns = correction::correction_csv_columns();
-  ASSERT_EQ(cells.size(), columns.size());
-  std::map<std::string, std::string, std::less<>> cell;
-  for (std::size_t k = 0; k < columns.size(); ++k) cell[std::string(columns[k].name)] = cells[k];
+  auto cell = csv_cells_by_column(c);
+  ASSERT_EQ(cell.size(), correction::correction_csv_columns().size());
   EXPECT_EQ(cell["corrected_velocity"], "2");
   EXPECT_EQ(cell["corrected_turbulence_intensity"], "");
   EXPECT_EQ(cell["corrected_turbulence_intensity_q0.5"], "0.2");
