@@ -120,28 +120,33 @@ PhaseStatistics phase_statistics(const AirIntervals& signal, const PhaseStatisti
   p.duration = fs > 0.0 ? static_cast<double>(signal.sample_count) / fs : 0.0;
   p.void_fraction = signal.void_fraction();
   // Chords and interarrival times in samples, then sorted durations (the
-  // order of chords is not needed again).
-  std::vector<std::int64_t> air_samples, water_samples, arrival_samples, buffer;
+  // order of chords is not needed again), one kind at a time: a 300 s
+  // record's arrays are 3 MB each, and the three kinds' samples, durations
+  // and the sort's buffer held together were 27 MB of the run's peak
+  // memory (docs/performance.md).
   const auto& iv = signal.intervals;
-  air_samples.reserve(iv.size());
-  water_samples.reserve(iv.size());
-  arrival_samples.reserve(iv.size());
-  for (std::size_t i = 0; i < iv.size(); ++i) {
-    const bool complete = iv[i].start > 0 && iv[i].stop < signal.sample_count;
-    if (complete) air_samples.push_back(iv[i].stop - iv[i].start);
-    if (i + 1 < iv.size()) {
-      water_samples.push_back(iv[i + 1].start - iv[i].stop);
-      if (i > 0 || iv[i].start > 0) arrival_samples.push_back(iv[i + 1].start - iv[i].start);
-    }
-  }
-  const std::vector<double> air = sorted_durations(air_samples, buffer, fs);
-  const std::vector<double> water = sorted_durations(water_samples, buffer, fs);
-  const std::vector<double> arrivals = sorted_durations(arrival_samples, buffer, fs);
+  std::vector<std::int64_t> samples, buffer;
+  samples.reserve(iv.size());
+  auto durations_of = [&](auto&& collect) {
+    samples.clear();
+    for (std::size_t i = 0; i < iv.size(); ++i) collect(i);
+    return sorted_durations(samples, buffer, fs);
+  };
+  p.interarrival_time = summarise_sorted(durations_of([&](std::size_t i) {
+    if (i + 1 < iv.size() && (i > 0 || iv[i].start > 0)) samples.push_back(iv[i + 1].start - iv[i].start);
+  }));
+  const std::vector<double> air = durations_of([&](std::size_t i) {
+    if (iv[i].start > 0 && iv[i].stop < signal.sample_count) samples.push_back(iv[i].stop - iv[i].start);
+  });
+  const std::vector<double> water = durations_of([&](std::size_t i) {
+    if (i + 1 < iv.size()) samples.push_back(iv[i + 1].start - iv[i].stop);
+  });
+  samples = {};
+  buffer = {};
   const auto n = static_cast<double>(air.size());
   p.bubble_count_rate = p.duration > 0.0 ? n / p.duration : 0.0;
   p.air_chord_time = summarise_sorted(air);
   p.water_chord_time = summarise_sorted(water);
-  p.interarrival_time = summarise_sorted(arrivals);
   p.air_chord_histogram = histogram_of(air, options.histogram_bins);
   p.water_chord_histogram = histogram_of(water, options.histogram_bins);
   // Confidence intervals of c and F (alternating renewal process, see header).
