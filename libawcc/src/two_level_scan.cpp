@@ -22,12 +22,16 @@ TwoLevelScan::TwoLevelScan(std::size_t stride, std::span<const std::size_t> chan
 }
 
 bool TwoLevelScan::change(Tip& tip, std::int64_t index, std::int16_t value) {
-  if (tip.levels == 0 || (value != tip.level[0] && tip.levels == 1)) {
-    tip.level[tip.levels++] = value;
-  } else if (value != tip.level[0] && value != tip.level[1]) {
+  // The caller reports a change only where the value differs from the
+  // sample before, so the third run on is at level[run % 2] or at a third value.
+  const std::size_t run = tip.changes.size();
+  if (run < 2) {
+    tip.level[run] = value;
+    tip.levels = static_cast<int>(run) + 1;
+  } else if (value != tip.level[run % 2]) {
     return false;
   }
-  tip.changes.push_back({index, value});
+  tip.changes.push_back(index);
   return true;
 }
 
@@ -156,8 +160,8 @@ VoltageHistogram TwoLevelScan::histogram(int tip, double quantum) const {
   const Tip& t = tips_[static_cast<std::size_t>(tip)];
   std::int64_t count[2] = {0, 0};
   for (std::size_t c = 0; c < t.changes.size(); ++c) {
-    const std::int64_t end = c + 1 < t.changes.size() ? t.changes[c + 1].index : position_;
-    count[t.changes[c].value == t.level[0] ? 0 : 1] += end - t.changes[c].index;
+    const std::int64_t end = c + 1 < t.changes.size() ? t.changes[c + 1] : position_;
+    count[c % 2] += end - t.changes[c];
   }
   VoltageHistogram h(quantum);
   for (int l = 0; l < t.levels; ++l) {
@@ -183,11 +187,15 @@ AirIntervals TwoLevelScan::intervals(int tip, const Threshold& threshold, double
   out.sample_count = position_;
   bool in_air = false;
   std::int64_t start = 0;
-  for (const Change& c : t.changes) {
-    const bool now = air[c.value == t.level[0] ? 0 : 1];
+  // At most one interval for every two runs: reserved, so that the array
+  // does not grow by doubling beside the scan's changes (the binary path's
+  // peak memory).
+  out.intervals.reserve(t.changes.size() / 2 + 1);
+  for (std::size_t c = 0; c < t.changes.size(); ++c) {
+    const bool now = air[c % 2];
     if (now == in_air) continue;
-    if (now) start = c.index;
-    else out.intervals.push_back({start, c.index});
+    if (now) start = t.changes[c];
+    else out.intervals.push_back({start, t.changes[c]});
     in_air = now;
   }
   if (in_air) out.intervals.push_back({start, position_});
