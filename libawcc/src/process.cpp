@@ -358,6 +358,8 @@ class BandRecorder {
 
   AirIntervals resolve(const Threshold& t, double quantum, double fs) const {
     Binariser b(t, fs);
+    // An interval opens at one event and closes at a later one.
+    b.reserve(events_.size() / 2 + 1);
     const auto below = static_cast<float>((static_cast<double>(lo_) - 0.5) * quantum);
     const auto above = static_cast<float>((static_cast<double>(hi_) + 0.5) * quantum);
     for (std::size_t e = 0; e < events_.size(); ++e) {
@@ -374,6 +376,8 @@ class BandRecorder {
   }
 
   [[nodiscard]] std::int64_t samples() const { return position_; }
+  /// Frees the events once resolved (the next tip's resolving needs the room).
+  void release() { events_ = {}; }
 
  private:
   struct Event {
@@ -531,7 +535,10 @@ std::vector<TipSignal> binarise_tips(Recording& recording, const ProcessOptions&
           covered = covered && recorders[k].covers(out[k].threshold, info.quantum);
         }
         if (covered) {
-          for (std::size_t k = 0; k < tips; ++k) out[k].signal = recorders[k].resolve(out[k].threshold, info.quantum, info.fs);
+          for (std::size_t k = 0; k < tips; ++k) {
+            out[k].signal = recorders[k].resolve(out[k].threshold, info.quantum, info.fs);
+            recorders[k].release();
+          }
           return out;
         }
       }
