@@ -345,25 +345,17 @@ FeatureVector feature_vector(const std::vector<FeatureRange>& ranges, double mar
   return out;
 }
 
-// The offsets or envelope of a row's group (Calibration::offsets): with
-// its windows or its duration unknown, each value's largest over the bands
-// it could be in.
+// The offsets or envelope of a row's group (Calibration::offsets).
 template <std::size_t N>
 std::array<double, N> group_value(const Calibration& c, const std::vector<std::array<double, N>>& groups,
-                                  std::int64_t windows, double tu_median, double duration) {
+                                  std::int64_t windows, double tu_median) {
   const auto h = static_cast<std::size_t>(c.tu_band(tu_median));
   const int w = c.band(windows);
-  const int d = c.duration_band(duration);
-  if (w >= 0 && d >= 0) return groups[c.group_index(static_cast<std::size_t>(w), h, static_cast<std::size_t>(d))];
+  if (w >= 0) return groups[static_cast<std::size_t>(w) * c.tu_bands() + h];
   std::array<double, N> o;
   o.fill(-std::numeric_limits<double>::infinity());
-  for (std::size_t db = 0; db < c.duration_bands(); ++db) {
-    if (d >= 0 && db != static_cast<std::size_t>(d)) continue;
-    for (std::size_t b = 0; b < c.window_bands(); ++b) {
-      if (w >= 0 && b != static_cast<std::size_t>(w)) continue;
-      for (std::size_t k = 0; k < N; ++k) o[k] = std::max(o[k], groups[c.group_index(b, h, db)][k]);
-    }
-  }
+  for (std::size_t b = 0; b <= c.window_edges.size(); ++b)
+    for (std::size_t k = 0; k < N; ++k) o[k] = std::max(o[k], groups[b * c.tu_bands() + h][k]);
   return o;
 }
 
@@ -543,39 +535,19 @@ int Calibration::tu_band(double tu_median) const {
   return h;
 }
 
-int Calibration::duration_band(double duration) const {
-  if (duration_edges.empty()) return 0;  // one band holds every record, its duration known or not
-  if (!(duration > 0.0) || !std::isfinite(duration)) return -1;
-  int d = 0;
-  while (d < static_cast<int>(duration_edges.size()) && duration >= duration_edges[static_cast<std::size_t>(d)]) ++d;
-  return d;
-}
-
 std::array<double, 3> Calibration::offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
-                                           double tu_median, double duration) const {
-  return group_value(*this, groups, windows, tu_median, duration);
+                                           double tu_median) const {
+  return group_value(*this, groups, windows, tu_median);
 }
 
 std::optional<std::array<double, 2>> Calibration::envelope(const std::vector<std::array<double, 2>>& groups,
-                                                           std::int64_t windows, double tu_median,
-                                                           double duration) const {
+                                                           std::int64_t windows, double tu_median) const {
   if (groups.empty()) return std::nullopt;
   if (groups.size() == 1) return groups.front();
-  return group_value(*this, groups, windows, tu_median, duration);
+  return group_value(*this, groups, windows, tu_median);
 }
 
-std::string Calibration::group_text(std::int64_t windows, double tu_median, double duration) const {
-  std::string out = windows_and_tu_text(windows, tu_median);
-  if (duration_edges.empty()) return out;
-  const int d = duration_band(duration);
-  if (d < 0) return out + ", duration unknown: the widest band";
-  if (d == 0) return fmt::format("{}, records under {:g} s", out, duration_edges.front());
-  const auto i = static_cast<std::size_t>(d);
-  if (i == duration_edges.size()) return fmt::format("{}, records of {:g} s+", out, duration_edges.back());
-  return fmt::format("{}, records of {:g}-{:g} s", out, duration_edges[i - 1], duration_edges[i]);
-}
-
-std::string Calibration::windows_and_tu_text(std::int64_t windows, double tu_median) const {
+std::string Calibration::group_text(std::int64_t windows, double tu_median) const {
   std::string out;
   const int w = band(windows);
   if (window_edges.empty()) {
@@ -693,8 +665,8 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   // The group's Tu band: the Tu forest's own median, before calibration.
   const double tu_median = from_target(m.turbulence_form, tu_t[3], f.turbulence_intensity);
   if (!cal.empty()) {
-    Calibration::apply(cal.offsets(cal.velocity, f.windows_accepted, tu_median, f.duration), velocity_t);
-    Calibration::apply(cal.offsets(cal.turbulence_intensity, f.windows_accepted, tu_median, f.duration), tu_t);
+    Calibration::apply(cal.offsets(cal.velocity, f.windows_accepted, tu_median), velocity_t);
+    Calibration::apply(cal.offsets(cal.turbulence_intensity, f.windows_accepted, tu_median), tu_t);
   }
   const Quantity u{"AWCC forest's", "velocity", "m/s", "AWCC's", m.velocity_form, f.velocity, false};
   const Quantity tu{"AWCC forest's", "Tu", "", "AWCC's", m.turbulence_form, f.turbulence_intensity, true};
@@ -711,11 +683,10 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   const std::string runs = cal.envelope_from_training
                                ? "the forest's training runs"
                                : fmt::format("runs the model was not trained on ({})",
-                                             cal.group_text(f.windows_accepted, tu_median, f.duration));
-  auto verdict = untrusted_reasons(
-      u, velocity_d, cal.envelope(cal.velocity_envelope, f.windows_accepted, tu_median, f.duration), runs);
-  verdict.add(untrusted_reasons(
-      tu, tu_d, cal.envelope(cal.turbulence_envelope, f.windows_accepted, tu_median, f.duration), runs));
+                                             cal.group_text(f.windows_accepted, tu_median));
+  auto verdict =
+      untrusted_reasons(u, velocity_d, cal.envelope(cal.velocity_envelope, f.windows_accepted, tu_median), runs);
+  verdict.add(untrusted_reasons(tu, tu_d, cal.envelope(cal.turbulence_envelope, f.windows_accepted, tu_median), runs));
   verdict.add(unresolved_lag("AWCC's", f.velocity, f.dx, f.fs));
   verdict.add(chance_yield(f));
   judge(c, verdict);
@@ -861,8 +832,6 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
     for (auto e : calibration.window_edges) payload.i64(e);
     payload.u32(static_cast<std::uint32_t>(calibration.tu_bands()));
     for (double e : calibration.tu_edges) payload.f64(e);
-    payload.u32(static_cast<std::uint32_t>(calibration.duration_bands()));
-    for (double e : calibration.duration_edges) payload.f64(e);
     for (const auto* bands : {&calibration.velocity, &calibration.turbulence_intensity})
       for (const auto& b : *bands)
         for (double o : b) payload.f64(o);
@@ -977,16 +946,8 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
         e = r.f64();
         if (!std::isfinite(e) || (&e != c.tu_edges.data() && e <= *(&e - 1))) r.damaged("calibration Tu edges not increasing");
       }
-      const auto duration_bands = version >= 7 ? r.count(r.u32(), 48) : std::size_t{1};
-      if (duration_bands < 1) r.damaged("no duration band in the calibration");
-      c.duration_edges.resize(duration_bands - 1);
-      for (auto& e : c.duration_edges) {
-        e = r.f64();
-        if (!(e > 0.0) || !std::isfinite(e) || (&e != c.duration_edges.data() && e <= *(&e - 1)))
-          r.damaged("calibration duration edges not positive and increasing");
-      }
       for (auto* b : {&c.velocity, &c.turbulence_intensity}) {
-        b->resize(bands * tu_bands * duration_bands);
+        b->resize(bands * tu_bands);
         for (auto& band : *b)
           for (double& o : band) {
             o = r.f64();

@@ -170,22 +170,6 @@ const awcc::OptionField<T> kTraining[] = {
        for (double v : o.calibration_tu_bands) s += (s.empty() ? "" : ",") + fmt::format("{:g}", v);
        return s;
      }},
-    {"calibration-duration-bands", "s",
-     "record durations where the calibration's duration bands meet (each band is calibrated as a calibration of "
-     "its own; a row of unknown duration takes the widest); none = one band",
-     [](T& o, std::string_view t) {
-       o.calibration_duration_bands.clear();
-       if (t == "none") return;
-       for (const auto& cell : awcc::split_cells(t)) {
-         o.calibration_duration_bands.push_back(awcc::parse_quantity(cell, awcc::Dimension::time));
-       }
-     },
-     [](const T& o) {
-       if (o.calibration_duration_bands.empty()) return std::string("none");
-       std::string s;
-       for (double v : o.calibration_duration_bands) s += (s.empty() ? "" : ",") + fmt::format("{:g}", v);
-       return s;
-     }},
     {"feature-set", "-",
      "features of the model: measured (u, Tu, c, d32, dx, dy, Np), extended (also fs, duration and accepted "
      "windows) or extended-yield (fs, duration and the data yield); an extended set may end in +lag (AWCC's lag "
@@ -254,13 +238,6 @@ awcc::Validation TrainOptions::validate() const {
   for (std::size_t i = 0; i < calibration_tu_bands.size(); ++i) {
     if (!std::isfinite(calibration_tu_bands[i]) || (i > 0 && calibration_tu_bands[i] <= calibration_tu_bands[i - 1])) {
       return Validation::invalid("calibration-tu-bands", "calibration Tu bands: give increasing values of Tu");
-    }
-  }
-  for (std::size_t i = 0; i < calibration_duration_bands.size(); ++i) {
-    const double d = calibration_duration_bands[i];
-    if (!(d > 0.0) || !std::isfinite(d) || (i > 0 && d <= calibration_duration_bands[i - 1])) {
-      return Validation::invalid("calibration-duration-bands",
-                                 "calibration duration bands: give increasing record durations above 0 s");
     }
   }
   std::size_t features = 0;
@@ -607,8 +584,7 @@ namespace {
 // Tu} and their groups: the group's rows, else the window band's, else all
 // of them; too few even then, the model's own (its training targets').
 void set_envelopes(Calibration& c, const CorrectionModel& model, const std::vector<int>& band,
-                   const std::vector<int>& tu_band, const std::vector<int>& duration_band,
-                   const std::vector<std::array<double, 2>>& shifts) {
+                   const std::vector<int>& tu_band, const std::vector<std::array<double, 2>>& shifts) {
   auto envelope = [&](const std::function<bool(std::size_t)>& in, std::size_t q) {
     std::vector<double> e;
     for (std::size_t i = 0; i < shifts.size(); ++i)
@@ -625,26 +601,18 @@ void set_envelopes(Calibration& c, const CorrectionModel& model, const std::vect
     return;
   }
   c.envelope_from_training = false;
-  // Groups in group_index order: duration band, window band, Tu band.
-  for (std::size_t db = 0; db < c.duration_bands(); ++db) {
-    const int d = static_cast<int>(db);
-    const std::function<bool(std::size_t)> in_duration = [&, d](std::size_t i) { return duration_band[i] == d; };
-    for (std::size_t b = 0; b < c.window_bands(); ++b) {
-      const int w = static_cast<int>(b);
-      const std::function<bool(std::size_t)> in_band = [&, w, d](std::size_t i) {
-        return duration_band[i] == d && band[i] == w;
+  for (std::size_t b = 0; b <= c.window_edges.size(); ++b) {
+    const int w = static_cast<int>(b);
+    for (std::size_t h = 0; h < c.tu_bands(); ++h) {
+      const std::function<bool(std::size_t)> in_group = [&band, &tu_band, w, h](std::size_t i) {
+        return band[i] == w && tu_band[i] == static_cast<int>(h);
       };
-      for (std::size_t h = 0; h < c.tu_bands(); ++h) {
-        const std::function<bool(std::size_t)> in_group = [&, w, h, d](std::size_t i) {
-          return duration_band[i] == d && band[i] == w && tu_band[i] == static_cast<int>(h);
-        };
-        for (std::size_t q = 0; q < 2; ++q) {
-          auto e = envelope(in_group, q);
-          if (!e) e = envelope(in_band, q);
-          if (!e) e = envelope(in_duration, q);
-          if (!e) e = envelope(all, q);
-          (q == 0 ? c.velocity_envelope : c.turbulence_envelope).push_back(*e);
-        }
+      const std::function<bool(std::size_t)> in_band = [&band, w](std::size_t i) { return band[i] == w; };
+      for (std::size_t q = 0; q < 2; ++q) {
+        auto e = envelope(in_group, q);
+        if (!e) e = envelope(in_band, q);
+        if (!e) e = envelope(all, q);
+        (q == 0 ? c.velocity_envelope : c.turbulence_envelope).push_back(*e);
       }
     }
   }
@@ -665,18 +633,16 @@ std::vector<std::array<double, 2>> fscc_envelope(const FsccForest& f, const std:
 
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads,
-                      const std::vector<double>& tu_edges, const std::vector<double>& duration_edges) {
+                      const std::vector<double>& tu_edges) {
   std::vector<std::string> names;
   for (const auto& r : model.ranges) names.push_back(r.name);
   Calibration c;
   c.window_edges = window_edges;
   c.tu_edges = tu_edges;
-  c.duration_edges = duration_edges;
   // Scores of each row: velocity then Tu, intervals 50, 80, 95 %; its
-  // window band, Tu band (the Tu forest's median, as correct() finds it) and
-  // duration band (-1: not known, pooled only).
+  // window band and Tu band (the Tu forest's median, as correct() finds it).
   std::vector<std::array<double, 6>> scores(rows.size());
-  std::vector<int> band(rows.size()), tu_band(rows.size()), duration_band(rows.size());
+  std::vector<int> band(rows.size()), tu_band(rows.size());
   // The truth's shift from the measurement (model.hpp, trust rule (a)): velocity, Tu.
   std::vector<std::array<double, 2>> shifts(rows.size());
   parallel_for(rows.size(), threads, [&](std::size_t i) {
@@ -695,7 +661,6 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
       if (f == 1) tu_band[i] = c.tu_band(from_target(form, t[3], r.features.turbulence_intensity));
     }
     band[i] = c.band(r.features.windows_accepted);
-    duration_band[i] = c.duration_band(r.features.duration);
   });
   // The offsets of the rows that `in` admits.
   auto offsets = [&](const std::function<bool(std::size_t)>& in, std::size_t column0) {
@@ -709,37 +674,26 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
     return q;
   };
   // A group with too few calibration runs (fewer than 1/alpha for the 95 %
-  // interval, with margin) takes its window band's offsets within its
-  // duration band; a window band with too few, its duration band's pooled
-  // ones; a duration band with too few, the pooled ones of every run.
+  // interval, with margin) takes its window band's offsets; a window band
+  // with too few, the pooled ones.
   constexpr std::int64_t least = 50;
-  for (std::size_t db = 0; db < c.duration_bands(); ++db) {
-    const int d = static_cast<int>(db);
-    const auto in_duration = std::count(duration_band.begin(), duration_band.end(), d);
-    for (std::size_t b = 0; b < c.window_bands(); ++b) {
-      const int w = static_cast<int>(b);
-      std::int64_t in_band = 0;
-      for (std::size_t i = 0; i < rows.size(); ++i) in_band += duration_band[i] == d && band[i] == w;
-      for (std::size_t h = 0; h < c.tu_bands(); ++h) {
-        std::int64_t in_group = 0;
-        for (std::size_t i = 0; i < rows.size(); ++i)
-          in_group += duration_band[i] == d && band[i] == w && tu_band[i] == static_cast<int>(h);
-        std::function<bool(std::size_t)> in = [](std::size_t) { return true; };
-        if (in_group >= least) {
-          in = [&, w, h, d](std::size_t i) {
-            return duration_band[i] == d && band[i] == w && tu_band[i] == static_cast<int>(h);
-          };
-        } else if (in_band >= least) {
-          in = [&, w, d](std::size_t i) { return duration_band[i] == d && band[i] == w; };
-        } else if (in_duration >= least) {
-          in = [&, d](std::size_t i) { return duration_band[i] == d; };
-        }
-        c.velocity.push_back(offsets(in, 0));
-        c.turbulence_intensity.push_back(offsets(in, 3));
+  for (std::size_t b = 0; b <= window_edges.size(); ++b) {
+    const int w = static_cast<int>(b);
+    const auto in_band = std::count(band.begin(), band.end(), w);
+    for (std::size_t h = 0; h < c.tu_bands(); ++h) {
+      std::int64_t in_group = 0;
+      for (std::size_t i = 0; i < rows.size(); ++i) in_group += band[i] == w && tu_band[i] == static_cast<int>(h);
+      std::function<bool(std::size_t)> in = [](std::size_t) { return true; };
+      if (in_group >= least) {
+        in = [&band, &tu_band, w, h](std::size_t i) { return band[i] == w && tu_band[i] == static_cast<int>(h); };
+      } else if (in_band >= least) {
+        in = [&band, w](std::size_t i) { return band[i] == w; };
       }
+      c.velocity.push_back(offsets(in, 0));
+      c.turbulence_intensity.push_back(offsets(in, 3));
     }
   }
-  set_envelopes(c, model, band, tu_band, duration_band, shifts);
+  set_envelopes(c, model, band, tu_band, shifts);
   return c;
 }
 
@@ -1010,8 +964,7 @@ void learning_curve(const Split& split, const TrainOptions& o, const std::vector
                         : fit_model(subset, h.velocity_form, h.turbulence_form, h.velocity, h.turbulence, o.min_windows,
                                     names);
     if (num != den && !calibration_rows.empty()) {
-      m.calibration = calibrate(m, calibration_rows, o.calibration_bands, o.threads, o.calibration_tu_bands,
-                                o.calibration_duration_bands);
+      m.calibration = calibrate(m, calibration_rows, o.calibration_bands, o.threads, o.calibration_tu_bands);
     }
     // Every point scores the same held-out rows: those inside the full
     // model's ranges (a small subset's own ranges would drop the hard rows).
@@ -1186,8 +1139,7 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
                            names);
   if (!split.calibration.empty()) {
     result.model.calibration =
-        calibrate(result.model, split.calibration, o.calibration_bands, o.threads, o.calibration_tu_bands,
-                  o.calibration_duration_bands);
+        calibrate(result.model, split.calibration, o.calibration_bands, o.threads, o.calibration_tu_bands);
   }
   result.calibration_rows = static_cast<std::int64_t>(split.calibration.size());
   if (o.feature_set != "measured") train_fscc(set, o, h.velocity, result);
@@ -1229,21 +1181,20 @@ TrustResult measure_trust(CorrectionModel model, const TrainingSet& set, const T
   const Split fscc_split = split_runs(fscc_rows, split_options);
   const auto& measuring = split.training;
   auto& c = model.calibration;
-  std::vector<int> band(measuring.size()), tu_band(measuring.size()), duration_band(measuring.size());
+  std::vector<int> band(measuring.size()), tu_band(measuring.size());
   std::vector<std::array<double, 2>> shifts(measuring.size());
   parallel_for(measuring.size(), o.threads, [&](std::size_t i) {
     const auto& r = measuring[i];
     const auto& f = r.features;
     const auto tu = model.turbulence_intensity.quantiles(vector_of(f, names), std::array<double, 1>{0.5});
     band[i] = c.band(f.windows_accepted);
-    duration_band[i] = c.duration_band(f.duration);
     tu_band[i] = c.tu_band(from_target(model.turbulence_form, tu[0], f.turbulence_intensity));
     shifts[i] = {to_target(model.velocity_form, r.true_velocity, f.velocity) -
                      to_target(model.velocity_form, f.velocity, f.velocity),
                  to_target(model.turbulence_form, r.true_turbulence_intensity, f.turbulence_intensity) -
                      to_target(model.turbulence_form, f.turbulence_intensity, f.turbulence_intensity)};
   });
-  set_envelopes(c, model, band, tu_band, duration_band, shifts);
+  set_envelopes(c, model, band, tu_band, shifts);
   TrustResult result;
   result.envelope_rows = static_cast<std::int64_t>(measuring.size());
   if (model.fscc) {

@@ -2,10 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstring>
 #include <fmt/format.h>
 #include <fstream>
 #include <random>
@@ -468,14 +465,6 @@ TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   o.calibration_tu_bands = {0.2, 0.1};
   EXPECT_NE(o.validate().message.find("calibration Tu bands"), std::string::npos);
   EXPECT_EQ(o.validate().quantity, "calibration-tu-bands");
-  // Duration bands: increasing, above 0 s; a bare number has no unit and is refused.
-  o.calibration_tu_bands = {0.1, 0.2};
-  o.calibration_duration_bands = {600.0, 600.0};
-  EXPECT_EQ(o.validate().quantity, "calibration-duration-bands");
-  o.calibration_duration_bands = {0.0};
-  EXPECT_EQ(o.validate().quantity, "calibration-duration-bands");
-  o.calibration_duration_bands = {300.0, 600.0};
-  EXPECT_TRUE(o.validate().ok()) << o.validate().message;
 }
 
 // A model of one varying feature (velocity 1-2 m/s) whose forest learnt
@@ -692,95 +681,6 @@ TEST(Calibration, BandsAreCalibratedOnTheirOwnAndUnknownWindowsTakeTheWidest) {
   EXPECT_TRUE(again.calibration.tu_edges.empty());
   EXPECT_EQ(again.calibration.velocity, c.velocity);
   EXPECT_EQ(again.calibration.turbulence_intensity, c.turbulence_intensity);
-}
-
-TEST(Calibration, DurationBandsAreCalibratedOnTheirOwnAndUnknownDurationTakesTheWidest) {
-  // Records of 60 s spread 1, records of 1,200 s spread 0.5 (the forest knows
-  // neither: its 80 % interval is +/-2.56 wide for both). Calibrated with a
-  // duration edge at 600 s, each band's 80 % interval is set by its own runs
-  // and covers new runs of its kind at nominal (3000 runs: sd 0.7 %, bound
-  // 4 %, more than 5 sd); pooled over both lengths, the short records are
-  // under-covered and the long ones over-covered.
-  const auto model = shifted_model(2.0, 4);
-  auto with_duration = [](std::vector<correction::TrainingRow> rows, double duration, bool narrow) {
-    for (auto& r : rows) {
-      r.features.duration = duration;
-      if (narrow) r.true_velocity = 10.0 + 0.5 * (r.true_velocity - 10.0);
-    }
-    return rows;
-  };
-  auto both = with_duration(runs(600, 5, 500), 60.0, false);
-  const auto longer = with_duration(runs(600, 6, 500), 1200.0, true);
-  both.insert(both.end(), longer.begin(), longer.end());
-  auto m = model;
-  m.calibration = correction::calibrate(model, both, {}, 0, {}, {600.0});
-  const auto& c = m.calibration;
-  ASSERT_EQ(c.velocity.size(), 2u);  // one window band x one Tu band x two duration bands
-  EXPECT_EQ(c.duration_band(60.0), 0);
-  EXPECT_EQ(c.duration_band(599.999), 0);
-  EXPECT_EQ(c.duration_band(600.0), 1);
-  EXPECT_EQ(c.duration_band(0.0), -1);
-  EXPECT_EQ(c.group_index(0, 0, 1), 1u);
-  EXPECT_GT(c.velocity[0][1], c.velocity[1][1] + 0.3);  // the short records' band is wider
-  const auto new_short = with_duration(runs(3000, 7, 500), 60.0, false);
-  const auto new_long = with_duration(runs(3000, 8, 500), 1200.0, true);
-  EXPECT_NEAR(correction::score(m, new_short).velocity_coverage80, 0.80, 0.04);
-  EXPECT_NEAR(correction::score(m, new_long).velocity_coverage80, 0.80, 0.04);
-  auto pooled = model;
-  pooled.calibration = correction::calibrate(model, both, {}, 0, {});
-  EXPECT_LT(correction::score(pooled, new_short).velocity_coverage80, 0.75);
-  EXPECT_GT(correction::score(pooled, new_long).velocity_coverage80, 0.88);
-  // Unknown duration: each interval's widest band, so at least nominal for either kind.
-  const auto unknown = with_duration(runs(3000, 9, 500), 0.0, false);
-  EXPECT_GT(correction::score(m, unknown).velocity_coverage80, 0.77);
-  EXPECT_EQ(c.offsets(c.velocity, 500, 0.2, 0.0), c.velocity[0]);
-  EXPECT_EQ(c.group_text(500, 0.2, 1200.0), "all windows, records of 600 s+");
-  EXPECT_EQ(c.group_text(500, 0.2, 60.0), "all windows, records under 600 s");
-  EXPECT_EQ(c.group_text(500, 0.2, 0.0), "all windows, duration unknown: the widest band");
-  // A duration band with fewer than 50 calibration runs takes the pooled offsets of every run.
-  auto few_long = with_duration(runs(600, 5, 500), 60.0, false);
-  const auto forty = with_duration(runs(40, 6, 500), 1200.0, true);
-  few_long.insert(few_long.end(), forty.begin(), forty.end());
-  const auto sparse = correction::calibrate(model, few_long, {}, 0, {}, {600.0});
-  EXPECT_EQ(sparse.velocity[1], correction::calibrate(model, few_long, {}, 0, {}).velocity[0]);
-  // The bands survive the file.
-  const auto again = correction::CorrectionModel::parse(m.serialise(), "m.qrf");
-  EXPECT_EQ(again.calibration.duration_edges, c.duration_edges);
-  EXPECT_EQ(again.calibration.velocity, c.velocity);
-  EXPECT_EQ(again.calibration.turbulence_intensity, c.turbulence_intensity);
-  EXPECT_EQ(again.calibration.velocity_envelope, c.velocity_envelope);
-  // A file of format 6 has no duration band count after the Tu edges: made
-  // from a format-7 file of one duration band (a Tu edge of 0.123456789 s
-  // marks the place), it reads as that model.
-  auto one = model;
-  one.calibration = correction::calibrate(model, both, {}, 0, {0.123456789});
-  auto b = one.serialise();
-  std::array<std::uint8_t, 12> mark{};
-  std::uint64_t bits = 0;
-  const double edge = 0.123456789;
-  std::memcpy(&bits, &edge, 8);
-  for (std::size_t i = 0; i < 8; ++i) mark[i] = static_cast<std::uint8_t>(bits >> (8 * i));
-  mark[8] = 1;  // u32 1: one duration band
-  const auto at = std::search(b.begin(), b.end(), mark.begin(), mark.end());
-  ASSERT_NE(at, b.end());
-  b.erase(at + 8, at + 12);
-  b.resize(b.size() - 4);  // the CRC, computed again below
-  b[8] = 6;
-  std::uint64_t length = 0;
-  for (std::size_t i = 0; i < 8; ++i) length |= static_cast<std::uint64_t>(b[12 + i]) << (8 * i);
-  length -= 4;
-  for (std::size_t i = 0; i < 8; ++i) b[12 + i] = static_cast<std::uint8_t>(length >> (8 * i));
-  std::uint32_t crc = 0xffffffffu;  // CRC-32 (IEEE 802.3), bit by bit
-  for (auto byte : b) {
-    crc ^= byte;
-    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
-  }
-  crc = ~crc;
-  for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(crc >> (8 * i)));
-  const auto six = correction::CorrectionModel::parse(b, "six.qrf");
-  EXPECT_TRUE(six.calibration.duration_edges.empty());
-  EXPECT_EQ(six.calibration.velocity, one.calibration.velocity);
-  EXPECT_EQ(six.serialise(), one.serialise());
 }
 
 TEST(Calibration, TooFewRunsAreRefusedNotGuessed) {

@@ -106,14 +106,12 @@
 // versions 1 and 2 have the seven only) and, after the processing, the
 // calibration: u32 band count B (0: none), B - 1 window edges (i64), [version
 // 4: u32 Tu band count T, T - 1 Tu edges (f64); version 3: T = 1], then
-// [version 7: u32 duration band count D, D - 1 duration edges (f64, s);
-// older: D = 1], then D x B x T x 3 offsets (f64, in group_index order) for
-// the velocity and D x B x T x 3 for Tu; after the two
+// B x T x 3 offsets (f64) for the velocity and B x T x 3 for Tu; after the two
 // forests, u32 0 or 1, then the FSCC forest: its feature ranges (count, then
 // name, min, max), its calibration (u32 0 or 1, then 3 offsets), [version 5:
 // its envelope (u32 0 or 1, then below, above)] and the forest
 // ("fscc_velocity"). Version 5 adds, after the calibration offsets, the
-// envelopes of rule (a): u32 E (0: none, 1: pooled, or D x B x T: per group),
+// envelopes of rule (a): u32 E (0: none, 1: pooled, or B x T: per group),
 // then E x 2 values (below, above) for the velocity and E x 2 for Tu.
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
@@ -262,28 +260,14 @@ Correction not_corrected(CorrectionStatus status, std::string message);
 /// calibration runs takes its window band's offsets, and a window band with
 /// fewer, the pooled ones. A row whose windows are unknown takes each
 /// interval's widest window band at its Tu band.
-///
-/// Bands of record duration may cross them (format 7; none: one band). Why:
-/// the campaign's records are mostly 20-300 s, so calibration runs pooled
-/// over every length leave the few long ones' intervals as the short ones
-/// need them; records of 600-1,800 s covered their Tu at 72-78 % at the
-/// nominal 80 % so (docs/validation.md, "Coverage by record length"). Each
-/// duration band is calibrated as a calibration of its own (group, then
-/// window band, then the duration band pooled) and falls back to the pooled
-/// offsets of every run only when it holds fewer than 50. A row whose
-/// duration is unknown takes each interval's widest duration band.
 struct Calibration {
   /// Band g holds windows in [edges[g - 1], edges[g]) (band 0 from 0, the last to infinity).
   std::vector<std::int64_t> window_edges;
   /// Tu band h holds the Tu forest's median in [edges[h - 1], edges[h]);
   /// empty: one Tu band (format 3 files).
   std::vector<double> tu_edges;
-  /// Duration band d holds records of [edges[d - 1], edges[d]) s; empty: one
-  /// band (files of format 6 and older).
-  std::vector<double> duration_edges;
-  /// Per group (duration band d, window band w, Tu band h at
-  /// group_index(w, h, d)): Q of the 50 %, 80 % and 95 % intervals, in
-  /// target units.
+  /// Per group (window band w, Tu band h at w x (tu_edges.size() + 1) + h):
+  /// Q of the 50 %, 80 % and 95 % intervals, in target units.
   std::vector<std::array<double, 3>> velocity, turbulence_intensity;
   /// The envelopes of rule (a) (the trust rules above): {below, above}, the
   /// truth's shift from the measurement held by envelope_coverage of the
@@ -297,31 +281,17 @@ struct Calibration {
   [[nodiscard]] int band(std::int64_t windows) const;
   /// The Tu band of a median.
   [[nodiscard]] int tu_band(double tu_median) const;
-  /// The duration band of a record of `duration` s: with duration bands, -1
-  /// when it is not known (0 or less, or not finite); without, 0.
-  [[nodiscard]] int duration_band(double duration) const;
-  [[nodiscard]] std::size_t window_bands() const { return window_edges.size() + 1; }
   [[nodiscard]] std::size_t tu_bands() const { return tu_edges.size() + 1; }
-  [[nodiscard]] std::size_t duration_bands() const { return duration_edges.size() + 1; }
-  [[nodiscard]] std::size_t groups() const { return duration_bands() * window_bands() * tu_bands(); }
-  /// Where a group's values are in `velocity`, `turbulence_intensity` and the envelopes.
-  [[nodiscard]] std::size_t group_index(std::size_t window_band, std::size_t tu_band,
-                                        std::size_t duration_band = 0) const {
-    return (duration_band * window_bands() + window_band) * tu_bands() + tu_band;
-  }
-  /// The offsets of a row: its group's, or with unknown windows (duration)
-  /// each interval's widest over the window (duration) bands at its Tu band.
+  /// The offsets of a row: its group's, or with unknown windows each
+  /// interval's widest over the window bands at its Tu band.
   [[nodiscard]] std::array<double, 3> offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
-                                              double tu_median, double duration = 0.0) const;
+                                              double tu_median) const;
   /// The envelope of a row the same way (the pooled one when there is one);
   /// empty when there is none.
   [[nodiscard]] std::optional<std::array<double, 2>> envelope(const std::vector<std::array<double, 2>>& groups,
-                                                              std::int64_t windows, double tu_median,
-                                                              double duration = 0.0) const;
-  /// "windows 30-99, model Tu 0.1-0.2, records of 600 s+": the group of a row, in words.
-  [[nodiscard]] std::string group_text(std::int64_t windows, double tu_median, double duration = 0.0) const;
-  /// "windows 30-99, model Tu 0.1-0.2": the window and Tu bands alone.
-  [[nodiscard]] std::string windows_and_tu_text(std::int64_t windows, double tu_median) const;
+                                                              std::int64_t windows, double tu_median) const;
+  /// "windows 30-99, model Tu 0.1-0.2": the group of a row, in words.
+  [[nodiscard]] std::string group_text(std::int64_t windows, double tu_median) const;
   /// Applies the offsets of `band` to the quantiles t at correction_levels
   /// (target units), keeping them in order.
   static void apply(const std::array<double, 3>& offsets, std::vector<double>& t);
@@ -338,7 +308,7 @@ struct FsccForest {
 };
 
 struct CorrectionModel {
-  static constexpr std::uint32_t format_version = 7;
+  static constexpr std::uint32_t format_version = 6;
 
   std::string provenance;             ///< how the model was made (sweep, rows, options, held-out scores)
   std::vector<FeatureRange> ranges;   ///< training data [min, max] per feature, feature order

@@ -148,11 +148,6 @@ struct TrainOptions {
   /// calibrated by windows alone covered 92 % of the u of its least
   /// turbulent runs and 63 % of its most turbulent at nominal 80 %).
   std::vector<double> calibration_tu_bands{0.1, 0.2, 0.3};
-  /// Record durations (s) where the calibration's duration bands meet; none:
-  /// one band. Why: a campaign's records of one length range dominate its
-  /// calibration runs, and the intervals of the others then get offsets
-  /// they do not need (model.hpp, Calibration).
-  std::vector<double> calibration_duration_bands{};
   [[nodiscard]] awcc::Validation validate() const;
 };
 
@@ -288,7 +283,7 @@ CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm veloc
 /// the model's own (its training targets').
 Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRow>& rows,
                       const std::vector<std::int64_t>& window_edges, int threads = 0,
-                      const std::vector<double>& tu_edges = {}, const std::vector<double>& duration_edges = {});
+                      const std::vector<double>& tu_edges = {});
 
 /// Scores of held-out predictions in one band of runs: errors of the raw and
 /// the corrected values (velocity relative, Tu absolute) and the coverage of
