@@ -16,9 +16,15 @@ import sys
 
 def load(path):
     rows = []
-    for r in csv.DictReader(open(path)):
+    reader = csv.DictReader(open(path))
+    missing = {"status", "duration", "true_velocity", "corrected_velocity_q0.5"} - set(reader.fieldnames or [])
+    if missing:
+        sys.exit(f"{path}: not a pdp score --predictions file with durations (no column {', '.join(sorted(missing))})")
+    for r in reader:
         if r["status"] != "corrected":
             continue
+        if not r["duration"]:
+            sys.exit(f"{path}: run {r.get('run', '?')} has no duration; this table needs every row's record length")
         q = lambda name: float(r[name])
         tu_ok = r.get("turbulence_corrected", "1") == "1"
         rows.append({
@@ -61,10 +67,10 @@ def main(argv):
         argv = argv[2:]
     if not argv or len(argv) % 2:
         sys.exit(__doc__)
+    loaded = [(name, load(path)) for name, path in zip(argv[0::2], argv[1::2])]  # every file checked first
     print("| model | duration | rows | u median abs | u mean error | Tu median abs | Tu mean error | u 80 / 95 % | Tu 80 / 95 % |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for name, path in zip(argv[0::2], argv[1::2]):
-        rows = load(path)
+    for name, rows in loaded:
         bounds = [0.0] + edges + [math.inf]
         for lo, hi in zip(bounds[:-1], bounds[1:]):
             band = [r for r in rows if lo <= r["duration"] < hi]
