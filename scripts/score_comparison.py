@@ -14,9 +14,11 @@ With --paired the two files are two models' predictions of the same runs
 (candidate models, docs/validation.md "The time scale"): only the rows both
 corrected are scored (a row is a run and its weighting), and the standard
 error is that of the difference, from resampling the rows as pairs, so the
-runs' own spread cancels.
+runs' own spread cancels. --bands adds the paired medians and coverages band
+by band (accepted windows, sampling rate, true Tu, record length: the bands
+of pdp score's report), for "no band worse than today's".
 
-Usage: score_comparison.py [--paired] NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv
+Usage: score_comparison.py [--paired [--bands]] NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv
 """
 import csv
 import math
@@ -40,6 +42,8 @@ def rows(path):
         u, tu = q("true_velocity"), q("true_turbulence_intensity")
         out.append({
             "key": run + (seen[run],),
+            "band_of": {"windows": q("windows_accepted"), "fs": q("fs"), "true Tu": tu,
+                        "duration": q("duration")},
             "truth": (r["true_velocity"], r["true_turbulence_intensity"]),
             "u_err": q("corrected_velocity_q0.5") / u - 1.0,
             "tu_err": q("corrected_turbulence_intensity_q0.5") - tu,
@@ -91,11 +95,55 @@ def paired(a_name, a, b_name, b):
         print(f"| {name} | {va:.{digits}f} | {vb:.{digits}f} | {vb - va:+.{digits}f} +- {se:.{digits}f} | {z:+.2f} |")
 
 
+# The bands of pdp score's report (libcorrection's held-out bands), by the
+# quantity each is cut on; an unknown value (NaN: a peer's row) falls in none.
+BANDS = [
+    ("windows", "windows", [(10, 30, "10-29"), (30, 100, "30-99"), (100, math.inf, "100+")]),
+    ("fs", "fs", [(0, 50e3, "0-50 kHz"), (50e3, 200e3, "50-200 kHz"), (200e3, math.inf, "200 kHz+")]),
+    ("true Tu", "true Tu", [(0, 0.1, "0-0.1"), (0.1, 0.2, "0.1-0.2"), (0.2, 0.3, "0.2-0.3"),
+                            (0.3, 0.35, "0.3-0.35"), (0.35, math.inf, "0.35-0.45")]),
+    ("duration", "duration", [(0, 60, "0-60 s"), (60, 300, "60-300 s"), (300, math.inf, "300 s+")]),
+]
+
+BAND_SCORES = [SCORES[0], SCORES[2], SCORES[4], SCORES[6]]
+
+
+def paired_bands(a_name, a, b_name, b):
+    a_by = {r["key"]: r for r in a}
+    b_by = {r["key"]: r for r in b}
+    keys = sorted(set(a_by) & set(b_by))
+    rng = random.Random(0)
+    print(f"\nBand by band, {b_name} minus {a_name} (+- the paired bootstrap's standard error):\n")
+    print("| band | rows | " + " | ".join(n for n, _ in BAND_SCORES) + " |")
+    print("|---|---|" + "---|" * len(BAND_SCORES))
+    for title, field, cuts in BANDS:
+        for lo, hi, label in cuts:
+            ks = [k for k in keys if lo <= a_by[k]["band_of"][field] < hi]
+            if len(ks) < 10:
+                continue
+            pa, pb = [a_by[k] for k in ks], [b_by[k] for k in ks]
+            cells = []
+            for name, f in BAND_SCORES:
+                va, vb = f(pa), f(pb)
+                diffs = []
+                for _ in range(1000):
+                    idx = [rng.randrange(len(ks)) for _ in ks]
+                    diffs.append(f([pb[i] for i in idx]) - f([pa[i] for i in idx]))
+                se = statistics.stdev(diffs)
+                d = 4 if name.startswith("Tu m") else 2
+                cells.append(f"{va:.{d}f} -> {vb:.{d}f} ({vb - va:+.{d}f} +- {se:.{d}f})")
+            print(f"| {title} {label} | {len(ks)} | " + " | ".join(cells) + " |")
+
+
 def main():
     args = sys.argv[1:]
     if args and args[0] == "--paired":
-        a_name, a_path, b_name, b_path = args[1:5]
-        paired(a_name, rows(a_path), b_name, rows(b_path))
+        bands = len(args) > 1 and args[1] == "--bands"
+        a_name, a_path, b_name, b_path = args[2:6] if bands else args[1:5]
+        a, b = rows(a_path), rows(b_path)
+        paired(a_name, a, b_name, b)
+        if bands:
+            paired_bands(a_name, a, b_name, b)
         return
     a_name, a_path, b_name, b_path = args[0:4]
     a, b = rows(a_path), rows(b_path)
