@@ -27,10 +27,22 @@ import statistics
 import sys
 
 
+NEEDED = ["run", "status", "true_velocity", "true_turbulence_intensity", "windows_accepted", "fs", "duration"] + [
+    f"corrected_{q}_q{p}" for q in ("velocity", "turbulence_intensity") for p in ("0.025", "0.1", "0.5", "0.9", "0.975")]
+
+
 def rows(path):
     out = []
     seen = {}
-    for r in csv.DictReader(open(path)):
+    try:
+        reader = csv.DictReader(open(path))
+        missing = [c for c in NEEDED if c not in (reader.fieldnames or [])]
+    except OSError as e:
+        sys.exit(f"{path}: {e.strerror}")
+    if missing:
+        sys.exit(f"{path}: no column {', '.join(missing)}: not a pdp score --predictions file "
+                 "(write one with pdp score -m MODEL SWEEP.csv --predictions FILE)")
+    for r in reader:
         # A row's key: its run, its weighting and which of the rows with
         # those it is (held-out runs of several sweeps share run numbers;
         # two models trained on the same sweeps list them in one order).
@@ -135,8 +147,16 @@ def paired_bands(a_name, a, b_name, b):
             print(f"| {title} {label} | {len(ks)} | " + " | ".join(cells) + " |")
 
 
+USAGE = "usage: score_comparison.py [--paired [--bands]] NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv"
+
+
 def main():
     args = sys.argv[1:]
+    options = [a for a in args if a.startswith("--")]
+    if options not in ([], ["--paired"], ["--paired", "--bands"]) or args[:len(options)] != options \
+            or len(args) != len(options) + 4:
+        sys.exit(USAGE + ("\n--bands needs --paired: bands compare two models on the same runs"
+                          if "--bands" in options and "--paired" not in options else ""))
     if args and args[0] == "--paired":
         bands = len(args) > 1 and args[1] == "--bands"
         a_name, a_path, b_name, b_path = args[2:6] if bands else args[1:5]
