@@ -84,24 +84,33 @@ def bootstrap_se(rs, f, rng, n=2000):
     return statistics.stdev(values)
 
 
-def paired(a_name, a, b_name, b):
+def common_rows(a, b):
+    """The rows both files corrected, as two lists in one order."""
     a_by = {r["key"]: r for r in a}
     b_by = {r["key"]: r for r in b}
     keys = sorted(set(a_by) & set(b_by))
     if any(a_by[k]["truth"] != b_by[k]["truth"] for k in keys):
         sys.exit("--paired: the two files' rows are not the same runs (their truths differ)")
-    pa, pb = [a_by[k] for k in keys], [b_by[k] for k in keys]
+    return [a_by[k] for k in keys], [b_by[k] for k in keys]
+
+
+def paired_difference(pa, pb, f, rng, resamples):
+    """Score f on both, and the standard error of b - a from resampling the pairs."""
+    diffs = []
+    for _ in range(resamples):
+        idx = [rng.randrange(len(pa)) for _ in pa]
+        diffs.append(f([pb[i] for i in idx]) - f([pa[i] for i in idx]))
+    return f(pa), f(pb), statistics.stdev(diffs)
+
+
+def paired(a_name, a, b_name, b):
+    pa, pb = common_rows(a, b)
     rng = random.Random(0)
-    print(f"rows both corrected: {len(keys)} (of {len(a)} and {len(b)})\n")
+    print(f"rows both corrected: {len(pa)} (of {len(a)} and {len(b)})\n")
     print(f"| score | {a_name} | {b_name} | difference +- se | z |")
     print("|---|---|---|---|---|")
     for name, f in SCORES:
-        va, vb = f(pa), f(pb)
-        diffs = []
-        for _ in range(2000):
-            idx = [rng.randrange(len(keys)) for _ in keys]
-            diffs.append(f([pb[i] for i in idx]) - f([pa[i] for i in idx]))
-        se = statistics.stdev(diffs)
+        va, vb, se = paired_difference(pa, pb, f, rng, 2000)
         digits = 4 if name.startswith("Tu m") else 2
         z = (vb - va) / se if se > 0 else float("nan")
         print(f"| {name} | {va:.{digits}f} | {vb:.{digits}f} | {vb - va:+.{digits}f} +- {se:.{digits}f} | {z:+.2f} |")
@@ -121,30 +130,23 @@ BAND_SCORES = [SCORES[0], SCORES[2], SCORES[4], SCORES[6]]
 
 
 def paired_bands(a_name, a, b_name, b):
-    a_by = {r["key"]: r for r in a}
-    b_by = {r["key"]: r for r in b}
-    keys = sorted(set(a_by) & set(b_by))
+    pa_all, pb_all = common_rows(a, b)
     rng = random.Random(0)
     print(f"\nBand by band, {b_name} minus {a_name} (+- the paired bootstrap's standard error):\n")
     print("| band | rows | " + " | ".join(n for n, _ in BAND_SCORES) + " |")
     print("|---|---|" + "---|" * len(BAND_SCORES))
     for title, field, cuts in BANDS:
         for lo, hi, label in cuts:
-            ks = [k for k in keys if lo <= a_by[k]["band_of"][field] < hi]
-            if len(ks) < 10:
+            idx = [i for i, r in enumerate(pa_all) if lo <= r["band_of"][field] < hi]
+            if len(idx) < 10:
                 continue
-            pa, pb = [a_by[k] for k in ks], [b_by[k] for k in ks]
+            pa, pb = [pa_all[i] for i in idx], [pb_all[i] for i in idx]
             cells = []
             for name, f in BAND_SCORES:
-                va, vb = f(pa), f(pb)
-                diffs = []
-                for _ in range(1000):
-                    idx = [rng.randrange(len(ks)) for _ in ks]
-                    diffs.append(f([pb[i] for i in idx]) - f([pa[i] for i in idx]))
-                se = statistics.stdev(diffs)
+                va, vb, se = paired_difference(pa, pb, f, rng, 1000)
                 d = 4 if name.startswith("Tu m") else 2
                 cells.append(f"{va:.{d}f} -> {vb:.{d}f} ({vb - va:+.{d}f} +- {se:.{d}f})")
-            print(f"| {title} {label} | {len(ks)} | " + " | ".join(cells) + " |")
+            print(f"| {title} {label} | {len(pa)} | " + " | ".join(cells) + " |")
 
 
 USAGE = "usage: score_comparison.py [--paired [--bands]] NAME_A PREDICTIONS_A.csv NAME_B PREDICTIONS_B.csv"
