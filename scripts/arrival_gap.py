@@ -1,0 +1,91 @@
+#!/usr/bin/env python3
+"""Which arrival rule a real record's bubbles follow, from AWCC's weighting gap
+g = u_unweighted / u_duration_weighted - 1 (docs/validation.md, "Which arrival
+rule the real bubbles follow").
+
+When bubbles are spaced along the flow, a window of Np bubbles lasts less
+when the flow is fast, so the unweighted mean of the windows' velocities
+exceeds the duration-weighted one: g is about the variance of the windows'
+velocities over the mean squared (Tu_w^2, less the part that is measurement
+noise). When arrivals are set in time, a window's length does not follow its
+velocity and g is about 0. This compares the real rows' g with the
+campaign's runs of mixed conventions under the same conditions (AWCC Tu and
+accepted windows in the ranges below, fs at most FS_MAX), by arrival rule.
+
+Usage: arrival_gap.py WEIGHTED.csv UNWEIGHTED.csv SWEEP.csv [SWEEP.csv ...]
+  WEIGHTED.csv, UNWEIGHTED.csv: pdp process --csv of the same recordings with
+  --weighting duration and --weighting none; SWEEP.csv: pdp sweep CSVs with the
+  columns awcc_velocity_unweighted and arrival (the mixed-convention sweeps).
+"""
+import csv
+import statistics
+import sys
+
+TU_RANGE = (0.1, 0.2)        # AWCC's (duration-weighted) Tu of the rows compared
+WINDOWS_RANGE = (100, 1000)  # accepted windows: g's noise falls with their number
+FS_MAX = 60e3                # the real recordings' 20 kHz and its neighbours
+
+
+def number(row, name):
+    try:
+        return float(row[name])
+    except (KeyError, ValueError):
+        return None
+
+
+def comparable(tu, windows):
+    return tu is not None and windows is not None and TU_RANGE[0] <= tu < TU_RANGE[1] \
+        and WINDOWS_RANGE[0] <= windows <= WINDOWS_RANGE[1]
+
+
+def main():
+    if len(sys.argv) < 4:
+        sys.exit(__doc__.split("\n\n")[-1])
+    weighted_path, unweighted_path, sweeps = sys.argv[1], sys.argv[2], sys.argv[3:]
+    real = []
+    weighted = list(csv.DictReader(open(weighted_path)))
+    unweighted = list(csv.DictReader(open(unweighted_path)))
+    if [r.get("file") for r in weighted] != [r.get("file") for r in unweighted]:
+        sys.exit(f"{weighted_path}, {unweighted_path}: not the same recordings in the same order")
+    for path, rows, weighting in ((weighted_path, weighted, "duration"), (unweighted_path, unweighted, "none")):
+        if any(r.get("awcc_weighting") != weighting for r in rows):
+            sys.exit(f"{path}: not processed with --weighting {weighting} (its column awcc_weighting)")
+    for w, u in zip(weighted, unweighted):
+        uw, uu = number(w, "awcc_velocity"), number(u, "awcc_velocity")
+        tu, windows = number(w, "awcc_turbulence_intensity"), number(w, "awcc_windows_accepted")
+        if uw is None or uu is None:
+            continue
+        real.append((w.get("position") or w.get("file"), uu / uw - 1, tu, windows, comparable(tu, windows)))
+    by_rule = {"in time": [], "along the flow": []}
+    for path in sweeps:
+        reader = csv.DictReader(open(path))
+        if not {"awcc_velocity_unweighted", "arrival", "fs"} <= set(reader.fieldnames or []):
+            sys.exit(f"{path}: no columns awcc_velocity_unweighted, arrival and fs: not a pdp sweep CSV of generator version 2")
+        for r in reader:
+            if r.get("awcc_weighting", "duration") != "duration":
+                continue
+            uw, uu = number(r, "awcc_velocity"), number(r, "awcc_velocity_unweighted")
+            tu, windows, fs = number(r, "awcc_turbulence_intensity"), number(r, "awcc_windows_accepted"), number(r, "fs")
+            if uw is None or uu is None or fs is None or fs > FS_MAX or not comparable(tu, windows):
+                continue
+            by_rule["in time" if r["arrival"].endswith("time") else "along the flow"].append(uu / uw - 1)
+    print("| real row | g | AWCC Tu | accepted windows | compared |")
+    print("|---|---|---|---|---|")
+    for name, g, tu, windows, ok in real:
+        print(f"| {name} | {g:+.4f} | {tu:.3f} | {windows:.0f} | {'yes' if ok else 'no'} |")
+    largest = max((g for _, g, _, _, ok in real if ok), default=None)
+    print(f"\nCampaign runs with AWCC Tu {TU_RANGE[0]}-{TU_RANGE[1]}, {WINDOWS_RANGE[0]}-{WINDOWS_RANGE[1]} "
+          f"accepted windows, fs up to {FS_MAX / 1e3:.0f} kHz:\n")
+    print("| arrivals | runs | median g | 5-95 % of g | share at or below the real rows' largest g |")
+    print("|---|---|---|---|---|")
+    for rule, gs in by_rule.items():
+        if len(gs) < 20:
+            print(f"| {rule} | {len(gs)} | too few runs | | |")
+            continue
+        q = statistics.quantiles(gs, n=20)
+        share = "" if largest is None else f"{100 * sum(g <= largest for g in gs) / len(gs):.1f} %"
+        print(f"| {rule} | {len(gs)} | {statistics.median(gs):+.4f} | {q[0]:+.4f} to {q[-1]:+.4f} | {share} |")
+
+
+if __name__ == "__main__":
+    main()
