@@ -9,13 +9,15 @@ exceeds the duration-weighted one: g is about the variance of the windows'
 velocities over the mean squared (Tu_w^2, less the part that is measurement
 noise). When arrivals are set in time, a window's length does not follow its
 velocity and g is about 0. This compares the real rows' g with the
-campaign's runs of mixed conventions under the same conditions (AWCC Tu and
-accepted windows in the ranges below, fs at most FS_MAX), by arrival rule.
+campaign's runs of mixed conventions under the same conditions (AWCC Tu,
+accepted windows and T_u / T_W in the ranges below, fs at most FS_MAX), by
+arrival rule.
 
 Usage: arrival_gap.py WEIGHTED.csv UNWEIGHTED.csv SWEEP.csv [SWEEP.csv ...]
   WEIGHTED.csv, UNWEIGHTED.csv: pdp process --csv of the same recordings with
   --weighting duration and --weighting none; SWEEP.csv: pdp sweep CSVs with the
-  columns awcc_velocity_unweighted and arrival (the mixed-convention sweeps).
+  columns awcc_velocity_unweighted, awcc_time_scale_ratio and arrival (the
+  mixed-convention sweeps).
 """
 import csv
 import statistics
@@ -24,6 +26,11 @@ import sys
 TU_RANGE = (0.1, 0.2)        # AWCC's (duration-weighted) Tu of the rows compared
 WINDOWS_RANGE = (100, 1000)  # accepted windows: g's noise falls with their number
 FS_MAX = 60e3                # the real recordings' 20 kHz and its neighbours
+# AWCC's T_u / T_W: where the flow's time scale is short against a window, the
+# windows average over many eddies, their velocities scatter mostly by
+# measurement noise and g shrinks whatever the arrival rule; the real rows
+# are at 0.24-0.38.
+RATIO_RANGE = (0.15, 0.6)
 
 
 def number(row, name):
@@ -33,9 +40,9 @@ def number(row, name):
         return None
 
 
-def comparable(tu, windows):
-    return tu is not None and windows is not None and TU_RANGE[0] <= tu < TU_RANGE[1] \
-        and WINDOWS_RANGE[0] <= windows <= WINDOWS_RANGE[1]
+def comparable(tu, windows, ratio):
+    return None not in (tu, windows, ratio) and TU_RANGE[0] <= tu < TU_RANGE[1] \
+        and WINDOWS_RANGE[0] <= windows <= WINDOWS_RANGE[1] and RATIO_RANGE[0] <= ratio < RATIO_RANGE[1]
 
 
 def main():
@@ -53,29 +60,34 @@ def main():
     for w, u in zip(weighted, unweighted):
         uw, uu = number(w, "awcc_velocity"), number(u, "awcc_velocity")
         tu, windows = number(w, "awcc_turbulence_intensity"), number(w, "awcc_windows_accepted")
+        ratio = number(w, "awcc_time_scale_ratio")
         if uw is None or uu is None:
             continue
-        real.append((w.get("position") or w.get("file"), uu / uw - 1, tu, windows, comparable(tu, windows)))
+        real.append((w.get("position") or w.get("file"), uu / uw - 1, tu, windows, ratio,
+                     comparable(tu, windows, ratio)))
     by_rule = {"in time": [], "along the flow": []}
     for path in sweeps:
         reader = csv.DictReader(open(path))
-        if not {"awcc_velocity_unweighted", "arrival", "fs"} <= set(reader.fieldnames or []):
-            sys.exit(f"{path}: no columns awcc_velocity_unweighted, arrival and fs: not a pdp sweep CSV of generator version 2")
+        if not {"awcc_velocity_unweighted", "awcc_time_scale_ratio", "arrival", "fs"} <= set(reader.fieldnames or []):
+            sys.exit(f"{path}: no columns awcc_velocity_unweighted, awcc_time_scale_ratio, arrival and fs: "
+                     "not a pdp sweep CSV of generator version 2 with the time-scale ratio")
         for r in reader:
             if r.get("awcc_weighting", "duration") != "duration":
                 continue
             uw, uu = number(r, "awcc_velocity"), number(r, "awcc_velocity_unweighted")
             tu, windows, fs = number(r, "awcc_turbulence_intensity"), number(r, "awcc_windows_accepted"), number(r, "fs")
-            if uw is None or uu is None or fs is None or fs > FS_MAX or not comparable(tu, windows):
+            ratio = number(r, "awcc_time_scale_ratio")
+            if uw is None or uu is None or fs is None or fs > FS_MAX or not comparable(tu, windows, ratio):
                 continue
             by_rule["in time" if r["arrival"].endswith("time") else "along the flow"].append(uu / uw - 1)
-    print("| real row | g | AWCC Tu | accepted windows | compared |")
-    print("|---|---|---|---|---|")
-    for name, g, tu, windows, ok in real:
-        print(f"| {name} | {g:+.4f} | {tu:.3f} | {windows:.0f} | {'yes' if ok else 'no'} |")
-    largest = max((g for _, g, _, _, ok in real if ok), default=None)
+    print("| real row | g | AWCC Tu | accepted windows | T_u / T_W | compared |")
+    print("|---|---|---|---|---|---|")
+    for name, g, tu, windows, ratio, ok in real:
+        shown = "" if ratio is None else f"{ratio:.2f}"
+        print(f"| {name} | {g:+.4f} | {tu:.3f} | {windows:.0f} | {shown} | {'yes' if ok else 'no'} |")
+    largest = max((g for _, g, _, _, _, ok in real if ok), default=None)
     print(f"\nCampaign runs with AWCC Tu {TU_RANGE[0]}-{TU_RANGE[1]}, {WINDOWS_RANGE[0]}-{WINDOWS_RANGE[1]} "
-          f"accepted windows, fs up to {FS_MAX / 1e3:.0f} kHz:\n")
+          f"accepted windows, T_u / T_W {RATIO_RANGE[0]}-{RATIO_RANGE[1]}, fs up to {FS_MAX / 1e3:.0f} kHz:\n")
     print("| arrivals | runs | median g | 5-95 % of g | share at or below the real rows' largest g |")
     print("|---|---|---|---|---|")
     for rule, gs in by_rule.items():
