@@ -45,13 +45,20 @@ def comparable(tu, windows, ratio):
         and WINDOWS_RANGE[0] <= windows <= WINDOWS_RANGE[1] and RATIO_RANGE[0] <= ratio < RATIO_RANGE[1]
 
 
+def reader(path):
+    try:
+        return csv.DictReader(open(path))
+    except OSError as e:
+        sys.exit(f"{path}: {e.strerror}")
+
+
 def main():
     if len(sys.argv) < 4:
         sys.exit(__doc__.split("\n\n")[-1])
     weighted_path, unweighted_path, sweeps = sys.argv[1], sys.argv[2], sys.argv[3:]
     real = []
-    weighted = list(csv.DictReader(open(weighted_path)))
-    unweighted = list(csv.DictReader(open(unweighted_path)))
+    weighted = list(reader(weighted_path))
+    unweighted = list(reader(unweighted_path))
     if [r.get("file") for r in weighted] != [r.get("file") for r in unweighted]:
         sys.exit(f"{weighted_path}, {unweighted_path}: not the same recordings in the same order")
     for path, rows, weighting in ((weighted_path, weighted, "duration"), (unweighted_path, unweighted, "none")):
@@ -67,11 +74,11 @@ def main():
                      comparable(tu, windows, ratio)))
     by_rule = {"in time": [], "along the flow": []}
     for path in sweeps:
-        reader = csv.DictReader(open(path))
-        if not {"awcc_velocity_unweighted", "awcc_time_scale_ratio", "arrival", "fs"} <= set(reader.fieldnames or []):
+        rows = reader(path)
+        if not {"awcc_velocity_unweighted", "awcc_time_scale_ratio", "arrival", "fs"} <= set(rows.fieldnames or []):
             sys.exit(f"{path}: no columns awcc_velocity_unweighted, awcc_time_scale_ratio, arrival and fs: "
                      "not a pdp sweep CSV of generator version 2 with the time-scale ratio")
-        for r in reader:
+        for r in rows:
             if r.get("awcc_weighting", "duration") != "duration":
                 continue
             uw, uu = number(r, "awcc_velocity"), number(r, "awcc_velocity_unweighted")
