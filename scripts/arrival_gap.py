@@ -93,6 +93,10 @@ def main():
         shown = "" if ratio is None else f"{ratio:.2f}"
         print(f"| {name} | {g:+.4f} | {tu:.3f} | {windows:.0f} | {shown} | {'yes' if ok else 'no'} |")
     largest = max((g for _, g, _, _, _, ok in real if ok), default=None)
+    if largest is None:
+        sys.exit(f"\n{weighted_path}: no row with AWCC Tu {TU_RANGE[0]}-{TU_RANGE[1]}, {WINDOWS_RANGE[0]}-"
+                 f"{WINDOWS_RANGE[1]} accepted windows and T_u / T_W {RATIO_RANGE[0]}-{RATIO_RANGE[1]}: "
+                 "too few windows to tell the arrival rule (record longer)")
     print(f"\nCampaign runs with AWCC Tu {TU_RANGE[0]}-{TU_RANGE[1]}, {WINDOWS_RANGE[0]}-{WINDOWS_RANGE[1]} "
           f"accepted windows, T_u / T_W {RATIO_RANGE[0]}-{RATIO_RANGE[1]}, fs up to {FS_MAX / 1e3:.0f} kHz:\n")
     print("| arrivals | runs | median g | 5-95 % of g | share at or below the real rows' largest g |")
@@ -102,7 +106,7 @@ def main():
             print(f"| {rule} | {len(gs)} | too few runs | | |")
             continue
         q = statistics.quantiles(gs, n=20)
-        share = "" if largest is None else f"{100 * sum(g <= largest for g in gs) / len(gs):.1f} %"
+        share = f"{100 * sum(g <= largest for g in gs) / len(gs):.1f} %"
         print(f"| {rule} | {len(gs)} | {statistics.median(gs):+.4f} | {q[0]:+.4f} to {q[-1]:+.4f} | {share} |")
 
 
