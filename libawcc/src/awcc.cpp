@@ -500,11 +500,6 @@ double spr_of(std::span<const double> r, double prominence_fraction, AwccScratch
   return secondary_peak_ratio(scratch.turns, scratch, prominence_fraction);
 }
 
-double parabolic(double a, double b, double c) {
-  const double denom = a - 2 * b + c;
-  return denom < 0.0 ? 0.5 * (a - c) / denom : 0.0;
-}
-
 }  // namespace
 
 std::vector<std::pair<std::size_t, double>> peak_prominences(std::span<const double> r) {
@@ -528,9 +523,9 @@ CorrelationPeak analyse_correlation(std::span<const double> r, Subsample subsamp
   p.index = static_cast<std::size_t>(std::max_element(r.begin(), r.end()) - r.begin());
   p.height = r[p.index];
   p.refined_index = static_cast<double>(p.index);
-  if (subsample == Subsample::parabolic && p.index > 0 && p.index + 1 < r.size()) {
-    p.refined_index += parabolic(r[p.index - 1], r[p.index], r[p.index + 1]);
-  }
+  p.refined_index += subsample_offset(
+      subsample, [&](std::int64_t j) { return r[static_cast<std::size_t>(j)]; }, static_cast<std::int64_t>(p.index),
+      0, static_cast<std::int64_t>(r.size()) - 1);
   p.spr = spr_of(r, prominence_fraction, workspace.scratch());
   return p;
 }
@@ -544,9 +539,7 @@ CorrelationPeak analyse_correlation(const PiecewiseCorrelation& r, Subsample sub
   p.index = static_cast<std::size_t>(k - k_min);
   p.height = r.values[j];
   p.refined_index = static_cast<double>(p.index);
-  if (subsample == Subsample::parabolic && k > k_min && k < r.lags.back()) {
-    p.refined_index += parabolic(r.at(k - 1), p.height, r.at(k + 1));
-  }
+  p.refined_index += subsample_offset(subsample, [&](std::int64_t lag) { return r.at(lag); }, k, k_min, r.lags.back());
   // Peaks, prominences and heights of the piecewise-linear function are
   // those of its breakpoints' values (the bases and the tops sit on breakpoints).
   p.spr = spr_of(r.values, prominence_fraction, workspace.scratch());

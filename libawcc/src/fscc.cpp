@@ -21,7 +21,6 @@ Validation FsccOptions::validate() const {
   return {};
 }
 
-std::string_view to_string(Subsample subsample) { return subsample == Subsample::parabolic ? "parabolic" : "none"; }
 
 std::string_view to_string(FsccStatus status) {
   switch (status) {
@@ -663,11 +662,10 @@ FsccResult fscc_from_functions(CorrelationFunctions f, double dx, const FsccOpti
   out.lag_samples = out.r12_first_lag + static_cast<std::int64_t>(peak);
   double lag = static_cast<double>(out.lag_samples) / fs;
   if (felder) lag = tau12(peak);
-  if (options.subsample == Subsample::parabolic && peak > 0 && peak + 1 < out.r12.size()) {
-    const double a = out.r12[peak - 1], b = out.r12[peak], c = out.r12[peak + 1];
-    const double denom = a - 2 * b + c;
-    if (denom < 0.0) lag += 0.5 * (a - c) / denom / fs;
-  }
+  const auto r12_at = [&](std::int64_t j) { return out.r12[static_cast<std::size_t>(j)]; };
+  lag += subsample_offset(options.subsample, r12_at, static_cast<std::int64_t>(peak), 0,
+                          static_cast<std::int64_t>(out.r12.size()) - 1) /
+         fs;
   out.lag = lag;
   if (!(out.r12_max > 0.0)) {
     out.status = FsccStatus::no_positive_peak;

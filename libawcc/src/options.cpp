@@ -346,7 +346,7 @@ const OptionField<A> kAwcc[] = {
                                            format_quantity(*o.velocity_max, Dimension::velocity))
                              : std::string("all lags");
      }},
-    {"subsample", "", "peak refinement of FSCC and AWCC: none | parabolic",
+    {"subsample", "", "peak refinement of FSCC and AWCC below one sample: none | parabolic | gaussian | triangle | centroid",
      [](A& o, std::string_view t) { o.subsample = choice(t, values::subsample); },
      [](const A& o) { return name_of(o.subsample); }},
     {"windows-reported", "-", "AWCC quality: fewest accepted windows whose velocity and Tu are reported (insufficient below)",

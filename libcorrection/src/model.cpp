@@ -826,7 +826,7 @@ std::vector<std::uint8_t> CorrectionModel::serialise() const {
   payload.u8(processing.roc ? 1 : 0);
   payload.u8(processing.weighting == awcc::Weighting::none ? 1 : 0);
   payload.u8(processing.signal == awcc::CorrelationSignal::raw ? 1 : 0);
-  payload.u8(processing.subsample == awcc::Subsample::parabolic ? 1 : 0);
+  payload.u8(static_cast<std::uint8_t>(processing.subsample));  // awcc::Subsample's order is the code
   payload.u32(calibration.empty() ? 0 : static_cast<std::uint32_t>(calibration.window_edges.size() + 1));
   if (!calibration.empty()) {
     for (auto e : calibration.window_edges) payload.i64(e);
@@ -928,7 +928,9 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
     m.processing.roc = flag("outlier cutoff");
     m.processing.weighting = flag("weighting") ? awcc::Weighting::none : awcc::Weighting::duration;
     m.processing.signal = flag("signal") ? awcc::CorrelationSignal::raw : awcc::CorrelationSignal::binary;
-    m.processing.subsample = flag("peak refinement") ? awcc::Subsample::parabolic : awcc::Subsample::none;
+    const auto refinement = r.u8();
+    if (refinement >= std::size(awcc::values::subsample)) r.damaged(fmt::format("peak refinement code {}", refinement));
+    m.processing.subsample = awcc::values::subsample[refinement];
   }
   if (version >= 3) {
     const auto bands = r.count(r.u32(), 48);

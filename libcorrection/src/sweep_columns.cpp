@@ -1,14 +1,17 @@
 #include "correction/sweep_columns.hpp"
 
-#include <initializer_list>
+#include <span>
+
+#include "awcc/read_back.hpp"
 
 namespace correction {
 
 namespace {
 
-// The value whose written text is `text`, of the values an enum column takes.
+// The value whose written text is `text`, of the values an enum column takes
+// (awcc::values: the one list of each enum's values).
 template <class E>
-std::optional<E> value_named(std::string_view text, std::initializer_list<E> values) {
+std::optional<E> value_named(std::string_view text, std::span<const E> values) {
   for (E v : values)
     if (awcc::to_string(v) == text) return v;
   return std::nullopt;
@@ -33,15 +36,15 @@ std::optional<bool> roc_of(std::string_view text) {
 }
 
 std::optional<awcc::Weighting> weighting_of(std::string_view text) {
-  return value_named(text, {awcc::Weighting::duration, awcc::Weighting::none});
+  return value_named<awcc::Weighting>(text, awcc::values::weighting);
 }
 
 std::optional<awcc::CorrelationSignal> signal_of(std::string_view text) {
-  return value_named(text, {awcc::CorrelationSignal::binary, awcc::CorrelationSignal::raw});
+  return value_named<awcc::CorrelationSignal>(text, awcc::values::signal);
 }
 
 std::optional<awcc::Subsample> subsample_of(std::string_view text) {
-  return value_named(text, {awcc::Subsample::none, awcc::Subsample::parabolic});
+  return value_named<awcc::Subsample>(text, awcc::values::subsample);
 }
 
 }  // namespace correction

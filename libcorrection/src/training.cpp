@@ -358,7 +358,7 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
         p.roc = named(C::awcc_roc, roc_of, "on, off");
         p.weighting = named(C::awcc_weighting, weighting_of, "duration, none");
         p.signal = named(C::awcc_signal, signal_of, "binary, raw");
-        p.subsample = named(C::awcc_subsample, subsample_of, "none, parabolic");
+        p.subsample = named(C::awcc_subsample, subsample_of, "none, parabolic, gaussian, triangle, centroid");
         if (!processing_seen) set.processing = p;
         processing_seen = true;
         if (const auto why = processing_mismatch(set.processing, p); !why.empty()) {

@@ -68,12 +68,10 @@
 #include "awcc/air_intervals.hpp"
 #include "awcc/fft.hpp"
 #include "awcc/phase_statistics.hpp"
+#include "awcc/subsample_peak.hpp"
 #include "awcc/validation.hpp"
 
 namespace awcc {
-
-enum class Subsample { none, parabolic };
-std::string_view to_string(Subsample subsample);
 
 /// What FSCC correlates: the binarised signals or the raw voltages.
 enum class CorrelationSignal { binary, raw };

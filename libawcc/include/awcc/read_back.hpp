@@ -27,7 +27,8 @@ namespace awcc {
 namespace values {
 inline constexpr Weighting weighting[] = {Weighting::duration, Weighting::none};
 inline constexpr CorrelationSignal signal[] = {CorrelationSignal::binary, CorrelationSignal::raw};
-inline constexpr Subsample subsample[] = {Subsample::none, Subsample::parabolic};
+inline constexpr Subsample subsample[] = {Subsample::none, Subsample::parabolic, Subsample::gaussian,
+                                          Subsample::triangle, Subsample::centroid};
 inline constexpr ThresholdRule threshold_rule[] = {ThresholdRule::histogram, ThresholdRule::felder,
                                                    ThresholdRule::kramer, ThresholdRule::fixed,
                                                    ThresholdRule::hysteresis};
