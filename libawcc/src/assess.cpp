@@ -184,6 +184,18 @@ std::optional<Warning> multi_tip_doubtful(const ProcessResult& r) {
                              r.probe->quality_reason)};
 }
 
+// METHOD 7 (d): the weighting gap above what arrivals in time allow.
+std::optional<Warning> arrivals_along_flow(const ProcessResult& r) {
+  if (!r.awcc || !r.awcc->ok() || !r.awcc->weighting_gap || !r.awcc->weighting_gap->along_flow) return std::nullopt;
+  const auto& g = *r.awcc->weighting_gap;
+  return Warning{Flag::arrivals_along_flow,
+                 fmt::format("AWCC's weighting gap g = u_unweighted / u_weighted - 1 = {:.4f} (95 % {:.4f} to {:.4f}) "
+                             "lies above the {:.4f} ({:g} Tu^2) that bubbles arriving in time allow: the bubbles look "
+                             "spaced along the flow, a rule the bias correction was not trained on (its prior is "
+                             "arrivals in time), so a corrected value of this row may be biased beyond its interval",
+                             g.value, g.ci95.lower, g.ci95.upper, g.allowance, time_arrival_gap_allowance)};
+}
+
 }  // namespace
 
 std::vector<Warning> assess(const ProcessResult& r) {
@@ -204,6 +216,7 @@ std::vector<Warning> assess(const ProcessResult& r) {
   if (auto w = methods_disagree(r)) out.push_back(std::move(*w));
   if (auto w = events_disagree(r)) out.push_back(std::move(*w));
   if (auto w = multi_tip_doubtful(r)) out.push_back(std::move(*w));
+  if (auto w = arrivals_along_flow(r)) out.push_back(std::move(*w));
   return out;
 }
 

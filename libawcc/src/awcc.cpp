@@ -691,6 +691,7 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
   result.velocity = result.velocity_rms = result.turbulence_intensity = 0.0;
   result.velocity_ci95 = result.velocity_rms_ci95 = result.turbulence_intensity_ci95 = {};
   result.time_scale_ratio.reset();
+  result.weighting_gap.reset();
   result.mean_lag_samples = 0.0;
   result.one_sample_lag = result.chance_yield = false;
   auto insufficient = [&result] { result.quality_reason = result.message; };
@@ -756,6 +757,15 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options) {
       reported_quality(result.windows_accepted, result.windows_total, options.windows_ok, options.yield_ok, intervals,
                        {"accepted windows", "data yield", "windows accepted", "the accepted windows"});
   result.time_scale_ratio = capped_time_scale_ratio(result, time_scale_ratio_cap);
+  {
+    std::vector<double> velocities, durations;
+    for (const auto& w : windows) {
+      if (w.fate != WindowFate::accepted) continue;
+      velocities.push_back(w.velocity);
+      durations.push_back(w.duration);
+    }
+    result.weighting_gap = weighting_gap(velocities, durations, result.turbulence_intensity);
+  }
   result.mean_lag_samples = mean_lag_samples(windows, options.weighting);
   const double yield = static_cast<double>(result.windows_accepted) / static_cast<double>(result.windows_total);
   if (yield < chance_data_yield) {

@@ -313,7 +313,15 @@ constexpr PresetSetting kFelder[] = {
     {"method", "fscc"},            {"felder-defects", "on"},     {"voltage-pdf-bin", "0.1V"},
     {"chord-time-bin", "0.1ms"},   {"chord-time-max", "10ms"},   {"chord-length-bin", "0.5mm"},
     {"chord-length-max", "20mm"},  {"cluster-median-fraction", "0.1"}, {"cluster-constant-length", "1mm"},
-    {"cluster-constant-time", "1ms"},
+    {"cluster-constant-time", "1ms"},  {"subsample", "none"},
+};
+
+// Kramer's AWCC toolbox: its threshold rule (thres.m), the raw voltages
+// correlated, and the whole-sample peak of the published method (METHOD 4.3).
+constexpr PresetSetting kKramer[] = {
+    {"threshold-rule", "kramer"},
+    {"correlate", "raw"},
+    {"subsample", "none"},
 };
 
 using A = AwccOptions;
@@ -644,7 +652,8 @@ std::span<const OptionField<ProfileFlowOptions>> profile_flow_option_fields() { 
 
 std::span<const PresetSetting> preset_settings(std::string_view name) {
   if (name == "felder") return kFelder;
-  throw OptionError(fmt::format("'{}' is not a preset; the presets are: felder", name), "preset");
+  if (name == "kramer") return kKramer;
+  throw OptionError(fmt::format("'{}' is not a preset; the presets are: felder, kramer", name), "preset");
 }
 
 namespace {

@@ -565,6 +565,11 @@ json awcc_json(const AwccResult& a) {
       {"turbulence_intensity_measured", a.probe_corrected ? value(a.turbulence_intensity_measured) : json(nullptr)},
       {"windows_not_bubbly", a.windows_not_bubbly},
       {process_key::time_scale_ratio, a.time_scale_ratio ? json(*a.time_scale_ratio) : json(nullptr)},
+      {"weighting_gap", a.ok() && a.weighting_gap ? json{{"value", a.weighting_gap->value},
+                                                         {"ci95", ci(a.weighting_gap->ci95)},
+                                                         {"allowance", a.weighting_gap->allowance},
+                                                         {"along_flow", a.weighting_gap->along_flow}}
+                                                   : json(nullptr)},
       {"yield", a.windows_total > 0 ? json(static_cast<double>(a.windows_accepted) /
                                             static_cast<double>(a.windows_total))
                                       : json(nullptr)},
@@ -932,6 +937,10 @@ std::span<const ProfileColumn> profile_csv_columns() {
        "which estimate interfacial_area is: dual_tip (4 F / u = 6 c / d32) or multi_tip"},
       {profile_column::awcc_time_scale_ratio, "-", "/awcc/time_scale_ratio",
        "AWCC's T_u / T_W capped at 20: the bias correction's time-scale feature"},
+      {"awcc_weighting_gap", "-", "/awcc/weighting_gap/value",
+       "AWCC's weighting gap g = u_unweighted / u_weighted - 1 (near 0 for bubbles arriving in time)"},
+      {"awcc_weighting_gap_ci95_lower", "-", "/awcc/weighting_gap/ci95/0", "weighting gap, 95 % interval, lower"},
+      {"awcc_weighting_gap_ci95_upper", "-", "/awcc/weighting_gap/ci95/1", "weighting gap, 95 % interval, upper"},
   };
   return columns;
 }
@@ -1027,6 +1036,10 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
                      csv_number(area_ci ? std::optional(area_ci->upper) : std::nullopt),
                      area.source ? to_string(*area.source) : "");
   out += "," + csv_number(awcc_ok ? a->time_scale_ratio : std::nullopt);
+  const auto* gap = awcc_ok && a->weighting_gap ? &*a->weighting_gap : nullptr;
+  out += fmt::format(",{},{},{}", csv_number(gap ? std::optional(gap->value) : std::nullopt),
+                     csv_number(gap ? std::optional(gap->ci95.lower) : std::nullopt),
+                     csv_number(gap ? std::optional(gap->ci95.upper) : std::nullopt));
   return out;
 }
 
@@ -1238,6 +1251,13 @@ std::string ProcessResult::report() const {
                      a.count(WindowFate::lag), a.count(WindowFate::roc), a.count(WindowFate::constant),
                      a.count(WindowFate::too_short) ? fmt::format(", {} too short", a.count(WindowFate::too_short))
                                                     : std::string()));
+    if (a.ok() && a.weighting_gap) {
+      const auto& g = *a.weighting_gap;
+      line(fmt::format("        weighting gap g {:+.4f} (95 % {:+.4f} to {:+.4f}); bubbles arriving in time allow up "
+                       "to {:.4f}{}",
+                       g.value, g.ci95.lower, g.ci95.upper, g.allowance,
+                       g.along_flow ? ": they look spaced along the flow (flag arrivals_along_flow)" : ""));
+    }
   }
   if (events) {
     const auto& e = *events;

@@ -391,6 +391,11 @@ std::string sweep_row(const SweepRun& run, const RunResult* r, const std::string
     cell(SweepColumn::awcc_turbulence_intensity_unweighted) = num(rms / mean);
   }
   cell(SweepColumn::awcc_time_scale_ratio) = num(m.time_scale_ratio);
+  if (awcc && awcc->ok() && awcc->weighting_gap) {
+    cell(SweepColumn::awcc_weighting_gap) = num(awcc->weighting_gap->value);
+    cell(SweepColumn::awcc_weighting_gap_ci95_lower) = num(awcc->weighting_gap->ci95.lower);
+    cell(SweepColumn::awcc_weighting_gap_ci95_upper) = num(awcc->weighting_gap->ci95.upper);
+  }
   cell(SweepColumn::seconds_synth) = fmt::format("{:.4f}", r->seconds_synth);
   cell(SweepColumn::seconds_process) = fmt::format("{:.4f}", r->seconds_process);
   cell(SweepColumn::reason) = clean(reason);

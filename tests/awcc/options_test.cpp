@@ -143,10 +143,19 @@ TEST(ProcessOptions, APresetFillsWhatTheUserDoesNotGive) {
   EXPECT_TRUE(p.fscc && !p.awcc);
   const std::vector<OptionSetting> over{{"segments", "3", ""}, {"preset", "felder", ""}};
   EXPECT_EQ(awcc::process_options(over).fscc_options.segments, 3);  // the user's value wins, wherever listed
+  // Both published programs' presets keep the whole-sample peak (METHOD 4.3).
+  EXPECT_EQ(p.awcc_options.subsample, awcc::Subsample::none);
+  EXPECT_EQ(p.fscc_options.subsample, awcc::Subsample::none);
+  const std::vector<OptionSetting> kramer{{"preset", "kramer", ""}, {"subsample", "triangle", "cli"}};
+  const auto k = awcc::process_options(std::vector<OptionSetting>{{"preset", "kramer", ""}});
+  EXPECT_EQ(k.awcc_options.subsample, awcc::Subsample::none);
+  EXPECT_EQ(k.awcc_options.signal, awcc::CorrelationSignal::raw);
+  EXPECT_EQ(k.binarisation.rule, awcc::ThresholdRule::kramer);
+  EXPECT_EQ(awcc::process_options(kramer).fscc_options.subsample, awcc::Subsample::triangle);  // the user's wins
   const std::vector<OptionSetting> nope{{"preset", "nope", "a.toml:4"}};
   const auto unknown = error_of(nope);
   EXPECT_EQ(unknown.quantity(), "preset");
-  EXPECT_EQ(std::string(unknown.what()), "a.toml:4: preset: 'nope' is not a preset; the presets are: felder");
+  EXPECT_EQ(std::string(unknown.what()), "a.toml:4: preset: 'nope' is not a preset; the presets are: felder, kramer");
   // The preset's threshold 0.5 is a fraction; under the user's fixed rule it needs a voltage.
   const std::vector<OptionSetting> clash{{"preset", "felder", ""}, {"threshold-rule", "fixed", ""}};
   const auto e = error_of(clash);

@@ -97,7 +97,7 @@ fi
 expect 2 "fixed rule" "$pdp" process "$dir/rec.flac" --dx 5mm --threshold-trailing 2.6V
 expect 2 "use one of them" "$pdp" process "$dir/rec.flac" --dx 5mm --probe-correction --correct "$src/samples/model/awcc.qrf"
 expect 2 "has no unit" "$pdp" process "$dir/rec.flac" --dx 5mm --probe-correction --probe-angle 45
-expect 2 "not a preset" "$pdp" process "$dir/rec.flac" --dx 5mm --preset kramer
+expect 2 "not a preset" "$pdp" process "$dir/rec.flac" --dx 5mm --preset nope
 
 # The structure tables of a synthetic profile: each chord PDF sums to 1 over its bins.
 mkdir -p "$dir/structure"

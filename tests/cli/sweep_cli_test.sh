@@ -160,21 +160,23 @@ err=$("$pdp" sweep "$dir/other.toml" -o "$dir/two.csv" 2>&1) && fail "another st
 grep -q "another study" <<<"$err" || fail "other study message: $err"
 # Another generator version: a sweep of version 1 (written before the column
 # generator_version) and a row of another version are refused, never resumed.
-# (The version and the time-scale ratio after it are the last two columns.)
-sed 's/,generator_version,awcc_time_scale_ratio$//; 2,$s/,[0-9]*,[^,]*$//' "$dir/two.csv" >"$dir/version1.csv"
+# (The version is the fifth column from the end: the time-scale ratio and the
+# weighting gap's three follow it.)
+gap=',awcc_weighting_gap,awcc_weighting_gap_ci95_lower,awcc_weighting_gap_ci95_upper'
+sed "s/,generator_version,awcc_time_scale_ratio$gap\$//; 2,\$s/,[0-9]*,[^,]*,[^,]*,[^,]*,[^,]*\$//" "$dir/two.csv" >"$dir/version1.csv"
 cp "$dir/version1.csv" "$dir/version1.orig"
 err=$("$pdp" sweep "$dir/grid.toml" -o "$dir/version1.csv" 2>&1) && fail "a generator-version-1 sweep resumed"
 grep -q "written by pdp's generator version 1" <<<"$err" || fail "version 1 message: $err"
 cmp -s "$dir/version1.csv" "$dir/version1.orig" || fail "version-1 sweep modified"
-{ head -n 2 "$dir/two.csv"; sed -n 3p "$dir/two.csv" | sed 's/,[0-9]*\(,[^,]*\)$/,1\1/'; } >"$dir/mixed.csv"
+{ head -n 2 "$dir/two.csv"; sed -n 3p "$dir/two.csv" | sed 's/,[0-9]*\(,[^,]*,[^,]*,[^,]*,[^,]*\)$/,1\1/'; } >"$dir/mixed.csv"
 err=$("$pdp" sweep "$dir/grid.toml" -o "$dir/mixed.csv" 2>&1) && fail "a row of another generator version resumed"
 grep -q "mixed.csv:3: the run was made by generator version '1'" <<<"$err" || fail "mixed version message: $err"
-# A sweep of an earlier pdp (of this generator, before the column
-# awcc_time_scale_ratio): refused, never resumed, the missing column named.
-sed 's/,awcc_time_scale_ratio$//; 2,$s/,[^,]*$//' "$dir/two.csv" >"$dir/earlier.csv"
+# A sweep of an earlier pdp (of this generator, before the weighting gap's
+# columns): refused, never resumed, the missing columns named.
+sed "s/$gap\$//; 2,\$s/,[^,]*,[^,]*,[^,]*\$//" "$dir/two.csv" >"$dir/earlier.csv"
 cp "$dir/earlier.csv" "$dir/earlier.orig"
 err=$("$pdp" sweep "$dir/grid.toml" -o "$dir/earlier.csv" 2>&1) && fail "a sweep of an earlier pdp resumed"
-grep -q "written by an earlier pdp, whose rows end before the columns awcc_time_scale_ratio" <<<"$err" ||
+grep -q "written by an earlier pdp, whose rows end before the columns awcc_weighting_gap" <<<"$err" ||
   fail "earlier pdp message: $err"
 cmp -s "$dir/earlier.csv" "$dir/earlier.orig" || fail "the earlier sweep modified"
 printf '[sweep]\nmode = "grid"\n[grid]\nbubble-diameter = ["3 kg"]\n' >"$dir/bad.toml"

@@ -36,7 +36,8 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
              "Profile quantities (several recordings with positions: Y90, C_mean, discharge, models)");
   cmd->add_option("--preset", o.preset,
                   "felder: Felder's program (his threshold rule, 15 segments of raw voltages, his lags, scale rules, "
-                  "bins and defects; FSCC only); options given as well override it")
+                  "bins and defects; FSCC only, whole-sample peak); kramer: Kramer's AWCC toolbox (thres.m, raw "
+                  "voltages correlated, whole-sample peak); options given as well override it")
       ->group("Probe and methods");
   const auto* out = "Output";
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"))->group(out);

@@ -60,6 +60,7 @@
 #include "awcc/fscc.hpp"
 #include "awcc/phase_statistics.hpp"
 #include "awcc/probe_correction.hpp"
+#include "awcc/weighting_gap.hpp"
 
 namespace awcc {
 
@@ -227,6 +228,10 @@ struct AwccResult {
   /// (awcc/velocity_series.hpp, capped_time_scale_ratio): the bias
   /// correction's feature time_scale_ratio; empty unless ok.
   std::optional<double> time_scale_ratio;
+  /// The weighting gap g of the accepted windows and its flag
+  /// (awcc/weighting_gap.hpp): whether the bubbles arrive as the
+  /// correction's prior assumes; empty unless ok.
+  std::optional<WeightingGap> weighting_gap;
   std::vector<AwccWindow> windows;
 };
 

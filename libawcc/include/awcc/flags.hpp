@@ -24,6 +24,7 @@ enum class Flag {
   methods_disagree,          ///< FSCC and AWCC differ by more than their sampling intervals allow
   events_disagree,           ///< event detection's velocity differs from FSCC's (AWCC's) beyond their intervals
   multi_tip_doubtful,        ///< the multi-tip vectors' quality is low (ProbeResult::quality_reason says why)
+  arrivals_along_flow,       ///< AWCC's weighting gap says the bubbles arrive spaced along the flow (awcc/weighting_gap.hpp)
 };
 
 struct FlagName {
@@ -34,7 +35,7 @@ struct FlagName {
 
 /// Every flag in the enum's order: to_string, parse_flag and the lists of
 /// codes read this one table.
-inline constexpr std::array<FlagName, 9> flag_names{{
+inline constexpr std::array<FlagName, 10> flag_names{{
     {Flag::reader_note, "reader_note", "the reader accepted the file but notes something about it"},
     {Flag::signal_check, "signal_check",
      "a tip's voltage is not a clean two-level signal of the stated polarity, or its air level is the continuous one"},
@@ -50,12 +51,14 @@ inline constexpr std::array<FlagName, 9> flag_names{{
      "event detection's velocity differs from FSCC's (else AWCC's) by more than their 95 % sampling intervals allow"},
     {Flag::multi_tip_doubtful, "multi_tip_doubtful",
      "the multi-tip mean vector is doubtful: it disagrees with FSCC of the tip pair, or the solver's caution is raised"},
+    {Flag::arrivals_along_flow, "arrivals_along_flow",
+     "AWCC's weighting gap lies above what bubbles arriving in time allow: the correction's prior does not hold"},
 }};
 constexpr bool flag_names_in_enum_order() {
   for (std::size_t i = 0; i < flag_names.size(); ++i) {
     if (static_cast<std::size_t>(flag_names[i].flag) != i) return false;
   }
-  return static_cast<std::size_t>(Flag::multi_tip_doubtful) + 1 == flag_names.size();
+  return static_cast<std::size_t>(Flag::arrivals_along_flow) + 1 == flag_names.size();
 }
 static_assert(flag_names_in_enum_order(), "a flag added to Flag needs its row in flag_names, in the enum's order");
 

@@ -62,6 +62,7 @@ enum class SweepColumn : std::size_t {
   awcc_velocity_unweighted, awcc_turbulence_intensity_unweighted,
   generator_version,
   awcc_time_scale_ratio,
+  awcc_weighting_gap, awcc_weighting_gap_ci95_lower, awcc_weighting_gap_ci95_upper,
   count
 };
 
@@ -127,6 +128,11 @@ inline constexpr std::array<SweepColumnInfo, sweep_result_column_count> sweep_re
     {"awcc_time_scale_ratio", "-",
      "T_u / T_W of AWCC's accepted windows, capped at 20 (correction::Features::time_scale_ratio; the feature of the "
      "+scale sets)"},
+    {"awcc_weighting_gap", "-",
+     "AWCC's weighting gap g = u_unweighted / u_weighted - 1 of the accepted windows (awcc/weighting_gap.hpp: near 0 "
+     "for bubbles arriving in time); not a feature of the correction (METHOD 7 (d))"},
+    {"awcc_weighting_gap_ci95_lower", "-", "its 95 % interval (block jackknife), lower end"},
+    {"awcc_weighting_gap_ci95_upper", "-", "its 95 % interval, upper end"},
 }};
 
 [[nodiscard]] constexpr std::string_view column_name(SweepColumn c) {
