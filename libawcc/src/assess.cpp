@@ -84,6 +84,65 @@ std::optional<EventsComparison> compare_multi_tip(const MultiTipResult& vectors,
   return against_reference(vectors.velocity[0], vectors.velocity_ci95[0], vectors.turbulence_intensity[0], r);
 }
 
+// Event detection's velocity against FSCC's (else AWCC's of quality ok), by
+// the rule FSCC and AWCC are compared by (awcc/assess.hpp): differing by more
+// than their 95 % intervals allow together, event detection's quality is at
+// most low and says why. Its Kramer pairing takes unrelated later bubbles as
+// partners where bubbles are sparse or the tips offset, inside the outlier
+// band (event_detection.hpp): the comparison is what catches that.
+void judge_events(EventResult& e, const ProcessResult& out) {
+  if (!e.ok()) return;
+  const auto c = compare_events(e, out);
+  if (!c || !c->disagree()) return;
+  if (e.quality == AwccQuality::ok) e.quality = AwccQuality::low;
+  const std::string why = fmt::format("its velocity differs from {}'s by {:.0f} %, more than their sampling intervals "
+                                      "allow: its pairing is biased here",
+                                      c->reference, 100.0 * c->relative);
+  e.quality_reason = e.quality_reason.empty() ? why : e.quality_reason + "; " + why;
+}
+
+
+void judge_probe(ProbeResult& probe, const ProcessResult& out, const EventOptions& pairing) {
+  const MultiTipResult& v = probe.vectors;
+  if (!v.ok()) {
+    probe.quality = AwccQuality::insufficient;
+    probe.quality_reason = v.message;
+    return;
+  }
+  std::vector<std::string> why;
+  // A leading tip's signal that arrives after a trailing tip's is a channel
+  // mapped to the wrong tip: the vectors are then of a different probe.
+  auto order = [&](const std::optional<FsccResult>& f, std::size_t tip, double dx) {
+    if (!f || (f->status != FsccStatus::tips_swapped && f->status != FsccStatus::non_positive_lag)) return;
+    why.push_back(fmt::format("FSCC of the leading tip (channel {}) with tip {} (channel {}, {:.3g} mm downstream) "
+                              "finds {}: is the channel of one of them swapped with another tip's? (tip-channels)",
+                              probe.channels[0], tip, probe.channels[tip], dx * 1e3,
+                              f->status == FsccStatus::tips_swapped ? "the trailing tip's signal first"
+                                                                    : "no delay between them"));
+  };
+  order(out.fscc, 1, out.dx);
+  for (const auto& pair : probe.pairs) order(pair.fscc, pair.tip, pair.dx);
+  if (!v.caution.empty()) why.push_back(v.caution);
+  if (v.turbulence_intensity[0] > multi_tip_tu_truncated) {
+    why.push_back(fmt::format("Tu_x = {:.2f}: the pairing accepts speeds {:g}-{:g} times FSCC's and directions within "
+                              "{:g} degrees of x, which cut the tails of a flow this turbulent: u_x is biased high "
+                              "(4-11 % at a true Tu_x of 0.3) and Tu_x low (16-26 %)",
+                              v.turbulence_intensity[0], pairing.probe_speed_min, pairing.probe_speed_max,
+                              pairing.probe_angle_max));
+  }
+  if (const auto c = compare_multi_tip(v, out); c && c->disagree()) {
+    why.push_back(fmt::format("its streamwise component {:.3f} m/s ({:.3f}-{:.3f}, Tu_x {:.2f}) lies {:.0f} % {} the "
+                              "band {}'s velocity of the tip pair, {:.3f} m/s ({:.3f}-{:.3f}), allows ({:.3f}-{:.3f}): "
+                              "more than their sampling intervals and {:.0f} % allow",
+                              c->events, c->events_ci95.lower, c->events_ci95.upper, v.turbulence_intensity[0],
+                              100.0 * c->relative, c->difference < 0.0 ? "below" : "above", c->reference,
+                              c->reference_velocity, c->reference_ci95.lower, c->reference_ci95.upper, c->band_lower,
+                              c->band_upper, 100.0 * c->tolerance));
+  }
+  probe.quality = why.empty() ? AwccQuality::ok : AwccQuality::low;
+  for (const auto& w : why) probe.quality_reason += (probe.quality_reason.empty() ? "" : "; ") + w;
+}
+
 namespace {
 
 // "channel 2", "channels 2 and 3", "channels 2, 3 and 4", with the names a column file gives.

@@ -738,73 +738,6 @@ std::optional<double> first_velocity(const ProcessResult& out) {
   return std::nullopt;
 }
 
-// Event detection's velocity against FSCC's (else AWCC's of quality ok), by
-// the rule FSCC and AWCC are compared by (awcc/assess.hpp): differing by more
-// than their 95 % intervals allow together, event detection's quality is at
-// most low and says why. Its Kramer pairing takes unrelated later bubbles as
-// partners where bubbles are sparse or the tips offset, inside the outlier
-// band (event_detection.hpp): the comparison is what catches that.
-void check_events(EventResult& e, const ProcessResult& out) {
-  if (!e.ok()) return;
-  const auto c = compare_events(e, out);
-  if (!c || !c->disagree()) return;
-  if (e.quality == AwccQuality::ok) e.quality = AwccQuality::low;
-  const std::string why = fmt::format("its velocity differs from {}'s by {:.0f} %, more than their sampling intervals "
-                                      "allow: its pairing is biased here",
-                                      c->reference, 100.0 * c->relative);
-  e.quality_reason = e.quality_reason.empty() ? why : e.quality_reason + "; " + why;
-}
-
-// A measured Tu_x above which the joint pairing's speed band and cone
-// (probe-speed-min, probe-speed-max, probe-angle-max) cut the tails of the
-// velocity distribution enough to bias the mean: in the tip-geometry study
-// (docs/validation.md) a flow of Tu_x 0.3 came out with u_x 4-11 % high and
-// Tu_x 16-26 % low (measured Tu_x 0.22-0.25), one of 0.15 within 2.4 % and
-// 5 % (measured Tu_x <= 0.16).
-constexpr double multi_tip_tu_truncated = 0.2;
-
-// The multi-tip vectors' quality (ProbeResult::quality).
-void check_vectors(ProbeResult& probe, const ProcessResult& out, const EventOptions& pairing) {
-  const MultiTipResult& v = probe.vectors;
-  if (!v.ok()) {
-    probe.quality = AwccQuality::insufficient;
-    probe.quality_reason = v.message;
-    return;
-  }
-  std::vector<std::string> why;
-  // A leading tip's signal that arrives after a trailing tip's is a channel
-  // mapped to the wrong tip: the vectors are then of a different probe.
-  auto order = [&](const std::optional<FsccResult>& f, std::size_t tip, double dx) {
-    if (!f || (f->status != FsccStatus::tips_swapped && f->status != FsccStatus::non_positive_lag)) return;
-    why.push_back(fmt::format("FSCC of the leading tip (channel {}) with tip {} (channel {}, {:.3g} mm downstream) "
-                              "finds {}: is the channel of one of them swapped with another tip's? (tip-channels)",
-                              probe.channels[0], tip, probe.channels[tip], dx * 1e3,
-                              f->status == FsccStatus::tips_swapped ? "the trailing tip's signal first"
-                                                                    : "no delay between them"));
-  };
-  order(out.fscc, 1, out.dx);
-  for (const auto& pair : probe.pairs) order(pair.fscc, pair.tip, pair.dx);
-  if (!v.caution.empty()) why.push_back(v.caution);
-  if (v.turbulence_intensity[0] > multi_tip_tu_truncated) {
-    why.push_back(fmt::format("Tu_x = {:.2f}: the pairing accepts speeds {:g}-{:g} times FSCC's and directions within "
-                              "{:g} degrees of x, which cut the tails of a flow this turbulent: u_x is biased high "
-                              "(4-11 % at a true Tu_x of 0.3) and Tu_x low (16-26 %)",
-                              v.turbulence_intensity[0], pairing.probe_speed_min, pairing.probe_speed_max,
-                              pairing.probe_angle_max));
-  }
-  if (const auto c = compare_multi_tip(v, out); c && c->disagree()) {
-    why.push_back(fmt::format("its streamwise component {:.3f} m/s ({:.3f}-{:.3f}, Tu_x {:.2f}) lies {:.0f} % {} the "
-                              "band {}'s velocity of the tip pair, {:.3f} m/s ({:.3f}-{:.3f}), allows ({:.3f}-{:.3f}): "
-                              "more than their sampling intervals and {:.0f} % allow",
-                              c->events, c->events_ci95.lower, c->events_ci95.upper, v.turbulence_intensity[0],
-                              100.0 * c->relative, c->difference < 0.0 ? "below" : "above", c->reference,
-                              c->reference_velocity, c->reference_ci95.lower, c->reference_ci95.upper, c->band_lower,
-                              c->band_upper, 100.0 * c->tolerance));
-  }
-  probe.quality = why.empty() ? AwccQuality::ok : AwccQuality::low;
-  for (const auto& w : why) probe.quality_reason += (probe.quality_reason.empty() ? "" : "; ") + w;
-}
-
 // The bubble-by-bubble methods on the binarised tips: event detection on
 // the pair, the multi-tip vectors with FSCC and AWCC on every further pair.
 void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const ProcessOptions& options) {
@@ -813,7 +746,7 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
   const EventOptions event_options = options.effective_event_options();
   if (options.events) {
     out.events = event_detection(r.leading, r.trailing, options.dx, event_options, velocity);
-    check_events(*out.events, out);
+    judge_events(*out.events, out);
   }
   const std::size_t tips = r.tip_positions.size();
   if (!wants_multi_tip(options.multi_tip, tips)) return;
@@ -869,33 +802,50 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
     if (options.awcc) pair.awcc = awcc::awcc(r.leading, trailing, pair.dx, options.awcc_options);
     probe.pairs.push_back(std::move(pair));
   }
-  check_vectors(probe, out, event_options);
+  judge_probe(probe, out, event_options);
   out.probe = std::move(probe);
+}
+
+// The one list of processing steps after the correlations, whatever they
+// correlated (both entry points below): the tip order FSCC and AWCC say,
+// the phase statistics at the chosen velocity, the bubble-by-bubble methods,
+// the sizes, the structure, the velocity series and the row's warnings. A
+// new step goes here, once.
+void finish(ProcessResult& out, const BinarisedRecording& r, const ProcessOptions& options) {
+  apply_tip_order(out);
+  out.tips = tip_results(r, options, out.velocity());
+  add_bubble_methods(out, r, options);
+  add_sizes(out, r, options);
+  add_structure(out, r, options);
+  add_spectrum(out, options);
+  out.warnings = assess(out);
+}
+
+ProcessResult started(const RecordingInfo& info, const ProcessOptions& options) {
+  ProcessResult out;
+  out.info = info;
+  out.dx = options.dx;
+  out.dy = options.dy;
+  return out;
 }
 
 }  // namespace
 
 ProcessResult process_binarised(const BinarisedRecording& r, const ProcessOptions& given) {
   const ProcessOptions options = tip_pair_options(given, r.info);
-  ProcessResult out;
-  out.info = r.info;
-  out.dx = options.dx;
-  out.dy = options.dy;
-  if (options.fscc && options.awcc_options.signal == CorrelationSignal::binary) {
+  if (options.awcc_options.signal != CorrelationSignal::binary && (options.fscc || options.awcc)) {
+    throw OptionError(fmt::format("{}: FSCC and AWCC correlate the raw voltages here (correlate = raw), which a "
+                                  "binarised recording no longer holds: process the recording itself, or correlate "
+                                  "the binary signals",
+                                  r.info.path.string()),
+                      "correlate");
+  }
+  ProcessResult out = started(r.info, options);
+  if (options.fscc) {
     out.fscc = fscc(r.leading, r.trailing, options.dx, options.fscc_options, options.parallel_fscc && two_cores());
   }
-  if (options.awcc && options.awcc_options.signal == CorrelationSignal::binary) {
-    out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);
-  }
-  apply_tip_order(out);
-  out.tips = tip_results(r, options, out.velocity());
-  add_bubble_methods(out, r, options);
-  add_sizes(out, r, options);
-  if (options.awcc_options.signal == CorrelationSignal::binary) {
-    add_structure(out, r, options);
-    add_spectrum(out, options);
-    out.warnings = assess(out);
-  }
+  if (options.awcc) out.awcc = awcc::awcc(r.leading, r.trailing, options.dx, options.awcc_options);
+  finish(out, r, options);
   return out;
 }
 
@@ -1085,19 +1035,10 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     out = process_binarised(binarised, options);
   } else {
-    // The phase statistics wait for the velocity of the raw correlations.
-    out.info = binarised.info;
-    out.dx = options.dx;
-    out.dy = options.dy;
+    out = started(binarised.info, options);
     if (options.fscc) out.fscc = fscc_raw(recording, binarised, options, workspace.plans);
     if (options.awcc) out.awcc = awcc_raw(recording, binarised, options, workspace.awcc);
-    apply_tip_order(out);
-    out.tips = tip_results(binarised, options, out.velocity());
-    add_bubble_methods(out, binarised, options);
-    add_sizes(out, binarised, options);
-    add_structure(out, binarised, options);
-    add_spectrum(out, options);
-    out.warnings = assess(out);
+    finish(out, binarised, options);
   }
   // Whatever the reading did not hash (nothing, for a container read front to back) is read here.
   if (given.hash_input) out.input_sha256 = recording.sha256();

@@ -93,6 +93,29 @@ std::optional<EventsComparison> compare_events(const EventResult& events, const 
 /// against FSCC's velocity of the tip pair; empty unless both exist.
 std::optional<EventsComparison> compare_multi_tip(const MultiTipResult& vectors, const ProcessResult& result);
 
+/// The consistency rules' effect on the bubble-by-bubble methods' quality,
+/// here beside the warnings they raise (one owner): event detection of
+/// quality ok that compare_events finds in disagreement becomes low, saying
+/// why (its Kramer pairing takes unrelated later bubbles as partners where
+/// bubbles are sparse or the tips offset, inside the outlier band: the
+/// comparison is what catches that).
+void judge_events(EventResult& events, const ProcessResult& result);
+
+// A measured Tu_x above which the joint pairing's speed band and cone
+// (probe-speed-min, probe-speed-max, probe-angle-max) cut the tails of the
+// velocity distribution enough to bias the mean: in the tip-geometry study
+// (docs/validation.md) a flow of Tu_x 0.3 came out with u_x 4-11 % high and
+// Tu_x 16-26 % low (measured Tu_x 0.22-0.25), one of 0.15 within 2.4 % and
+// 5 % (measured Tu_x <= 0.16).
+inline constexpr double multi_tip_tu_truncated = 0.2;
+
+/// The multi-tip vectors' quality (ProbeResult::quality): insufficient
+/// without vectors; low, with every reason, when FSCC of the leading tip with
+/// a trailing tip finds no delay or the trailing signal first (a channel
+/// mapped to the wrong tip), the solver's caution is raised, the measured
+/// Tu_x exceeds multi_tip_tu_truncated, or compare_multi_tip disagrees.
+void judge_probe(ProbeResult& probe, const ProcessResult& result, const EventOptions& pairing);
+
 /// Every warning of a processed recording, in the order of the list above.
 std::vector<Warning> assess(const ProcessResult& result);
 
