@@ -543,18 +543,21 @@ CharacteristicDepth characteristic_depth(std::span<const double> y, std::span<co
   return out;
 }
 
-std::string repeated_position(std::span<const double> y, std::span<const std::string> names) {
-  if (y.size() != names.size()) throw std::invalid_argument("repeated_position: as many names as positions");
-  std::vector<std::size_t> order(y.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return y[a] < y[b]; });
-  for (std::size_t i = 1; i < order.size(); ++i) {
-    if (y[order[i - 1]] == y[order[i]]) {
-      return fmt::format("position y = {:.6g} m given twice ({} and {}): one recording a position", y[order[i]],
-                         names[order[i - 1]], names[order[i]]);
+std::optional<std::pair<std::size_t, std::size_t>> repeated_position_pair(std::span<const double> y) {
+  for (std::size_t j = 0; j < y.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      if (y[i] == y[j]) return std::pair{i, j};
     }
   }
-  return {};
+  return std::nullopt;
+}
+
+std::string repeated_position(std::span<const double> y, std::span<const std::string> names) {
+  if (y.size() != names.size()) throw std::invalid_argument("repeated_position: as many names as positions");
+  const auto pair = repeated_position_pair(y);
+  if (!pair) return {};
+  return fmt::format("position y = {:.6g} m given twice ({} and {}): one recording a position", y[pair->second],
+                     names[pair->first], names[pair->second]);
 }
 
 ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOptions& options) {

@@ -327,8 +327,8 @@ ProfileValidation validate_profile(const ProfileSpec& spec, const ProfileValidat
   ProfileValidation v;
   v.spec = spec;
   v.truth = profile_truth(spec, options.flow.levels);
-  std::vector<awcc::ProfileRow> rows, exact;
-  std::vector<std::string> notes;
+  std::vector<correction::ProfileRowOf> rows;
+  std::vector<awcc::ProfileRow> exact;
   for (std::size_t i = 0; i < spec.positions.size(); ++i) {
     v.runs.push_back(run_scene(position_scene(spec, i), options.run));
     const correction::Correction* corrected = nullptr;
@@ -337,11 +337,10 @@ ProfileValidation validate_profile(const ProfileSpec& spec, const ProfileValidat
       corrected = &v.corrections.back();
     }
     auto r = correction::profile_row(v.runs.back().processed, spec.positions[i], corrected);
-    if (!r.note.empty()) notes.push_back(std::move(r.note));
     r.row.name = fmt::format("position {} (y = {})", i + 1, awcc::format_quantity(spec.positions[i], Dimension::length));
-    rows.push_back(std::move(r.row));
     awcc::ProfileRow e;
-    e.name = rows.back().name;
+    e.name = r.row.name;
+    rows.push_back(std::move(r));
     e.y = spec.positions[i];
     e.c = profile_void_fraction(spec, e.y);
     e.c_ci95 = {e.c, e.c};
@@ -352,8 +351,8 @@ ProfileValidation validate_profile(const ProfileSpec& spec, const ProfileValidat
   }
   auto flow_options = options.flow;
   flow_options.discharge = v.truth.water_discharge;
-  v.flow = awcc::profile_flow(std::move(rows), flow_options);
-  v.flow.notes.insert(v.flow.notes.end(), notes.begin(), notes.end());
+  // The flow builder of every profile (its rows' notes in its notes and alerts).
+  v.flow = correction::profile_flow_of(std::move(rows), flow_options);
   auto exact_options = flow_options;
   exact_options.draws = 0;
   v.exact_flow = awcc::profile_flow(std::move(exact), exact_options);

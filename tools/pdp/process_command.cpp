@@ -79,16 +79,15 @@ int run_process(ProcessCommandOptions& o) {
   } catch (const std::exception& e) {
     return report_error(e);
   }
-  Processed processed;
+  study::ProfileRun processed;
   try {
     processed = process_files(o, plan);
   } catch (const std::exception& e) {
     return report_error(e);
   }
-  const auto corrections = corrections_of(plan, processed);
   try {
     // A run fails whole or writes all: every folder is checked before any output is written.
-    const auto rendered = render(o, plan, processed, corrections);
+    const auto rendered = render(o, plan, processed);
     for (const auto& [path, text] : rendered.outputs) awcc::check_output_folder(path);
     if (!o.report.empty()) awcc::check_output_folder(o.report);
     for (const auto& [path, text] : rendered.outputs) awcc::write_text_atomically(path, text);

@@ -4,7 +4,6 @@
 #include "awcc/errors.hpp"
 #include "hints.hpp"
 #include "process_steps.hpp"
-#include "synth/sidecar.hpp"
 #include "terminal.hpp"
 
 namespace pdp {
@@ -18,57 +17,34 @@ void warn_about(const std::string& file, const awcc::ProcessResult& r) {
 
 }  // namespace
 
-Processed process_files(const ProcessCommandOptions& o, const Plan& plan) {
-  Processed out;
+study::ProfileRun process_files(const ProcessCommandOptions& o, const Plan& plan) {
   Progress progress("processing");
-  awcc::ProcessWorkspace workspace;  // FFT plans shared by the records
-  for (std::size_t i = 0; i < o.files.size(); ++i) {
-    // A synthetic recording's sidecar states its volts per count.
-    awcc::ProcessOptions file_options = plan.options;
-    // The JSON (or the report made from it) records each input's SHA-256: hashed as the file is read.
-    file_options.hash_input = !o.json.empty() || !o.report.empty();
-    if (!(file_options.reader.volts_per_count > 0.0)) {
-      if (const auto vpc = synth::sidecar_volts_per_count(o.files[i])) file_options.reader.volts_per_count = *vpc;
-    }
-    try {
-      out.results.push_back(awcc::process_recording(o.files[i], file_options, workspace));
-    } catch (const awcc::InputError& e) {
-      // Among several inputs (a glob), a file that is not a recording is
-      // skipped and said; a damaged recording still stops the profile.
-      if (o.files.size() == 1 || e.quantity() != "not_a_recording") throw;
-      spdlog::warn("skipped: {}", e.what());
-      out.skipped.push_back(e.what());
-      continue;
-    }
-    add_flag_hints(out.results.back());
-    if (!o.manifest.empty() && !plan.positions[i]) {
-      const auto name = std::filesystem::path(o.files[i]).filename().string();
-      throw std::invalid_argument(
-          fmt::format("{}: no position for {}; add a row '{},<position>'", o.manifest, name, name));
-    }
-    out.positions.push_back(plan.positions[i]);
-    out.inputs.push_back(o.files[i]);
-    warn_about(o.files[i], out.results.back());
-    spdlog::debug("{}: {:.3f} s", o.files[i], out.results.back().seconds);
-    progress(static_cast<double>(i + 1) / static_cast<double>(o.files.size()));
+  study::ProfileRunOptions options;
+  options.processing = plan.options;
+  options.flow = plan.flow;
+  options.model = plan.model ? &*plan.model : nullptr;
+  // The JSON (or the report made from it) records each input's SHA-256: hashed as the file is read.
+  options.hash_inputs = !o.json.empty() || !o.report.empty();
+  options.manifest = o.manifest;
+  options.on_result = [](awcc::ProcessResult& r) { add_flag_hints(r); };
+  options.progress = [&progress](double f) { progress(f); };
+  auto run = study::process_profile(o.files, plan.positions, options);
+  for (const auto& s : run.skipped) spdlog::warn("skipped: {}", s);
+  for (std::size_t i = 0; i < run.results.size(); ++i) {
+    warn_about(run.inputs[i], run.results[i]);
+    spdlog::debug("{}: {:.3f} s", run.inputs[i], run.results[i].seconds);
   }
-  if (out.results.empty()) {
-    throw awcc::InputError(fmt::format("none of the {} inputs is a recording", o.files.size()));
+  for (std::size_t i = 0; i < run.corrections.size(); ++i) {
+    const auto& c = run.corrections[i];
+    const std::string file = run.results[i].info.path.string();
+    if (!c.corrected()) spdlog::warn("{}: not corrected: {}", file, c.why_not());
+    for (const auto& n : c.notes) spdlog::warn("{}: {}", file, n);
+    if (c.large_bubbles) spdlog::warn("{}: {}", file, c.turbulence_message);
   }
-  return out;
-}
-
-std::vector<correction::Correction> corrections_of(const Plan& plan, const Processed& p) {
-  std::vector<correction::Correction> corrections;
-  if (!plan.model) return corrections;
-  for (const auto& r : p.results) {
-    corrections.push_back(plan.model->correct(correction::measurement_of(r)));
-    const auto& c = corrections.back();
-    if (!c.corrected()) spdlog::warn("{}: not corrected: {}", r.info.path.string(), c.why_not());
-    for (const auto& n : c.notes) spdlog::warn("{}: {}", r.info.path.string(), n);
-    if (c.large_bubbles) spdlog::warn("{}: {}", r.info.path.string(), c.turbulence_message);
+  if (run.flow) {
+    for (const auto& w : run.flow->warnings()) spdlog::warn("{}", w);
   }
-  return corrections;
+  return run;
 }
 
 }  // namespace pdp

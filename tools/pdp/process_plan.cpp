@@ -12,6 +12,7 @@
 #include "awcc/sha256.hpp"
 #include "awcc/units.hpp"
 #include "process_steps.hpp"
+#include "study/profile_run.hpp"
 
 namespace pdp {
 
@@ -42,77 +43,15 @@ awcc::ProcessOptions build_options(const ProcessCommandOptions& o) {
   return p;
 }
 
-// Positions per file: from --positions, or a manifest CSV "file,position".
+// Positions per file: from --positions, or a manifest CSV "file,position"
+// (study/profile_run.hpp reads both).
 std::vector<std::optional<double>> positions_for(const ProcessCommandOptions& o) {
-  std::vector<std::optional<double>> out(o.files.size());
-  auto length = [](const std::string& text, const std::string& where) {
-    try {
-      return awcc::parse_quantity(text, awcc::Dimension::length);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
-    }
-  };
   if (!o.positions.empty() && !o.manifest.empty()) {
     throw std::invalid_argument("--positions and --manifest both give the positions; give one of them");
   }
-  if (!o.positions.empty()) {
-    const auto items = awcc::split_cells(o.positions);
-    if (items.size() != o.files.size()) {
-      throw std::invalid_argument(fmt::format("--positions gives {} positions for {} files; give one per file",
-                                              items.size(), o.files.size()));
-    }
-    for (std::size_t i = 0; i < items.size(); ++i) out[i] = length(items[i], "--positions");
-  } else if (!o.manifest.empty()) {
-    std::ifstream in(o.manifest);
-    std::map<std::string, double> by_name;
-    std::map<std::string, int> line_of;
-    std::string line;
-    int number = 0;
-    while (std::getline(in, line)) {
-      ++number;
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      const auto cells = awcc::split_cells(line);
-      if (cells.size() < 2) continue;
-      double position = 0.0;
-      try {
-        position = awcc::parse_quantity(cells[1], awcc::Dimension::length);
-      } catch (const std::invalid_argument& e) {
-        if (number == 1) continue;  // header row
-        throw std::invalid_argument(fmt::format("{}:{}: {}", o.manifest, number, e.what()));
-      }
-      const auto name = std::filesystem::path(cells[0]).filename().string();
-      if (const auto [at, fresh] = line_of.emplace(name, number); !fresh) {
-        throw std::invalid_argument(
-            fmt::format("{}: lines {} and {} both position {}; keep one", o.manifest, at->second, number, name));
-      }
-      by_name[name] = position;
-    }
-    std::map<std::string, std::string> seen;
-    for (std::size_t i = 0; i < o.files.size(); ++i) {
-      const auto name = std::filesystem::path(o.files[i]).filename().string();
-      if (const auto [at, fresh] = seen.emplace(name, o.files[i]); !fresh) {
-        throw std::invalid_argument(fmt::format("{} and {} share the name {}, which the manifest matches by: rename "
-                                                "one or give --positions",
-                                                at->second, o.files[i], name));
-      }
-      // A file without a row is refused once it proves to be a recording
-      // (a README caught by the same glob is skipped, not positioned).
-      if (const auto it = by_name.find(name); it != by_name.end()) out[i] = it->second;
-    }
-  }
-  // One position per recording: a position given twice is a typo (or two
-  // recordings of one position, which a profile cannot tell apart).
-  for (std::size_t j = 0; j < out.size(); ++j) {
-    for (std::size_t i = 0; i < j; ++i) {
-      if (!out[i] || !out[j] || *out[i] != *out[j]) continue;
-      throw std::invalid_argument(
-          fmt::format("{} gives {} and {} the same position, {}; a profile has one recording "
-                      "per position: correct the position, or process the repeat on its own",
-                      o.positions.empty() ? o.manifest : std::string("--positions"), o.files[i], o.files[j],
-                      awcc::format_quantity(*out[i], awcc::Dimension::length)));
-    }
-  }
-  return out;
+  if (!o.positions.empty()) return study::positions_of_list(awcc::split_cells(o.positions), o.files, "--positions");
+  if (!o.manifest.empty()) return study::positions_of_manifest(o.manifest, o.files);
+  return std::vector<std::optional<double>>(o.files.size());
 }
 
 // Two outputs into one file would leave only the last; inputs are never

@@ -72,46 +72,15 @@ int report_of(const ProcessCommandOptions& o, const std::string& json_text) {
   return write_report({scratch, "-o", o.report, "--input-name", "the results of pdp process (no --json written)"});
 }
 
-Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processed& p,
-                const std::vector<correction::Correction>& corrections) {
+Rendered render(const ProcessCommandOptions& o, const Plan& plan, const study::ProfileRun& p) {
   const auto& results = p.results;
   const auto& positions = p.positions;
+  const auto& corrections = p.corrections;
   const bool corrected = plan.model.has_value();
-  auto correction_json = [&](std::size_t i) {
-    auto c = correction::to_json(corrections[i]);
-    c["model"] = std::filesystem::path(o.correct).filename().string();
-    return c;
-  };
+  const auto& flow = p.flow;
   Rendered out;
-  // A profile's flow quantities (METHOD 12): every recording kept has a position.
-  // A profile (several files) whose files were all skipped but one still has
-  // its flow, refused with the reason.
-  std::optional<awcc::ProfileFlowResult> flow;
-  if (o.files.size() >= 2 && !results.empty() &&
-      std::all_of(positions.begin(), positions.end(), [](const std::optional<double>& y) { return y.has_value(); })) {
-    std::vector<correction::ProfileRowOf> rows;
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      rows.push_back(correction::profile_row(results[i], *positions[i], corrected ? &corrections[i] : nullptr));
-    }
-    flow = correction::profile_flow_of(std::move(rows), plan.flow);
-    for (const auto& w : flow->warnings()) spdlog::warn("{}", w);
-  }
   if (!o.json.empty() || !o.report.empty()) {
-    nlohmann::json j;
-    if (results.size() == 1 && o.files.size() == 1) {
-      j = awcc::to_json(results[0]);
-      if (corrected) j["correction"] = correction_json(0);
-    } else {
-      j["profile"] = nlohmann::json::array();
-      for (std::size_t i = 0; i < results.size(); ++i) {
-        auto row = awcc::to_json(results[i]);
-        row[awcc::process_key::position] = positions[i] ? nlohmann::json(*positions[i]) : nlohmann::json(nullptr);
-        if (corrected) row["correction"] = correction_json(i);
-        j["profile"].push_back(row);
-      }
-      if (!p.skipped.empty()) j["skipped"] = p.skipped;
-      if (flow) j[awcc::process_key::flow] = awcc::to_json(*flow);
-    }
+    auto j = study::profile_run_json(p, std::filesystem::path(o.correct).filename().string());
     // The inputs' digests were taken as they were read (process_files asks for them when the JSON is written).
     std::vector<awcc::ProvenanceInput> inputs;
     for (std::size_t i = 0; i < p.inputs.size(); ++i) inputs.push_back({p.inputs[i], results[i].input_sha256});

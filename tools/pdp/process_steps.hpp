@@ -13,6 +13,7 @@
 #include "awcc/profile_flow.hpp"
 #include "correction/model.hpp"
 #include "process_command.hpp"
+#include "study/profile_run.hpp"
 
 namespace pdp {
 
@@ -26,15 +27,9 @@ struct Plan {
 
 Plan plan_of(const ProcessCommandOptions& o);
 
-// The recordings processed, with the positions and names of those kept.
-struct Processed {
-  std::vector<awcc::ProcessResult> results;
-  std::vector<std::optional<double>> positions;
-  std::vector<std::string> inputs, skipped;
-};
-
-Processed process_files(const ProcessCommandOptions& o, const Plan& plan);
-std::vector<correction::Correction> corrections_of(const Plan& plan, const Processed& p);
+// The recordings processed (study::process_profile), corrected when a model
+// is given, with the profile's flow.
+study::ProfileRun process_files(const ProcessCommandOptions& o, const Plan& plan);
 
 // Every output rendered (path, text), before any is written, and what goes
 // to stdout and to the report when no JSON is written.
@@ -43,8 +38,7 @@ struct Rendered {
   std::string stdout_text, json_for_report;
 };
 
-Rendered render(const ProcessCommandOptions& o, const Plan& plan, const Processed& p,
-                const std::vector<correction::Correction>& corrections);
+Rendered render(const ProcessCommandOptions& o, const Plan& plan, const study::ProfileRun& run);
 /// The HTML report drawn from the JSON (the --json file or a scratch copy).
 int report_of(const ProcessCommandOptions& o, const std::string& json_text);
 

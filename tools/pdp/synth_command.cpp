@@ -11,6 +11,7 @@
 #include "synth/sidecar.hpp"
 #include "synth/synthesiser.hpp"
 #include "study/profile.hpp"
+#include "study/profile_run.hpp"
 #include "terminal.hpp"
 
 namespace pdp {
@@ -92,7 +93,7 @@ int run_synth_profile(const SynthOptions& options, const synth::SynthesisOptions
   const std::filesystem::path out = options.output;
   const auto stem = out.parent_path() / out.stem();
   const auto extension = out.extension().string();
-  std::string manifest = "file,position\n";
+  std::vector<std::string> names;
   try {
     for (std::size_t i = 0; i < spec.positions.size(); ++i) {
       const auto scene = study::position_scene(spec, i);
@@ -108,8 +109,7 @@ int run_synth_profile(const SynthOptions& options, const synth::SynthesisOptions
         synthesis = synth::synthesise(scene, position_options);
       }
       write_synthesis(file, scene, synthesis, recording);
-      manifest += fmt::format("{},{}\n", file.filename().string(),
-                              awcc::format_quantity(spec.positions[i], awcc::Dimension::length));
+      names.push_back(file.filename().string());
       if (!options.quiet) {
         fmt::print("position {} (y = {}): c {:.4f} (law {:.4f}), u {:.4f} m/s (law {:.4f}), {} chords at the first tip\n",
                    i + 1, awcc::format_quantity(spec.positions[i], awcc::Dimension::length),
@@ -118,7 +118,7 @@ int run_synth_profile(const SynthOptions& options, const synth::SynthesisOptions
       }
     }
     const auto truth = study::profile_truth(spec, awcc::ProfileFlowOptions{}.levels);
-    awcc::write_text_atomically(stem.string() + ".positions.csv", manifest);
+    awcc::write_text_atomically(stem.string() + ".positions.csv", study::manifest_text(names, spec.positions));
     awcc::write_text_atomically(stem.string() + ".profile.json", awcc::json_text(study::profile_truth_json(spec, truth)));
     spdlog::info("wrote {} recordings, {}.positions.csv and {}.profile.json", spec.positions.size(), stem.string(),
                  stem.string());

@@ -84,6 +84,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "awcc/phase_statistics.hpp"
@@ -252,6 +253,9 @@ struct ProfileFlowResult {
 /// the two by `names` (one each); empty when none is. profile_flow refuses
 /// such rows; a front end may call it before processing, to fail fast.
 std::string repeated_position(std::span<const double> y, std::span<const std::string> names);
+/// The rule behind it: the first pair (i < j, by j) of positions that are
+/// equal, or none. A front end that names its inputs its own way reads it.
+std::optional<std::pair<std::size_t, std::size_t>> repeated_position_pair(std::span<const double> y);
 
 /// The profile quantities of `rows` (any order). Throws OptionError when the
 /// options are refused; a profile that cannot be used (fewer than two rows,
