@@ -8,6 +8,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
 namespace awcc {
 
 namespace {
@@ -28,31 +31,16 @@ double log_sum_exp(const std::vector<double>& beta) {
   return m + std::log(s);
 }
 
-// Solves H x = g in place (H symmetric positive definite, n x n row-major) by
-// Cholesky; false when H is not numerically positive definite.
-bool cholesky_solve(std::vector<double> H, std::vector<double>& g, std::size_t n) {
-  for (std::size_t j = 0; j < n; ++j) {
-    double d = H[j * n + j];
-    for (std::size_t k = 0; k < j; ++k) d -= H[j * n + k] * H[j * n + k];
-    if (!(d > 0.0)) return false;
-    d = std::sqrt(d);
-    H[j * n + j] = d;
-    for (std::size_t i = j + 1; i < n; ++i) {
-      double s = H[i * n + j];
-      for (std::size_t k = 0; k < j; ++k) s -= H[i * n + k] * H[j * n + k];
-      H[i * n + j] = s / d;
-    }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    double s = g[i];
-    for (std::size_t k = 0; k < i; ++k) s -= H[i * n + k] * g[k];
-    g[i] = s / H[i * n + i];
-  }
-  for (std::size_t i = n; i-- > 0;) {
-    double s = g[i];
-    for (std::size_t k = i + 1; k < n; ++k) s -= H[k * n + i] * g[k];
-    g[i] = s / H[i * n + i];
-  }
+// Solves H x = g in place (H symmetric positive definite, n x n row-major)
+// by Eigen's Cholesky (LLT); false when H is not numerically positive definite.
+bool cholesky_solve(const std::vector<double>& H, std::vector<double>& g, std::size_t n) {
+  const auto size = static_cast<Eigen::Index>(n);
+  const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> matrix(H.data(), size,
+                                                                                                        size);
+  const Eigen::LLT<Eigen::MatrixXd> llt(matrix);
+  if (llt.info() != Eigen::Success) return false;
+  Eigen::Map<Eigen::VectorXd> x(g.data(), size);
+  x = llt.solve(x);
   return true;
 }
 
@@ -364,7 +352,7 @@ SizeDistribution invert(Chords chords, std::int64_t given, const SizeDistributio
         g[j] = c[j] - N * w[j] - pb;
         for (std::size_t k = 0; k < bins; ++k) H[j * bins + k] += N * ((j == k ? w[j] : 0.0) - w[j] * w[k]);
       }
-      if (!cholesky_solve(std::move(H), g, bins)) break;  // g now holds the step
+      if (!cholesky_solve(H, g, bins)) break;  // g now holds the step
       std::vector<double> trial(bins);
       double t = 1.0, q_trial = -std::numeric_limits<double>::infinity();
       for (; t > 1e-6; t *= 0.5) {

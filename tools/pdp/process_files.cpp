@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include "awcc/errors.hpp"
+#include "awcc/memory.hpp"
 #include "hints.hpp"
 #include "process_steps.hpp"
 #include "terminal.hpp"
@@ -28,6 +29,11 @@ study::ProfileRun process_files(const ProcessCommandOptions& o, const Plan& plan
   options.manifest = o.manifest;
   options.on_result = [](awcc::ProcessResult& r) { add_flag_hints(r); };
   options.progress = [&progress](double f) { progress(f); };
+  // Several recordings run one after another on each thread, as scenes do
+  // in a sweep: keep the freed blocks instead of faulting the same pages in
+  // again for each (docs/performance.md, "Freed memory kept only where
+  // scenes repeat").
+  if (o.files.size() > 1) awcc::keep_freed_memory();
   auto run = study::process_profile(o.files, plan.positions, options);
   for (const auto& s : run.skipped) spdlog::warn("skipped: {}", s);
   for (std::size_t i = 0; i < run.results.size(); ++i) {

@@ -14,8 +14,10 @@
 // long double. Memory depends on the chunk and the lag range, not on B.
 
 #include <complex>
+#include <memory>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "awcc/fft.hpp"
@@ -59,7 +61,25 @@ class LaggedPearson {
   const FftPlan* plan_;
   FftBuffers x_fft_, y_fft_;  // x's spectrum stays while y's is made
   // x from x_next_ (next chunk start) on; y from x_next_ + k_first on.
-  std::vector<double> x_buffer_, y_buffer_;
+  /// Grows the buffers without zeroing what feed() overwrites at once (the
+  /// zeroing was a tenth of Felder's raw correlations' time).
+  template <class T>
+  struct Uninitialised : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = Uninitialised<U>;
+    };
+    using std::allocator<T>::allocator;
+    template <class U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+  };
+  std::vector<double, Uninitialised<double>> x_buffer_, y_buffer_;
   std::int64_t x_next_ = 0, x_fed_ = 0, y_fed_ = 0;  // next chunk start; samples fed so far up to these indices
   bool same_signal_ = false;
   bool offsets_set_ = false;
