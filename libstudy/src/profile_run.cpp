@@ -122,6 +122,14 @@ ProfileRun process_profile(std::span<const std::string> files, std::span<const s
   if (!positions.empty() && positions.size() != files.size()) {
     throw std::invalid_argument("process_profile: one position per file, or none");
   }
+  if (options.model) {
+    const auto why = options.model->mismatch(correction::processing_of(options.processing.awcc_options));
+    if (!why.empty()) {
+      throw std::invalid_argument(fmt::format("the correction model was trained on results processed otherwise ({}); "
+                                              "process with the model's settings or train a model for these",
+                                              why));
+    }
+  }
   const std::size_t n = files.size();
   std::vector<std::optional<awcc::ProcessResult>> processed(n);
   std::vector<std::exception_ptr> failed(n);
@@ -201,6 +209,21 @@ ProfileRun process_profile(std::span<const std::string> files, std::span<const s
     run.flow = correction::profile_flow_of(std::move(rows), options.flow);
   }
   return run;
+}
+
+std::vector<std::string> ProfileRun::warnings() const {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < corrections.size(); ++i) {
+    const auto& c = corrections[i];
+    const std::string file = results[i].info.path.string();
+    if (!c.corrected()) out.push_back(fmt::format("{}: not corrected: {}", file, c.why_not()));
+    for (const auto& note : c.notes) out.push_back(fmt::format("{}: {}", file, note));
+    if (c.large_bubbles) out.push_back(fmt::format("{}: {}", file, c.turbulence_message));
+  }
+  if (flow) {
+    for (const auto& w : flow->warnings()) out.push_back(w);
+  }
+  return out;
 }
 
 nlohmann::json profile_run_json(const ProfileRun& run, const std::string& model_name) {

@@ -548,40 +548,45 @@ def process(source, trail=None, *, fs=None, preset=None, correct=None, positions
             err.quantity = "positions"
             raise err
     settings = _settings({**options, "fs": fs} if isinstance(source, (str, _os.PathLike, list, tuple)) else options)
-    if isinstance(source, (str, _os.PathLike)):
-        r, windows, detail = _pdp.process_file(_os.fspath(source), settings, preset or "")
-        inputs = [_os.fspath(source)]
-        out = r
-    elif isinstance(source, (list, tuple)):
-        paths = [_os.fspath(p) for p in source]
+    flow = None
+    if isinstance(source, (str, _os.PathLike, list, tuple)):
+        # Files: the library's profile run (study/profile_run.hpp), as pdp process runs it.
+        paths = [_os.fspath(source)] if isinstance(source, (str, _os.PathLike)) else [_os.fspath(p) for p in source]
         if positions is not None and len(positions) != len(paths):
             raise OptionError(f"{len(positions)} positions for {len(paths)} files; give one per file")
-        rows, details = [], []
-        for i, path in enumerate(paths):
-            row, windows, detail = _pdp.process_file(path, settings, preset or "")
-            row["position"] = None if positions is None else float(positions[i])
-            rows.append(row)
-            details.append(_detail(windows, detail))
-        inputs, out = paths, {"profile": rows}
+        at = [] if positions is None or not isinstance(source, (list, tuple)) else [float(y) for y in positions]
+        out, windows, details, warnings, flow_json, flow_report, inputs = _pdp.process_profile(
+            paths, at, settings, preset or "", "" if correct is None else _os.fspath(correct), flow_settings,
+            isinstance(source, (list, tuple)))
+        _issue(warnings)
+        if profile and flow_json is not None:
+            flow = _wrap(flow_json, "flow")
+            flow._report = flow_report
     else:
         out, windows, detail = _arrays(source, trail, fs, volts_per_count, options, preset)
         inputs = []
-    if correct is not None:
-        out, warnings = _pdp.correct(_json.dumps(out), _os.fspath(correct), None, None, None)
-        for w in warnings:
-            import warnings as _warnings
-            _warnings.warn(w, stacklevel=2)
+        if correct is not None:
+            out, warnings = _pdp.correct(_json.dumps(out), _os.fspath(correct), None, None, None)
+            _issue(warnings)
     out["provenance"] = _pdp.provenance(inputs, settings, preset or "", call)
-    flow = _flow_of(_pdp.profile_flow(_json.dumps(out), "results", flow_settings)) if profile else None
     result = _wrap(out)
     if flow is not None:
         result["flow"] = flow
-    if isinstance(source, (list, tuple)):
-        for row, row_detail in zip(result.profile, details):
-            row.__dict__.update(row_detail)
+    if "profile" in out:
+        for row, row_windows, row_detail in zip(result.profile, windows, details):
+            row.__dict__.update(_detail(row_windows, row_detail))
+    elif isinstance(source, (str, _os.PathLike, list, tuple)):
+        result.__dict__.update(_detail(windows[0], details[0]))
     else:
         result.__dict__.update(_detail(windows, detail))
     return result
+
+
+def _issue(warnings):
+    """Issues the compiled core's warnings as Python warnings."""
+    import warnings as _warnings
+    for w in warnings:
+        _warnings.warn(w, stacklevel=3)
 
 
 def _detail(windows, detail):

@@ -37,6 +37,7 @@
 #include "synth/recording.hpp"
 #include "synth/scene.hpp"
 #include "synth/sidecar.hpp"
+#include "study/profile_run.hpp"
 #include "synth/synthesiser.hpp"
 
 namespace py = pybind11;
@@ -414,6 +415,41 @@ py::tuple process_file(const std::filesystem::path& path, const Settings& settin
   return result_of(r);
 }
 
+// A profile run (study::process_profile, as pdp process runs it): the JSON
+// of the rows with their corrections and the flow, each row's detail, and
+// the warnings to issue. positions: one per file (m), or empty.
+py::tuple process_profile(const std::vector<std::string>& paths, const std::vector<double>& positions,
+                          const Settings& settings, const std::string& preset, const std::string& model_path,
+                          const Settings& flow_settings, bool as_profile) {
+  study::ProfileRunOptions o;
+  o.processing = awcc::process_options(option_settings(settings, preset));
+  o.flow = awcc::profile_flow_options(option_settings(flow_settings));
+  std::optional<correction::CorrectionModel> model;
+  study::ProfileRun run;
+  {
+    py::gil_scoped_release unlocked;
+    if (!model_path.empty()) model = correction::CorrectionModel::load(model_path);
+    o.model = model ? &*model : nullptr;
+    std::vector<std::optional<double>> at(positions.begin(), positions.end());
+    run = study::process_profile(paths, at, o);
+  }
+  run.single = !as_profile;  // a list of one file is a profile of one row, as before
+  py::list windows, details;
+  for (const auto& r : run.results) {
+    windows.append(r.awcc ? py::object(windows_of(*r.awcc)) : py::none());
+    details.append(detail_of(r));
+  }
+  nlohmann::json flow_json;
+  std::string flow_report;
+  if (run.flow) {
+    flow_json = awcc::to_json(*run.flow);
+    flow_report = run.flow->report();
+  }
+  return py::make_tuple(python_of(study::profile_run_json(run, std::filesystem::path(model_path).filename().string())),
+                        windows, details, run.warnings(), run.flow ? python_of(flow_json) : py::object(py::none()),
+                        flow_report, run.inputs);
+}
+
 py::object provenance(const std::vector<std::string>& inputs, const Settings& settings, const std::string& preset,
                       const std::string& call) {
   const auto o = awcc::process_options(option_settings(settings, preset));
@@ -648,6 +684,8 @@ PYBIND11_MODULE(_pdp, m) {
   m.def("process_arrays", &process_arrays, py::arg("channels"), py::arg("fs"), py::arg("volts_per_count"),
         py::arg("settings"), py::arg("preset"));
   m.def("process_file", &process_file, py::arg("path"), py::arg("settings"), py::arg("preset"));
+  m.def("process_profile", &process_profile, py::arg("paths"), py::arg("positions"), py::arg("settings"),
+        py::arg("preset"), py::arg("model"), py::arg("flow_settings"), py::arg("as_profile"));
   m.def("provenance", &provenance, py::arg("inputs"), py::arg("settings"), py::arg("preset"), py::arg("call"));
   m.def("correct", &correct, py::arg("json"), py::arg("model"), py::arg("dx"), py::arg("dy"), py::arg("np"));
   m.def("synthesise", &synthesise, py::arg("settings"), py::arg("signal"));

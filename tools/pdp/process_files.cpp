@@ -40,16 +40,7 @@ study::ProfileRun process_files(const ProcessCommandOptions& o, const Plan& plan
     warn_about(run.inputs[i], run.results[i]);
     spdlog::debug("{}: {:.3f} s", run.inputs[i], run.results[i].seconds);
   }
-  for (std::size_t i = 0; i < run.corrections.size(); ++i) {
-    const auto& c = run.corrections[i];
-    const std::string file = run.results[i].info.path.string();
-    if (!c.corrected()) spdlog::warn("{}: not corrected: {}", file, c.why_not());
-    for (const auto& n : c.notes) spdlog::warn("{}: {}", file, n);
-    if (c.large_bubbles) spdlog::warn("{}: {}", file, c.turbulence_message);
-  }
-  if (run.flow) {
-    for (const auto& w : run.flow->warnings()) spdlog::warn("{}", w);
-  }
+  for (const auto& w : run.warnings()) spdlog::warn("{}", w);
   return run;
 }
 

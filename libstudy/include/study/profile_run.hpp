@@ -89,11 +89,17 @@ struct ProfileRun {
   std::optional<awcc::ProfileFlowResult> flow;
   /// One recording given on its own (not a profile).
   bool single = false;
+
+  /// What a front end tells its user beside the outputs, one text each: a
+  /// row not corrected and why, a correction's notes, the flow's warnings
+  /// (the rows' own warnings are in each result).
+  [[nodiscard]] std::vector<std::string> warnings() const;
 };
 
 /// Processes `files` at `positions` (one per file, or empty: none). Throws
-/// what processing throws (InputError, OptionError) and std::invalid_argument
-/// for a file the manifest does not position.
+/// what processing throws (InputError, OptionError), std::invalid_argument
+/// for a file the manifest does not position and for a model trained on
+/// results processed otherwise (naming what differs).
 ProfileRun process_profile(std::span<const std::string> files, std::span<const std::optional<double>> positions,
                            const ProfileRunOptions& options);
 
