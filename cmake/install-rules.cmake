@@ -1,5 +1,5 @@
 # Installs the libraries (awcc::core, awcc::io, awcc::awcc, synth::synth,
-# correction::correction, awcc::study), their headers, the pdp tool and one
+# correction::correction, study::study), their headers, the pdp tool and one
 # CMake package "pdp": consumers write find_package(pdp CONFIG REQUIRED) and
 # link what they use. Headers under awcc/detail/ are the libraries' own and not installed.
 include(CMakePackageConfigHelpers)
@@ -25,7 +25,7 @@ install(EXPORT awcc_ioTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDI
 install(EXPORT awccTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT synthTargets NAMESPACE synth:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 install(EXPORT correctionTargets NAMESPACE correction:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
-install(EXPORT studyTargets NAMESPACE awcc:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
+install(EXPORT studyTargets NAMESPACE study:: DESTINATION ${PDP_INSTALL_CMAKEDIR})
 
 configure_package_config_file(cmake/pdpConfig.cmake.in
   ${PROJECT_BINARY_DIR}/pdpConfig.cmake

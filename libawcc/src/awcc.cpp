@@ -53,8 +53,9 @@ AwccWorkspace& AwccWorkspace::operator=(AwccWorkspace&&) noexcept = default;
 
 Validation AwccOptions::validate() const {
   if (auto v = probe_correction.validate(); !v.ok()) return v;
-  if (np < 1 || np > 1000)
-    return Validation::invalid("np", fmt::format("np = {}: particles per window must lie in [1, 1000]", np));
+  if (np < np_min || np > np_max)
+    return Validation::invalid("np", fmt::format("np = {}: particles per window must lie in [{}, {}]", np, np_min,
+                                                 np_max));
   if (!(filter_a >= 0.0 && filter_a <= 1.0))
     return Validation::invalid("filter-a", fmt::format("filter A = {} must lie in [0, 1]", filter_a));
   if (!(prominence_fraction >= 0.0 && prominence_fraction <= 1.0))
@@ -585,9 +586,13 @@ WeightedMoments weighted_moments(std::span<const double> values, std::span<const
 }
 
 MomentIntervals moment_intervals95(double mean, double rms, std::int64_t count) {
+  return moment_intervals95(mean, rms, count, mean);
+}
+
+MomentIntervals moment_intervals95(double mean, double rms, std::int64_t count, double scale) {
   MomentIntervals out;
   const double n = static_cast<double>(count);
-  const double tu = rms / mean;
+  const double tu = rms / scale;
   out.turbulence_intensity = tu;
   out.mean_half = 1.96 * rms / std::sqrt(n);
   out.rms_half = 1.96 * rms / std::sqrt(2.0 * n);

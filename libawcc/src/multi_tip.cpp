@@ -256,15 +256,12 @@ void multi_tip_summarise(MultiTipResult& result, const MultiTipOptions& options)
   const double n = static_cast<double>(result.bubbles_accepted);
   for (std::size_t j = 0; j < 3; ++j) {
     const double rms = std::sqrt(result.reynolds_stress[j][j]);
-    const double tu = rms / result.speed;
+    const auto intervals = detail::moment_intervals95(result.velocity[j], rms, result.bubbles_accepted, result.speed);
     result.velocity_rms[j] = rms;
-    result.turbulence_intensity[j] = tu;
-    const double hu = 1.96 * rms / std::sqrt(n);
-    const double hr = 1.96 * rms / std::sqrt(2.0 * n);
-    const double ht = 1.96 * std::sqrt(tu * tu * (tu * tu / n + 1.0 / (2.0 * n)));
-    result.velocity_ci95[j] = {result.velocity[j] - hu, result.velocity[j] + hu};
-    result.velocity_rms_ci95[j] = {rms - hr, rms + hr};
-    result.turbulence_intensity_ci95[j] = {tu - ht, tu + ht};
+    result.turbulence_intensity[j] = intervals.turbulence_intensity;
+    result.velocity_ci95[j] = intervals.mean;
+    result.velocity_rms_ci95[j] = intervals.rms;
+    result.turbulence_intensity_ci95[j] = intervals.tu;
   }
   {
     // a = 4 N_0 m / T and its interval (multi_tip.hpp).

@@ -327,7 +327,7 @@ constexpr PresetSetting kKramer[] = {
 using A = AwccOptions;
 const OptionField<A> kAwcc[] = {
     {"np", "-", "AWCC particles (air chords of the leading tip) per window, 1-1000",
-     [](A& o, std::string_view t) { o.np = static_cast<int>(whole(t, 1, 1000)); },
+     [](A& o, std::string_view t) { o.np = static_cast<int>(whole(t, np_min, np_max)); },
      [](const A& o) { return std::to_string(o.np); }},
     {"filter-a", "-", "AWCC correlation filter threshold A: windows with R12max / (SPR^2 + 1) < A are rejected",
      [](A& o, std::string_view t) {

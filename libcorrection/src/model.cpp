@@ -678,7 +678,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   c.notes = x.notes;
   if (mixed) {
     c.notes.push_back("how AWCC's moments were taken is not known for this row: the answers for duration-weighted "
-                      "and unweighted moments are mixed, equally weighted (state it: pdp correct --weighting)");
+                      "and unweighted moments are mixed, equally weighted (state it: the setting weighting)");
   }
   const std::string runs = cal.envelope_from_training
                                ? "the forest's training runs"

@@ -275,8 +275,8 @@ ProfileRowsRead profile_rows_of_json(const nlohmann::json& j, const std::string&
     if (!r.is_object()) e.refuse("", "object");
     if (!r.contains(key::position) || r[key::position].is_null()) {
       out.rows.clear();
-      out.why_none = fmt::format("{}: {} has no position (a profile's flow needs every position: --positions or "
-                                 "--manifest)",
+      out.why_none = fmt::format("{}: {} has no position (a profile's flow needs every position: give the "
+                                 "positions or a manifest)",
                                  file, e.at);
       return out;
     }
@@ -313,8 +313,8 @@ ProfileRowsRead profile_rows_of_csv(const std::string& text, const std::string& 
     const auto position = r.optional(column::position);
     if (!position) {
       out.rows.clear();
-      out.why_none = fmt::format("{}: {} has no position (a profile's flow needs every position: --positions or "
-                                 "--manifest)",
+      out.why_none = fmt::format("{}: {} has no position (a profile's flow needs every position: give the "
+                                 "positions or a manifest)",
                                  file, r.line);
       return out;
     }

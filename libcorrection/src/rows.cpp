@@ -205,7 +205,7 @@ FileCorrection correct_tool_csv(const CorrectionModel& model, const std::string&
                                      !model.takes_weighting() ? ""
                                      : d.weighting ? fmt::format(", moments {} as stated", awcc::to_string(*d.weighting))
                                                    : ", the weighting excepted: not known, both answers mixed "
-                                                     "(state it with --weighting)"));
+                                                     "(state it: the setting weighting)"));
   out.text = line;
   for (const char* q : {"u", "Tu"}) {
     const char* unit = q[0] == 'u' ? "m/s" : "-";

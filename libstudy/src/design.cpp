@@ -157,7 +157,7 @@ struct DesignFile {
         lists.probes_given = true;
       } else if (s.key == "np") {
         d.nps.clear();
-        for (const auto& x : s.items) d.nps.push_back(static_cast<int>(whole(where, x, 1, 1000)));
+        for (const auto& x : s.items) d.nps.push_back(static_cast<int>(whole(where, x, awcc::np_min, awcc::np_max)));
       } else if (s.key == "fs") {
         d.fss.clear();
         for (const auto& x : s.items) d.fss.push_back(quantity(where, x, awcc::Dimension::frequency));
@@ -184,7 +184,7 @@ struct DesignFile {
       given.insert(s.key);
       if (s.key == "dx") c.dx = quantity(where, s.text, awcc::Dimension::length);
       else if (s.key == "dy") c.dy = quantity(where, s.text, awcc::Dimension::length);
-      else if (s.key == "np") c.np = static_cast<int>(whole(where, s.text, 1, 1000));
+      else if (s.key == "np") c.np = static_cast<int>(whole(where, s.text, awcc::np_min, awcc::np_max));
       else if (s.key == "fs") c.fs = quantity(where, s.text, awcc::Dimension::frequency);
       else if (s.key == "duration") c.duration = quantity(where, s.text, awcc::Dimension::time);
       else if (s.key == "needle") c.needle = quantity(where, s.text, awcc::Dimension::length);

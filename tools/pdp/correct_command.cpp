@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "awcc/atomic_output.hpp"
+#include "awcc/awcc.hpp"
 #include "awcc/errors.hpp"
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
@@ -33,7 +34,7 @@ void setup_correct(CLI::App& app, Command& command, CorrectOptions& o) {
   path_option(cmd->add_option("-o,--output", o.output, "output file (same format as the input) [default: stdout]"));
   cmd->add_option("--dx", o.dx, "streamwise tip separation, m (units allowed), where the input has none");
   cmd->add_option("--dy", o.dy, "lateral tip separation, m (units allowed), where the input has none");
-  cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(1, 1000));
+  cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(awcc::np_min, awcc::np_max));
   cmd->add_option("--fs", o.fs, "sampling rate, Hz (units allowed), where the input has none (extended models)");
   cmd->add_option("--duration", o.duration, "record length, s (units allowed), where the input has none (extended models)");
   cmd->add_option("--weighting", o.weighting,

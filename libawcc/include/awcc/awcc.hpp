@@ -78,9 +78,13 @@ static_assert(static_cast<std::size_t>(WindowFate::correction) + 1 == window_fat
 std::string_view to_string(WindowFate fate);
 std::string_view to_string(Weighting weighting);
 
+/// Np's range, the one statement of it (options, validation, designs, pdp correct).
+inline constexpr int np_min = 1, np_max = 1000;
+
 struct AwccOptions {
-  /// Particles (air chords of the leading tip) per window, 1-1000. Fewer give
-  /// more windows (a finer velocity series) but noisier correlations.
+  /// Particles (air chords of the leading tip) per window, np_min-np_max.
+  /// Fewer give more windows (a finer velocity series) but noisier
+  /// correlations.
   int np = 10;
   /// Correlation filter threshold A, -: windows with R12max / (SPR^2 + 1) < A
   /// are rejected; 0.4 balances yield against spurious peaks (Kramer 2019).

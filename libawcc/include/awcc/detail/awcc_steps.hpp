@@ -108,6 +108,9 @@ struct MomentIntervals {
   Interval95 mean, rms, tu;
 };
 MomentIntervals moment_intervals95(double mean, double rms, std::int64_t n);
+/// The same for one component of a vector mean, whose turbulence intensity
+/// is rms / scale (the multi-tip vectors' Tu_j = rms_j / |mean vector|).
+MomentIntervals moment_intervals95(double mean, double rms, std::int64_t n, double scale);
 
 /// The words of a quality reason: what is counted ("accepted windows"),
 /// the yield's name ("data yield"), its ratio ("windows accepted") and the
