@@ -757,7 +757,7 @@ TEST(Correction, TheWeightingAsAFeatureCorrectsEitherAndMixesAnUnknownOne) {
   EXPECT_DOUBLE_EQ(unknown.velocity->quantiles.front(), 9.5);
   EXPECT_DOUBLE_EQ(unknown.velocity->quantiles.back(), 10.0);
   ASSERT_FALSE(unknown.notes.empty());
-  EXPECT_NE(unknown.notes.back().find("--weighting"), std::string::npos);
+  EXPECT_NE(unknown.notes.back().find("the setting weighting"), std::string::npos) << unknown.notes.back();
   correction::Processing none;
   none.weighting = awcc::Weighting::none;
   EXPECT_EQ(m.mismatch(none), "");
