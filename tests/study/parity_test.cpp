@@ -12,6 +12,10 @@
 #include <cmath>
 #include <fstream>
 
+#include <fmt/format.h>
+
+#include "../awcc/clean_scene.hpp"
+#include "awcc/csv.hpp"
 #include "awcc/json_text.hpp"
 #include "awcc/process.hpp"
 #include "awcc/serialise.hpp"
@@ -183,6 +187,67 @@ TEST(Parity, AStudysD32IsPdpProcesss) {
   EXPECT_EQ(*reported.value, *p.tips[0].phase.sauter_diameter);
   EXPECT_EQ(*reported.value, 1.5 * *p.velocity() * p.tips[0].phase.void_fraction / p.tips[0].phase.bubble_count_rate);
   EXPECT_FALSE(other.value);
+}
+
+}  // namespace
+
+namespace {
+
+// A four-tip probe, processed bubble by bubble: the sweep row's multi-tip
+// cells, pdp process of the written file (its tips declared, as a lab
+// declares them for a FLAC) and the JSON of that result say the same mean
+// vector, Tu per component and interfacial area, to the row's ten digits.
+TEST(Parity, AFourTipSweepRowIsPdpProcessOfItsFileAndItsJson) {
+  study::SweepRun run;
+  run.index = 5;
+  run.np = 10;
+  run.scene = pdp_test::clean_four_tip_scene(12.0);
+  study::RunOptions options;
+  options.awcc.np = run.np;
+  const auto r = study::run_scene(run.scene, options);
+  ASSERT_TRUE(r.processed.probe);
+  const auto row = study::run_sweep_row(run, options, 78);
+
+  const auto file = pdp_test::test_file("four-tip.flac");
+  const auto syn = synth::synthesise(run.scene);
+  synth::write_recording(file, run.scene, syn.signals);
+  awcc::ProcessOptions p;
+  for (const auto& t : run.scene.probe_tips()) p.probe.positions.push_back({t.x, t.y, t.z});
+  p.awcc_options = options.awcc;
+  p.fscc_options = options.fscc;
+  const auto processed = awcc::process_recording(file, p);
+  ASSERT_TRUE(processed.probe);
+  const auto& a = r.processed.probe->vectors;
+  const auto& b = processed.probe->vectors;
+  ASSERT_TRUE(a.ok() && b.ok()) << a.message << b.message;
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_EQ(a.velocity[j], b.velocity[j]) << j;
+    EXPECT_EQ(a.turbulence_intensity[j], b.turbulence_intensity[j]) << j;
+  }
+  EXPECT_EQ(a.interfacial_area, b.interfacial_area);
+  EXPECT_EQ(a.bubbles_accepted, b.bubbles_accepted);
+  EXPECT_EQ(r.processed.probe->quality, processed.probe->quality);
+  // The row holds them as written ({:.10g}).
+  const auto cells = awcc::split_cells(row);
+  const auto names = awcc::split_cells(study::sweep_header());
+  auto cell = [&](const std::string& name) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return cells.at(i);
+    ADD_FAILURE() << "no column " << name;
+    return std::string();
+  };
+  EXPECT_EQ(cell("multi_tip_velocity_x"), fmt::format("{:.10g}", b.velocity[0]));
+  EXPECT_EQ(cell("multi_tip_velocity_z"), fmt::format("{:.10g}", b.velocity[2]));
+  EXPECT_EQ(cell("multi_tip_turbulence_intensity_y"), fmt::format("{:.10g}", b.turbulence_intensity[1]));
+  EXPECT_EQ(cell("multi_tip_interfacial_area"), fmt::format("{:.10g}", *b.interfacial_area));
+  // And the JSON of pdp process's result, read back.
+  const auto j = nlohmann::json::parse(awcc::json_text(awcc::to_json(processed)));
+  const auto& m = j.at("multi_tip");
+  EXPECT_EQ(m.at("velocity").at(0).get<double>(), b.velocity[0]);
+  EXPECT_EQ(m.at("velocity").at(1).get<double>(), b.velocity[1]);
+  EXPECT_EQ(m.at("turbulence_intensity").at(2).get<double>(), b.turbulence_intensity[2]);
+  // The pair's measurement too, as in the three-tip scenes.
+  expect_identical(r.measurement, correction::measurement_of(processed), "four tips: sweep against pdp process");
 }
 
 }  // namespace
