@@ -434,6 +434,17 @@ const OptionField<PF> kFlow[] = {
        for (double l : o.levels) out += fmt::format("{}{:g}", out.empty() ? "" : ",", l);
        return out;
      }},
+    {"chute-angle", "rad",
+     "profile: the chute's angle to the horizontal (e.g. 50deg), for the residual head H_res = d cos(theta) + "
+     "q_w^2 / (2 g d^2); none: no residual head",
+     [](PF& o, std::string_view t) {
+       if (t == "none") {
+         o.chute_angle.reset();
+       } else {
+         o.chute_angle = quantity(t, Dimension::angle);
+       }
+     },
+     [](const PF& o) { return o.chute_angle ? format_quantity(*o.chute_angle, Dimension::angle) : std::string("none"); }},
     {"flow-draws", "-", "profile: Monte Carlo draws of the profile quantities' 95 % intervals",
      [](PF& o, std::string_view t) { o.draws = static_cast<int>(whole(t, 100, 10000000)); },
      [](const PF& o) { return std::to_string(o.draws); }},

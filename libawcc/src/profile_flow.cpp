@@ -159,6 +159,10 @@ ModelFit fit_model(ConcentrationModelKind kind, std::span<const double> y_rel, s
   return out;
 }
 
+constexpr double kGravity = 9.80665;  // standard gravity, m/s2
+const std::string no_chute_angle =
+    "no chute angle given (option chute-angle): H_res = d cos(theta) + q_w^2 / (2 g d^2) needs it";
+
 // Every quantity from one set of row values (the rows' own, or one draw).
 // `why_*` are written only when `explain` (the point estimate): the draws
 // need the numbers alone.
@@ -168,10 +172,10 @@ struct Evaluation {
   double c_mean = kNaN, clear_water_depth = kNaN;
   double n = kNaN, u90 = kNaN, power_residual = kNaN;
   int power_points = 0;
-  double q_w = kNaN, q_a = kNaN, continuity = kNaN;
+  double q_w = kNaN, q_a = kNaN, continuity = kNaN, residual_head = kNaN;
   std::array<ModelFit, 2> models{};
   int model_points = 0;
-  std::string why_y90, why_c_mean, why_power, why_discharge, why_continuity;
+  std::string why_y90, why_c_mean, why_power, why_discharge, why_continuity, why_residual_head;
   std::array<std::string, 2> why_model;
 };
 
@@ -197,6 +201,7 @@ class Evaluator {
                                     ? fmt::format("no Y90: {}", e.y90.message)
                                     : fmt::format("Y90 is only bounded: {}", e.y90.message);
         e.why_y90 = e.why_c_mean = e.why_power = e.why_discharge = e.why_continuity = why;
+        e.why_residual_head = options_.chute_angle ? why : no_chute_angle;
         e.why_model = {why, why};
       }
       return e;
@@ -313,6 +318,20 @@ class Evaluator {
         if (!options_.discharge) e.why_continuity = "no discharge given (option discharge)";
         else if (!is_finite(e.q_w)) e.why_continuity = "no water discharge: " + e.why_discharge;
       }
+    }
+
+    // The residual head at the chute's end (spillway design):
+    // H_res = d cos(theta) + q_w^2 / (2 g d^2), the specific energy of the
+    // equivalent clear-water flow of depth d and velocity q_w / d.
+    if (!options_.chute_angle) {
+      if (explain) e.why_residual_head = no_chute_angle;
+    } else if (!is_finite(e.clear_water_depth) || !(e.clear_water_depth > 0.0)) {
+      if (explain) e.why_residual_head = "no clear-water depth d: " + e.why_c_mean;
+    } else if (!is_finite(e.q_w)) {
+      if (explain) e.why_residual_head = "no water discharge: " + e.why_discharge;
+    } else {
+      const double d = e.clear_water_depth;
+      e.residual_head = d * std::cos(*options_.chute_angle) + e.q_w * e.q_w / (2.0 * kGravity * d * d);
     }
 
     // Air-concentration models over 0 < y <= Y90.
@@ -487,6 +506,11 @@ Validation ProfileFlowOptions::validate() const {
                                                         "so it must be positive",
                                                         *discharge));
   }
+  if (chute_angle && !(*chute_angle >= 0.0 && *chute_angle <= 0.5 * std::numbers::pi)) {
+    return Validation::invalid("chute-angle", fmt::format("chute angle {:.6g} rad: a chute slopes 0-90 degrees to the "
+                                                          "horizontal",
+                                                          *chute_angle));
+  }
   if (draws < 0) {
     return Validation::invalid("draws", fmt::format("draws = {}: the Monte Carlo draws cannot be negative (0: no "
                                                     "intervals)",
@@ -629,7 +653,8 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
   const Evaluation point = evaluate(c, u, true);
 
   // The Monte Carlo draws (header).
-  enum Slot : std::size_t { y90, c_mean, depth, n, u90, q_w, q_a, continuity, smooth, stepped, slot_count };
+  enum Slot : std::size_t { y90, c_mean, depth, n, u90, q_w, q_a, continuity, smooth, stepped, residual_head,
+                            slot_count };
   const std::size_t slots = slot_count + options.levels.size();
   std::vector<std::vector<double>> draws(slots);
   for (auto& d : draws) d.reserve(static_cast<std::size_t>(options.draws));
@@ -661,6 +686,7 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
       draws[continuity].push_back(e.continuity);
       draws[smooth].push_back(e.models[0].diffusivity);
       draws[stepped].push_back(e.models[1].diffusivity);
+      draws[residual_head].push_back(e.residual_head);
       for (std::size_t j = 0; j < options.levels.size(); ++j) draws[slot_count + j].push_back(ok_y(e.levels[j]));
     }
   }
@@ -684,6 +710,8 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
   result.water_discharge = summarise(point.q_w, point.why_discharge, draws[q_w], options.draws);
   result.air_discharge = summarise(point.q_a, point.why_discharge, draws[q_a], options.draws);
   result.continuity_error = summarise(point.continuity, point.why_continuity, draws[continuity], options.draws);
+  result.residual_head =
+      summarise(point.residual_head, point.why_residual_head, draws[residual_head], options.draws);
   for (std::size_t j = 0; j < 2; ++j) {
     auto& fit = j == 0 ? result.smooth_chute : result.stepped_chute;
     const auto& m = point.models[j];
@@ -765,6 +793,15 @@ std::string ProfileFlowResult::report() const {
                        fit->points, smooth ? "D'" : "D_0", quantity_text(fit->diffusivity, 1.0, ""));
     if (fit->residual) out += fmt::format(", rms residual {:.3g}", *fit->residual);
     out += "\n";
+  }
+  // The quantities listed after the fits, each from its row of flow_quantity_names.
+  bool after_fits = false;
+  for (const auto& q : flow_quantity_names) {
+    if (after_fits) {
+      const std::string unit = q.shown_unit == "-" ? std::string() : " " + std::string(q.shown_unit);
+      out += fmt::format("  {} = {}\n", q.symbol, quantity_text(q.of(*this), q.shown_scale, unit.c_str()));
+    }
+    after_fits = after_fits || q.pointer == "/stepped_chute";
   }
   return out;
 }

@@ -787,24 +787,25 @@ json to_json(const ProfileFlowResult& f) {
              {"u90", quantity_json(f.power_law.u90)},
              {"residual", optional(f.power_law.residual)},
              {"points", f.power_law.points}};
-  return json{{process_key::status, to_string(f.status)},
-              {process_key::reason, f.message.empty() ? json(nullptr) : json(f.message)},
-              {"notes", f.notes},
-              {"invert", to_string(f.options.invert)},
-              {"discharge", optional(f.options.discharge)},
-              {"draws", f.draws},
-              {"seed", f.options.seed},
-              {"y90", depth_json(f.y90_point, f.y90)},
-              {"levels", levels},
-              {"c_mean", quantity_json(f.c_mean)},
-              {"clear_water_depth", quantity_json(f.clear_water_depth)},
-              {"power_law", power},
-              {"water_discharge", quantity_json(f.water_discharge)},
-              {"air_discharge", quantity_json(f.air_discharge)},
-              {"continuity_error", quantity_json(f.continuity_error)},
-              {process_key::smooth_chute, fit_json(f.smooth_chute)},
-              {process_key::stepped_chute, fit_json(f.stepped_chute)},
-              {"rows", rows}};
+  json out{{process_key::status, to_string(f.status)},
+           {process_key::reason, f.message.empty() ? json(nullptr) : json(f.message)},
+           {"notes", f.notes},
+           {"invert", to_string(f.options.invert)},
+           {"discharge", optional(f.options.discharge)},
+           {"chute_angle", optional(f.options.chute_angle)},
+           {"draws", f.draws},
+           {"seed", f.options.seed},
+           {"y90", depth_json(f.y90_point, f.y90)},
+           {"levels", levels},
+           {"power_law", power},
+           {process_key::smooth_chute, fit_json(f.smooth_chute)},
+           {process_key::stepped_chute, fit_json(f.stepped_chute)},
+           {"rows", rows}};
+  // The plain quantities, each from its row of flow_quantity_names.
+  for (const auto& q : flow_quantity_names) {
+    if (q.plain) out[json::json_pointer(std::string(q.pointer))] = quantity_json(q.of(f));
+  }
+  return out;
 }
 
 json to_json(const ProcessResult& r) {

@@ -108,11 +108,8 @@ class Profile(Result):
 
 # The quantities of a profile's flow, in the order Flow.to_dataframe lists
 # them: (name, unit, where in the flow JSON).
-_FLOW_QUANTITIES = (("Y90", "m", ("y90",)), ("C_mean", "-", ("c_mean",)), ("d", "m", ("clear_water_depth",)),
-                    ("N", "-", ("power_law", "n")), ("u90", "m/s", ("power_law", "u90")),
-                    ("q_w", "m2/s", ("water_discharge",)), ("q_a", "m2/s", ("air_discharge",)),
-                    ("continuity_error", "-", ("continuity_error",)), ("D'", "-", ("smooth_chute",)),
-                    ("D_0", "-", ("stepped_chute",)))
+_FLOW_QUANTITIES = tuple((q["symbol"], q["unit"], tuple(q["pointer"].split("/")[1:]))
+                         for q in _pdp.flow_quantities())
 
 
 class ConcentrationFit(Result):
@@ -158,7 +155,7 @@ class Flow(Result):
     def to_dataframe(self):
         """The quantities as a pandas DataFrame, one row each: ``quantity``
         (Y90, Y50 ..., C_mean, d, N, u90, q_w, q_a, continuity_error, D',
-        D_0), ``value``, ``ci95_lower``, ``ci95_upper``, ``unit`` and
+        D_0, H_res), ``value``, ``ci95_lower``, ``ci95_upper``, ``unit`` and
         ``reason`` (NaN/None where there is none); the units also in
         ``attrs["units"]``. Needs pandas (Debian's python3-pandas)."""
         try:

@@ -181,17 +181,14 @@ def gap_reason(row, pointer, have_positions):
 
 # (JSON pointer in "flow", quantity, symbol, unit shown, scale from the JSON's unit to it), in a paper's order;
 # the characteristic depths come first (flow_table).
-FLOW_QUANTITIES = [
-    ("/c_mean", "depth-averaged void fraction", "C_mean", "-", 1.0),
-    ("/clear_water_depth", "equivalent clear-water depth (1 - C_mean) Y90", "d", "mm", 1e3),
-    ("/power_law/n", "exponent of the power law u / u90 = (y / Y90)^(1/N)", "N", "-", 1.0),
-    ("/power_law/u90", "velocity at Y90 of the power law", "u90", "m/s", 1.0),
-    ("/water_discharge", "water discharge per unit width", "q_w", "m\u00b2/s", 1.0),
-    ("/air_discharge", "air discharge per unit width", "q_a", "m\u00b2/s", 1.0),
-    ("/continuity_error", "continuity error (q_w - q) / q", "", "%", 100.0),
-    ("/smooth_chute", "diffusivity, smooth chute (Chanson 1997)", "D'", "-", 1.0),
-    ("/stepped_chute", "diffusivity, stepped chute (Chanson & Toombes 2002)", "D_0", "-", 1.0),
-]
+def _flow_quantities():
+    import pdp
+    # The characteristic depths come first (flow_table); the continuity error has no symbol of its own.
+    return [(q["pointer"], q["meaning"], "" if q["pointer"] == "/continuity_error" else q["symbol"], q["shown_unit"],
+             q["shown_scale"]) for q in pdp._pdp.flow_quantities() if q["pointer"] != "/y90"]
+
+
+FLOW_QUANTITIES = _flow_quantities()
 
 # What each rule does below the lowest position (awcc/profile_flow.hpp, InvertRule).
 INVERT_RULES = {

@@ -28,6 +28,7 @@
 #include "awcc/json_text.hpp"
 #include "awcc/options.hpp"
 #include "awcc/process.hpp"
+#include "awcc/profile_flow.hpp"
 #include "awcc/read_back.hpp"
 #include "awcc/serialise.hpp"
 #include "awcc/version.hpp"
@@ -667,6 +668,16 @@ PYBIND11_MODULE(_pdp, m) {
     return py::dict(py::arg("windows") = units_of(awcc::awcc_window_columns()),
                     py::arg("bubbles") = units_of(awcc::event_bubble_columns()),
                     py::arg("vectors") = units_of(awcc::multi_tip_bubble_columns()));
+  });
+  m.def("flow_quantities", [] {
+    // The profile quantities, each once (awcc/profile_flow.hpp, flow_quantity_names).
+    py::list out;
+    for (const auto& q : awcc::flow_quantity_names) {
+      out.append(py::dict(py::arg("pointer") = std::string(q.pointer), py::arg("symbol") = std::string(q.symbol),
+                          py::arg("unit") = std::string(q.unit), py::arg("meaning") = std::string(q.meaning),
+                          py::arg("shown_unit") = std::string(q.shown_unit), py::arg("shown_scale") = q.shown_scale));
+    }
+    return out;
   });
   m.def("flags", [] {
     // The codes a result's "flags" may hold, with their meanings (awcc/flags.hpp).

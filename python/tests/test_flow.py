@@ -101,7 +101,7 @@ def test_the_object_table_and_report(square_waves):
     f = p.flow
     frame = f.to_dataframe()
     assert list(frame["quantity"]) == ["Y90", "Y50", "C_mean", "d", "N", "u90", "q_w", "q_a", "continuity_error",
-                                       "D'", "D_0"]
+                                       "D'", "D_0", "H_res"]
     y90 = frame.set_index("quantity").loc["Y90"]
     assert y90["value"] == f.y90.value and y90["ci95_lower"] == f.y90.ci95[0] and y90["unit"] == "m"
     assert frame.attrs["units"]["q_w"] == "m2/s"

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -621,6 +622,48 @@ TEST(ProfileFlowMonteCarlo, IntervalsCoverTheTruthAtTheirLevel) {
     const double half = std::accumulate(halves[j].begin(), halves[j].end(), 0.0) / repetitions;
     EXPECT_NEAR(half / (1.959964 * sd), 1.0, 0.2) << picks[j].first << " coverage " << coverage;
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The residual head H_res = d cos(theta) + q_w^2 / (2 g d^2) (issue 52):
+// computed in closed form from the same linear profile at constant velocity
+// as the discharge test above (left-out invert), so that d and q_w are exact:
+// d = (1 - C_mean) Y90, C_mean = integral / (Y90 - y0), q_w = u ((Y90 - y0) - integral).
+TEST(ProfileFlow, ResidualHeadOfAConstantVelocityIsItsClosedForm) {
+  const double a = 0.1, b = 4.0, y90 = 0.2, u = 3.0, y0 = 0.02, theta = 50.0 * std::numbers::pi / 180.0;
+  std::vector<ProfileRow> rows;
+  for (double y : {0.02, 0.05, 0.1, 0.15, 0.22}) rows.push_back(exact_row(y, a + b * y, u));
+  auto o = no_draws(InvertRule::left_out);
+  o.chute_angle = theta;
+  const auto r = awcc::profile_flow(rows, o);
+  const double integral = a * (y90 - y0) + 0.5 * b * (y90 * y90 - y0 * y0);
+  const double d = (1.0 - integral / (y90 - y0)) * y90, q = u * ((y90 - y0) - integral);
+  ASSERT_TRUE(r.residual_head.value) << r.residual_head.reason;
+  EXPECT_NEAR(*r.residual_head.value, d * std::cos(theta) + q * q / (2.0 * 9.80665 * d * d), 1e-13);
+  EXPECT_NE(r.report().find("  H_res = "), std::string::npos) << r.report();
+  // Without the angle: none, saying which setting gives it; the profile is
+  // still complete (H_res is asked for, not required).
+  const auto none = awcc::profile_flow(rows, no_draws(InvertRule::left_out));
+  EXPECT_FALSE(none.residual_head.value);
+  EXPECT_NE(none.residual_head.reason.find("chute-angle"), std::string::npos) << none.residual_head.reason;
+  EXPECT_EQ(none.status, r.status);
+  // With draws its interval holds the value (the rows are exact: zero width).
+  o.draws = 200;
+  const auto drawn = awcc::profile_flow(rows, o);
+  ASSERT_TRUE(drawn.residual_head.ci95);
+  EXPECT_NEAR(drawn.residual_head.ci95->lower, *r.residual_head.value, 1e-12);
+  EXPECT_NEAR(drawn.residual_head.ci95->upper, *r.residual_head.value, 1e-12);
+}
+
+TEST(ProfileFlow, AChuteAngleBeyondTheVerticalIsRefused) {
+  ProfileFlowOptions o;
+  o.chute_angle = 95.0 * std::numbers::pi / 180.0;
+  EXPECT_FALSE(o.validate().ok());
+  o.chute_angle = 0.5 * std::numbers::pi;
+  EXPECT_TRUE(o.validate().ok());
 }
 
 }  // namespace

@@ -79,6 +79,7 @@
 //    test gave coverage 0.91 to 0.925 and half-widths 0.87 of it: the
 //    interval is then somewhat narrow.
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -143,6 +144,10 @@ struct ProfileFlowOptions {
   int draws = 1000;
   /// The Monte Carlo seed: the same seed gives the same numbers.
   std::uint64_t seed = 0;
+  /// The chute's angle to the horizontal, rad (theta, 0 to pi/2): gives the
+  /// residual head H_res = d cos(theta) + q_w^2 / (2 g d^2), the energy a
+  /// stilling basin must dissipate. None: no residual head.
+  std::optional<double> chute_angle;
 
   [[nodiscard]] Validation validate() const;
 };
@@ -239,6 +244,7 @@ struct ProfileFlowResult {
   FlowQuantity continuity_error;   ///< (q_w - q) / q, -
   ConcentrationFit smooth_chute;   ///< D'
   ConcentrationFit stepped_chute;  ///< D_0
+  FlowQuantity residual_head;      ///< H_res, m
   int draws = 0;                   ///< Monte Carlo draws made
 
   /// A few readable lines: every quantity with its interval or its reason,
@@ -248,6 +254,49 @@ struct ProfileFlowResult {
   /// first position with its reason: what a front end logs as warnings.
   [[nodiscard]] std::vector<std::string> warnings() const;
 };
+
+/// The profile quantities, each once: the entry every front end lists them
+/// from (the flow JSON's plain quantities, the summary's lines after the
+/// fits, Python's Flow table, the report's table). A new quantity of a
+/// profile is a FlowQuantity member of ProfileFlowResult, its computation in
+/// profile_flow.cpp (the point estimate and each Monte Carlo draw), and one
+/// row here.
+struct FlowQuantityName {
+  std::string_view pointer;     ///< where the flow JSON holds it ("/power_law/n")
+  std::string_view symbol;      ///< as papers write it ("q_w")
+  std::string_view unit;        ///< SI, as the JSON holds it
+  std::string_view meaning;     ///< one line
+  std::string_view shown_unit;  ///< the report's unit
+  double shown_scale;           ///< from unit to shown_unit
+  /// Written by the JSON and the summary from this row alone (the depths,
+  /// the power law and the fits carry more and are written by their own code).
+  bool plain;
+  const FlowQuantity& (*of)(const ProfileFlowResult&);
+};
+inline constexpr std::array<FlowQuantityName, 11> flow_quantity_names{{
+    {"/y90", "Y90", "m", "depth where the void fraction reaches 0.9", "mm", 1e3, false,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.y90; }},
+    {"/c_mean", "C_mean", "-", "depth-averaged void fraction", "-", 1.0, true,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.c_mean; }},
+    {"/clear_water_depth", "d", "m", "equivalent clear-water depth (1 - C_mean) Y90", "mm", 1e3, true,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.clear_water_depth; }},
+    {"/power_law/n", "N", "-", "exponent of the power law u / u90 = (y / Y90)^(1/N)", "-", 1.0, false,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.power_law.n; }},
+    {"/power_law/u90", "u90", "m/s", "velocity at Y90 of the power law", "m/s", 1.0, false,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.power_law.u90; }},
+    {"/water_discharge", "q_w", "m2/s", "water discharge per unit width", "m\u00b2/s", 1.0, true,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.water_discharge; }},
+    {"/air_discharge", "q_a", "m2/s", "air discharge per unit width", "m\u00b2/s", 1.0, true,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.air_discharge; }},
+    {"/continuity_error", "continuity_error", "-", "continuity error (q_w - q) / q", "%", 100.0, true,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.continuity_error; }},
+    {"/smooth_chute", "D'", "-", "diffusivity, smooth chute (Chanson 1997)", "-", 1.0, false,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.smooth_chute.diffusivity; }},
+    {"/stepped_chute", "D_0", "-", "diffusivity, stepped chute (Chanson & Toombes 2002)", "-", 1.0, false,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.stepped_chute.diffusivity; }},
+    {"/residual_head", "H_res", "m", "residual head d cos(theta) + q_w^2 / (2 g d^2)", "m", 1.0, true,
+     [](const ProfileFlowResult& f) -> const FlowQuantity& { return f.residual_head; }},
+}};
 
 /// Why `y` cannot be a profile's positions: a position given twice, naming
 /// the two by `names` (one each); empty when none is. profile_flow refuses
