@@ -402,21 +402,22 @@ const OptionField<A> kAwcc[] = {
      [](const A& o) { return name_of(o.path, kPaths); }},
 };
 
+// An optional quantity of a setting: "none" or a value with its unit.
+std::optional<double> quantity_or_none(std::string_view t, Dimension d) {
+  if (t == "none") return std::nullopt;
+  return quantity(t, d);
+}
+std::string text_or_none(const std::optional<double>& v, Dimension d) {
+  return v ? format_quantity(*v, d) : std::string("none");
+}
+
 using PF = ProfileFlowOptions;
 const OptionField<PF> kFlow[] = {
     {"discharge", "m2/s",
      "profile: the discharge per unit width the lab set (e.g. 0.2m2/s, 150l/s/m), for the continuity error "
      "(q_w - q) / q; none: no check",
-     [](PF& o, std::string_view t) {
-       if (t == "none") {
-         o.discharge.reset();
-       } else {
-         o.discharge = quantity(t, Dimension::discharge_per_width);
-       }
-     },
-     [](const PF& o) {
-       return o.discharge ? format_quantity(*o.discharge, Dimension::discharge_per_width) : std::string("none");
-     }},
+     [](PF& o, std::string_view t) { o.discharge = quantity_or_none(t, Dimension::discharge_per_width); },
+     [](const PF& o) { return text_or_none(o.discharge, Dimension::discharge_per_width); }},
     {"invert", "",
      "profile: the void fraction from the invert to the first position, which no probe reaches: held (the first "
      "reading) | zero | left-out",
@@ -437,14 +438,8 @@ const OptionField<PF> kFlow[] = {
     {"chute-angle", "rad",
      "profile: the chute's angle to the horizontal (e.g. 50deg), for the residual head H_res = d cos(theta) + "
      "q_w^2 / (2 g d^2); none: no residual head",
-     [](PF& o, std::string_view t) {
-       if (t == "none") {
-         o.chute_angle.reset();
-       } else {
-         o.chute_angle = quantity(t, Dimension::angle);
-       }
-     },
-     [](const PF& o) { return o.chute_angle ? format_quantity(*o.chute_angle, Dimension::angle) : std::string("none"); }},
+     [](PF& o, std::string_view t) { o.chute_angle = quantity_or_none(t, Dimension::angle); },
+     [](const PF& o) { return text_or_none(o.chute_angle, Dimension::angle); }},
     {"flow-draws", "-", "profile: Monte Carlo draws of the profile quantities' 95 % intervals",
      [](PF& o, std::string_view t) { o.draws = static_cast<int>(whole(t, 100, 10000000)); },
      [](const PF& o) { return std::to_string(o.draws); }},
