@@ -471,8 +471,9 @@ void check_tips(BinarisedRecording& out, const ProcessOptions& options, std::opt
     if (tip.check.status == SignalStatus::inverted_polarity) quantity = "probe,allow-bad-signal";
   }
   if (!first) return;
+  const std::string what = out.info.path.empty() ? out.info.description : out.info.path.string();
   throw InputError(fmt::format("{}: {}; to process it anyway, with the failure in every output, allow a bad signal",
-                               out.info.path.string(), refusal),
+                               what, refusal),
                    quantity);
 }
 
@@ -627,6 +628,64 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& g
   out.tip_positions = std::move(resolved.positions);
   check_tips(out, options,
              recording->has_int16() && info.quantum > 0.0 ? std::optional(int16_limits(info.quantum)) : std::nullopt);
+  return out;
+}
+
+namespace {
+
+// A binary channel as a binary file reads (TwoLevelScan): the histogram of
+// its two levels, 0 water and 1 air, one count per level.
+VoltageHistogram two_levels(const AirIntervals& signal) {
+  VoltageHistogram h(1.0);
+  const std::int64_t air = signal.air_samples();
+  const std::int64_t counts[2] = {signal.sample_count - air, air};
+  h.add_counts(counts, 0);
+  return h;
+}
+
+}  // namespace
+
+BinarisedRecording binary_recording(std::vector<AirIntervals> signals, const ProcessOptions& options,
+                                    std::vector<int> channels, std::vector<Vec3> positions) {
+  if (channels.empty()) {
+    for (std::size_t k = 0; k < signals.size(); ++k) channels.push_back(static_cast<int>(k));
+  }
+  if (signals.size() < 2 || channels.size() != signals.size() || (!positions.empty() && positions.size() != signals.size())) {
+    throw std::invalid_argument(fmt::format("binary_recording: {} signals, {} channels and {} tip positions: give at "
+                                            "least two signals, one channel each, and one position each or none",
+                                            signals.size(), channels.size(), positions.size()));
+  }
+  BinarisedRecording out;
+  out.info.description = "binary signals in memory";
+  out.info.channels = *std::max_element(channels.begin(), channels.end()) + 1;
+  out.info.fs = signals[0].fs;
+  out.info.frames = signals[0].sample_count;
+  out.info.quantum = 1.0;
+  const BinarisationOptions& bopt = options.binarisation;
+  for (std::size_t k = 0; k < signals.size(); ++k) {
+    VoltageHistogram h = two_levels(signals[k]);
+    const Threshold threshold = choose_threshold(h, tip_options(bopt, k));
+    if (k == 0) {
+      out.leading_threshold = threshold;
+      out.leading = std::move(signals[k]);
+      out.leading_histogram = std::move(h);
+    } else if (k == 1) {
+      out.trailing_threshold = threshold;
+      out.trailing = std::move(signals[k]);
+      out.trailing_histogram = std::move(h);
+    } else {
+      BinarisedTip& tip = out.further_tips.emplace_back();
+      tip.channel = channels[k];
+      tip.threshold = threshold;
+      tip.signal = std::move(signals[k]);
+      tip.histogram = std::move(h);
+    }
+  }
+  out.tip_positions = std::move(positions);
+  ProcessOptions checked = options;
+  checked.leading_channel = channels[0];
+  checked.trailing_channel = channels[1];
+  check_tips(out, checked, std::nullopt);
   return out;
 }
 

@@ -54,7 +54,7 @@ std::vector<BenchRow> bench_one(const std::string& name, std::uint64_t seed, con
     s.seed = seed;
     const auto syn = synth::synthesise(s);
     const double dx = s.streamwise_separation(), dy = s.lateral_separation();
-    const auto record = binarised_recording(syn.signals[0], syn.signals[1]);
+    const auto record = awcc::binary_recording({syn.signals[0], syn.signals[1]}, processing_options({}, dx, dy));
     const bool base = duration == plan.base_duration && fs == 500e3;
     auto row = [&](std::string method, int np) {
       BenchRow r;

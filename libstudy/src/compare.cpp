@@ -32,8 +32,9 @@ Comparison compare_recording(const std::filesystem::path& file, const awcc::Proc
 
 Comparison compare_scene(const synth::Scene& scene, const RunOptions& options) {
   auto syn = synthesise_pair(scene);
-  auto c = compare(binarised_recording(std::move(syn.signals[0]), std::move(syn.signals[1])), options,
-                   scene.streamwise_separation(), scene.lateral_separation());
+  const double dx = scene.streamwise_separation(), dy = scene.lateral_separation();
+  syn.signals.resize(2);
+  auto c = compare(awcc::binary_recording(std::move(syn.signals), processing_options(options, dx, dy)), options, dx, dy);
   c.what = fmt::format("synthetic scene (seed {})", scene.seed);
   c.truth_velocity = syn.truth.realised.mean_velocity[0];
   c.truth_turbulence_intensity = syn.truth.realised.turbulence_intensity[0];

@@ -345,7 +345,10 @@ std::vector<DesignRow> run_design_task(const DesignDefinition& d, const DesignTa
   std::vector<DesignRow> rows;
   for (std::size_t g = 0; g < d.geometries.size(); ++g) {
     const double dx = d.geometries[g].first, dy = d.geometries[g].second;
-    const auto record = binarised_recording(syn.signals.at(0), syn.signals.at(g + 1));
+    RunOptions reading;
+    reading.awcc = processing;
+    const auto record =
+        awcc::binary_recording({syn.signals.at(0), syn.signals.at(g + 1)}, processing_options(reading, dx, dy));
     for (int np : d.nps) {
       RunOptions run;
       run.awcc = processing;

@@ -126,28 +126,21 @@ awcc::RecordingInfo synthetic_info(const synth::Scene& scene, std::size_t tips) 
   return info;
 }
 
-// The synthetic signals as process_binarised takes a probe's recording:
-// the tip pair first, then the further tips, in the channel order pdp
-// process chose (`resolved`, from tip_pair_options), each binarised as a
-// binary channel is (the further tips like the trailing one), with every
-// tip's position.
+// The synthetic signals as process_binarised takes a probe's recording
+// (awcc::binary_recording, the signal check included): the tip pair first,
+// then the further tips, in the channel order pdp process chose
+// (`resolved`, from tip_pair_options), with every tip's position.
 awcc::BinarisedRecording probe_recording(const synth::Synthesis& syn, const awcc::ProcessOptions& resolved,
                                          const awcc::ProbeGeometry& geometry) {
   const auto channels = resolved.tip_channels();
-  const auto signal = [&](int c) -> const awcc::AirIntervals& { return syn.signals.at(static_cast<std::size_t>(c)); };
-  auto r = binarised_recording(signal(channels[0]), signal(channels[1]), resolved.binarisation);
-  r.info.channels = static_cast<int>(syn.signals.size());
-  for (std::size_t j = 2; j < channels.size(); ++j) {
-    // A pair of the tip with itself: its trailing half is the tip binarised
-    // as a trailing tip, what BinarisedTip holds.
-    auto alone = binarised_recording(signal(channels[j]), signal(channels[j]), resolved.binarisation);
-    auto& t = r.further_tips.emplace_back();
-    t.channel = channels[j];
-    t.threshold = alone.trailing_threshold;
-    t.signal = std::move(alone.trailing);
-    t.histogram = std::move(alone.trailing_histogram);
+  std::vector<awcc::AirIntervals> signals;
+  std::vector<awcc::Vec3> positions;
+  for (const int c : channels) {
+    signals.push_back(syn.signals.at(static_cast<std::size_t>(c)));
+    positions.push_back(geometry.positions().at(static_cast<std::size_t>(c)));
   }
-  for (const int c : channels) r.tip_positions.push_back(geometry.positions().at(static_cast<std::size_t>(c)));
+  auto r = awcc::binary_recording(std::move(signals), resolved, channels, std::move(positions));
+  r.info.channels = static_cast<int>(syn.signals.size());
   return r;
 }
 

@@ -30,65 +30,6 @@ awcc::ProcessOptions processing_options(const RunOptions& options, double dx, do
   return p;
 }
 
-namespace {
-
-// A binary channel as process.cpp reads one (TwoLevelScan): the histogram of
-// its two levels, 0 water and 1 air (volts unknown, one count per level).
-awcc::VoltageHistogram two_levels(const awcc::AirIntervals& signal) {
-  awcc::VoltageHistogram h(1.0);
-  const std::int64_t air = signal.air_samples();
-  const std::int64_t counts[2] = {signal.sample_count - air, air};
-  h.add_counts(counts, 0);
-  return h;
-}
-
-}  // namespace
-
-awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
-                                             const awcc::BinarisationOptions& binarisation) {
-  awcc::BinarisedRecording out;
-  out.info.description = "synthesised binary signals";
-  out.info.channels = 2;
-  out.info.fs = leading.fs;
-  out.info.frames = leading.sample_count;
-  out.info.quantum = 1.0;
-  out.leading_histogram = two_levels(leading);
-  out.trailing_histogram = two_levels(trailing);
-  out.leading_threshold = awcc::choose_threshold(*out.leading_histogram, binarisation);
-  out.trailing_threshold = awcc::choose_threshold(*out.trailing_histogram, binarisation.for_trailing_tip());
-  // The signal check pdp process makes of the file's channels: binary input,
-  // flagged air_continuous where air holds the droplet regime's share (a
-  // spray scene, synth::DispersedPhase::droplets).
-  out.leading_signal = awcc::check_signal(*out.leading_histogram, binarisation.probe, std::nullopt);
-  out.trailing_signal = awcc::check_signal(*out.trailing_histogram, binarisation.probe, std::nullopt);
-  out.leading = std::move(leading);
-  out.trailing = std::move(trailing);
-  return out;
-}
-
-awcc::BinarisedRecording binarised_probe(std::vector<awcc::AirIntervals> signals,
-                                         const std::vector<awcc::Vec3>& positions,
-                                         const awcc::BinarisationOptions& binarisation) {
-  if (signals.size() < 2 || signals.size() != positions.size()) {
-    throw std::invalid_argument(fmt::format("a probe of {} signals and {} tip positions: give one position per tip",
-                                            signals.size(), positions.size()));
-  }
-  std::vector<awcc::AirIntervals> further(std::make_move_iterator(signals.begin() + 2),
-                                          std::make_move_iterator(signals.end()));
-  awcc::BinarisedRecording out = binarised_recording(std::move(signals[0]), std::move(signals[1]), binarisation);
-  out.info.channels = static_cast<int>(positions.size());
-  for (std::size_t k = 0; k < further.size(); ++k) {
-    awcc::BinarisedTip& tip = out.further_tips.emplace_back();
-    tip.channel = static_cast<int>(k + 2);
-    tip.histogram = two_levels(further[k]);
-    tip.threshold = awcc::choose_threshold(*tip.histogram, binarisation.for_trailing_tip());
-    tip.check = awcc::check_signal(*tip.histogram, binarisation.probe, std::nullopt);
-    tip.signal = std::move(further[k]);
-  }
-  out.tip_positions = positions;
-  return out;
-}
-
 awcc::ProcessResult process_synthesis(awcc::AirIntervals leading, awcc::AirIntervals trailing,
                                       const awcc::ProcessOptions& options) {
   if (options.awcc_options.signal != awcc::CorrelationSignal::binary) {
@@ -96,8 +37,10 @@ awcc::ProcessResult process_synthesis(awcc::AirIntervals leading, awcc::AirInter
         "signal = raw: a synthesised record in memory holds binary signals only; write it as a voltage recording "
         "(synth::write_recording) and process the file");
   }
-  return awcc::process_binarised(binarised_recording(std::move(leading), std::move(trailing), options.binarisation),
-                                 options);
+  std::vector<awcc::AirIntervals> signals;
+  signals.push_back(std::move(leading));
+  signals.push_back(std::move(trailing));
+  return awcc::process_binarised(awcc::binary_recording(std::move(signals), options), options);
 }
 
 synth::Synthesis synthesise_pair(const synth::Scene& scene, const synth::SynthesisOptions& options) {
@@ -142,8 +85,8 @@ RunResult run_scene(const synth::Scene& scene, const RunOptions& options) {
     }
     std::vector<awcc::Vec3> positions;
     for (const auto& t : tips) positions.push_back({t.x, t.y, t.z});
-    r.processed = awcc::process_binarised(
-        binarised_probe(std::move(syn.signals), positions, processing.binarisation), processing);
+    r.processed =
+        awcc::process_binarised(awcc::binary_recording(std::move(syn.signals), processing, {}, positions), processing);
   } else {
     r.processed = process_synthesis(std::move(syn.signals[0]), std::move(syn.signals[1]), processing);
   }

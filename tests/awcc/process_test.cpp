@@ -16,6 +16,7 @@
 #include "synth/synthesiser.hpp"
 #include "test_paths.hpp"
 #include "result_warnings.hpp"
+#include "signal_builders.hpp"
 
 namespace {
 
@@ -528,6 +529,64 @@ TEST(ProcessInput, AConstantChannelIsRefusedUnlessAllowed) {
   const auto j = awcc::to_json(r);
   EXPECT_TRUE(j["fscc"]["velocity"].is_null());
   EXPECT_FALSE(j["fscc"]["reason"].is_null());
+}
+
+
+// The one way from binary signals in memory to a recording (what studies and
+// the multi-tip validation process): for a four-tip scene it equals what
+// binarise_recording reads from the binary file written from the same
+// signals, tip by tip (signal, threshold, histogram, signal check), and a
+// dead tip is refused with the file's message unless allowed.
+TEST(ProcessInput, BinarySignalsInMemoryAreTheRecordingOfTheirFile) {
+  synth::Scene s;
+  s.duration = 1.5;
+  s.tips = {{0.0, 0.0, 0.0}, {5e-3, 0.0, 0.0}, {4e-3, 1e-3, 0.0}, {4e-3, 0.0, 1e-3}};
+  const auto w = write_scene(s, synth::SignalKind::binary, "in_memory_four.flac");
+  awcc::ProcessOptions o;
+  o.trailing_channel = 1;
+  o.further_channels = {2, 3};
+  const auto file = awcc::binarise_recording(w.path, o);
+  const auto memory = awcc::binary_recording(w.synthesis.signals, o);
+  ASSERT_EQ(memory.further_tips.size(), 2u);
+  EXPECT_EQ(memory.info.fs, file.info.fs);
+  EXPECT_EQ(memory.info.frames, file.info.frames);
+  EXPECT_EQ(memory.leading.intervals, file.leading.intervals);
+  EXPECT_EQ(memory.trailing.intervals, file.trailing.intervals);
+  // The levels' scale differs (0 and 1 in memory, 0 and one count in the
+  // file), so the thresholds' values do; both are binary input, not applied.
+  EXPECT_TRUE(memory.leading_threshold.binary_input && file.leading_threshold.binary_input);
+  EXPECT_TRUE(memory.trailing_threshold.binary_input && file.trailing_threshold.binary_input);
+  EXPECT_EQ(memory.leading_signal.status, awcc::SignalStatus::binary_input);
+  EXPECT_EQ(memory.leading_signal.status, file.leading_signal.status);
+  EXPECT_EQ(memory.trailing_signal.air_share, file.trailing_signal.air_share);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& m = memory.further_tips[k];
+    const auto& f = file.further_tips[k];
+    EXPECT_EQ(m.channel, f.channel);
+    EXPECT_EQ(m.signal.intervals, f.signal.intervals);
+    EXPECT_TRUE(m.threshold.binary_input && f.threshold.binary_input);
+    // A further tip gets the check too (the multi-tip validation's did not).
+    EXPECT_EQ(m.check.status, f.check.status) << "tip " << k + 2;
+    EXPECT_EQ(m.check.air_share, f.check.air_share);
+    ASSERT_TRUE(m.histogram && f.histogram);
+    EXPECT_EQ(m.histogram->total(), f.histogram->total());
+  }
+
+  // A dead fourth tip (all water): refused naming its channel, as a file's.
+  auto dead = w.synthesis.signals;
+  dead[3] = pdp_test::all_water_like(dead[3]);
+  try {
+    (void)awcc::binary_recording(dead, o);
+    ADD_FAILURE() << "a dead tip in memory was accepted without allow-bad-signal";
+  } catch (const awcc::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("binary signals in memory: channel 3 (tip 3): ", 0), 0u) << what;
+    EXPECT_EQ(e.quantity(), "allow-bad-signal");
+  }
+  o.signal_check.allow_bad_signal = true;
+  const auto allowed = awcc::binary_recording(dead, o);
+  EXPECT_EQ(allowed.further_tips[1].check.status, awcc::SignalStatus::one_level);
+  EXPECT_TRUE(allowed.further_tips[1].check.overridden);
 }
 
 }  // namespace

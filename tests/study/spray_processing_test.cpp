@@ -103,7 +103,7 @@ TEST(SprayProcessing, ChordsAndClustersTakeTheDropletsAsTheParticles) {
   auto options = study::processing_options({}, s.streamwise_separation(), s.lateral_separation());
   options.structure.enabled = true;
   const auto processed =
-      awcc::process_binarised(study::binarised_recording(syn.signals[0], syn.signals[1]), options);
+      awcc::process_binarised(awcc::binary_recording({syn.signals[0], syn.signals[1]}, options), options);
   ASSERT_TRUE(processed.structure);
   const auto& st = *processed.structure;
   for (const auto* clusters : {&st.clusters_time, &st.clusters_length}) {

@@ -254,6 +254,22 @@ BinarisedRecording binarise_recording(const std::filesystem::path& path, const P
 /// The same from an open recording (read from its start; options.reader is not used).
 BinarisedRecording binarise_recording(Recording& recording, const ProcessOptions& options);
 
+/// Binary tip signals already in memory (a synthesis, a study, the
+/// multi-tip validation) as a recording, built as binarise_recording builds
+/// a binary file's: each tip's histogram holds its two levels (0 water, 1
+/// air, one count per level), its threshold comes from that histogram by the
+/// processing's rule (the trailing rule for every tip but the leading one),
+/// and every tip gets the signal check under the options' policy (a failure
+/// throws InputError naming the channel unless
+/// signal_check.allow_bad_signal). The one way from signals to a recording,
+/// so that a sweep row and pdp process of the file written from the same
+/// signals see the same tips. signals[k] is the tip on channels[k] (leading,
+/// trailing, further tips; 0, 1, 2, ... when channels is empty); positions,
+/// m, one per signal where the probe's tips are known (else empty). fs and
+/// frames come from the leading signal.
+BinarisedRecording binary_recording(std::vector<AirIntervals> signals, const ProcessOptions& options,
+                                    std::vector<int> channels = {}, std::vector<Vec3> positions = {});
+
 /// Phase statistics (and FSCC, and AWCC on the binary signals) from binarised signals.
 ProcessResult process_binarised(const BinarisedRecording& recording, const ProcessOptions& options);
 

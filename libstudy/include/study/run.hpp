@@ -37,23 +37,6 @@ struct RunOptions {
 /// not made: a study reads none of them, and they change nothing else.
 awcc::ProcessOptions processing_options(const RunOptions& options, double dx, double dy);
 
-/// Two binary signals of a synthesised record as pdp process reads them from
-/// the recording libsynth writes: binary input, two levels per tip, whose
-/// thresholds process.cpp's rule (awcc::choose_threshold of the two-level
-/// histogram) marks as not applied again, and whose signal check is the
-/// file's (binary input; air_continuous for a spray scene); fs and frames
-/// from the signals. `binarisation` is the processing's (it names the rule
-/// in the thresholds and the probe type the check reads).
-awcc::BinarisedRecording binarised_recording(awcc::AirIntervals leading, awcc::AirIntervals trailing,
-                                             const awcc::BinarisationOptions& binarisation = {});
-
-/// The same for every tip of a probe of four or more tips (signals in the
-/// scene's tip order, the first two the pair): the further tips on channels
-/// 2, 3, ... and every tip's position (m), so that processing treats the
-/// record as a multi-tip probe.
-awcc::BinarisedRecording binarised_probe(std::vector<awcc::AirIntervals> signals,
-                                         const std::vector<awcc::Vec3>& positions,
-                                         const awcc::BinarisationOptions& binarisation = {});
 /// Synthesises a scene for a study: it needs two tips, the first two being
 /// the pair processed (throws std::invalid_argument naming the tips otherwise).
 synth::Synthesis synthesise_pair(const synth::Scene& scene, const synth::SynthesisOptions& options = {});
