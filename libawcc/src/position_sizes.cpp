@@ -183,8 +183,8 @@ SizesResult position_sizes(const AirIntervals& leading, const PhaseStatistics& p
     out.status = SizesStatus::coarse_sampling;
     out.message = fmt::format("the inverted number median, {:.3g} mm, spans {:.2g} samples, fewer than "
                               "size-samples-min = {:g}: chord times are whole samples, and at 2 samples the median "
-                              "comes out 15 % low (size_distribution_bench --sampling); sample faster. 1.5 x mean "
-                              "chord = {:.4g} mm is d32 without inversion",
+                              "comes out 15 % low (docs/validation.md, \"Bubble sizes from chord lengths\"); "
+                              "sample faster. 1.5 x mean chord = {:.4g} mm is d32 without inversion",
                               1e3 * d.median, out.median_samples, options.samples_min, 1e3 * d.sauter_from_chords);
     SizeDistribution kept;
     kept.status = SizeStatus::too_few_chords;

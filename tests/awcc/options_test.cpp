@@ -423,4 +423,19 @@ TEST(ProfileFlowOptions, EachDeclaredDefaultReadsBackAndADischargeNeedsItsUnit) 
   } catch (const awcc::OptionError& e) {
     EXPECT_EQ(e.quantity(), "discharge");
   }
+  // The chute angle: degrees or radians as written, none by default; a bare
+  // 30 (degrees or radians?) is refused naming the option.
+  EXPECT_FALSE(awcc::ProfileFlowOptions{}.chute_angle);
+  for (const auto& [text, radians] : {std::pair{"30deg", 30.0 * std::numbers::pi / 180.0}, {"0.5rad", 0.5}}) {
+    const auto a = awcc::profile_flow_options(std::vector<awcc::OptionSetting>{{"chute-angle", text, ""}});
+    ASSERT_TRUE(a.chute_angle) << text;
+    EXPECT_NEAR(*a.chute_angle, radians, 1e-15) << text;
+  }
+  try {
+    (void)awcc::profile_flow_options(std::vector<awcc::OptionSetting>{{"chute-angle", "30", ""}});
+    ADD_FAILURE() << "a chute angle without a unit was accepted";
+  } catch (const awcc::OptionError& e) {
+    EXPECT_EQ(e.quantity(), "chute-angle");
+    EXPECT_NE(std::string(e.what()).find("deg"), std::string::npos) << e.what();
+  }
 }
