@@ -289,32 +289,43 @@ std::optional<bool> ProfileComparison::covered() const {
 
 namespace {
 
-// The profile quantities with a truth, in the report's order.
+// The laws' truth of a profile quantity (by its awcc::flow_quantity_names
+// pointer), where the laws give one: the continuity error and the residual
+// head have none, and of the diffusivities only the profile's own model's.
+std::optional<double> truth_of(std::string_view pointer, const ProfileSpec& spec, const ProfileTruth& t) {
+  const bool stepped = spec.model == awcc::ConcentrationModelKind::stepped_chute;
+  if (pointer == "/y90") return t.y90;
+  if (pointer == "/c_mean") return t.c_mean;
+  if (pointer == "/clear_water_depth") return t.clear_water_depth;
+  if (pointer == "/power_law/n") return t.power_law_n;
+  if (pointer == "/power_law/u90") return t.u90;
+  if (pointer == "/water_discharge") return t.water_discharge;
+  if (pointer == "/air_discharge") return t.air_discharge;
+  if (pointer == (stepped ? "/stepped_chute" : "/smooth_chute")) return t.diffusivity;
+  return std::nullopt;
+}
+
+// The profile quantities with a truth, in the order of the quantities'
+// table (awcc/profile_flow.hpp, its one owner of names and units), each
+// depth level after Y90; the key is the quantity's JSON pointer in words
+// ("/power_law/n": "power_law_n").
 std::vector<ProfileComparison> compare(const ProfileSpec& spec, const ProfileTruth& t,
                                        const awcc::ProfileFlowResult& measured, const awcc::ProfileFlowResult& exact) {
   std::vector<ProfileComparison> out;
-  auto add = [&](std::string name, std::string key, std::string unit, double truth,
-                 const awcc::FlowQuantity awcc::ProfileFlowResult::*member) {
-    out.push_back({std::move(name), std::move(key), std::move(unit), truth, (exact.*member).value, measured.*member});
-  };
-  add("Y90", "y90", "m", t.y90, &awcc::ProfileFlowResult::y90);
-  for (std::size_t i = 0; i < measured.levels.size() && i < t.levels.size(); ++i) {
-    if (!t.depths[i]) continue;
-    const auto name = fmt::format("Y{:g}", 100 * t.levels[i]);
-    out.push_back({name, fmt::format("y{:g}", 100 * t.levels[i]), "m", *t.depths[i],
-                   i < exact.levels.size() ? exact.levels[i].depth.value : std::nullopt, measured.levels[i].depth});
+  for (const auto& q : awcc::flow_quantity_names) {
+    const auto truth = truth_of(q.pointer, spec, t);
+    if (!truth) continue;
+    std::string key(q.pointer.substr(1));
+    std::replace(key.begin(), key.end(), '/', '_');
+    out.push_back({std::string(q.symbol), key, std::string(q.unit), *truth, q.of(exact).value, q.of(measured)});
+    if (q.pointer != "/y90") continue;
+    for (std::size_t i = 0; i < measured.levels.size() && i < t.levels.size(); ++i) {
+      if (!t.depths[i]) continue;
+      out.push_back({fmt::format("Y{:g}", 100 * t.levels[i]), fmt::format("y{:g}", 100 * t.levels[i]), "m",
+                     *t.depths[i], i < exact.levels.size() ? exact.levels[i].depth.value : std::nullopt,
+                     measured.levels[i].depth});
+    }
   }
-  add("C_mean", "c_mean", "-", t.c_mean, &awcc::ProfileFlowResult::c_mean);
-  add("d", "clear_water_depth", "m", t.clear_water_depth, &awcc::ProfileFlowResult::clear_water_depth);
-  out.push_back({"N", "power_law_n", "-", t.power_law_n, exact.power_law.n.value, measured.power_law.n});
-  out.push_back({"u90", "u90", "m/s", t.u90, exact.power_law.u90.value, measured.power_law.u90});
-  add("q_w", "water_discharge", "m2/s", t.water_discharge, &awcc::ProfileFlowResult::water_discharge);
-  add("q_a", "air_discharge", "m2/s", t.air_discharge, &awcc::ProfileFlowResult::air_discharge);
-  const bool stepped = spec.model == awcc::ConcentrationModelKind::stepped_chute;
-  const auto& fit = stepped ? measured.stepped_chute : measured.smooth_chute;
-  const auto& exact_fit = stepped ? exact.stepped_chute : exact.smooth_chute;
-  out.push_back({stepped ? "D_0" : "D'", stepped ? "stepped_chute_diffusivity" : "smooth_chute_diffusivity", "-",
-                 t.diffusivity, exact_fit.diffusivity.value, fit.diffusivity});
   return out;
 }
 
