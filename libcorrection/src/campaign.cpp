@@ -31,10 +31,6 @@
 
 namespace correction {
 
-using awcc::cell_number;
-using awcc::mix64;
-using awcc::parallel_for;
-using awcc::split_cells;
 using namespace detail;
 
 std::string_view to_string(TruthKind truth) { return truth == TruthKind::realised ? "realised" : "imposed"; }

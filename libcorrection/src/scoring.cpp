@@ -30,10 +30,6 @@
 
 namespace correction {
 
-using awcc::cell_number;
-using awcc::mix64;
-using awcc::parallel_for;
-using awcc::split_cells;
 using namespace detail;
 
 namespace {

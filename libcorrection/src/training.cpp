@@ -31,10 +31,6 @@
 
 namespace correction {
 
-using awcc::cell_number;
-using awcc::mix64;
-using awcc::parallel_for;
-using awcc::split_cells;
 using namespace detail;
 
 CorrectionModel fit_model(const std::vector<TrainingRow>& rows, TargetForm velocity_form,

@@ -9,10 +9,18 @@
 #include <chrono>
 #include <vector>
 
+#include "awcc/csv.hpp"
+#include "awcc/parallel.hpp"
+#include "awcc/random.hpp"
 #include "correction/model.hpp"
 #include "correction/training.hpp"
 
 namespace correction::detail {
+
+using awcc::cell_number;
+using awcc::mix64;
+using awcc::parallel_for;
+using awcc::split_cells;
 
 double seconds_since(std::chrono::steady_clock::time_point start);
 
