@@ -255,6 +255,36 @@ std::optional<Warning> arrivals_along_flow(const ProcessResult& r) {
                              g.value, g.ci95.lower, g.ci95.upper, g.allowance, time_arrival_gap_allowance)};
 }
 
+// AWCC's edge rule (awcc/awcc.hpp, lag_range_end_share): any accepted
+// window at an end of the velocity range's lags, with its count.
+std::optional<Warning> lag_range_end(const ProcessResult& r) {
+  if (!r.awcc || !r.awcc->ok()) return std::nullopt;
+  const auto& a = *r.awcc;
+  const std::int64_t at_ends = a.windows_at_least_lag + a.windows_at_greatest_lag;
+  if (at_ends == 0) return std::nullopt;
+  return Warning{Flag::lag_range_end,
+                 fmt::format("{} of {} accepted AWCC windows peak at an end of the lags the velocity range {}-{} m/s "
+                             "lets AWCC search ({} at the least lag, {} at the greatest): their peaks may lie beyond "
+                             "it{}; widen the velocity range (velocity-range) or drop it",
+                             at_ends, a.windows_accepted, a.options.velocity_min.value_or(0.0),
+                             a.options.velocity_max.value_or(0.0), a.windows_at_least_lag, a.windows_at_greatest_lag,
+                             lags_pile_up_at_range_end(a) ? ", and so many pile up there that the mean and Tu are "
+                                                            "truncated (quality low; not corrected)"
+                                                          : "")};
+}
+
+// AWCC's spread rule (AwccResult::turbulence_measured).
+std::optional<Warning> tu_not_measured(const ProcessResult& r) {
+  if (!r.awcc || !r.awcc->ok() || r.awcc->turbulence_measured) return std::nullopt;
+  const auto& a = *r.awcc;
+  return Warning{Flag::tu_not_measured,
+                 fmt::format("every one of the {} accepted AWCC windows peaks at the same lag: u_rms is 0 by the lag's "
+                             "resolution, so Tu is not measured and not given, and the velocity is bounded "
+                             "({:.4g}-{:.4g} m/s); refine the peak (subsample), sample faster or widen the velocity "
+                             "range",
+                             a.windows_accepted, a.velocity_ci95.lower, a.velocity_ci95.upper)};
+}
+
 }  // namespace
 
 std::vector<Warning> assess(const ProcessResult& r) {
@@ -276,6 +306,8 @@ std::vector<Warning> assess(const ProcessResult& r) {
   if (auto w = events_disagree(r)) out.push_back(std::move(*w));
   if (auto w = multi_tip_doubtful(r)) out.push_back(std::move(*w));
   if (auto w = arrivals_along_flow(r)) out.push_back(std::move(*w));
+  if (auto w = lag_range_end(r)) out.push_back(std::move(*w));
+  if (auto w = tu_not_measured(r)) out.push_back(std::move(*w));
   return out;
 }
 

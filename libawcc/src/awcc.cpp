@@ -809,7 +809,77 @@ void flag_unresolved_lag(AwccResult& result, double dx, double fs) {
   result.quality_reason = result.chance_yield ? result.quality_reason + "; " + why : why;
 }
 
+namespace {
+
+// A quality reason of `result` lowered to low: after another specific
+// reason, both; in place of a generic one (too few windows, a low yield).
+void lower_quality(AwccResult& result, const std::string& why, bool specific) {
+  result.quality = AwccQuality::low;
+  result.quality_reason = specific ? result.quality_reason + "; " + why : why;
+}
+
+}  // namespace
+
+void judge_lag_range_and_spread(AwccResult& result, double dx, double fs, const AwccOptions& options) {
+  result.windows_at_least_lag = result.windows_at_greatest_lag = 0;
+  result.turbulence_measured = true;
+  if (!result.ok()) return;
+  const bool ranged = options.velocity_min && options.velocity_max && dx > 0.0;
+  std::optional<double> shared_lag;
+  bool one_lag = true;
+  for (const auto& w : result.windows) {
+    if (w.fate != WindowFate::accepted) continue;
+    if (!shared_lag) shared_lag = w.lag;
+    one_lag = one_lag && w.lag == *shared_lag;
+    if (!ranged) continue;
+    // An end set by the velocity range, not by the window's own length.
+    const auto [least, greatest] = awcc_lag_range(w.length, dx, fs, options);
+    const std::int64_t reach = std::min(w.length - 1, options.max_lag_samples);
+    result.windows_at_least_lag += w.lag_samples == least && least > -reach;
+    result.windows_at_greatest_lag += w.lag_samples == greatest && greatest < reach;
+  }
+  bool specific = result.quality == AwccQuality::low && (result.chance_yield || result.one_sample_lag);
+  if (lags_pile_up_at_range_end(result)) {
+    lower_quality(result, fmt::format(
+        "{} of {} accepted windows peak at an end of the lags the velocity range {}-{} m/s lets AWCC search ({} at "
+        "the least lag, the fastest velocity; {} at the greatest): the flow's delays run past it, so those peaks are "
+        "the range's and the mean and Tu are truncated; widen the velocity range (velocity-range) or drop it",
+        result.windows_at_least_lag + result.windows_at_greatest_lag, result.windows_accepted,
+        *options.velocity_min, *options.velocity_max, result.windows_at_least_lag, result.windows_at_greatest_lag),
+                  specific);
+    specific = true;
+  }
+  if (one_lag && shared_lag && *shared_lag > 0.0) {
+    // The true delays lie within half a sample of the common lag: the
+    // velocity is bounded by them, and its spread is not measured.
+    const double lag_samples = *shared_lag * fs;
+    const double lo = dx * fs / (lag_samples + 0.5), hi = lag_samples > 0.5 ? dx * fs / (lag_samples - 0.5) : 0.0;
+    result.turbulence_measured = false;
+    result.velocity_ci95 = {std::min(result.velocity_ci95.lower, lo),
+                            hi > 0.0 ? std::max(result.velocity_ci95.upper, hi) : result.velocity_ci95.upper};
+    lower_quality(result, fmt::format(
+        "every one of the {} accepted windows peaks at the same lag, {:.4g} samples{}: their velocities are all "
+        "dx / lag, so u_rms is 0 by the lag's resolution, not by the flow, and Tu is not measured; the delays lie "
+        "within half a sample of it, so the velocity lies within {:.4g}-{:.4g} m/s (refine the peak, subsample = "
+        "triangle, sample faster, or widen the velocity range)",
+        result.windows_accepted, lag_samples,
+        result.count(WindowFate::roc) > 0
+            ? fmt::format(" (the outlier cutoff rejected the other {}: with half the windows or more at one lag, its "
+                          "spread estimate, 1.4826 times the median absolute deviation, is 0)",
+                          result.count(WindowFate::roc))
+            : std::string(),
+        lo, hi > 0.0 ? hi : std::numeric_limits<double>::infinity()),
+                  specific);
+  }
+}
+
 }  // namespace detail
+
+bool lags_pile_up_at_range_end(const AwccResult& result) {
+  if (!result.ok() || result.windows_accepted <= 0) return false;
+  const auto at_ends = static_cast<double>(result.windows_at_least_lag + result.windows_at_greatest_lag);
+  return at_ends > lag_range_end_share * static_cast<double>(result.windows_accepted);
+}
 
 std::pair<double, double> accepted_moments(std::span<const AwccWindow> windows, Weighting weighting,
                                            double AwccWindow::*velocity) {
@@ -897,6 +967,7 @@ AwccResult run_awcc(const AirIntervals& leading, double dx, const AwccOptions& o
   awcc_summarise(result, options);
   if (!(dx > 0.0) && result.ok()) no_tip_separation(result);
   flag_unresolved_lag(result, dx, fs);
+  judge_lag_range_and_spread(result, dx, fs, options);
   return result;
 }
 

@@ -542,6 +542,9 @@ json fscc_json(const FsccResult& f) {
 json awcc_json(const AwccResult& a) {
   auto value = [&](double v) { return a.ok() ? json(v) : json(nullptr); };
   auto interval = [&](const Interval95& i) { return a.ok() ? ci(i) : json(nullptr); };
+  // The spread and Tu where they are measured (AwccResult::turbulence_measured).
+  auto spread = [&](double v) { return a.turbulence_measured ? value(v) : json(nullptr); };
+  auto spread_interval = [&](const Interval95& i) { return a.turbulence_measured ? interval(i) : json(nullptr); };
   json out{
       {process_key::status, to_string(a.status)},
       {process_key::reason, a.ok() ? json(nullptr) : json(a.message)},
@@ -549,16 +552,19 @@ json awcc_json(const AwccResult& a) {
       {process_key::options, to_json(a.options)},
       {process_key::velocity, value(a.velocity)},
       {process_key::velocity_ci95, interval(a.velocity_ci95)},
-      {"velocity_rms", value(a.velocity_rms)},
-      {"velocity_rms_ci95", interval(a.velocity_rms_ci95)},
-      {process_key::turbulence_intensity, value(a.turbulence_intensity)},
-      {"turbulence_intensity_ci95", interval(a.turbulence_intensity_ci95)},
+      {"velocity_rms", spread(a.velocity_rms)},
+      {"velocity_rms_ci95", spread_interval(a.velocity_rms_ci95)},
+      {process_key::turbulence_intensity, spread(a.turbulence_intensity)},
+      {"turbulence_intensity_ci95", spread_interval(a.turbulence_intensity_ci95)},
+      {process_key::turbulence_measured, a.ok() ? json(a.turbulence_measured) : json(nullptr)},
+      {process_key::windows_at_least_lag, a.windows_at_least_lag},
+      {process_key::windows_at_greatest_lag, a.windows_at_greatest_lag},
       {process_key::windows_total, a.windows_total},
       {"windows_lag_zero", a.lag_zero_windows},
       {"roc_iterations", a.roc_iterations},
       {"windows_negative_lag", a.negative_lag_windows},
       {"quality", to_string(a.quality)},
-      {"quality_reason", a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
+      {process_key::quality_reason, a.quality_reason.empty() ? json(nullptr) : json(a.quality_reason)},
       {process_key::probe_corrected, a.probe_corrected},
       {"velocity_measured", a.probe_corrected ? value(a.velocity_measured) : json(nullptr)},
       {"velocity_rms_measured", a.probe_corrected ? value(a.velocity_rms_measured) : json(nullptr)},
@@ -887,7 +893,7 @@ std::span<const ProfileColumn> profile_csv_columns() {
       {profile_column::fs, "Hz", "/fs", "sampling rate"},
       {profile_column::duration, "s", "/duration", "record duration"},
       {profile_column::awcc_quality, "", "/awcc/quality", "AWCC quality level: ok, low or insufficient"},
-      {"awcc_quality_reason", "", "/awcc/quality_reason", "why the quality is not ok"},
+      {profile_column::awcc_quality_reason, "", "/awcc/quality_reason", "why the quality is not ok"},
       {profile_column::void_fraction_ci95_lower, "-", "/tips/0/void_fraction_ci95/0", "void fraction, 95 % interval, lower"},
       {profile_column::void_fraction_ci95_upper, "-", "/tips/0/void_fraction_ci95/1", "void fraction, 95 % interval, upper"},
       {profile_column::bubble_count_rate_ci95_lower, "1/s", "/tips/0/bubble_count_rate_ci95/0", "bubble count rate, 95 % interval, lower"},
@@ -942,6 +948,12 @@ std::span<const ProfileColumn> profile_csv_columns() {
        "AWCC's weighting gap g = u_unweighted / u_weighted - 1 (near 0 for bubbles arriving in time)"},
       {"awcc_weighting_gap_ci95_lower", "-", "/awcc/weighting_gap/ci95/0", "weighting gap, 95 % interval, lower"},
       {"awcc_weighting_gap_ci95_upper", "-", "/awcc/weighting_gap/ci95/1", "weighting gap, 95 % interval, upper"},
+      {profile_column::awcc_turbulence_measured, "", "/awcc/turbulence_measured",
+       "whether AWCC's Tu is measured (off: every accepted window at one lag, Tu empty)"},
+      {profile_column::awcc_windows_at_least_lag, "-", "/awcc/windows_at_least_lag",
+       "AWCC accepted windows at the least lag of the velocity range"},
+      {profile_column::awcc_windows_at_greatest_lag, "-", "/awcc/windows_at_greatest_lag",
+       "AWCC accepted windows at the greatest lag of the velocity range"},
   };
   return columns;
 }
@@ -970,9 +982,11 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
       csv_number(f ? f->t05 : std::nullopt), csv_number(f ? f->tau05 : std::nullopt),
       csv_number(f ? f->turbulence_intensity_chanson : std::nullopt), csv_number(lead.sauter_diameter),
       csv_cell(f && !f->ok() ? f->message : std::string()));
+  // The spread and Tu where they are measured (AwccResult::turbulence_measured).
+  const bool awcc_spread = awcc_ok && a->turbulence_measured;
   out += fmt::format(",{},{},{},{},{},{}", csv_number(awcc_ok ? std::optional(a->velocity) : std::nullopt),
-                     csv_number(awcc_ok ? std::optional(a->velocity_rms) : std::nullopt),
-                     csv_number(awcc_ok ? std::optional(a->turbulence_intensity) : std::nullopt),
+                     csv_number(awcc_spread ? std::optional(a->velocity_rms) : std::nullopt),
+                     csv_number(awcc_spread ? std::optional(a->turbulence_intensity) : std::nullopt),
                      a ? std::to_string(a->windows_accepted) : std::string(),
                      a ? std::to_string(a->windows_total) : std::string(),
                      csv_cell(a && !a->ok() ? a->message : std::string()));
@@ -995,8 +1009,8 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
                      interval(true, lead.void_fraction_ci95), interval(true, lead.bubble_count_rate_ci95),
                      interval(fscc_interval, fscc_interval ? *f->velocity_ci95 : Interval95{}),
                      interval(awcc_ok, a ? a->velocity_ci95 : Interval95{}),
-                     interval(awcc_ok, a ? a->velocity_rms_ci95 : Interval95{}),
-                     interval(awcc_ok, a ? a->turbulence_intensity_ci95 : Interval95{}), to_string(r.velocity_source()),
+                     interval(awcc_spread, a ? a->velocity_rms_ci95 : Interval95{}),
+                     interval(awcc_spread, a ? a->turbulence_intensity_ci95 : Interval95{}), to_string(r.velocity_source()),
                      version);
   out += "," + csv_cell(joined(warning_texts(r))) + "," + csv_cell(joined(flag_codes(r)));
   const bool corrected = awcc_ok && a->probe_corrected;
@@ -1041,6 +1055,9 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   out += fmt::format(",{},{},{}", csv_number(gap ? std::optional(gap->value) : std::nullopt),
                      csv_number(gap ? std::optional(gap->ci95.lower) : std::nullopt),
                      csv_number(gap ? std::optional(gap->ci95.upper) : std::nullopt));
+  out += fmt::format(",{},{},{}", awcc_ok ? switch_text(a->turbulence_measured) : "",
+                     a ? std::to_string(a->windows_at_least_lag) : std::string(),
+                     a ? std::to_string(a->windows_at_greatest_lag) : std::string());
   return out;
 }
 
@@ -1230,7 +1247,11 @@ std::string ProcessResult::report() const {
   }
   if (awcc) {
     const auto& a = *awcc;
-    if (a.ok()) {
+    if (a.ok() && !a.turbulence_measured) {
+      line(fmt::format("  AWCC: velocity {:.4f} m/s (bounded by the lag's resolution: {:.4f} - {:.4f}), Tu not "
+                       "measured (every window at one lag)",
+                       a.velocity, a.velocity_ci95.lower, a.velocity_ci95.upper));
+    } else if (a.ok()) {
       line(fmt::format("  AWCC: velocity {:.4f} m/s (95 % sampling interval {:.4f} - {:.4f}), u_rms {:.4f} m/s, Tu "
                        "{:.4f} ({:.4f} - {:.4f})",
                        a.velocity, a.velocity_ci95.lower, a.velocity_ci95.upper, a.velocity_rms,

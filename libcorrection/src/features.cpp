@@ -19,6 +19,7 @@ std::string_view to_string(CorrectionStatus status) {
     case CorrectionStatus::too_few_windows: return "too_few_windows";
     case CorrectionStatus::outside_training_range: return "outside_training_range";
     case CorrectionStatus::probe_corrected: return "probe_corrected";
+    case CorrectionStatus::awcc_not_measured: return "awcc_not_measured";
     case CorrectionStatus::untrusted: return "untrusted";
   }
   return "unknown";
@@ -217,6 +218,12 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
     m.velocity = r.awcc->velocity;
     m.turbulence_intensity = r.awcc->turbulence_intensity;
     m.time_scale_ratio = r.awcc->time_scale_ratio;
+    // AWCC's edge and spread rules: the model learnt AWCC's bias where its
+    // lags were measured; a study still records the raw values above.
+    if (!r.awcc->turbulence_measured || awcc::lags_pile_up_at_range_end(*r.awcc)) {
+      out.status = CorrectionStatus::awcc_not_measured;
+      out.message = "AWCC's lags are not measured: " + r.awcc->quality_reason;
+    }
   }
   return out;
 }

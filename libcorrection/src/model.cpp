@@ -492,6 +492,7 @@ bool fscc_may_follow(CorrectionStatus s) {
     case CorrectionStatus::awcc_not_run:
     case CorrectionStatus::no_awcc_velocity:
     case CorrectionStatus::too_few_windows:
+    case CorrectionStatus::awcc_not_measured:
     case CorrectionStatus::outside_training_range: return true;
     default: return false;
   }

@@ -109,6 +109,18 @@ awcc::ProcessResult awcc_outcome_of(const json& r, const std::string& row, const
     res.status = status_of(a, res.status, awcc::parse_awcc_status, row + "/awcc", file);
     if (has(a, key::reason) && a[key::reason].is_string()) res.message = a[key::reason].get<std::string>();
     res.probe_corrected = a.value(key::probe_corrected, false);
+    // The edge and spread rules' counts (absent from a JSON of an earlier pdp: measured).
+    if (has(a, key::turbulence_measured) && a[key::turbulence_measured].is_boolean()) {
+      res.turbulence_measured = a[key::turbulence_measured].get<bool>();
+    }
+    for (auto [k, count] : {std::pair{key::windows_at_least_lag, &res.windows_at_least_lag},
+                            std::pair{key::windows_at_greatest_lag, &res.windows_at_greatest_lag},
+                            std::pair{key::windows_accepted, &res.windows_accepted}}) {
+      if (has(a, k) && a[k].is_number()) *count = a[k].get<std::int64_t>();
+    }
+    if (has(a, key::quality_reason) && a[key::quality_reason].is_string()) {
+      res.quality_reason = a[key::quality_reason].get<std::string>();
+    }
     p.awcc = std::move(res);
   }
   return p;
@@ -392,6 +404,15 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       a.message = text_of(column::awcc_reason);
       const auto probe = text_of(column::awcc_probe_corrected);
       a.probe_corrected = !probe.empty() && awcc::parse_switch(probe, at(column::awcc_probe_corrected));
+      // The edge and spread rules (empty in a CSV of an earlier pdp or another tool's: measured).
+      const auto measured = text_of(column::awcc_turbulence_measured);
+      a.turbulence_measured = measured.empty() || awcc::parse_switch(measured, at(column::awcc_turbulence_measured));
+      for (auto [name, count] : {std::pair{column::awcc_windows_at_least_lag, &a.windows_at_least_lag},
+                                 std::pair{column::awcc_windows_at_greatest_lag, &a.windows_at_greatest_lag},
+                                 std::pair{column::awcc_windows_accepted, &a.windows_accepted}}) {
+        if (const auto v = value(name)) *count = whole(*v, where, std::string(name).c_str());
+      }
+      a.quality_reason = text_of(column::awcc_quality_reason);
       p.awcc = std::move(a);
     }
     const auto outcome = measurement_of(p);

@@ -544,4 +544,138 @@ TEST(Hysteresis, CrossingBothThresholdsTogglesEveryTime) {
   }
 }
 
+
+// ---------------------------------------------------------------------------
+// The edge and spread rules (awcc.hpp, lag_range_end_share and
+// AwccResult::turbulence_measured): accepted windows at an end of the lags a
+// velocity range lets AWCC search are counted, above 5 % of them the result
+// is quality low; windows that all peak at one lag give no Tu.
+
+// An ok result of `accepted` windows (fs 1 kHz, dx 1 m, 1,000 samples each),
+// `at_least` of them at lag 4 and the rest spread over lags 5-19.
+awcc::AwccResult with_windows_at_least_lag(int accepted, int at_least) {
+  awcc::AwccResult r;
+  r.status = awcc::AwccStatus::ok;
+  r.quality = awcc::AwccQuality::ok;
+  r.windows_accepted = accepted;
+  for (int i = 0; i < accepted; ++i) {
+    awcc::AwccWindow w = accepted_at(i < at_least ? 4 : 5 + i % 15, 1.0);
+    w.length = 1000;
+    w.lag = static_cast<double>(w.lag_samples) / 1000.0;
+    r.windows.push_back(w);
+  }
+  return r;
+}
+
+TEST(LagRangeEnd, FivePercentAtAnEndIsFlaggedOneMoreWindowPilesUp) {
+  // Velocity range 50-250 m/s at dx fs = 1000 m/s: lags searched 4-20.
+  awcc::AwccOptions o;
+  o.velocity_min = 50.0;
+  o.velocity_max = 250.0;
+  const auto [least, greatest] = awcc::detail::awcc_lag_range(1000, 1.0, 1000.0, o);
+  ASSERT_EQ(least, 4);
+  ASSERT_EQ(greatest, 20);
+  auto at_limit = with_windows_at_least_lag(100, 5);
+  awcc::detail::judge_lag_range_and_spread(at_limit, 1.0, 1000.0, o);
+  EXPECT_EQ(at_limit.windows_at_least_lag, 5);
+  EXPECT_EQ(at_limit.windows_at_greatest_lag, 0);
+  EXPECT_FALSE(awcc::lags_pile_up_at_range_end(at_limit));
+  EXPECT_EQ(at_limit.quality, awcc::AwccQuality::ok);
+  auto beyond = with_windows_at_least_lag(100, 6);
+  awcc::detail::judge_lag_range_and_spread(beyond, 1.0, 1000.0, o);
+  EXPECT_TRUE(awcc::lags_pile_up_at_range_end(beyond));
+  EXPECT_EQ(beyond.quality, awcc::AwccQuality::low);
+  EXPECT_EQ(beyond.quality_reason.rfind("6 of 100 accepted windows peak at an end of the lags the velocity range "
+                                        "50-250 m/s lets AWCC search (6 at the least lag",
+                                        0),
+            0u)
+      << beyond.quality_reason;
+  EXPECT_NE(beyond.quality_reason.find("(velocity-range)"), std::string::npos);
+  // Without a velocity range the window's own reach bounds the lags: no end is counted.
+  auto unranged = with_windows_at_least_lag(100, 50);
+  awcc::detail::judge_lag_range_and_spread(unranged, 1.0, 1000.0, awcc::AwccOptions{});
+  EXPECT_EQ(unranged.windows_at_least_lag + unranged.windows_at_greatest_lag, 0);
+  EXPECT_EQ(unranged.quality, awcc::AwccQuality::ok);
+}
+
+// A trailing tip delayed by 8, 9, ..., 12 samples in turn (a segment of
+// 20,000 samples each, repeated): windows peak at lags 8-12, u = dx fs / lag.
+awcc::AirIntervals delayed_in_turn(const awcc::AirIntervals& x) {
+  const auto dense = awcc::to_dense(x);
+  std::vector<std::uint8_t> out(dense.size(), 0);
+  for (std::size_t i = 0; i < dense.size(); ++i) {
+    const std::size_t delay = 8 + (i / 20'000) % 5;
+    if (i + delay < dense.size()) out[i + delay] = dense[i];
+  }
+  return awcc::from_dense(out, x.fs);
+}
+
+TEST(LagRangeEnd, PlantedDelaysBeyondTheRangePileUpAtItsEnd) {
+  // dx fs = 1000 m/s: the delays of 8-12 samples are 83-125 m/s. A range of
+  // 50-111 m/s searches lags 9-20: the windows of delays 8 and 9 (2 in 5)
+  // peak at 9 (fewer than half at one lag: the outlier cutoff's spread
+  // stays above 0). A range of 20-500 m/s (lags 2-50) holds every delay.
+  const auto x = pdp_test::telegraph(400'000, 7, 1000.0);
+  const auto y = delayed_in_turn(x);
+  awcc::AwccOptions o;
+  o.velocity_min = 50.0;
+  o.velocity_max = 111.0;
+  const auto clipped = awcc::awcc(x, y, 1.0, o);
+  ASSERT_TRUE(clipped.ok()) << clipped.message;
+  EXPECT_GT(clipped.windows_at_least_lag, clipped.windows_accepted / 4);
+  EXPECT_EQ(clipped.windows_at_greatest_lag, 0);
+  EXPECT_TRUE(awcc::lags_pile_up_at_range_end(clipped));
+  EXPECT_EQ(clipped.quality, awcc::AwccQuality::low);
+  EXPECT_TRUE(clipped.turbulence_measured) << clipped.quality_reason;  // lags 10-12 remain
+  o.velocity_min = 20.0;
+  o.velocity_max = 500.0;
+  const auto held = awcc::awcc(x, y, 1.0, o);
+  ASSERT_TRUE(held.ok()) << held.message;
+  EXPECT_EQ(held.windows_at_least_lag + held.windows_at_greatest_lag, 0);
+  EXPECT_FALSE(awcc::lags_pile_up_at_range_end(held));
+  EXPECT_TRUE(held.turbulence_measured);
+  EXPECT_GT(held.turbulence_intensity, 0.05);
+}
+
+TEST(TuNotMeasured, WindowsAtOneLagGiveNoTuAndAHalfSampleBoundTwoLagsGiveATu) {
+  // Every window at lag 10 (dx fs = 1000 m/s): u = 100 m/s, u_rms 0 by the
+  // lag's resolution; the delays lie in 9.5-10.5 samples, u in 95.2-105.3.
+  const auto x = pdp_test::telegraph(200'000, 43, 1000.0);
+  const auto one = awcc::awcc(x, pdp_test::shifted(x, 10), 1.0, awcc::AwccOptions{});
+  ASSERT_TRUE(one.ok()) << one.message;
+  EXPECT_FALSE(one.turbulence_measured);
+  EXPECT_EQ(one.quality, awcc::AwccQuality::low);
+  EXPECT_NEAR(one.velocity, 100.0, 1e-12);
+  EXPECT_DOUBLE_EQ(one.velocity_ci95.lower, 1000.0 / 10.5);
+  EXPECT_DOUBLE_EQ(one.velocity_ci95.upper, 1000.0 / 9.5);
+  EXPECT_NE(one.quality_reason.find("peaks at the same lag, 10 samples"), std::string::npos) << one.quality_reason;
+  // Five lags (delays of 8-12 samples in turn): a spread, measured.
+  const auto spread = awcc::awcc(x, delayed_in_turn(x), 1.0, awcc::AwccOptions{});
+  ASSERT_TRUE(spread.ok()) << spread.message;
+  EXPECT_TRUE(spread.turbulence_measured);
+  EXPECT_GT(spread.turbulence_intensity, 0.05);
+  // More than half the windows at one lag: the outlier cutoff's spread
+  // estimate (1.4826 MAD) is 0 and it rejects every other lag; the rule
+  // says so (a record delayed by 10 samples for 60 %, then by 11).
+  const auto dense = awcc::to_dense(x);
+  std::vector<std::uint8_t> mostly(dense.size(), 0);
+  for (std::size_t i = 0; i + 11 < dense.size(); ++i) mostly[i + (i < dense.size() * 3 / 5 ? 10 : 11)] = dense[i];
+  const auto collapsed = awcc::awcc(x, awcc::from_dense(mostly, x.fs), 1.0, awcc::AwccOptions{});
+  ASSERT_TRUE(collapsed.ok()) << collapsed.message;
+  EXPECT_FALSE(collapsed.turbulence_measured);
+  EXPECT_GT(collapsed.count(WindowFate::roc), 0);
+  EXPECT_NE(collapsed.quality_reason.find("the outlier cutoff rejected the other"), std::string::npos)
+      << collapsed.quality_reason;
+  // With the peak refined, windows of one whole-sample lag keep their own
+  // sub-sample lags (the rule reads the lags the velocities come from): a
+  // spread is measured, and for a copy delayed by exactly 10 samples it is
+  // small (the correlation's peak is a triangle only near its top).
+  awcc::AwccOptions refined;
+  refined.subsample = awcc::Subsample::triangle;
+  const auto r = awcc::awcc(x, pdp_test::shifted(x, 10), 1.0, refined);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r.turbulence_measured);
+  EXPECT_LT(r.turbulence_intensity, 0.01);
+}
+
 }  // namespace

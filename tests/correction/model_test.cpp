@@ -432,6 +432,22 @@ TEST(Correction, MeasurementOfAProcessedRecording) {
   m = correction::measurement_of(r);
   ASSERT_TRUE(m.measurement.time_scale_ratio);
   EXPECT_EQ(*correction::make_features(m.measurement).features.value("time_scale_ratio"), 3.25);
+  // AWCC's edge and spread rules (awcc.hpp): a Tu not measured, or windows
+  // piled up at an end of the velocity range, are refused with AWCC's
+  // reason; a study still reads the raw values. 16 of 321 at the ends is 5.0 %,
+  // not above the share; 17 is.
+  r.awcc->quality_reason = "every one of the windows peaks at one lag";
+  r.awcc->turbulence_measured = false;
+  m = correction::measurement_of(r);
+  EXPECT_EQ(m.status, correction::CorrectionStatus::awcc_not_measured);
+  EXPECT_NE(m.message.find("every one of the windows"), std::string::npos) << m.message;
+  EXPECT_EQ(m.measurement.velocity, 10.0);
+  r.awcc->turbulence_measured = true;
+  r.awcc->windows_at_least_lag = 10;
+  r.awcc->windows_at_greatest_lag = 6;
+  EXPECT_EQ(correction::measurement_of(r).status, correction::CorrectionStatus::corrected);
+  r.awcc->windows_at_greatest_lag = 7;
+  EXPECT_EQ(correction::measurement_of(r).status, correction::CorrectionStatus::awcc_not_measured);
 }
 
 // The feature contract refuses what has no features, each with its status.

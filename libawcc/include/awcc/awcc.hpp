@@ -191,6 +191,19 @@ inline constexpr double least_resolved_lag_samples = 1.5;
 /// (correction/model.hpp) read it.
 inline constexpr double chance_data_yield = 0.001;
 
+/// The share of accepted windows at an end of the lags a velocity range lets
+/// AWCC search above which they pile up there: the flow's delays run past
+/// that end, so the peaks found there are the range's, not the windows', and
+/// the mean and Tu are truncated (quality low, and the correction refuses
+/// the row). A range that holds the flow's delays leaves an end empty but
+/// for a window whose peak the outlier cutoff did not catch: on the ten
+/// real recordings at 20 kHz with 0.5-20 m/s, 0 of 1,934 accepted windows;
+/// the 0.5-3.5 m/s on dc157_10 put 130 of 320 (41 %) at the least
+/// lag. 5 % is far from both, and a truncation that moves fewer windows
+/// than that moves the mean by less than the lag's resolution. Any window
+/// at an end is still flagged (lag_range_end), with its count.
+inline constexpr double lag_range_end_share = 0.05;
+
 struct AwccResult {
   AwccStatus status = AwccStatus::too_few_particles;
   std::string message;          ///< why not ok (empty when ok)
@@ -219,6 +232,19 @@ struct AwccResult {
   bool one_sample_lag = false;
   /// An ok result's data yield is below chance_data_yield.
   bool chance_yield = false;
+  /// Accepted windows whose peak lag is the least (the fastest velocity) or
+  /// the greatest (the slowest) that the velocity range lets AWCC search
+  /// (options.velocity_min, velocity_max): the window's own peak may lie
+  /// beyond. Both zero without a velocity range. Above lag_range_end_share
+  /// of the accepted windows: quality low (lags_pile_up_at_range_end).
+  std::int64_t windows_at_least_lag = 0, windows_at_greatest_lag = 0;
+  /// Whether Tu is a measurement. False when every accepted window peaks at
+  /// the same lag (whole-sample lags at a slow rate, a range clipped to one
+  /// lag, a trailing tip stuck to the leading one): u_rms is then 0 by the
+  /// lag's quantisation, not by the flow; the outputs give no Tu, the
+  /// velocity's interval is the half-sample bound, quality is low and the
+  /// correction refuses the row.
+  bool turbulence_measured = true;
   int roc_iterations = 0;
   /// How the moments were taken (options.weighting): a correction model
   /// learns the bias of one weighting, or takes it as a feature.
@@ -238,6 +264,10 @@ struct AwccResult {
   std::optional<WeightingGap> weighting_gap;
   std::vector<AwccWindow> windows;
 };
+
+/// Whether an ok result's accepted windows pile up at an end of the
+/// velocity range's lags (lag_range_end_share).
+[[nodiscard]] bool lags_pile_up_at_range_end(const AwccResult& result);
 
 namespace detail {
 struct AwccScratch;

@@ -25,6 +25,8 @@ enum class Flag {
   events_disagree,           ///< event detection's velocity differs from FSCC's (AWCC's) beyond their intervals
   multi_tip_doubtful,        ///< the multi-tip vectors' quality is low (ProbeResult::quality_reason says why)
   arrivals_along_flow,       ///< AWCC's weighting gap says the bubbles arrive spaced along the flow (awcc/weighting_gap.hpp)
+  lag_range_end,             ///< AWCC windows peak at an end of the lags the velocity range lets it search (awcc/awcc.hpp)
+  tu_not_measured,           ///< every accepted AWCC window peaks at one lag: Tu is not a measurement (awcc/awcc.hpp)
 };
 
 struct FlagName {
@@ -35,7 +37,7 @@ struct FlagName {
 
 /// Every flag in the enum's order: to_string, parse_flag and the lists of
 /// codes read this one table.
-inline constexpr std::array<FlagName, 10> flag_names{{
+inline constexpr std::array<FlagName, 12> flag_names{{
     {Flag::reader_note, "reader_note", "the reader accepted the file but notes something about it"},
     {Flag::signal_check, "signal_check",
      "a tip's voltage is not a clean two-level signal of the stated polarity, or its air level is the continuous one"},
@@ -53,12 +55,16 @@ inline constexpr std::array<FlagName, 10> flag_names{{
      "the multi-tip mean vector is doubtful: it disagrees with FSCC of the tip pair, or the solver's caution is raised"},
     {Flag::arrivals_along_flow, "arrivals_along_flow",
      "AWCC's weighting gap lies above what bubbles arriving in time allow: the correction's prior does not hold"},
+    {Flag::lag_range_end, "lag_range_end",
+     "AWCC windows peak at an end of the lags the velocity range lets it search: their peaks may lie beyond it"},
+    {Flag::tu_not_measured, "tu_not_measured",
+     "every accepted AWCC window peaks at one lag: Tu is 0 by the lag's resolution, not measured, and not given"},
 }};
 constexpr bool flag_names_in_enum_order() {
   for (std::size_t i = 0; i < flag_names.size(); ++i) {
     if (static_cast<std::size_t>(flag_names[i].flag) != i) return false;
   }
-  return static_cast<std::size_t>(Flag::arrivals_along_flow) + 1 == flag_names.size();
+  return static_cast<std::size_t>(Flag::tu_not_measured) + 1 == flag_names.size();
 }
 static_assert(flag_names_in_enum_order(), "a flag added to Flag needs its row in flag_names, in the enum's order");
 

@@ -108,6 +108,13 @@ inline constexpr std::string_view velocity = "velocity";
 inline constexpr std::string_view velocity_ci95 = "velocity_ci95";  ///< FSCC's or AWCC's; null when none
 inline constexpr std::string_view r12_max = "r12_max";
 inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
+/// AWCC's: false when every accepted window peaks at one lag (Tu then null);
+/// absent from a JSON of an earlier pdp (measured).
+inline constexpr std::string_view turbulence_measured = "turbulence_measured";
+inline constexpr std::string_view quality_reason = "quality_reason";  ///< AWCC's: why the quality is not ok
+/// AWCC's accepted windows at the least and the greatest lag of the velocity range.
+inline constexpr std::string_view windows_at_least_lag = "windows_at_least_lag";
+inline constexpr std::string_view windows_at_greatest_lag = "windows_at_greatest_lag";
 inline constexpr std::string_view windows_accepted = "windows_accepted";
 inline constexpr std::string_view windows_total = "windows_total";
 inline constexpr std::string_view time_scale_ratio = "time_scale_ratio";  ///< AWCC's, capped (AwccResult)
@@ -187,6 +194,10 @@ inline constexpr std::string_view flags = "flags";        ///< the codes, joined
 inline constexpr std::string_view sizes_status = "sizes_status";
 inline constexpr std::string_view interfacial_area_source = "interfacial_area_source";
 inline constexpr std::string_view awcc_time_scale_ratio = "awcc_time_scale_ratio";
+inline constexpr std::string_view awcc_quality_reason = "awcc_quality_reason";
+inline constexpr std::string_view awcc_turbulence_measured = "awcc_turbulence_measured";
+inline constexpr std::string_view awcc_windows_at_least_lag = "awcc_windows_at_least_lag";
+inline constexpr std::string_view awcc_windows_at_greatest_lag = "awcc_windows_at_greatest_lag";
 }  // namespace profile_column
 
 }  // namespace awcc

@@ -101,6 +101,10 @@ enum class CorrectionStatus {
   outside_training_range,  ///< a feature outside the model's training data
   probe_corrected,         ///< AWCC was bubble-probe corrected: the model corrects uncorrected AWCC
   untrusted,               ///< the forest gave quantiles outside the envelope its inputs allow (model.hpp, trust rules)
+  /// AWCC's windows pile up at an end of the velocity range's lags, or all
+  /// peak at one lag: its mean or Tu is not a measurement (awcc.hpp,
+  /// lags_pile_up_at_range_end, AwccResult::turbulence_measured)
+  awcc_not_measured,
 };
 std::string_view to_string(CorrectionStatus status);
 

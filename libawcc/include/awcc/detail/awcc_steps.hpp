@@ -151,6 +151,11 @@ void awcc_summarise(AwccResult& result, const AwccOptions& options);
 /// Quality `low`, with the bounds, when an ok result's mean lag is below
 /// least_resolved_lag_samples: its velocity is bounded, not measured.
 void flag_unresolved_lag(AwccResult& result, double dx, double fs);
+/// The edge and spread rules (AwccResult::windows_at_least_lag,
+/// turbulence_measured): counts the accepted windows at an end of the
+/// velocity range's lags, and finds whether they all share one lag; either
+/// lowers the quality with the reason.
+void judge_lag_range_and_spread(AwccResult& result, double dx, double fs, const AwccOptions& options);
 
 /// The bubble-probe correction of every accepted window (when the options
 /// ask for it): velocity becomes u0, measured_velocity keeps dx / lag; a
