@@ -123,10 +123,22 @@ void judge_probe(ProbeResult& probe, const ProcessResult& out, const EventOption
   order(out.fscc, 1, out.dx);
   for (const auto& pair : probe.pairs) order(pair.fscc, pair.tip, pair.dx);
   if (!v.caution.empty()) why.push_back(v.caution);
+  // Two of the probe's tips holding one signal twice: no vector rests on them.
+  for (const auto& c : out.channel_copies) {
+    const auto in_probe = [&](int channel) {
+      return std::find(probe.channels.begin(), probe.channels.end(), channel) != probe.channels.end();
+    };
+    if (in_probe(c.first) && in_probe(c.second)) {
+      why.push_back(fmt::format("channels {} and {} hold {} signal (flag channels_copied): the vectors solved with "
+                                "both are not a probe's",
+                                c.first, c.second, c.identical ? "the same" : "nearly the same"));
+    }
+  }
   if (v.turbulence_intensity[0] > multi_tip_tu_truncated) {
     why.push_back(fmt::format("Tu_x = {:.2f}: the pairing accepts speeds {:g}-{:g} times FSCC's and directions within "
-                              "{:g} degrees of x, which cut the tails of a flow this turbulent: u_x is biased high "
-                              "(4-11 % at a true Tu_x of 0.3) and Tu_x low (16-26 %)",
+                              "{:g} degrees of x, which cut the tails of a flow this turbulent: u_x and Tu_x are "
+                              "biased (on the synthetic validation at a true Tu_x of 0.3, u_x 4-11 % high and Tu_x "
+                              "16-26 % low; a real flow's u_x may be biased either way)",
                               v.turbulence_intensity[0], pairing.probe_speed_min, pairing.probe_speed_max,
                               pairing.probe_angle_max));
   }
@@ -285,6 +297,21 @@ std::optional<Warning> tu_not_measured(const ProcessResult& r) {
                              a.windows_accepted, a.velocity_ci95.lower, a.velocity_ci95.upper)};
 }
 
+// Two tips holding one signal twice (process.hpp, copied_channel_correlation).
+std::vector<Warning> channels_copied(const ProcessResult& r) {
+  std::vector<Warning> out;
+  for (const auto& c : r.channel_copies) {
+    out.push_back({Flag::channels_copied,
+                   fmt::format("channel {} ({}) {} channel {} ({}) (r = {:.6f} at lag 0, above {:g}): one channel "
+                               "copied or cross-talk, not two tips; the delay between them, the velocities and "
+                               "vectors that rest on both are not measurements (check the acquisition's channels)",
+                               c.second, c.second_tip,
+                               c.identical ? "holds the same signal as" : "holds nearly the same signal as", c.first,
+                               c.first_tip, c.correlation, copied_channel_correlation)});
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<Warning> assess(const ProcessResult& r) {
@@ -308,6 +335,7 @@ std::vector<Warning> assess(const ProcessResult& r) {
   if (auto w = arrivals_along_flow(r)) out.push_back(std::move(*w));
   if (auto w = lag_range_end(r)) out.push_back(std::move(*w));
   if (auto w = tu_not_measured(r)) out.push_back(std::move(*w));
+  for (auto& w : channels_copied(r)) out.push_back(std::move(w));
   return out;
 }
 

@@ -234,6 +234,15 @@ void summarise_events(EventResult& result, const EventOptions& options) {
       detail::reported_quality(result.bubbles_paired, result.bubbles_complete, options.bubbles_ok,
                                options.pairing_yield_ok, intervals,
                                {"paired bubbles", "pairing yield", "complete leading bubbles paired", "the paired bubbles"});
+  // The spread rule: bubbles that all share one centre lag have no measured spread.
+  if (std::all_of(values.begin(), values.end(), [&](double v) { return v == values.front(); })) {
+    result.turbulence_measured = false;
+    result.quality = AwccQuality::low;
+    result.quality_reason = fmt::format(
+        "every one of the {} paired bubbles has the same centre lag (u = {:.4g} m/s): u_rms is 0 by the interface "
+        "times' resolution, not by the flow, so Tu is not measured (sample faster)",
+        result.bubbles_paired, mean);
+  }
 }
 
 }  // namespace

@@ -470,7 +470,34 @@ void check_tips(BinarisedRecording& out, const ProcessOptions& options, std::opt
     }
     if (tip.check.status == SignalStatus::inverted_polarity) quantity = "probe,allow-bad-signal";
   }
-  if (!first) return;
+  // Two tips holding one signal twice (copied_channel_correlation): r of
+  // binary signals at lag 0 from their air and shared air samples.
+  std::vector<const AirIntervals*> signals{&out.leading, &out.trailing};
+  for (const auto& tip : out.further_tips) signals.push_back(&tip.signal);
+  out.copies.clear();
+  bool copy_refused = false;
+  for (std::size_t i = 0; options.signal_check.find_copies && i < signals.size(); ++i) {
+    for (std::size_t j = i + 1; j < signals.size(); ++j) {
+      const AirIntervals& a = *signals[i];
+      const AirIntervals& b = *signals[j];
+      const auto n = static_cast<double>(a.sample_count);
+      const auto na = static_cast<double>(a.air_samples()), nb = static_cast<double>(b.air_samples());
+      const double spread = na * (n - na) * nb * (n - nb);
+      if (a.sample_count != b.sample_count || !(spread > 0.0)) continue;
+      const double r = (n * static_cast<double>(shared_air_samples(a, b)) - na * nb) / std::sqrt(spread);
+      if (r < copied_channel_correlation) continue;
+      out.copies.push_back({tips[i].channel, tips[j].channel, tips[i].name, tips[j].name, r,
+                            a.intervals == b.intervals});
+      const auto& copy = out.copies.back();
+      if (!copy.identical || allowed) continue;
+      refusal += fmt::format("{}channel {} ({}) holds the same signal as channel {} ({}): one channel copied (a "
+                             "wiring or channel-map slip) gives no delay between them and no velocity vector; check "
+                             "the acquisition's channels",
+                             refusal.empty() ? "" : "; ", copy.second, copy.second_tip, copy.first, copy.first_tip);
+      copy_refused = true;
+    }
+  }
+  if (!first && !copy_refused) return;
   const std::string what = out.info.path.empty() ? out.info.description : out.info.path.string();
   throw InputError(fmt::format("{}: {}; to process it anyway, with the failure in every output, allow a bad signal",
                                what, refusal),
@@ -871,6 +898,7 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
 // the sizes, the structure, the velocity series and the row's warnings. A
 // new step goes here, once.
 void finish(ProcessResult& out, const BinarisedRecording& r, const ProcessOptions& options) {
+  out.channel_copies = r.copies;  // before the probe's judgement reads them
   apply_tip_order(out);
   out.tips = tip_results(r, options, out.velocity());
   add_bubble_methods(out, r, options);

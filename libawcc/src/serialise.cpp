@@ -594,6 +594,8 @@ json vec(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
 json events_json(const EventResult& e) {
   auto value = [&](double v) { return e.ok() ? json(v) : json(nullptr); };
   auto interval = [&](const Interval95& i) { return e.ok() ? ci(i) : json(nullptr); };
+  auto spread = [&](double v) { return e.turbulence_measured ? value(v) : json(nullptr); };
+  auto spread_interval = [&](const Interval95& i) { return e.turbulence_measured ? interval(i) : json(nullptr); };
   json out{
       {process_key::status, to_string(e.status)},
       {process_key::reason, e.ok() ? json(nullptr) : json(e.message)},
@@ -603,10 +605,11 @@ json events_json(const EventResult& e) {
       {"first_velocity", optional(e.first_velocity)},
       {process_key::velocity, value(e.velocity)},
       {"velocity_ci95", interval(e.velocity_ci95)},
-      {"velocity_rms", value(e.velocity_rms)},
-      {"velocity_rms_ci95", interval(e.velocity_rms_ci95)},
-      {process_key::turbulence_intensity, value(e.turbulence_intensity)},
-      {"turbulence_intensity_ci95", interval(e.turbulence_intensity_ci95)},
+      {"velocity_rms", spread(e.velocity_rms)},
+      {"velocity_rms_ci95", spread_interval(e.velocity_rms_ci95)},
+      {process_key::turbulence_intensity, spread(e.turbulence_intensity)},
+      {"turbulence_intensity_ci95", spread_interval(e.turbulence_intensity_ci95)},
+      {process_key::turbulence_measured, e.ok() ? json(e.turbulence_measured) : json(nullptr)},
       {"bubbles_total", e.bubbles_total},
       {"bubbles_complete", e.bubbles_complete},
       {"bubbles_paired", e.bubbles_paired},
@@ -1026,7 +1029,8 @@ std::string profile_csv_row(const ProcessResult& r, const std::optional<double>&
   auto if_events = [&](double v) { return csv_number(events_ok ? std::optional(v) : std::nullopt); };
   out += fmt::format(",{},{},{},{},{},{}", if_events(e ? e->velocity : 0.0),
                      if_events(e ? e->velocity_ci95.lower : 0.0), if_events(e ? e->velocity_ci95.upper : 0.0),
-                     if_events(e ? e->turbulence_intensity : 0.0), e ? to_string(e->quality) : "",
+                     csv_number(events_ok && e->turbulence_measured ? std::optional(e->turbulence_intensity) : std::nullopt),
+                     e ? to_string(e->quality) : "",
                      e ? std::to_string(e->bubbles_paired) : std::string());
   if (r.probe) {
     const auto& v = r.probe->vectors;
@@ -1283,7 +1287,11 @@ std::string ProcessResult::report() const {
   }
   if (events) {
     const auto& e = *events;
-    if (e.ok()) {
+    if (e.ok() && !e.turbulence_measured) {
+      line(fmt::format("  events ({} pairing): velocity {:.4f} m/s, Tu not measured (every bubble at one lag); d32 "
+                       "{:.3f} mm from each bubble's own velocity",
+                       to_string(e.options.pairing), e.velocity, e.sauter_diameter * 1e3));
+    } else if (e.ok()) {
       line(fmt::format("  events ({} pairing): velocity {:.4f} m/s (95 % sampling interval {:.4f} - {:.4f}), u_rms "
                        "{:.4f} m/s, Tu {:.4f} ({:.4f} - {:.4f}); d32 {:.3f} mm from each bubble's own velocity",
                        to_string(e.options.pairing), e.velocity, e.velocity_ci95.lower, e.velocity_ci95.upper,

@@ -11,6 +11,17 @@ std::int64_t AirIntervals::air_samples() const {
   return total;
 }
 
+std::int64_t shared_air_samples(const AirIntervals& a, const AirIntervals& b) {
+  std::int64_t shared = 0;
+  auto i = a.intervals.begin(), j = b.intervals.begin();
+  while (i != a.intervals.end() && j != b.intervals.end()) {
+    shared += std::max<std::int64_t>(0, std::min(i->stop, j->stop) - std::max(i->start, j->start));
+    if (i->stop < j->stop) ++i;
+    else ++j;
+  }
+  return shared;
+}
+
 double AirIntervals::void_fraction() const {
   if (sample_count <= 0) return 0.0;
   return static_cast<double>(air_samples()) / static_cast<double>(sample_count);

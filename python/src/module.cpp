@@ -370,9 +370,16 @@ py::tuple read_recording(const std::filesystem::path& path, const Settings& sett
   return py::make_tuple(data, info.fs, meta);
 }
 
+// One array passed twice (the module pairs a tip with itself to binarise
+// one tip): no copied channel to look for (SignalCheckOptions::find_copies).
+bool one_array_twice(const std::vector<py::array>& channels) {
+  return channels.size() == 2 && channels[0].ptr() == channels[1].ptr();
+}
+
 py::dict binarise(const std::vector<py::array>& channels, double fs, std::optional<double> volts_per_count,
                   const Settings& settings) {
-  const auto o = awcc::process_options(option_settings(settings));
+  auto o = awcc::process_options(option_settings(settings));
+  o.signal_check.find_copies = !one_array_twice(channels);
   auto recording = recording_of(channels, fs, volts_per_count);
   awcc::BinarisedRecording b;
   {
@@ -391,7 +398,8 @@ py::dict binarise(const std::vector<py::array>& channels, double fs, std::option
 
 py::tuple process_arrays(const std::vector<py::array>& channels, double fs, std::optional<double> volts_per_count,
                          const Settings& settings, const std::string& preset) {
-  const auto o = awcc::process_options(option_settings(settings, preset));
+  auto o = awcc::process_options(option_settings(settings, preset));
+  o.signal_check.find_copies = !one_array_twice(channels);
   auto recording = recording_of(channels, fs, volts_per_count);
   awcc::ProcessResult r;
   {

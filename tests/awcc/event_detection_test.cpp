@@ -6,6 +6,7 @@
 #include "awcc/event_detection.hpp"
 
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +16,7 @@
 
 #include "awcc/awcc.hpp"
 #include "awcc/options.hpp"
+#include "awcc/process.hpp"
 #include "awcc/serialise.hpp"
 #include "clean_scene.hpp"
 #include "synth/synthesiser.hpp"
@@ -97,6 +99,43 @@ TEST(EventDetection, RecoversPlantedSampleLagsFromBinarySignals) {
     EXPECT_NEAR(r.bubbles[h].centre_lag, planted[h], 1e-12) << h;
     EXPECT_NEAR(r.bubbles[h].velocity / (dx / planted[h]), 1.0, 1e-9) << h;
   }
+}
+
+// The spread rule: bubbles that all share one centre lag (a copy delayed by
+// 30 whole samples) give no Tu, quality low; lags of 29, 30 and 31 samples
+// in turn give a spread, measured.
+TEST(EventDetection, BubblesAllAtOneLagGiveNoTuOneOtherLagGivesOne) {
+  const double fs = 20e3, dx = 7.15e-3;
+  awcc::AirIntervals a, b;
+  a.fs = b.fs = fs;
+  a.sample_count = b.sample_count = 200000;
+  for (std::int64_t i = 0; i < 300; ++i) {
+    const std::int64_t start = 100 + 600 * i, length = 20 + i % 7;
+    a.intervals.push_back({start, start + length});
+    b.intervals.push_back({start + 30, start + 30 + length});
+  }
+  const auto one = awcc::event_detection(a, b, dx);
+  ASSERT_TRUE(one.ok()) << one.message;
+  EXPECT_FALSE(one.turbulence_measured);
+  EXPECT_EQ(one.quality, awcc::AwccQuality::low);
+  EXPECT_NE(one.quality_reason.find(fmt::format("every one of the {} paired bubbles has the same centre lag",
+                                                one.bubbles_paired)),
+            std::string::npos)
+      << one.quality_reason;
+  awcc::ProcessResult processed;
+  processed.tips.resize(2);
+  processed.events = one;
+  const auto j = awcc::to_json(processed)["events"];
+  EXPECT_TRUE(j["turbulence_intensity"].is_null()) << j;
+  EXPECT_FALSE(j["turbulence_measured"].get<bool>());
+  for (std::size_t i = 0; i < b.intervals.size(); ++i) {
+    const std::int64_t shift = static_cast<std::int64_t>(i % 3) - 1;
+    b.intervals[i] = {b.intervals[i].start + shift, b.intervals[i].stop + shift};
+  }
+  const auto two = awcc::event_detection(a, b, dx);
+  ASSERT_TRUE(two.ok());
+  EXPECT_TRUE(two.turbulence_measured);
+  EXPECT_GT(two.turbulence_intensity, 0.0);
 }
 
 // ---- moments against the planted distribution ----------------------------

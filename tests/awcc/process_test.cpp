@@ -589,4 +589,72 @@ TEST(ProcessInput, BinarySignalsInMemoryAreTheRecordingOfTheirFile) {
   EXPECT_TRUE(allowed.further_tips[1].check.overridden);
 }
 
+
+// A channel copied in the acquisition (issue 53): two tips holding the same
+// signal are refused naming both channels, for a tip pair and for a
+// further tip of a probe; allowed, the row is flagged channels_copied. A
+// near copy (a few samples differ, r above copied_channel_correlation) is
+// flagged, not refused; tips a sample apart are neither.
+TEST(ProcessInput, ACopiedChannelIsRefusedNamingBothTips) {
+  const auto path = pdp_test::temp_dir() / "copied.dat";
+  auto level = [](int i, int tip) {
+    const int shift = tip == 3 ? 1 : tip;  // tip 3 copies tip 1
+    return ((i + 13 * shift) / (29 + shift)) % 4 == 0;
+  };
+  std::vector<std::int16_t> data;
+  for (int i = 0; i < 40000; ++i) {
+    for (int tip = 0; tip < 4; ++tip) data.push_back(static_cast<std::int16_t>(level(i, tip) ? 2000 : 27000));
+  }
+  write_dat(path, data, 4);
+  awcc::ProcessOptions o;
+  o.reader.fs = 20000;
+  o.dx = 5e-3;
+  o.further_channels = {2, 3};
+  const std::string refused = process_error(path, o);
+  EXPECT_NE(refused.find("channel 3 (tip 3) holds the same signal as channel 1 (trailing tip)"), std::string::npos)
+      << refused;
+  EXPECT_NE(refused.find("allow a bad signal"), std::string::npos) << refused;
+  // The pair alone: trailing tip 3 copies the leading... here tip 1 and 3 as the pair.
+  o.further_channels.clear();
+  o.leading_channel = 1;
+  o.trailing_channel = 3;
+  EXPECT_NE(process_error(path, o).find("channel 3 (trailing tip) holds the same signal as channel 1 (leading tip)"),
+            std::string::npos)
+      << process_error(path, o);
+  // Allowed: processed, flagged in every output's list.
+  o.signal_check.allow_bad_signal = true;
+  const auto r = awcc::process_recording(path, o);
+  ASSERT_EQ(r.channel_copies.size(), 1u);
+  EXPECT_TRUE(r.channel_copies[0].identical);
+  EXPECT_DOUBLE_EQ(r.channel_copies[0].correlation, 1.0);
+  EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(),
+                          [](const awcc::Warning& w) { return w.flag == awcc::Flag::channels_copied; }));
+  // Distinct tips (channels 0 and 1: other bubbles) are not a copy.
+  o.leading_channel = 0;
+  o.trailing_channel = 1;
+  o.signal_check.allow_bad_signal = false;
+  EXPECT_TRUE(awcc::process_recording(path, o).channel_copies.empty());
+}
+
+TEST(ProcessInput, ANearCopyIsFlaggedAndTipsASampleApartAreNot) {
+  // A signal of chords of 2,000 samples, half air: its copy with one chord
+  // a sample longer (r = 0.99998) is a near copy; the same signal two
+  // samples later differs by 4 samples a chord pair, r = 1 - 4 / 2000 =
+  // 0.998: two tips.
+  const auto x = pdp_test::square_wave(400'000, 2000, 2000, 20e3);
+  auto near = x;
+  near.intervals[10].stop += 1;
+  for (const auto& [trailing, copied] : {std::pair{near, true}, std::pair{pdp_test::shifted(x, 2), false}}) {
+    awcc::ProcessOptions o;
+    o.dx = 5e-3;
+    o.signal_check.allow_bad_signal = false;
+    const auto rec = awcc::binary_recording({x, trailing}, o);
+    EXPECT_EQ(rec.copies.size(), copied ? 1u : 0u);
+    if (copied) {
+      EXPECT_FALSE(rec.copies[0].identical);
+      EXPECT_GT(rec.copies[0].correlation, awcc::copied_channel_correlation);
+    }
+  }
+}
+
 }  // namespace

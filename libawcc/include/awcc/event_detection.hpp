@@ -255,6 +255,11 @@ struct EventResult {
   double velocity_rms = 0.0;   ///< m/s
   double turbulence_intensity = 0.0;
   Interval95 velocity_ci95, velocity_rms_ci95, turbulence_intensity_ci95;
+  /// Whether Tu is a measurement: false when every paired bubble has the
+  /// same centre lag (interface times at whole samples of a slow rate):
+  /// u_rms is then 0 by the lag's resolution; the outputs give no Tu and
+  /// quality is low (AWCC's spread rule, awcc/awcc.hpp).
+  bool turbulence_measured = true;
   std::int64_t bubbles_total = 0;     ///< leading bubbles (crossings), censored included
   std::int64_t bubbles_complete = 0;  ///< leading bubbles not censored: the yield's denominator
   std::int64_t bubbles_paired = 0;    ///< count(BubbleFate::paired), the N of the moments

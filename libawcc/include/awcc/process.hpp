@@ -150,6 +150,25 @@ struct TipResult {
   SignalCheck signal;                 ///< the signal check of its voltage
 };
 
+/// Pearson's r of two tips' binary signals at lag 0 above which they are one
+/// signal twice (a channel copied in the acquisition, or cross-talk), not
+/// two tips. Two tips a whole sample or more apart differ at each bubble's
+/// front and rear, so 1 - r is about twice the lag over the mean chord in
+/// samples: 0.05 for a lag of one sample and chords of 20 (1 mm bubbles at
+/// 1 m/s and 20 kHz), and 0.999 needs chords of some 2,000 samples per
+/// sample of lag, where AWCC and FSCC cannot resolve the delay anyway. The
+/// exact copy (the same air intervals) is refused unless a bad signal is
+/// allowed; a near copy is flagged (channels_copied).
+inline constexpr double copied_channel_correlation = 0.999;
+
+/// Two tips whose binary signals are one signal twice (copied_channel_correlation).
+struct ChannelCopy {
+  int first = 0, second = 0;   ///< their channels
+  std::string first_tip, second_tip;  ///< "leading tip", "trailing tip", "tip 3"
+  double correlation = 0.0;    ///< Pearson's r of the binary signals at lag 0
+  bool identical = false;      ///< the same air intervals
+};
+
 /// A further tip of a probe of more than two tips, binarised like the trailing tip.
 struct BinarisedTip {
   int channel = 0;
@@ -170,6 +189,9 @@ struct BinarisedRecording {
   /// The signal check of each tip's histogram (unchecked without one).
   SignalCheck leading_signal, trailing_signal;
   std::vector<BinarisedTip> further_tips;   ///< tips 2, 3, ... in the order of further_channels
+  /// Pairs of tips that hold one signal twice (processed only when a bad
+  /// signal is allowed, or when nearly but not exactly the same).
+  std::vector<ChannelCopy> copies;
   /// Every binarised tip's position, m, in the same order (leading,
   /// trailing, further tips), where the probe's tips are declared or stated
   /// by the recording; else empty.
@@ -228,6 +250,8 @@ struct ProcessResult {
   std::optional<SizesResult> sizes;
   /// Dual-tip 4 F / u and the multi-tip estimate where there is one.
   InterfacialArea interfacial_area;
+  /// Pairs of tips that hold one signal twice (BinarisedRecording::copies).
+  std::vector<ChannelCopy> channel_copies;
   /// Every warning of the recording with its flag, in one list (awcc/assess.hpp
   /// assembles it; every output writes it).
   std::vector<Warning> warnings;

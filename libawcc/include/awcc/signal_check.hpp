@@ -96,6 +96,11 @@ struct SignalCheckOptions {
   double min_separation_counts = 16.0;   ///< 4: least separation of the levels, in histogram resolutions
   double min_minor_share = 1e-4;         ///< 4: least share of samples on the far side of the midpoint, -
   double zero_level_ratio = 2.0;         ///< 5b: how much farther from 0 V the signal level must lie, -
+  /// Look for two tips holding one signal twice (awcc/process.hpp,
+  /// copied_channel_correlation). Not a user's option: off only where the
+  /// caller pairs a tip with itself on purpose (the Python module's
+  /// one-tip binarise and phase statistics, which pass one array twice).
+  bool find_copies = true;
 
   [[nodiscard]] Validation validate() const;
 };

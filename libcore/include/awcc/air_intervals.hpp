@@ -37,6 +37,10 @@ struct AirIntervals {
 /// a union of per-bubble intervals becomes a valid AirIntervals list.
 void normalise(std::vector<AirInterval>& intervals);
 
+/// The samples where both signals are air (their intervals' intersection),
+/// in one merge of the two lists.
+[[nodiscard]] std::int64_t shared_air_samples(const AirIntervals& a, const AirIntervals& b);
+
 /// Renders one record as a dense 0/1 vector (tests and small records only).
 std::vector<std::uint8_t> to_dense(const AirIntervals& signal);
 
