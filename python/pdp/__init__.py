@@ -389,6 +389,11 @@ def _settings(kwargs):
     return out
 
 
+# The most tips of a probe a 2-D array is read as (samples x channels): a
+# wider array with at most this many rows is refused as transposed.
+_MOST_TIPS = 16
+
+
 def _channels(lead, trail):
     """The signals as 1-D arrays: a Recording, a 2-D array (samples x
     channels), or one array per tip."""
@@ -397,6 +402,14 @@ def _channels(lead, trail):
     a = _np.asarray(lead)
     if trail is None:
         if a.ndim == 2:
+            # Samples x channels; a probe has a few tips and a record many
+            # samples, so a wide array is a transposed one.
+            if a.shape[1] > a.shape[0] and a.shape[0] <= _MOST_TIPS:
+                err = OptionError(f"an array of shape {a.shape}: pdp takes samples x channels, so this would be "
+                                  f"{a.shape[1]} channels of {a.shape[0]} samples; give its transpose "
+                                  f"(array.T, shape {a.shape[::-1]})")
+                err.quantity = "channels"
+                raise err
             return [a[:, k] for k in range(a.shape[1])], None
         return [a], None
     return [a, _np.asarray(trail)], None

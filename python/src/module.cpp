@@ -152,6 +152,20 @@ std::unique_ptr<awcc::Recording> recording_of(const std::vector<py::array>& chan
     throw awcc::OptionError(fmt::format("volts_per_count = {}: give a positive scale", *volts_per_count),
                             "volts-per-count");
   }
+  // Integer samples are a digitiser's counts: without their scale a threshold
+  // in counts would be printed as volts and the signal check's levels would
+  // be meaningless. Only a 0/1 (or boolean) phase signal needs none.
+  for (std::size_t k = 0; k < channels.size() && !volts_per_count; ++k) {
+    if (kinds[k] == SampleKind::volts || channels[k].dtype().kind() == 'b' || channels[k].size() == 0) continue;
+    const auto lo = channels[k].attr("min")().cast<double>(), hi = channels[k].attr("max")().cast<double>();
+    if (lo >= 0.0 && hi <= 1.0) continue;
+    throw awcc::OptionError(
+        fmt::format("channel {} holds integer samples ({}, {} to {}): integers are a digitiser's counts, whose volts "
+                    "pdp cannot guess; give volts_per_count=... (V per count, the digitiser's range over its "
+                    "counts), or float samples in volts",
+                    k, py::str(channels[k].dtype()).cast<std::string>(), lo, hi),
+        "volts-per-count");
+  }
   const auto n = static_cast<std::size_t>(channels[0].shape(0));
   const auto c = channels.size();
   const bool all16 = std::all_of(kinds.begin(), kinds.end(), [](SampleKind k) { return k == SampleKind::counts16; });

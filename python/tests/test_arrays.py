@@ -73,10 +73,25 @@ def test_counts_with_a_scale_are_volts():
     counts = (volts(lead) / 5 * 32768).astype(np.int16), (volts(trail) / 5 * 32768).astype(np.int16)
     r = pdp.process(*counts, fs=FS, dx=DX, volts_per_count=5 / 32768, threshold_rule="fixed", threshold="2.5V")
     assert r.tips[0].threshold == 2.5
-    without = pdp.process(*counts, fs=FS, dx=DX)
-    assert [t.void_fraction for t in r.tips] == [t.void_fraction for t in without.tips]
-    with pytest.raises(pdp.InputError, match="volts"):  # a fixed threshold needs volts
-        pdp.process(*counts, fs=FS, dx=DX, threshold_rule="fixed", threshold="2.5V")
+    # Without the scale integer counts are refused, naming the keyword (they
+    # were taken at 1 V a count: a threshold of 16901 "V"; issue 53).
+    for dtype in (np.int16, np.int32, np.int64):
+        with pytest.raises(pdp.OptionError, match="volts_per_count") as e:
+            pdp.process(*(c.astype(dtype) for c in counts), fs=FS, dx=DX)
+        assert "integer samples" in str(e.value)
+        assert e.value.quantity == "volts-per-count"
+    by_scale = pdp.process(*counts, fs=FS, dx=DX, volts_per_count=5 / 32768)
+    assert [t.void_fraction for t in r.tips] == [t.void_fraction for t in by_scale.tips]
+
+
+def test_a_transposed_array_is_refused_naming_its_shape():
+    lead, trail = planted()
+    wide = np.stack([volts(lead), volts(trail)])  # 2 x N: channels x samples
+    with pytest.raises(pdp.OptionError, match=r"shape \(2, %d\).*array\.T" % len(lead)) as e:
+        pdp.process(wide, fs=FS, dx=DX)
+    assert e.value.quantity == "channels"
+    assert pdp.process(wide.T, fs=FS, dx=DX).awcc.velocity == pdp.process(volts(lead), volts(trail), fs=FS,
+                                                                           dx=DX).awcc.velocity
 
 
 def test_binarise_gives_intervals_or_the_binary_signal():
