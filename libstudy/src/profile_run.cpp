@@ -46,6 +46,25 @@ std::vector<std::optional<double>> positions_of_list(std::span<const std::string
   return out;
 }
 
+std::vector<std::string> files_of_manifest(const std::filesystem::path& manifest) {
+  std::ifstream in(manifest);
+  if (!in) throw std::invalid_argument(fmt::format("{}: cannot read the manifest", manifest.string()));
+  std::vector<std::string> out;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto cells = awcc::split_cells(line);
+    if (cells.size() < 2 || cells[0].empty() || (number == 1 && cells[0] == "file")) continue;
+    const std::filesystem::path file(cells[0]);
+    out.push_back((file.is_absolute() ? file : manifest.parent_path() / file).string());
+  }
+  if (out.empty()) {
+    throw std::invalid_argument(fmt::format("{}: the manifest names no recording (rows file,position)",
+                                            manifest.string()));
+  }
+  return out;
+}
+
 std::vector<std::optional<double>> positions_of_manifest(const std::filesystem::path& manifest,
                                                          std::span<const std::string> files) {
   const std::string where = manifest.string();

@@ -56,6 +56,14 @@ printf 'file,position\nrec.flac,14mm\nrec2.flac,20mm\n' >"$dir/manifest.csv"
 "$pdp" process "$dir/rec.flac" "$dir/rec2.flac" --dx 5mm --manifest "$dir/manifest.csv" --csv "$dir/profile.csv" ||
   fail "manifest"
 grep -q "^rec.flac,0.014," "$dir/profile.csv" || fail "manifest position not applied"
+# The manifest alone names the recordings (relative to its folder; issue 53:
+# it failed with "files is required"); the same rows as with the files given.
+(cd / && "$pdp" --log-level error process --dx 5mm --manifest "$dir/manifest.csv" --csv "$dir/profile-alone.csv") ||
+  fail "the manifest alone"
+cmp -s <(cut -d, -f1-4 "$dir/profile.csv") <(cut -d, -f1-4 "$dir/profile-alone.csv") ||
+  fail "the manifest alone gives other rows"
+"$pdp" process --dx 5mm 2>"$dir/none.err" && fail "no recording and no manifest accepted"
+grep -q "files is required: give the recordings, or --manifest FILE" "$dir/none.err" || fail "$(cat "$dir/none.err")"
 
 # Real recordings, when they are beside the repository.
 if [[ -d $data ]]; then

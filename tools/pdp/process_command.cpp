@@ -7,6 +7,7 @@
 #include "awcc/atomic_output.hpp"
 #include "awcc/options.hpp"
 #include "process_steps.hpp"
+#include "study/profile_run.hpp"
 
 namespace pdp {
 
@@ -15,12 +16,11 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   auto* cmd = app.add_subcommand("process", "Process recordings: binarisation, phase statistics, FSCC and AWCC");
   command.app = cmd;
   add_config_option(command);
-  command.required.push_back(
-      path_option(
-          cmd->add_option("files", o.files,
-                          "recordings (one: a summary; several: a profile, one CSV row each; among several, files that "
-                          "are not recordings are skipped with a warning)"))
-          ->check(CLI::ExistingPath));
+  // Not required: a manifest's rows may name the recordings (run_process).
+  path_option(cmd->add_option("files", o.files,
+                              "recordings (one: a summary; several: a profile, one CSV row each; among several, files "
+                              "that are not recordings are skipped with a warning); with --manifest alone, its rows'"))
+      ->check(CLI::ExistingPath);
   const awcc::ProcessOptions defaults;
   o.library.add(cmd, awcc::process_option_fields(), defaults, "Probe and methods");
   auto& probe = command.option_tables.emplace_back("probe", std::vector<std::string>{});
@@ -75,6 +75,11 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
 int run_process(ProcessCommandOptions& o) {
   Plan plan;
   try {
+    if (o.files.empty() && o.manifest.empty()) {
+      throw std::invalid_argument("files is required: give the recordings, or --manifest FILE whose rows name them "
+                                  "with their positions; see pdp process --help");
+    }
+    if (o.files.empty()) o.files = study::files_of_manifest(o.manifest);
     plan = plan_of(o);
   } catch (const std::exception& e) {
     return report_error(e);

@@ -43,6 +43,11 @@ namespace study {
 std::vector<std::optional<double>> positions_of_list(std::span<const std::string> lengths,
                                                      std::span<const std::string> files, const std::string& source);
 
+/// The recordings a manifest CSV names, in its rows' order, each relative to
+/// the manifest's folder (as pdp synth writes it beside them). Throws
+/// std::invalid_argument naming the manifest when it names none.
+std::vector<std::string> files_of_manifest(const std::filesystem::path& manifest);
+
 /// The positions of `files` from a manifest CSV (matched by file name; a file
 /// without a row has none). Throws std::invalid_argument naming the manifest's
 /// line: a length without its unit, a file positioned twice, two inputs of
