@@ -129,8 +129,16 @@ double parse_quantity(std::string_view text, Dimension dimension) {
     // A bare number of a dimensional quantity is refused: "--dx 7.15" meant
     // millimetres and was taken as 7.15 m. Zero is zero in any unit.
     if (dimension == Dimension::dimensionless || value == 0.0) return value;
+    // The number in the usual unit, and the same quantity in the other one
+    // (20000 Hz is 20 kHz: not "20000kHz", a thousand times more).
     const auto [usual, other] = usual_units(dimension);
-    throw std::invalid_argument(fmt::format("{} has no unit: write {}{} (or {}{})", s, s, usual, s, other));
+    double usual_scale = 1.0, other_scale = 1.0;
+    for (const auto& u : units_of(dimension)) {
+      if (u.symbol == usual) usual_scale = u.scale;
+      if (u.symbol == other) other_scale = u.scale;
+    }
+    throw std::invalid_argument(fmt::format("{} has no unit: write {}{} (or the same as {:.6g}{})", s, s, usual,
+                                            value * usual_scale / other_scale, other));
   }
   for (const auto& u : units_of(dimension)) {
     if (u.symbol == unit) return value * u.scale;

@@ -40,7 +40,7 @@ TEST(ParseQuantity, DimensionalQuantitiesNeedTheirUnit) {
     (void)parse_quantity("7.15", Dimension::length);
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_STREQ(e.what(), "7.15 has no unit: write 7.15mm (or 7.15m)");
+    EXPECT_STREQ(e.what(), "7.15 has no unit: write 7.15mm (or the same as 0.00715m)");
   }
   for (auto d : {Dimension::time, Dimension::frequency, Dimension::velocity, Dimension::voltage}) {
     EXPECT_THROW((void)parse_quantity("2.5", d), std::invalid_argument);

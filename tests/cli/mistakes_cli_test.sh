@@ -19,11 +19,11 @@ py() { /usr/bin/python3 "$@"; }
   fail "synth"
 
 # 1. Quantities need units, on the command line and in settings files; zero needs none.
-expect 2 "dx: 7.15 has no unit: write 7.15mm (or 7.15m) (--dx)" "$pdp" process "$dir/rec.wav" --dx 7.15 --json "$dir/a.json"
+expect 2 "dx: 7.15 has no unit: write 7.15mm (or the same as 0.00715m) (--dx)" "$pdp" process "$dir/rec.wav" --dx 7.15 --json "$dir/a.json"
 [[ -e $dir/a.json ]] && fail "an output was written for a unit-less dx"
 printf 'dx = 7.15\n' >"$dir/unitless.toml"
 expect 2 "7.15 has no unit" "$pdp" process "$dir/rec.wav" --config "$dir/unitless.toml"
-expect 2 "fs: 20000 has no unit: write 20000Hz (or 20000kHz) (--fs)" "$pdp" synth -q --fs 20000 -o "$dir/x.flac"
+expect 2 "fs: 20000 has no unit: write 20000Hz (or the same as 20kHz) (--fs)" "$pdp" synth -q --fs 20000 -o "$dir/x.flac"
 "$pdp" --log-level error process "$dir/rec.wav" --dx 5mm --dy 0 >/dev/null || fail "dy 0 without a unit refused"
 
 # 2. Values implausible for a probe are refused, naming the range, unless allowed.

@@ -39,7 +39,7 @@ printf 'tips = "0,0,0;5mm,0,0"\n[probe]\ntips = [["0mm", "0mm", "0mm"], ["5mm", 
 expect 2 "twice.toml:1: tips is given again in [probe] (line 3); keep one" "$pdp" process "$dir/two.flac" --config "$dir/twice.toml"
 
 # 3. Mistakes, each named with its fix; nothing written.
-expect 2 "tips: point 1 '5,0,0', coordinate x: 5 has no unit: write 5mm (or 5m) (--tips)" \
+expect 2 "tips: point 1 '5,0,0', coordinate x: 5 has no unit: write 5mm (or the same as 0.005m) (--tips)" \
   "$pdp" process "$dir/two.flac" --tips "0,0,0;5,0,0" --json "$dir/x.json"
 printf '[probe]\ntips = [["0mm", "0mm", "0mm"], ["5mm", "0mm", "0mm"], ["5mm", "0mm", "0mm"]]\n' >"$dir/twice_tip.toml"
 expect 2 "twice_tip.toml:2: tips: tips 1 and 2 are both at (5mm, 0mm, 0mm) (tips are numbered from 0): a tip listed twice" \
