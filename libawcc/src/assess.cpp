@@ -318,7 +318,14 @@ std::vector<Warning> assess(const ProcessResult& r) {
   std::vector<Warning> out;
   for (const auto& w : r.info.warnings) out.push_back({Flag::reader_note, w});
   for (std::size_t i = 0; i < r.tips.size(); ++i) {
-    auto text = signal_warning(r.tips[i].signal, r.tips[i].channel, i == 0 ? "leading" : "trailing");
+    auto text = signal_warning(r.tips[i].signal, r.tips[i].channel, i == 0 ? "leading tip" : "trailing tip");
+    if (!text.empty()) out.push_back({Flag::signal_check, std::move(text)});
+  }
+  // A probe's further tips: their checks too (a dead tip processed with
+  // allow-bad-signal is in every output, as the pair's).
+  for (std::size_t k = 0; r.probe && k < r.probe->further_tips.size(); ++k) {
+    const auto& tip = r.probe->further_tips[k];
+    auto text = signal_warning(tip.signal, tip.channel, fmt::format("tip {}", k + 2));
     if (!text.empty()) out.push_back({Flag::signal_check, std::move(text)});
   }
   if (auto w = channels_ignored(r)) out.push_back(std::move(*w));

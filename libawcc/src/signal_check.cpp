@@ -212,7 +212,7 @@ SignalCheck check_signal(const VoltageHistogram& h, ProbeType probe, std::option
 
 std::string signal_warning(const SignalCheck& check, int channel, std::string_view tip) {
   if (check.message.empty()) return {};
-  const auto where = fmt::format("channel {} ({} tip)", channel, tip);
+  const auto where = fmt::format("channel {} ({})", channel, tip);
   if (!check.overridden) return fmt::format("{}: {}", where, check.message);
   return fmt::format("{}: {}; processed anyway, as allow-bad-signal asks: this tip's numbers may describe no flow",
                      where, check.message);

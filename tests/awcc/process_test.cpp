@@ -587,6 +587,26 @@ TEST(ProcessInput, BinarySignalsInMemoryAreTheRecordingOfTheirFile) {
   const auto allowed = awcc::binary_recording(dead, o);
   EXPECT_EQ(allowed.further_tips[1].check.status, awcc::SignalStatus::one_level);
   EXPECT_TRUE(allowed.further_tips[1].check.overridden);
+  // Processed as a probe, the dead tip's failure is in the warnings (every
+  // output's list), as a pair's tip's is (issue 53: the JSON's were empty).
+  awcc::ProcessOptions probe = o;
+  probe.further_channels.clear();
+  for (const auto& t : s.tips) probe.probe.positions.push_back({t.x, t.y, t.z});
+  probe.multi_tip = awcc::MultiTipChoice::on;
+  awcc::RecordingInfo info = allowed.info;
+  const auto resolved = awcc::tip_pair_options(probe, info);
+  std::vector<awcc::Vec3> positions;
+  for (const int c : resolved.tip_channels()) {
+    const auto& t = s.tips.at(static_cast<std::size_t>(c));
+    positions.push_back({t.x, t.y, t.z});
+  }
+  const auto r = awcc::process_binarised(
+      awcc::binary_recording(dead, resolved, resolved.tip_channels(), std::move(positions)), resolved);
+  ASSERT_TRUE(r.probe);
+  EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(), [](const awcc::Warning& warning) {
+    return warning.flag == awcc::Flag::signal_check && warning.text.rfind("channel 3 (tip 3): ", 0) == 0 &&
+           warning.text.find("allow-bad-signal") != std::string::npos;
+  })) << (r.warnings.empty() ? std::string("no warning") : r.warnings.front().text);
 }
 
 
