@@ -1200,9 +1200,14 @@ std::string ProcessResult::report() const {
   for (std::size_t i = 0; i < tips.size(); ++i) {
     const auto& t = tips[i];
     const auto& p = t.phase;
-    line(fmt::format("  {} tip (channel {}{}): threshold {:.4f} V ({}{}), air {:.4f} V, water {:.4f} V", names[i % 2],
-                     t.channel, t.name.empty() ? std::string() : fmt::format(", '{}'", t.name), t.threshold.threshold, to_string(t.threshold.rule),
-                     t.threshold.binary_input ? ", binary input" : "", t.threshold.air_level, t.threshold.water_level));
+    // Volts where the file states them; else the file's own units (a WAV's
+    // normalised samples, counts without their scale), said so.
+    const char* unit = info.volts_known ? " V" : "";
+    line(fmt::format("  {} tip (channel {}{}): threshold {:.4f}{} ({}{}), air {:.4f}{}, water {:.4f}{}{}", names[i % 2],
+                     t.channel, t.name.empty() ? std::string() : fmt::format(", '{}'", t.name), t.threshold.threshold,
+                     unit, to_string(t.threshold.rule), t.threshold.binary_input ? ", binary input" : "",
+                     t.threshold.air_level, unit, t.threshold.water_level, unit,
+                     info.volts_known ? "" : " (the file's units, not volts: it states no volts per count)"));
     line(fmt::format("    void fraction        {:.5f}  (95 % CI {:.5f} - {:.5f})", p.void_fraction,
                      p.void_fraction_ci95.lower, p.void_fraction_ci95.upper));
     line(fmt::format("    {:<20} {:.3f} /s  (95 % CI {:.3f} - {:.3f}), {} complete chords",
