@@ -1,6 +1,7 @@
 #include "awcc/profile_flow.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <array>
@@ -774,20 +775,34 @@ std::string ProfileFlowResult::report() const {
                                                                 : quantity_text(l.depth, 1e3, " mm");
     out += "\n";
   }
-  out += "  C_mean = " + quantity_text(c_mean, 1.0, "") + "\n";
-  out += "  d = " + quantity_text(clear_water_depth, 1e3, " mm") + "\n";
-  out += fmt::format("  power law ({} points): N = {}, u90 = {}", power_law.points, quantity_text(power_law.n, 1.0, ""),
-                     quantity_text(power_law.u90, 1.0, " m/s"));
-  if (power_law.residual) out += fmt::format(", rms residual of ln u {:.3g}", *power_law.residual);
-  out += "\n";
-  out += "  q_w = " + quantity_text(water_discharge, 1.0, " m2/s") + "\n";
-  out += "  q_a = " + quantity_text(air_discharge, 1.0, " m2/s") + "\n";
-  if (options.discharge) {
+  // Without Y90 every quantity taken up to it is none for that one reason:
+  // said once, with their names, not once per quantity.
+  std::vector<std::string> need_y90;
+  const auto for_want_of_y90 = [&](const FlowQuantity& q, std::string_view symbol) {
+    if (q.value || !q.reason.starts_with("no Y90")) return false;
+    need_y90.emplace_back(symbol);
+    return true;
+  };
+  if (!for_want_of_y90(c_mean, "C_mean")) out += "  C_mean = " + quantity_text(c_mean, 1.0, "") + "\n";
+  if (!for_want_of_y90(clear_water_depth, "d")) {
+    out += "  d = " + quantity_text(clear_water_depth, 1e3, " mm") + "\n";
+  }
+  const bool law_wants = for_want_of_y90(power_law.n, "N");
+  if (!(law_wants && for_want_of_y90(power_law.u90, "u90"))) {
+    out += fmt::format("  power law ({} points): N = {}, u90 = {}", power_law.points,
+                       quantity_text(power_law.n, 1.0, ""), quantity_text(power_law.u90, 1.0, " m/s"));
+    if (power_law.residual) out += fmt::format(", rms residual of ln u {:.3g}", *power_law.residual);
+    out += "\n";
+  }
+  if (!for_want_of_y90(water_discharge, "q_w")) out += "  q_w = " + quantity_text(water_discharge, 1.0, " m2/s") + "\n";
+  if (!for_want_of_y90(air_discharge, "q_a")) out += "  q_a = " + quantity_text(air_discharge, 1.0, " m2/s") + "\n";
+  if (options.discharge && !for_want_of_y90(continuity_error, "continuity error")) {
     out += fmt::format("  continuity error against q = {:.5g} m2/s: ", *options.discharge) +
            quantity_text(continuity_error, 100.0, " %") + "\n";
   }
   for (const auto* fit : {&smooth_chute, &stepped_chute}) {
     const bool smooth = fit == &smooth_chute;
+    if (for_want_of_y90(fit->diffusivity, smooth ? "D'" : "D_0")) continue;
     out += fmt::format("  {} ({} points): {} = {}", to_string(smooth ? ConcentrationModelKind::smooth_chute
                                                                       : ConcentrationModelKind::stepped_chute),
                        fit->points, smooth ? "D'" : "D_0", quantity_text(fit->diffusivity, 1.0, ""));
@@ -797,11 +812,15 @@ std::string ProfileFlowResult::report() const {
   // The quantities listed after the fits, each from its row of flow_quantity_names.
   bool after_fits = false;
   for (const auto& q : flow_quantity_names) {
-    if (after_fits) {
+    if (after_fits && !for_want_of_y90(q.of(*this), q.symbol)) {
       const std::string unit = q.shown_unit == "-" ? std::string() : " " + std::string(q.shown_unit);
       out += fmt::format("  {} = {}\n", q.symbol, quantity_text(q.of(*this), q.shown_scale, unit.c_str()));
     }
     after_fits = after_fits || q.pointer == "/stepped_chute";
+  }
+  if (!need_y90.empty()) {
+    out += fmt::format("  none of {}: each is taken up to Y90, which the profile does not give\n",
+                       fmt::join(need_y90, ", "));
   }
   return out;
 }

@@ -667,3 +667,25 @@ TEST(ProfileFlow, AChuteAngleBeyondTheVerticalIsRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+// A profile that never reaches c = 0.9: every quantity taken up to Y90 is
+// none for that one reason, said once with their names (issue 53: the
+// summary said "no Y90" nine times).
+TEST(ProfileFlow, WithoutY90TheQuantitiesThatNeedItAreNamedOnce) {
+  std::vector<ProfileRow> rows;
+  for (double y : {0.01, 0.02, 0.03, 0.04}) rows.push_back(exact_row(y, 0.05 + y, 3.0));
+  const auto r = awcc::profile_flow(rows, no_draws(InvertRule::held));
+  ASSERT_FALSE(r.y90.value);
+  const std::string text = r.report();
+  EXPECT_NE(text.find("  none of C_mean, d, N, u90, q_w, q_a, D', D_0: each is taken up to Y90"), std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("C_mean = none"), std::string::npos) << text;
+  std::size_t said = 0;
+  for (auto at = text.find("no Y90"); at != std::string::npos; at = text.find("no Y90", at + 1)) ++said;
+  EXPECT_EQ(said, 0u) << text;  // the reason is said once, in words of its own
+  EXPECT_NE(text.find("  Y90 = none: the profile never reaches c = 0.9"), std::string::npos) << text;
+}
+
+}  // namespace
