@@ -1223,15 +1223,36 @@ SIZES_WITH_VALUES = ("ok", "not_converged")  # statuses whose distribution and d
 
 
 def _sizes_missing(rows, labels):
-    """Each position without a distribution (or whose EM did not converge): its status and reason."""
-    out = []
+    """The positions without a distribution (or whose EM did not converge),
+    grouped by status: each status once, with its positions and the first
+    one's reason (the reasons of one status differ only in their numbers)."""
+    groups = {}  # status -> (labels, first reason)
     for label, r in zip(labels, rows):
         s = r.get("sizes")
         if s is None:
-            out.append(f"{label}: no size distribution (pdp process --sizes off, or a JSON without sizes)")
+            status, reason = "no size distribution", "pdp process --sizes off, or a JSON without sizes"
         elif s.get("status") != "ok":
-            out.append(f"{label}: {s.get('status')}" + (f": {s['reason']}" if s.get("reason") else ""))
+            status, reason = s.get("status"), s.get("reason")
+        else:
+            continue
+        groups.setdefault(status, ([], reason))[0].append(label)
+    out = []
+    for status, (where, reason) in groups.items():
+        first = f" (at {where[0]}: {reason})" if reason and len(where) > 1 else (f": {reason}" if reason else "")
+        out.append(f"{', '.join(where)}: {status}{first}")
     return out
+
+
+def sizes_drawable(rows):
+    """Whether any row has a size distribution to draw (else the size
+    figures are left out and one note says why: sizes_note)."""
+    return any(get(r, "sizes", "status") in SIZES_WITH_VALUES and get(r, "sizes", "bins") is not None for r in rows)
+
+
+def sizes_note(rows):
+    """The one note that stands for the size figures when no row has a distribution."""
+    labels, _, _ = _row_labels(rows)
+    return "Bubble size distributions: none to draw. " + "; ".join(_sizes_missing(rows, labels)) + "."
 
 
 def _row_labels(rows):

@@ -342,10 +342,16 @@ def detail_for(index, row, data, json_dir, pdp, options):
 def _profile_svgs(rows, flow):
     """The profile figures; the flow's (plotting.FLOW_FIGURES) when the JSON has a flow object."""
     from pdp import plotting
+    # The size figures only where a row has a distribution; else one note
+    # (an svg of None) says why for every position at once.
+    sizes = plotting.sizes_drawable(rows)
     figures = list(plotting.PROFILE_FIGURES) + [(key, title, make) for key, title, make, method in
                                                  plotting.BUBBLE_PROFILE_FIGURES
-                                                 if any(r.get(method) is not None for r in rows)]
+                                                 if any(r.get(method) is not None for r in rows)
+                                                 and (method != "sizes" or sizes)]
     svgs = [(key, title, plotting.svg(make(rows), salt=key)) for key, title, make in figures]
+    if not sizes and any(r.get("sizes") is not None for r in rows):
+        svgs.append(("size-distributions", plotting.sizes_note(rows), None))
     if flow is not None:
         svgs += [(key, title, plotting.svg(make(rows, flow), salt=key)) for key, title, make in plotting.FLOW_FIGURES]
     return svgs

@@ -15,6 +15,7 @@ objects that follow docs/output.md's schema."""
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -399,3 +400,19 @@ def test_the_report_draws_the_size_figures_when_a_row_has_sizes(sized, real_prof
     bare_text = (tmp_path / "bare.html").read_text()
     for key in ("size-distributions", "size-d32"):
         assert f'data-figure="{key}"' not in bare_text  # rows without sizes: no size figure
+
+
+def test_a_profile_without_a_distribution_has_one_note_for_the_size_figures(real_profile, tmp_path):
+    # The real recordings at 20 kHz: every position coarse_sampling (issue 53:
+    # an empty panel and the same four-line note ten times, twice).
+    d, data = real_profile
+    assert all(r["sizes"]["status"] == "coarse_sampling" for r in data["profile"])
+    (tmp_path / "real.json").write_text(json.dumps(data))
+    made("report", tmp_path / "real.json", "-o", tmp_path / "r.html", "--no-detail")
+    text = (tmp_path / "r.html").read_text()
+    for key in ("size-distributions", "size-d32"):
+        assert f'data-figure="{key}"' not in text
+    notes = re.findall(r'<p class="figure-note"[^>]*data-figure-note="size-distributions">([^<]*)</p>', text)
+    assert len(notes) == 1, notes
+    assert notes[0].count("coarse_sampling") == 1, notes[0]
+    assert notes[0].startswith("Bubble size distributions: none to draw. y = "), notes[0]
