@@ -288,6 +288,14 @@ def process_options(provenance, pdp):
             if k in defaults and defaults[k] != v}
 
 
+def shown_path(path, json_path):
+    """A recording's path as the report shows it: relative to the JSON's
+    folder (where the report is read), the written path kept in the data."""
+    if not path or not os.path.isabs(path):
+        return path
+    return os.path.relpath(path, os.path.dirname(os.path.abspath(json_path)))
+
+
 def detail_for(index, row, data, json_dir, pdp, options):
     """(detail dict, None) or (None, why not)."""
     provenance = data.get("provenance") or {}
@@ -440,7 +448,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
         cells = []
         for i, row in enumerate(rows):
             value = cell_value(row, c, provenance)
-            cell = {"value": json.dumps(value), "text": display(value, c["unit"]), "gap": None, "note": False}
+            shown = shown_path(value, json_path) if c["name"] == "file" and isinstance(value, str) else value
+            cell = {"value": json.dumps(value), "text": display(shown, c["unit"]), "gap": None, "note": False}
             if c in text_columns and value:  # long text: told below the table, linked from here
                 cell["text"], cell["note"] = "see note", True
             if value is None or value == []:
@@ -471,7 +480,8 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
         bubble = [(name, *plotting.verdict(row, key)[:2]) for key, name in (("multi_tip", "multi-tip"),
                                                                              ("events", "event detection"))
                   if row.get(key) is not None]
-        positions.append({"index": i, "label": labels[i], "file": row.get("file"), "svg": position_svgs[i],
+        positions.append({"index": i, "label": labels[i], "file": shown_path(row.get("file"), json_path),
+                          "svg": position_svgs[i],
                           "quality": (row.get("awcc") or {}).get("quality"), "bubble": bubble, "notes": notes,
                           "detail_note": detail_notes[i]})
 
@@ -484,7 +494,9 @@ def build(json_path, detail=True, jobs=1, command_line=None, input_name=None):
     return env.get_template("report.html.j2").render(
         title=input_name or os.path.basename(json_path), rows=rows, labels=labels, profile_svgs=profile_svgs,
         positions=positions, table=table, gaps=sorted(gaps.items(), key=lambda kv: kv[1]),
-        provenance=provenance, made=made, panels=plotting.POSITION_PANELS, bubble_panels=plotting.BUBBLE_PANELS,
+        provenance=dict(provenance, inputs=[dict(i, file=shown_path(i.get("file"), json_path))
+                                            for i in provenance.get("inputs") or []]),
+        made=made, panels=plotting.POSITION_PANELS, bubble_panels=plotting.BUBBLE_PANELS,
         flow=flow_table(data["flow"]) if isinstance(data.get("flow"), dict) else None,
         flow_absent=flow_absent_reason(data),
         single="profile" not in data,

@@ -14,6 +14,7 @@ figure and in the table. The size figures are tested on hand-made `sizes`
 objects that follow docs/output.md's schema."""
 
 import json
+import os
 import math
 import re
 
@@ -416,3 +417,15 @@ def test_a_profile_without_a_distribution_has_one_note_for_the_size_figures(real
     assert len(notes) == 1, notes
     assert notes[0].count("coarse_sampling") == 1, notes[0]
     assert notes[0].startswith("Bubble size distributions: none to draw. y = "), notes[0]
+
+
+def test_the_report_shows_recordings_relative_to_the_json(real_profile, real_files):
+    # real_files are absolute paths (issue 53: the table's file row showed
+    # them wrapped); the report shows them from the JSON's folder.
+    d, data = real_profile
+    text = (d / "report.html").read_text()
+    absolute = os.path.abspath(real_files[0])
+    assert os.path.isabs(data["profile"][0]["file"]) or os.path.isabs(data["provenance"]["inputs"][0]["file"])
+    # Shown relative (the data-value attribute and the command line keep what was written).
+    assert ">" + absolute not in text
+    assert ">" + os.path.relpath(absolute, d) + "<" in text
