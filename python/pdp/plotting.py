@@ -461,12 +461,59 @@ def _untrusted_medians(ax, y, rows, quantity, unit):
     ax.set_xlim(lo, hi)
 
 
+def _from_fscc_forest(r):
+    return get(r, "correction", "forest") == "fscc"
+
+
+def _limit_to_the_measured(ax, y, rows, quantity, unit, measured):
+    """The value axis set by what was measured and the corrections of the
+    AWCC forest with their bands; a row corrected by the FSCC forest (no
+    usable AWCC: a sparse row, whose 95 % band can reach twice the flow's
+    velocity) sets it by its median and 80 % band only, its 95 % band
+    clipped at the edge with a marker and its end, instead of stretching
+    the axis for every other row."""
+    values = [v for r in rows for v in measured(r) if v is not None]
+    for r in rows:
+        if _untrusted(r, quantity):
+            continue
+        values += [number(get(r, "correction", quantity, "median"))]
+        band = _quantiles(r, quantity, "0.1", "0.9") if _from_fscc_forest(r) else \
+            _quantiles(r, quantity, "0.025", "0.975")
+        values += list(band) if band else []
+    values = [v for v in values if v is not None and math.isfinite(v)]
+    if not values:
+        return
+    lo, hi = min(values), max(values)
+    pad = 0.05 * (hi - lo) if hi > lo else 0.05 * abs(hi) + 1e-9
+    lo, hi = lo - pad, hi + pad
+    style = dict(ls="none", color=GREY, ms=6, clip_on=False, scalex=False, scaley=False)
+    clipped = False
+    for yi, r in zip(y, rows):
+        band = _quantiles(r, quantity, "0.025", "0.975") if _from_fscc_forest(r) and not _untrusted(r, quantity) \
+            else None
+        if not band or band[0] is None or band[1] is None:
+            continue
+        for end, edge, marker, side in ((band[1], hi, ">", -1), (band[0], lo, "<", 1)):
+            if (end > edge) if side < 0 else (end < edge):
+                ax.plot([edge], [yi], marker=marker, **style)
+                ax.annotate(f"95 % to {end:.3g} {unit}".rstrip(), (edge, yi), textcoords="offset points",
+                            xytext=(-8 * -side if side > 0 else -8, 6), ha="right" if side < 0 else "left",
+                            va="bottom", fontsize=7, color=GREY)
+                clipped = True
+    if clipped:
+        ax.plot([], [], marker=">", ls="none", color=GREY, label="a 95 % band beyond the axis (its end written)")
+    ax.set_xlim(lo, hi)
+
+
 def profile_velocity(rows, ax=None):
     fig, ax = _profile_axes(ax)
     y, ylabel = positions_mm(rows)
     _series(ax, y, rows, lambda r: get(r, "fscc", "velocity"), color=BLACK, marker="D", ls=":", mfc="none",
             label="FSCC")
     _awcc_and_corrected(ax, y, rows, "velocity", "AWCC, 95 % interval")
+    _limit_to_the_measured(ax, y, rows, "velocity", "m/s", lambda r: [
+        number(get(r, "fscc", "velocity")), number(get(r, "awcc", "velocity")),
+        *(number(v) for v in (get(r, "awcc", "velocity_ci95") or []))])
     _untrusted_medians(ax, y, rows, "velocity", "m/s")
     _finish(ax, ylabel, "mean interfacial velocity (m/s)", "Velocity")
     return fig
