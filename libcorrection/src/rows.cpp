@@ -116,7 +116,7 @@ awcc::ProcessResult awcc_outcome_of(const json& r, const std::string& row, const
     for (auto [k, count] : {std::pair{key::windows_at_least_lag, &res.windows_at_least_lag},
                             std::pair{key::windows_at_greatest_lag, &res.windows_at_greatest_lag},
                             std::pair{key::windows_accepted, &res.windows_accepted}}) {
-      if (has(a, k) && a[k].is_number()) *count = a[k].get<std::int64_t>();
+      if (has(a, k) && a[k].is_number()) *count = whole(a[k].get<double>(), file, fmt::format("awcc.{}", k).c_str());
     }
     if (has(a, key::quality_reason) && a[key::quality_reason].is_string()) {
       res.quality_reason = a[key::quality_reason].get<std::string>();

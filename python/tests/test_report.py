@@ -133,7 +133,8 @@ def check_figures(page, rows, flow=False):
     flow's for a JSON with a flow object), then each position's panels."""
     assert page.figures == [key for key, _, _ in plotting.PROFILE_FIGURES] + \
         [key for key, _, _, method in plotting.BUBBLE_PROFILE_FIGURES
-         if any(isinstance(r, dict) and r.get(method) is not None for r in rows)] + \
+         if any(isinstance(r, dict) and r.get(method) is not None for r in rows)
+         and (method != "sizes" or plotting.sizes_drawable([r for r in rows if isinstance(r, dict)]))] + \
         ([key for key, _, _ in plotting.FLOW_FIGURES] if flow else [])
     assert page.positions == list(range(len(rows)))
     for i in range(len(rows)):
