@@ -427,6 +427,12 @@ std::string check_row(const ProfileRow& r, const std::string& name) {
                            name, j + 1);
       }
     }
+    if (r.u_sampling_ci95 && !(is_finite(r.u_sampling_ci95->lower) && is_finite(r.u_sampling_ci95->upper) &&
+                               r.u_sampling_ci95->lower <= r.u_sampling_ci95->upper)) {
+      return fmt::format("{}: the sampling interval [{}, {}] of the corrected velocity needs finite ends, lower <= "
+                         "upper",
+                         name, r.u_sampling_ci95->lower, r.u_sampling_ci95->upper);
+    }
     return {};
   }
   if (!r.u_ci95) {
@@ -667,13 +673,33 @@ ProfileFlowResult profile_flow(std::vector<ProfileRow> rows, const ProfileFlowOp
                         : !r.u_quantiles.empty() ? quantile_knots(r.u_quantiles)
                                                  : interval_knots(*r.u, *r.u_ci95));
     }
-    std::vector<double> cd(sorted.size()), ud(sorted.size());
+    // The weight a_i of the shared score (header); zero for a row whose
+    // spread is all its own.
+    std::vector<double> shared(sorted.size(), 0.0);
+    bool any_shared = false;
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      const auto& r = sorted[i];
+      if (!r.u || r.u_quantiles.empty() || !r.u_sampling_ci95) continue;
+      const double sigma = (u_knots[i].at(kZ975) - u_knots[i].at(-kZ975)) / (2 * kZ975);
+      const double s = (r.u_sampling_ci95->upper - r.u_sampling_ci95->lower) / (2 * kZ975);
+      if (!(sigma > 0.0) || !(s < sigma)) continue;
+      shared[i] = std::sqrt(1.0 - (s / sigma) * (s / sigma));
+      any_shared = true;
+    }
+    std::vector<double> cd(sorted.size()), ud(sorted.size()), zu(sorted.size());
     for (int m = 0; m < options.draws; ++m) {
       Rng rng(derive_seed(options.seed, static_cast<std::uint64_t>(m)), 0);
       for (std::size_t i = 0; i < sorted.size(); ++i) {
-        const double zc = rng.normal(), zu = rng.normal();
+        const double zc = rng.normal();
+        zu[i] = rng.normal();
         cd[i] = std::clamp(c_knots[i].at(zc), 0.0, 1.0);
-        ud[i] = sorted[i].u ? std::max(u_knots[i].at(zu), 0.0) : kNaN;
+      }
+      // Drawn after the rows' own scores, so that a profile without a shared
+      // part draws exactly what it drew before there was one.
+      const double z0 = any_shared ? rng.normal() : 0.0;
+      for (std::size_t i = 0; i < sorted.size(); ++i) {
+        const double z = shared[i] * z0 + std::sqrt(1.0 - shared[i] * shared[i]) * zu[i];
+        ud[i] = sorted[i].u ? std::max(u_knots[i].at(z), 0.0) : kNaN;
       }
       const Evaluation e = evaluate(cd, ud, false);
       const auto ok_y = [](const CharacteristicDepth& d) { return d.status == DepthStatus::ok ? *d.y : kNaN; };

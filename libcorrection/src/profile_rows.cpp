@@ -23,11 +23,19 @@ ProfileRowOf profile_row(const RowFields& f) {
   row.bubble_frequency_ci95 = f.bubble_frequency_ci95;
   const auto& v = f.velocities;
   if (v.correction && v.correction->corrected && v.correction->forest == "awcc" && v.correction->velocity) {
-    const auto& q = *v.correction->velocity;
-    row.u = q[3];  // the median: correction_levels[3] = 0.5
-    row.u_source = awcc::FlowVelocitySource::corrected_awcc;
-    for (std::size_t i = 0; i < correction_levels.size(); ++i) row.u_quantiles.push_back({correction_levels[i], q[i]});
-    return out;
+    const auto& c = *v.correction;
+    const auto& q = *c.velocity;  // at correction_levels: q[3] the median, front and back 2.5 and 97.5 %
+    if (!(c.fscc && c.fscc_ci95 && (q.back() < c.fscc_ci95->lower || q.front() > c.fscc_ci95->upper))) {
+      row.u = q[3];
+      row.u_source = awcc::FlowVelocitySource::corrected_awcc;
+      for (std::size_t i = 0; i < correction_levels.size(); ++i) row.u_quantiles.push_back({correction_levels[i], q[i]});
+      row.u_sampling_ci95 = c.awcc_ci95;
+      return out;
+    }
+    out.note = fmt::format("{}: the corrected AWCC velocity {:.3f} m/s (95 % {:.3f}-{:.3f}) excludes FSCC's {:.3f} "
+                           "m/s (95 % {:.3f}-{:.3f}): the methods disagree beyond their uncertainty, so the row "
+                           "contributes its uncorrected velocity (METHOD 12 as docs/validation.md decides it)",
+                           row.name, q[3], q.front(), q.back(), *c.fscc, c.fscc_ci95->lower, c.fscc_ci95->upper);
   }
   switch (v.source) {
     case awcc::VelocitySource::awcc:
@@ -76,6 +84,14 @@ RowFields row_fields(const awcc::ProcessResult& r, double position, const Correc
     c.corrected = correction->corrected();
     c.forest = correction->forest;
     if (correction->velocity) c.velocity = correction->velocity->quantiles;
+    if (r.awcc && r.awcc->ok()) {
+      c.awcc_ci95 = r.awcc->velocity_ci95;
+      c.awcc_quality_low = r.awcc->quality != awcc::AwccQuality::ok;
+    }
+    if (r.fscc && r.fscc->ok()) {
+      c.fscc = r.fscc->velocity;
+      c.fscc_ci95 = r.fscc->velocity_ci95;
+    }
     v.correction = std::move(c);
   }
   return f;
@@ -179,6 +195,24 @@ RowFields fields_of_json(const json& r, double position, const JsonEntry& e) {
       for (std::size_t i = 0; i < values.size(); ++i) values[i] = levels.number(q, correction_level_names[i]);
       out.velocity = values;
     }
+    if (r.contains(key::awcc) && r[key::awcc].is_object()) {
+      const JsonEntry at_awcc{e.file, e.at + "/" + std::string(key::awcc)};
+      const auto& a = r[key::awcc];
+      if (at_awcc.text(a, key::status) == awcc::to_string(awcc::AwccStatus::ok)) {
+        out.awcc_ci95 = at_awcc.optional_interval(a, key::velocity_ci95);
+        out.awcc_quality_low =
+            awcc::parse_awcc_quality(at_awcc.text(a, key::quality), {e.file, at_awcc.at, key::quality}) !=
+            awcc::AwccQuality::ok;
+      }
+    }
+    if (r.contains(key::fscc) && r[key::fscc].is_object()) {
+      const JsonEntry at_fscc{e.file, e.at + "/" + std::string(key::fscc)};
+      const auto& s = r[key::fscc];
+      if (at_fscc.text(s, key::status) == awcc::to_string(awcc::FsccStatus::ok)) {
+        out.fscc = at_fscc.number(s, key::velocity);
+        out.fscc_ci95 = at_fscc.optional_interval(s, key::velocity_ci95);
+      }
+    }
     v.correction = std::move(out);
   }
   return f;
@@ -250,6 +284,15 @@ RowFields fields_of_csv(const CsvRow& r, double position) {
         values[i] = r.number(std::string(correction_column::velocity_quantile) + correction_level_names[i]);
       }
       c.velocity = values;
+    }
+    if (r.text(column::awcc_status) == awcc::to_string(awcc::AwccStatus::ok)) {
+      c.awcc_ci95 = r.optional_interval(column::awcc_velocity_ci95_lower, column::awcc_velocity_ci95_upper);
+      c.awcc_quality_low = awcc::parse_awcc_quality(r.text(column::awcc_quality),
+                                                    {r.file, r.line, column::awcc_quality}) != awcc::AwccQuality::ok;
+    }
+    if (r.text(column::fscc_status) == awcc::to_string(awcc::FsccStatus::ok)) {
+      c.fscc = r.optional(column::fscc_velocity);
+      c.fscc_ci95 = r.optional_interval(column::fscc_velocity_ci95_lower, column::fscc_velocity_ci95_upper);
     }
     v.correction = std::move(c);
   }

@@ -13,6 +13,7 @@
 // of D: its values are held to a relative 1e-7.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
@@ -84,6 +85,8 @@ void same_row(const correction::ProfileRowOf& got, const correction::ProfileRowO
   near(*a.u, *b.u, relative, what + " u");
   ASSERT_EQ(a.u_ci95.has_value(), b.u_ci95.has_value()) << what;
   if (b.u_ci95) near(*a.u_ci95, *b.u_ci95, relative, what + " u_ci95");
+  ASSERT_EQ(a.u_sampling_ci95.has_value(), b.u_sampling_ci95.has_value()) << what;
+  if (b.u_sampling_ci95) near(*a.u_sampling_ci95, *b.u_sampling_ci95, relative, what + " u_sampling_ci95");
   ASSERT_EQ(a.u_quantiles.size(), b.u_quantiles.size()) << what;
   for (std::size_t k = 0; k < b.u_quantiles.size(); ++k) {
     EXPECT_EQ(a.u_quantiles[k].probability, b.u_quantiles[k].probability) << what;
@@ -150,6 +153,87 @@ TEST(ProfileRows, RowsReadBackFromJsonAndCsvAreTheResultsRows) {
   EXPECT_EQ(sources, (std::set<awcc::FlowVelocitySource>{awcc::FlowVelocitySource::corrected_awcc,
                                                          awcc::FlowVelocitySource::awcc,
                                                          awcc::FlowVelocitySource::fscc}));
+}
+
+// The rule of a corrected row the profile leans on (the header): the
+// corrected 95 % interval [q_2.5, q_97.5] must meet FSCC's 95 % sampling
+// interval. Here the quantiles span [2.0, 2.4]; FSCC's interval is moved
+// across the limit on either side.
+correction::RowFields corrected_fields(awcc::Interval95 fscc_ci95, bool awcc_low) {
+  correction::RowFields f;
+  f.name = "r.dat";
+  f.position = 0.01;
+  f.c = 0.2;
+  f.c_ci95 = {0.19, 0.21};
+  f.bubble_frequency = 100;
+  f.bubble_frequency_ci95 = {90, 110};
+  auto& v = f.velocities;
+  v.source = awcc_low ? awcc::VelocitySource::fscc : awcc::VelocitySource::awcc;
+  v.awcc = 2.6;
+  v.awcc_ci95 = {2.55, 2.65};
+  v.fscc = 0.5 * (fscc_ci95.lower + fscc_ci95.upper);
+  v.fscc_ci95 = fscc_ci95;
+  correction::RowVelocities::Corrected c;
+  c.corrected = true;
+  c.forest = "awcc";
+  c.velocity = std::array<double, 7>{2.0, 2.05, 2.1, 2.2, 2.3, 2.35, 2.4};
+  c.awcc_ci95 = v.awcc_ci95;
+  c.awcc_quality_low = awcc_low;
+  c.fscc = v.fscc;
+  c.fscc_ci95 = fscc_ci95;
+  v.correction = c;
+  return f;
+}
+
+TEST(ProfileRows, ACorrectedIntervalThatExcludesFsccsIsNotLeanedOn) {
+  using awcc::FlowVelocitySource;
+  // Meeting at one point, above and below: leaned on, with AWCC's sampling interval as its own part.
+  for (const auto ci : {awcc::Interval95{2.4, 2.6}, awcc::Interval95{1.8, 2.0}, awcc::Interval95{2.1, 2.2}}) {
+    const auto r = correction::profile_row(corrected_fields(ci, false));
+    EXPECT_EQ(r.row.u_source, FlowVelocitySource::corrected_awcc) << ci.lower;
+    EXPECT_EQ(*r.row.u, 2.2);
+    ASSERT_TRUE(r.row.u_sampling_ci95);
+    EXPECT_EQ(r.row.u_sampling_ci95->lower, 2.55);
+    EXPECT_EQ(r.note, "");
+  }
+  // Just beyond on either side: the uncorrected velocity (AWCC of quality ok here), a note naming both.
+  for (const auto ci : {awcc::Interval95{2.4000001, 2.6}, awcc::Interval95{1.8, 1.9999999}}) {
+    const auto r = correction::profile_row(corrected_fields(ci, false));
+    EXPECT_EQ(r.row.u_source, FlowVelocitySource::awcc) << ci.lower;
+    EXPECT_EQ(*r.row.u, 2.6);
+    EXPECT_TRUE(r.row.u_quantiles.empty());
+    EXPECT_NE(r.note.find("corrected AWCC velocity 2.200 m/s (95 % 2.000-2.400) excludes FSCC's"), std::string::npos)
+        << r.note;
+  }
+  // AWCC's low quality alone does not demote the corrected velocity; with the exclusion the row takes FSCC's.
+  EXPECT_EQ(correction::profile_row(corrected_fields({2.1, 2.2}, true)).row.u_source,
+            FlowVelocitySource::corrected_awcc);
+  const auto fscc = correction::profile_row(corrected_fields({2.5, 2.7}, true));
+  EXPECT_EQ(fscc.row.u_source, FlowVelocitySource::fscc);
+  EXPECT_EQ(*fscc.row.u, 2.6);
+  // Without FSCC's interval there is nothing to exclude: leaned on.
+  auto no_fscc = corrected_fields({2.5, 2.7}, false);
+  no_fscc.velocities.correction->fscc_ci95.reset();
+  EXPECT_EQ(correction::profile_row(no_fscc).row.u_source, FlowVelocitySource::corrected_awcc);
+}
+
+// The real 8 mm row (issue 53): the corrected AWCC median from 10 windows
+// lies far below FSCC and Felder's program; the profile does not lean on it.
+TEST(ProfileRows, TheRealEightMillimetreRowContributesItsUncorrectedVelocity) {
+  if (!fs::exists(spillway_dir())) GTEST_SKIP() << "the real recordings are not at " << spillway_dir();
+  awcc::ProcessOptions o;
+  o.reader.fs = 20e3;
+  o.dx = 7.15e-3;
+  const auto r = awcc::process_recording(spillway_dir() / "dc157_02.dat", o);
+  const auto model = correction::CorrectionModel::load(pdp_test::source_dir() / "samples" / "model" / "awcc.qrf");
+  const auto c = model.correct(correction::measurement_of(r));
+  ASSERT_TRUE(c.corrected() && c.forest == "awcc" && c.velocity) << c.message;
+  ASSERT_TRUE(r.fscc && r.fscc->ok() && r.fscc->velocity_ci95);
+  ASSERT_LT(c.velocity->quantiles.back(), r.fscc->velocity_ci95->lower);
+  const auto row = correction::profile_row(r, 0.008, &c);
+  EXPECT_NE(row.row.u_source, awcc::FlowVelocitySource::corrected_awcc);
+  EXPECT_EQ(*row.row.u, *r.velocity());
+  EXPECT_NE(row.note.find("dc157_02.dat: the corrected AWCC velocity"), std::string::npos) << row.note;
 }
 
 TEST(ProfileRows, AFileWithoutEveryPositionHasNoFlowAndSaysWhy) {

@@ -11,12 +11,26 @@
 //
 // The velocity (METHOD 12): the bias-corrected AWCC median with the AWCC
 // forest's quantiles where the row is corrected (not when untrusted, nor
-// FSCC-forest quantiles, which correct FSCC's velocity and are named so);
-// else the velocity of ProcessResult::velocity_source() (AWCC of quality ok,
-// else FSCC, else AWCC of quality low) with its 95 % sampling interval. A
-// velocity without an interval (FSCC whose segments give none) is left out:
-// a value without uncertainty would make every interval too narrow; the
-// row's note says so.
+// FSCC-forest quantiles, which correct FSCC's velocity and are named so),
+// with AWCC's sampling interval as the quantiles' own part of their spread
+// (awcc/profile_flow.hpp: the rest is drawn shared between the corrected
+// rows); else the velocity of ProcessResult::velocity_source() (AWCC of
+// quality ok, else FSCC, else AWCC of quality low) with its 95 % sampling
+// interval. A velocity without an interval (FSCC whose segments give none)
+// is left out: a value without uncertainty would make every interval too
+// narrow; the row's note says so.
+//
+// The rule for a corrected row the profile should not lean on: when the
+// corrected 95 % interval excludes FSCC's 95 % sampling interval (they do not
+// overlap), the two methods disagree beyond their uncertainty and the row
+// contributes its uncorrected velocity, with a note naming both. AWCC's low
+// quality alone does not demote the corrected velocity. Both decided by
+// `pdp validate --profile` over 8 seeds of each sample profile
+// (docs/validation.md, "Profile intervals and the correction"): the
+// exclusion rule cut the u90 and q_w errors by half with every interval
+// still covering; demoting low-quality rows too put the raw velocities'
+// high-Tu bias back into the rows near the invert, and N's interval covered
+// 0 of 8.
 //
 // Read back, the JSON's numbers are the doubles written (json_text writes the
 // shortest text that reads back as the same double): its rows equal the
@@ -47,6 +61,14 @@ struct RowVelocities {
     bool corrected = false;  ///< status corrected (not untrusted, not refused)
     std::string forest;      ///< "awcc" or "fscc"; empty when no quantiles
     std::optional<std::array<double, correction_levels.size()>> velocity;  ///< quantiles at correction_levels
+    /// The AWCC forest's: the 95 % sampling interval of AWCC's velocity (the
+    /// quantiles' own part, awcc/profile_flow.hpp) and its quality.
+    std::optional<awcc::Interval95> awcc_ci95;
+    bool awcc_quality_low = false;
+    /// FSCC's velocity and sampling interval, whatever the source: the rule
+    /// of whether the profile leans on the corrected velocity reads them.
+    std::optional<double> fscc;
+    std::optional<awcc::Interval95> fscc_ci95;
   };
   std::optional<Corrected> correction;
 };
