@@ -274,15 +274,21 @@ def test_the_real_profile_has_no_y90_and_says_why_on_figure_and_table(real_profi
 
 def test_each_velocity_has_the_interval_of_its_source(real_files, tmp_path):
     """The corrected real profile: its rows' velocities are the corrected
-    AWCC medians (a row without AWCC, FSCC's own: METHOD 12); each point's
-    bar is its source's interval: the AWCC forest's 2.5 and 97.5 % quantiles,
-    FSCC's 95 % interval."""
+    AWCC medians (a row without AWCC, FSCC's own; a row whose corrected
+    interval excludes FSCC's, its uncorrected velocity: METHOD 12 as
+    docs/validation.md decides it); each point's bar is its source's
+    interval: the AWCC forest's 2.5 and 97.5 % quantiles, AWCC's or FSCC's
+    95 % interval."""
     positions = ",".join(f"{p}mm" for p in (2, 8, 14, 20, 26, 32, 38, 44, 50, 54))
     made("process", *real_files, "--fs", "20kHz", "--dx", "7.15mm", "--positions", positions, "--correct", MODEL,
          "--json", tmp_path / "profile.json")
     data = json.loads((tmp_path / "profile.json").read_text())
     flow, rows = data["flow"], data["profile"]
-    assert {r["velocity_source"] for r in flow["rows"]} == {"corrected awcc", "fscc"}
+    assert {r["velocity_source"] for r in flow["rows"]} == {"corrected awcc", "awcc", "fscc"}
+    # The 8 mm row's corrected median (1.636 m/s, 10 windows) excludes FSCC's 2.509: FSCC's is taken, and said.
+    (row_8mm,) = [f for f in flow["rows"] if f["position"] == pytest.approx(0.008)]
+    assert row_8mm["velocity_source"] == "fscc" and row_8mm["velocity"] == pytest.approx(2.509, abs=1e-3)
+    assert any(n.startswith("dc157_02.dat: the corrected AWCC velocity 1.636 m/s") for n in flow["notes"]), flow["notes"]
     ax = plotting.flow_velocity(rows, flow).axes[0]
     checked = 0
     for container in ax.containers:

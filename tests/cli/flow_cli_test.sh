@@ -136,12 +136,23 @@ corrected = [e for e in after["profile"]
              if e["correction"]["status"] == "corrected" and e["correction"]["forest"] == "awcc"]
 assert corrected, "no row corrected by the AWCC forest"
 by_position = {e["position"]: e for e in after["profile"]}
+# A corrected row is leaned on unless its 95 % interval excludes FSCC's
+# (METHOD 12 as docs/validation.md decides it): then its uncorrected
+# velocity, and a note naming it.
+notes = after["flow"]["notes"]
 for r in rows:
-    c = by_position[r["position"]]["correction"]
+    e = by_position[r["position"]]
+    c = e["correction"]
     if c["status"] == "corrected" and c["forest"] == "awcc":
-        assert r["velocity_source"] == "corrected awcc" and r["velocity"] == c["velocity"]["median"], r
+        q, f = c["velocity"]["quantiles"], e["fscc"].get("velocity_ci95")
+        if f and (q["0.975"] < f[0] or q["0.025"] > f[1]):
+            assert r["velocity_source"] in ("awcc", "fscc"), r
+            assert any(n.startswith(r["name"] + ": the corrected AWCC velocity") for n in notes), (r, notes)
+        else:
+            assert r["velocity_source"] == "corrected awcc" and r["velocity"] == c["velocity"]["median"], r
     else:
         assert r["velocity_source"] != "corrected awcc", r
+assert sum(n.count(": the corrected AWCC velocity") for n in notes) == 2, notes
 assert after["flow"]["seed"] == 7 and before["flow"]["seed"] == 0
 PY
   grep -q "profile of 10 positions" "$dir/corrected.txt" || fail "pdp correct -o prints no flow summary"
