@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <string>
 
 namespace awcc {
@@ -312,6 +313,35 @@ std::vector<Warning> channels_copied(const ProcessResult& r) {
   return out;
 }
 
+// One chord of a phase far longer than the tip's chords allow (assess.hpp,
+// single_phase_stretch_factor).
+std::optional<std::string> single_phase_stretch(const Summary& chords, std::string_view phase) {
+  if (chords.count < single_phase_stretch_chords_min || !(chords.mean > 0.0)) return std::nullopt;
+  const double chance = chords.mean * std::log(static_cast<double>(chords.count));
+  if (!(chords.max > single_phase_stretch_factor * chance)) return std::nullopt;
+  return fmt::format("one {} chord lasts {:.3f} s, {:.0f} times what its {} {} chords (mean {:.3g} ms) reach by "
+                     "chance (their mean times the log of their count; above {:g} times is no flow)",
+                     phase, chords.max, chords.max / chance, chords.count, phase, 1e3 * chords.mean,
+                     single_phase_stretch_factor);
+}
+
+std::vector<Warning> long_single_phase(const ProcessResult& r) {
+  std::vector<Warning> out;
+  for (std::size_t i = 0; i < r.tips.size(); ++i) {
+    const auto& phase = r.tips[i].phase;
+    std::vector<std::string> parts;
+    if (auto t = single_phase_stretch(phase.air_chord_time, "air")) parts.push_back(std::move(*t));
+    if (auto t = single_phase_stretch(phase.water_chord_time, "water")) parts.push_back(std::move(*t));
+    if (parts.empty()) continue;
+    out.push_back({Flag::long_single_phase,
+                   fmt::format("channel {} ({}): {}: the probe out of the flow, a stopped flow or a lost connection "
+                               "for that long? c, F and the velocities include that stretch; cut the record to the "
+                               "part that measured the flow",
+                               r.tips[i].channel, i == 0 ? "leading tip" : "trailing tip", fmt::join(parts, "; "))});
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<Warning> assess(const ProcessResult& r) {
@@ -343,6 +373,7 @@ std::vector<Warning> assess(const ProcessResult& r) {
   if (auto w = lag_range_end(r)) out.push_back(std::move(*w));
   if (auto w = tu_not_measured(r)) out.push_back(std::move(*w));
   for (auto& w : channels_copied(r)) out.push_back(std::move(w));
+  for (auto& w : long_single_phase(r)) out.push_back(std::move(w));
   return out;
 }
 

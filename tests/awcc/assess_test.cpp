@@ -8,6 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <numbers>
 #include <numeric>
 #include <set>
 #include <string>
@@ -17,9 +23,11 @@
 #include "awcc/fscc.hpp"
 #include "awcc/process.hpp"
 #include "awcc/read_back.hpp"
+#include "awcc/random.hpp"
 #include "awcc/velocity_series.hpp"
 #include "random_signals.hpp"
 #include "signal_builders.hpp"
+#include "test_paths.hpp"
 
 namespace {
 
@@ -428,3 +436,119 @@ TEST(MultiTipDoubtful, TheStreamwiseComponentAgainstFsccAndTheQualityInTheRowsLi
   ASSERT_NE(it, w.end());
   EXPECT_NE(it->text.find("is doubtful: because"), std::string::npos) << it->text;
 }
+
+namespace {
+
+// A tip's longest chord against single_phase_stretch_factor times its chords'
+// mean times the log of their count (awcc/assess.hpp), for air and water, on
+// each side of the limit, and the least count of chords the rule reads.
+std::vector<awcc::Warning> stretch_warnings(std::int64_t count, double mean, double max, bool water) {
+  auto r = row(fscc_at_2(), awcc_at(2.0, awcc::AwccQuality::ok));
+  auto& s = water ? r.tips[1].phase.water_chord_time : r.tips[1].phase.air_chord_time;
+  s.count = count;
+  s.mean = mean;
+  s.max = max;
+  std::vector<awcc::Warning> out;
+  for (auto& w : awcc::assess(r)) {
+    if (w.flag == awcc::Flag::long_single_phase) out.push_back(std::move(w));
+  }
+  return out;
+}
+
+TEST(LongSinglePhase, AtTheLimitOnEachSideForAirAndWater) {
+  const double mean = 2e-3, limit = awcc::single_phase_stretch_factor * mean * std::log(1000.0);
+  for (const bool water : {false, true}) {
+    EXPECT_TRUE(stretch_warnings(1000, mean, limit, water).empty()) << water;
+    const auto w = stretch_warnings(1000, mean, limit * (1 + 1e-9), water);
+    ASSERT_EQ(w.size(), 1u) << water;
+    EXPECT_TRUE(mentions(w[0].text, "channel 1 (trailing tip): one "));
+    EXPECT_TRUE(mentions(w[0].text, water ? "water chord lasts 0.207 s, 15 times" : "air chord lasts 0.207 s"))
+        << w[0].text;
+    EXPECT_TRUE(mentions(w[0].text, "cut the record")) << w[0].text;
+  }
+  // Below 20 chords the log of their count says too little: no rule.
+  const double few = 100 * mean * std::log(19.0);
+  EXPECT_TRUE(stretch_warnings(19, mean, few, false).empty());
+  EXPECT_EQ(stretch_warnings(20, mean, few, false).size(), 1u);
+}
+
+// A real recording (dc157_05) with 5 s of its 45 s replaced by the air level
+// (the probe lifted out of the flow): flagged on both tips; the recording
+// itself is not (its longest chords are 2-4 times m ln n).
+TEST(LongSinglePhase, AProbeLiftedOutOfTheFlowIsFlaggedOnARealRecording) {
+  const auto source = pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway" /
+                      "dc157_05.dat";
+  if (!std::filesystem::exists(source)) GTEST_SKIP() << "the real recordings are not at " << source;
+  std::ifstream in(source, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  awcc::ProcessOptions o;
+  o.reader.fs = 20e3;
+  o.dx = 7.15e-3;
+  const auto flagged = [&](const std::filesystem::path& p) {
+    int n = 0;
+    for (const auto& w : awcc::assess(awcc::process_recording(p, o))) n += w.flag == awcc::Flag::long_single_phase;
+    return n;
+  };
+  EXPECT_EQ(flagged(source), 0);
+  // 8 bytes of header, then int16 pairs; the air level is near 5,000 counts on both channels.
+  for (std::size_t k = 300000; k < 400000; ++k) {
+    for (std::size_t c = 0; c < 2; ++c) {
+      const std::int16_t air = 5000;
+      std::memcpy(bytes.data() + 8 + 4 * k + 2 * c, &air, 2);
+    }
+  }
+  const auto lifted = pdp_test::test_file("lifted.dat");
+  std::ofstream(lifted, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  EXPECT_EQ(flagged(lifted), 2);
+}
+
+// What else an acquisition does to a recording mid-record (issue 53): a gain
+// or an offset that changes halfway, electrical noise, mains hum on a working
+// probe. Each is refused by the signal check's flat-level rule
+// (awcc/signal_check.hpp) naming the channel, not read as bubbles. The real
+// dc157_05 is first halved about 16,000 counts so that nothing clips.
+TEST(AcquisitionFaults, AGainOrOffsetChangeNoiseOrHumIsRefusedAsNoFlatLevel) {
+  const auto source = pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway" /
+                      "dc157_05.dat";
+  if (!std::filesystem::exists(source)) GTEST_SKIP() << "the real recordings are not at " << source;
+  std::ifstream in(source, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t n = (bytes.size() - 8) / 4;
+  std::vector<double> x(2 * n);
+  for (std::size_t k = 0; k < 2 * n; ++k) {
+    std::int16_t v = 0;
+    std::memcpy(&v, bytes.data() + 8 + 2 * k, 2);
+    x[k] = (v - 16000.0) * 0.5 + 16000.0;
+  }
+  // The levels after halving: water about 21,500 and air about 10,600 counts.
+  const double separation = 10900.0;
+  awcc::Rng rng(53, 0);
+  const std::vector<std::pair<std::string, std::function<double(std::size_t, double)>>> faults{
+      {"gain", [&](std::size_t k, double v) { return k >= n ? v * 0.8 : v; }},
+      {"offset", [&](std::size_t k, double v) { return k >= n ? v - 0.15 * separation : v; }},
+      {"noise", [&](std::size_t, double v) { return v + 0.15 * separation * rng.normal(); }},
+      {"hum", [&](std::size_t k, double v) {
+         return v + 0.2 * separation * std::sin(2 * std::numbers::pi * 50.0 * static_cast<double>(k / 2) / 20e3);
+       }}};
+  awcc::ProcessOptions o;
+  o.reader.fs = 20e3;
+  o.dx = 7.15e-3;
+  for (const auto& [name, fault] : faults) {
+    auto out = bytes;
+    for (std::size_t k = 0; k < 2 * n; ++k) {
+      const auto v = static_cast<std::int16_t>(std::clamp(std::round(fault(k, x[k])), -32767.0, 32766.0));
+      std::memcpy(out.data() + 8 + 2 * k, &v, 2);
+    }
+    const auto path = pdp_test::test_file(name + ".dat");
+    std::ofstream(path, std::ios::binary).write(out.data(), static_cast<std::streamsize>(out.size()));
+    try {
+      awcc::process_recording(path, o);
+      ADD_FAILURE() << name << ": processed";
+    } catch (const awcc::InputError& e) {
+      EXPECT_TRUE(mentions(e.what(), "channel 0 (leading tip): the voltage histogram has no flat level")) << e.what();
+      EXPECT_TRUE(mentions(e.what(), name + ".dat")) << e.what();
+    }
+  }
+}
+
+}  // namespace

@@ -1,4 +1,5 @@
 #pragma once
+#include <cstdint>
 // A processed recording's one list of warnings (awcc/flags.hpp), assembled in
 // one place after processing: the reader's notes, the channels not processed,
 // FSCC's plausibility warnings, the velocity series' time-scale warning and
@@ -108,6 +109,17 @@ void judge_events(EventResult& events, const ProcessResult& result);
 // Tu_x 16-26 % low (measured Tu_x 0.22-0.25), one of 0.15 within 2.4 % and
 // 5 % (measured Tu_x <= 0.16).
 inline constexpr double multi_tip_tu_truncated = 0.2;
+
+// A stretch of one phase far longer than the record's chords allow: the
+// probe lifted out of the flow, a flow stopped, a connection lost for a
+// while. Among n chords of a phase with mean m drawn independently from an
+// exponential law, P(longest > k m ln n) = 1 - (1 - n^-k)^n, about n^(1-k):
+// nothing at k = 15. Real chords are clustered and overdispersed: on the ten
+// real recordings the longest chord of either phase is 1.1-4.3 times m ln n;
+// 5 s of a 45 s record in air gave 175, in water 28, one channel at 0 V for
+// 1 s 96 (docs/reliability.md). Below 20 chords ln n says too little.
+inline constexpr double single_phase_stretch_factor = 15.0;
+inline constexpr std::int64_t single_phase_stretch_chords_min = 20;
 
 /// The multi-tip vectors' quality (ProbeResult::quality): insufficient
 /// without vectors; low, with every reason, when FSCC of the leading tip with

@@ -28,6 +28,7 @@ enum class Flag {
   lag_range_end,             ///< AWCC windows peak at an end of the lags the velocity range lets it search (awcc/awcc.hpp)
   tu_not_measured,           ///< every accepted AWCC window peaks at one lag: Tu is not a measurement (awcc/awcc.hpp)
   channels_copied,           ///< two tips hold one signal twice (awcc/process.hpp, copied_channel_correlation)
+  long_single_phase,         ///< a tip stays in one phase far longer than its chords allow (awcc/assess.hpp)
 };
 
 struct FlagName {
@@ -38,7 +39,7 @@ struct FlagName {
 
 /// Every flag in the enum's order: to_string, parse_flag and the lists of
 /// codes read this one table.
-inline constexpr std::array<FlagName, 13> flag_names{{
+inline constexpr std::array<FlagName, 14> flag_names{{
     {Flag::reader_note, "reader_note", "the reader accepted the file but notes something about it"},
     {Flag::signal_check, "signal_check",
      "a tip's voltage is not a clean two-level signal of the stated polarity, or its air level is the continuous one"},
@@ -62,12 +63,15 @@ inline constexpr std::array<FlagName, 13> flag_names{{
      "every accepted AWCC window peaks at one lag: Tu is 0 by the lag's resolution, not measured, and not given"},
     {Flag::channels_copied, "channels_copied",
      "two tips hold one signal twice (a copied channel or cross-talk): what rests on both is not a measurement"},
+    {Flag::long_single_phase, "long_single_phase",
+     "a tip stays in one phase far longer than its chords allow: the probe out of the flow, a stopped flow or a lost "
+     "connection for a while"},
 }};
 constexpr bool flag_names_in_enum_order() {
   for (std::size_t i = 0; i < flag_names.size(); ++i) {
     if (static_cast<std::size_t>(flag_names[i].flag) != i) return false;
   }
-  return static_cast<std::size_t>(Flag::channels_copied) + 1 == flag_names.size();
+  return static_cast<std::size_t>(Flag::long_single_phase) + 1 == flag_names.size();
 }
 static_assert(flag_names_in_enum_order(), "a flag added to Flag needs its row in flag_names, in the enum's order");
 
