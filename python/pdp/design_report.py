@@ -24,7 +24,7 @@ conditions' descriptions (with Python 3.11's tomllib; older interpreters name
 the file only). Figures are inline SVG drawn with pdp.plotting's layer, which
 this file loads from beside itself: the compiled core is not needed.
 
-Exit status as pdp's (README, "Exit status"): 1 bad input, 2 bad usage,
+Exit status as pdp's (docs/guide/settings.md, "Exit status"): 1 bad input, 2 bad usage,
 3 output not written, 4 internal error, 5 a package is missing.
 """
 

@@ -1461,14 +1461,14 @@ def write_page(text, out, prefix=".pdp-page-"):
         raise
 
 
-# pdp's exit status (README, "Exit status") for what finish_page decides.
+# pdp's exit status (docs/guide/settings.md, "Exit status") for what finish_page decides.
 EXIT_OUTPUT_FAILED, EXIT_INTERNAL = 3, 4
 
 
 def finish_page(program, build, output, output_flag, problems, prefix=".pdp-page-"):
     """The end of a page script (pdp report, pdp design --report): builds the
-    page, writes it (write_page) and returns pdp's exit status (README, "Exit
-    status"). `problems` maps the script's exception classes to their exit
+    page, writes it (write_page) and returns pdp's exit status
+    (docs/guide/settings.md, "Exit status"). `problems` maps the script's exception classes to their exit
     status (bad input 1, bad usage 2); any other exception is a defect (4),
     an unwritable page 3."""
     import sys

@@ -20,7 +20,7 @@ and processed again with the provenance's options through the Python module;
 the report uses it only when the re-processed velocities (FSCC, AWCC, event
 detection, the multi-tip mean vector) equal the JSON's. Otherwise the position says why its detail is missing.
 
-Exit status as pdp's (README, "Exit status"): 1 bad input, 2 bad usage,
+Exit status as pdp's (docs/guide/settings.md, "Exit status"): 1 bad input, 2 bad usage,
 3 output not written, 4 internal error, 5 a package is missing.
 """
 

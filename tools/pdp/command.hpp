@@ -3,7 +3,7 @@
 // names as its flags; the command line wins; CLI11 2.1 reads no config for
 // subcommands, so it is applied here), its required arguments (checked after
 // the file is applied, so that a file may give them), and the exit codes of
-// the README's table.
+// the table of docs/guide/settings.md.
 
 #include <CLI/CLI.hpp>
 #include <exception>
@@ -14,7 +14,7 @@
 
 namespace pdp {
 
-/// The documented exit codes (README, "Exit status").
+/// The documented exit codes (docs/guide/settings.md, "Exit status").
 enum ExitCode : int {
   exit_ok = 0,
   exit_bad_input = 1,     ///< input data that cannot be used (a recording, model or results file)

@@ -1,6 +1,6 @@
 // pdp: the dual-tip phase-detection probe toolkit's command line. Each
 // subcommand is one source file: parse, call the libraries, print. Exit
-// codes: command.hpp (the README's table).
+// codes: command.hpp (the table of docs/guide/settings.md).
 #include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>

@@ -37,7 +37,7 @@ std::pair<std::int64_t, std::int64_t> parse_shard(const std::string& text);
 
 /// study::run_tasks, or over the ranks when `mpi` has more than one (rank 0
 /// writes and hands out tasks one at a time). Progress on a terminal under
-/// `label`. Returns an exit code (README, "Exit status").
+/// `label`. Returns an exit code (docs/guide/settings.md, "Exit status").
 int run_tasks(const std::vector<std::int64_t>& tasks, const std::function<std::string(std::int64_t)>& compute,
               const std::string& output, int threads, const std::string& label, const MpiSession& mpi);
 
