@@ -472,15 +472,24 @@ TEST(LongSinglePhase, AtTheLimitOnEachSideForAirAndWater) {
   EXPECT_EQ(stretch_warnings(20, mean, few, false).size(), 1u);
 }
 
+// The real dc157_05.dat (45 s at 20 kHz; a UQ .dat: 8 bytes of header, then
+// int16 pairs) and its bytes, which the acquisition-fault tests alter.
+std::filesystem::path real_recording() {
+  return pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway" / "dc157_05.dat";
+}
+
+std::vector<char> bytes_of(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 // A real recording (dc157_05) with 5 s of its 45 s replaced by the air level
 // (the probe lifted out of the flow): flagged on both tips; the recording
 // itself is not (its longest chords are 2-4 times m ln n).
 TEST(LongSinglePhase, AProbeLiftedOutOfTheFlowIsFlaggedOnARealRecording) {
-  const auto source = pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway" /
-                      "dc157_05.dat";
+  const auto source = real_recording();
   if (!std::filesystem::exists(source)) GTEST_SKIP() << "the real recordings are not at " << source;
-  std::ifstream in(source, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto bytes = bytes_of(source);
   awcc::ProcessOptions o;
   o.reader.fs = 20e3;
   o.dx = 7.15e-3;
@@ -508,11 +517,9 @@ TEST(LongSinglePhase, AProbeLiftedOutOfTheFlowIsFlaggedOnARealRecording) {
 // (awcc/signal_check.hpp) naming the channel, not read as bubbles. The real
 // dc157_05 is first halved about 16,000 counts so that nothing clips.
 TEST(AcquisitionFaults, AGainOrOffsetChangeNoiseOrHumIsRefusedAsNoFlatLevel) {
-  const auto source = pdp_test::source_dir().parent_path() / "shared" / "data" / "felder-stepped-spillway" /
-                      "dc157_05.dat";
+  const auto source = real_recording();
   if (!std::filesystem::exists(source)) GTEST_SKIP() << "the real recordings are not at " << source;
-  std::ifstream in(source, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto bytes = bytes_of(source);
   const std::size_t n = (bytes.size() - 8) / 4;
   std::vector<double> x(2 * n);
   for (std::size_t k = 0; k < 2 * n; ++k) {
