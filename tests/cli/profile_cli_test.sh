@@ -67,6 +67,18 @@ PY
 # setting that cannot work), and nothing written.
 printf '[profile]\ny90 = "50mm"\npositions = "5mm,10mm"\n[scene]\nvoid-fraction = 0.3\n' >"$dir/law.toml"
 expect 1 "void-fraction" "$pdp" synth --profile "$dir/law.toml" -o "$dir/law.flac"
+# Issue 53, item 6: the stepped sample corrected with the shipped model gave
+# u90 -2.0 % and q_w -1.2 % with 95 % intervals that missed the truth (the
+# corrected rows drawn independently, the rows whose corrected interval
+# excludes FSCC's leaned on). Both intervals now cover it.
+"$pdp" --log-level error validate --profile "$src/samples/stepped-profile.toml" \
+  --correct "$src/samples/model/awcc.qrf" --json "$dir/stepped.json" >/dev/null || fail "validate --profile --correct"
+/usr/bin/python3 - "$dir/stepped.json" <<'PY' || fail "the corrected stepped profile's u90 or q_w interval misses its truth"
+import json, sys
+c = {q["key"]: q for q in json.load(open(sys.argv[1]))["comparisons"]}
+for key in ("power_law_u90", "water_discharge"):
+    assert c[key]["covered"], c[key]
+PY
 printf '[profile]\ny90 = "50mm"\npositions = "10mm,5mm"\n' >"$dir/order.toml"
 expect 2 "do not increase" "$pdp" synth --profile "$dir/order.toml" -o "$dir/order.flac"
 expect 2 "do not increase" "$pdp" validate --profile "$dir/order.toml"
