@@ -84,10 +84,7 @@ RowFields row_fields(const awcc::ProcessResult& r, double position, const Correc
     c.corrected = correction->corrected();
     c.forest = correction->forest;
     if (correction->velocity) c.velocity = correction->velocity->quantiles;
-    if (r.awcc && r.awcc->ok()) {
-      c.awcc_ci95 = r.awcc->velocity_ci95;
-      c.awcc_quality_low = r.awcc->quality != awcc::AwccQuality::ok;
-    }
+    if (r.awcc && r.awcc->ok()) c.awcc_ci95 = r.awcc->velocity_ci95;
     if (r.fscc && r.fscc->ok()) {
       c.fscc = r.fscc->velocity;
       c.fscc_ci95 = r.fscc->velocity_ci95;
@@ -200,9 +197,6 @@ RowFields fields_of_json(const json& r, double position, const JsonEntry& e) {
       const auto& a = r[key::awcc];
       if (at_awcc.text(a, key::status) == awcc::to_string(awcc::AwccStatus::ok)) {
         out.awcc_ci95 = at_awcc.optional_interval(a, key::velocity_ci95);
-        out.awcc_quality_low =
-            awcc::parse_awcc_quality(at_awcc.text(a, key::quality), {e.file, at_awcc.at, key::quality}) !=
-            awcc::AwccQuality::ok;
       }
     }
     if (r.contains(key::fscc) && r[key::fscc].is_object()) {
@@ -287,8 +281,6 @@ RowFields fields_of_csv(const CsvRow& r, double position) {
     }
     if (r.text(column::awcc_status) == awcc::to_string(awcc::AwccStatus::ok)) {
       c.awcc_ci95 = r.optional_interval(column::awcc_velocity_ci95_lower, column::awcc_velocity_ci95_upper);
-      c.awcc_quality_low = awcc::parse_awcc_quality(r.text(column::awcc_quality),
-                                                    {r.file, r.line, column::awcc_quality}) != awcc::AwccQuality::ok;
     }
     if (r.text(column::fscc_status) == awcc::to_string(awcc::FsccStatus::ok)) {
       c.fscc = r.optional(column::fscc_velocity);

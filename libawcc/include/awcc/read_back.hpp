@@ -111,7 +111,6 @@ inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
 /// AWCC's: false when every accepted window peaks at one lag (Tu then null);
 /// absent from a JSON of an earlier pdp (measured).
 inline constexpr std::string_view turbulence_measured = "turbulence_measured";
-inline constexpr std::string_view quality = "quality";  ///< AWCC's: ok or low
 inline constexpr std::string_view quality_reason = "quality_reason";  ///< AWCC's: why the quality is not ok
 /// AWCC's accepted windows at the least and the greatest lag of the velocity range.
 inline constexpr std::string_view windows_at_least_lag = "windows_at_least_lag";

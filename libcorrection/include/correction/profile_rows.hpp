@@ -62,9 +62,8 @@ struct RowVelocities {
     std::string forest;      ///< "awcc" or "fscc"; empty when no quantiles
     std::optional<std::array<double, correction_levels.size()>> velocity;  ///< quantiles at correction_levels
     /// The AWCC forest's: the 95 % sampling interval of AWCC's velocity (the
-    /// quantiles' own part, awcc/profile_flow.hpp) and its quality.
+    /// quantiles' own part, awcc/profile_flow.hpp).
     std::optional<awcc::Interval95> awcc_ci95;
-    bool awcc_quality_low = false;
     /// FSCC's velocity and sampling interval, whatever the source: the rule
     /// of whether the profile leans on the corrected velocity reads them.
     std::optional<double> fscc;
