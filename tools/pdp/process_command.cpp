@@ -42,6 +42,15 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   const auto* out = "Output";
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"))->group(out);
   path_option(cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)"))->group(out);
+  path_option(cmd->add_option("--mat", o.mat,
+                              "write the results as MATLAB variables: the JSON's content as structs (the profile's "
+                              "rows a struct array), and tables ready for struct2table with their units (one "
+                              "recording: its AWCC windows and bubbles; a profile: profile_table); version 5 "
+                              "(docs/output.md)"))
+      ->group(out);
+  cmd->add_flag("--mat-v73", o.mat_v73,
+                "--mat as MATLAB version 7.3 (HDF5; chosen anyway when a variable exceeds version 5's 2 GiB)")
+      ->group(out);
   path_option(cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)"))->group(out);
   path_option(cmd->add_option("--bubbles", o.bubbles,
                               "per-bubble table as CSV (one recording): the multi-tip vectors, or event detection's "
@@ -95,7 +104,9 @@ int run_process(ProcessCommandOptions& o) {
     const auto rendered = render(o, plan, processed);
     for (const auto& [path, text] : rendered.outputs) awcc::check_output_folder(path);
     if (!o.report.empty()) awcc::check_output_folder(o.report);
+    if (rendered.mat) awcc::check_output_folder(rendered.mat->path);
     for (const auto& [path, text] : rendered.outputs) awcc::write_text_atomically(path, text);
+    if (const auto& m = rendered.mat) awcc::write_mat(m->path, m->document, m->tables, m->version);
     fmt::print("{}", rendered.stdout_text);
     std::fflush(stdout);
     if (!o.report.empty()) return report_of(o, rendered.json_for_report);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 
@@ -52,6 +53,73 @@ std::string correction_report(const correction::Correction& c) {
   return out;
 }
 
+// A column of a per-window or per-bubble table as a MAT column: numbers, or
+// text for the one text column.
+template <typename Column, typename Row>
+awcc::MatTable::Column mat_column(const Column& c, const std::vector<Row>& rows) {
+  awcc::MatTable::Column out{std::string(c.name), std::string(c.unit), {}};
+  if (c.text) {
+    std::vector<std::string> v;
+    for (const auto& r : rows) v.emplace_back(c.text(r));
+    out.values = std::move(v);
+  } else {
+    std::vector<double> v;
+    for (const auto& r : rows) v.push_back(c.value(r));
+    out.values = std::move(v);
+  }
+  return out;
+}
+
+template <typename Columns, typename Row>
+awcc::MatTable mat_table(std::string name, const Columns& columns, const std::vector<Row>& rows) {
+  awcc::MatTable t{std::move(name), {}};
+  for (const auto& c : columns) t.columns.push_back(mat_column(c, rows));
+  return t;
+}
+
+// The tables of --mat (awcc/mat_output.hpp): one recording's AWCC windows
+// and bubbles; a profile's rows as the profile CSV's columns, each read from
+// the row's JSON at its pointer (a number, a switch as 1/0, a text; NaN or
+// "" where the row has none).
+std::vector<awcc::MatTable> mat_tables(const std::vector<awcc::ProcessResult>& results, const nlohmann::json& j) {
+  std::vector<awcc::MatTable> out;
+  if (results.size() == 1) {
+    const auto& r = results[0];
+    if (r.awcc) out.push_back(mat_table("windows", awcc::awcc_window_columns(), r.awcc->windows));
+    if (r.events) out.push_back(mat_table("event_bubbles", awcc::event_bubble_columns(), r.events->bubbles));
+    if (r.probe) out.push_back(mat_table("bubbles", awcc::multi_tip_bubble_columns(), r.probe->vectors.bubbles));
+  }
+  if (j.contains(awcc::process_key::profile)) {
+    awcc::MatTable t{"profile_table", {}};
+    for (const auto& c : awcc::profile_csv_columns()) {
+      if (c.json_pointer.empty()) continue;
+      const nlohmann::json::json_pointer at{std::string(c.json_pointer)};
+      const bool text = c.unit.empty();
+      std::vector<double> numbers;
+      std::vector<std::string> texts;
+      for (const auto& row : j[awcc::process_key::profile]) {
+        const auto* v = row.contains(at) ? &row[at] : nullptr;
+        if (text) {
+          std::string cell = !v || v->is_null() ? std::string() : v->is_string() ? v->get<std::string>() : v->dump();
+          // The CSV's rule: a file by its name.
+          if (c.name == awcc::profile_column::file) cell = std::filesystem::path(cell).filename().string();
+          texts.push_back(std::move(cell));
+        } else {
+          numbers.push_back(!v || !(v->is_number() || v->is_boolean()) ? std::nan("")
+                            : v->is_boolean()                          ? (v->get<bool>() ? 1.0 : 0.0)
+                                                                       : v->get<double>());
+        }
+      }
+      awcc::MatTable::Column col{std::string(c.name), std::string(c.unit), {}};
+      if (text) col.values = std::move(texts);
+      else col.values = std::move(numbers);
+      t.columns.push_back(std::move(col));
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
 }  // namespace
 
 // The report is drawn from the JSON: the --json file, or the same text in a
@@ -79,14 +147,17 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const study::P
   const bool corrected = plan.model.has_value();
   const auto& flow = p.flow;
   Rendered out;
-  if (!o.json.empty() || !o.report.empty()) {
+  if (!o.json.empty() || !o.report.empty() || !o.mat.empty()) {
     auto j = study::profile_run_json(p, std::filesystem::path(o.correct).filename().string());
     // The inputs' digests were taken as they were read (process_files asks for them when the JSON is written).
     std::vector<awcc::ProvenanceInput> inputs;
     for (std::size_t i = 0; i < p.inputs.size(); ++i) inputs.push_back({p.inputs[i], results[i].input_sha256});
     j["provenance"] = awcc::provenance_json(plan.options, inputs, command_line());
+    if (!o.mat.empty()) {
+      out.mat = Rendered::Mat{o.mat, j, mat_tables(results, j), o.mat_v73 ? awcc::MatVersion::v7_3 : awcc::MatVersion::v5};
+    }
     if (!o.json.empty()) out.outputs.emplace_back(o.json, awcc::json_text(j));
-    else out.json_for_report = awcc::json_text(j);
+    else if (!o.report.empty()) out.json_for_report = awcc::json_text(j);
   }
   if (!o.windows.empty() && results[0].awcc) out.outputs.emplace_back(o.windows, awcc::awcc_windows_csv(*results[0].awcc));
   if (!o.bubbles.empty()) {

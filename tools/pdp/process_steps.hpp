@@ -4,11 +4,13 @@
 // processed and corrected (process_files.cpp), every output rendered before
 // any is written (process_render.cpp).
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "awcc/mat_output.hpp"
 #include "awcc/process.hpp"
 #include "awcc/profile_flow.hpp"
 #include "correction/model.hpp"
@@ -36,6 +38,14 @@ study::ProfileRun process_files(const ProcessCommandOptions& o, const Plan& plan
 struct Rendered {
   std::vector<std::pair<std::string, std::string>> outputs;
   std::string stdout_text, json_for_report;
+  /// --mat: the JSON's content and the tables (awcc/mat_output.hpp).
+  struct Mat {
+    std::string path;
+    nlohmann::json document;
+    std::vector<awcc::MatTable> tables;
+    awcc::MatVersion version = awcc::MatVersion::v5;
+  };
+  std::optional<Mat> mat;
 };
 
 Rendered render(const ProcessCommandOptions& o, const Plan& plan, const study::ProfileRun& run);
