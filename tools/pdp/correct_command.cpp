@@ -32,6 +32,7 @@ void setup_correct(CLI::App& app, Command& command, CorrectOptions& o) {
                                   "correction model (.qrf, from pdp train; samples/model/awcc.qrf ships)"))
           ->check(CLI::ExistingFile));
   path_option(cmd->add_option("-o,--output", o.output, "output file (same format as the input) [default: stdout]"));
+  add_mat_options(cmd, o.mat, "profile_table (a profile; a JSON input)");
   cmd->add_option("--dx", o.dx, "streamwise tip separation, m (units allowed), where the input has none");
   cmd->add_option("--dy", o.dy, "lateral tip separation, m (units allowed), where the input has none");
   cmd->add_option("--np", o.np, "AWCC particles per window, where the input has none")->check(CLI::Range(awcc::np_min, awcc::np_max));
@@ -77,6 +78,10 @@ int run_correct(const CorrectOptions& o) {
         (std::filesystem::equivalent(o.output, o.input) || std::filesystem::equivalent(o.output, o.model))) {
       throw std::invalid_argument(fmt::format("{} is an input; choose another output file", o.output));
     }
+    if (!o.mat.path.empty() && std::filesystem::exists(o.mat.path) &&
+        (std::filesystem::equivalent(o.mat.path, o.input) || std::filesystem::equivalent(o.mat.path, o.model))) {
+      throw std::invalid_argument(fmt::format("--mat {} is an input; choose another output file", o.mat.path));
+    }
     const auto model = correction::CorrectionModel::load(o.model);
     std::ifstream in(o.input, std::ios::binary);
     std::stringstream buffer;
@@ -84,6 +89,14 @@ int run_correct(const CorrectOptions& o) {
     const std::string text = buffer.str();
     const auto first = text.find_first_not_of(" \t\r\n");
     const bool json = first != std::string::npos && (text[first] == '{' || text[first] == '[');
+    if (!o.mat.path.empty() && !json) {
+      // A CSV's rows stay a CSV (MATLAB's readtable reads it); the MAT file
+      // holds a JSON's tree, which a CSV does not have.
+      throw awcc::OptionError(fmt::format("--mat: {} is a profile CSV; --mat needs the JSON of pdp process --json "
+                                          "(or read the corrected CSV with MATLAB's readtable)",
+                                          o.input),
+                              "mat");
+    }
     const std::string model_name = std::filesystem::path(o.model).filename().string();
     const auto flow_options = awcc::profile_flow_options(o.flow.settings());
     auto out = json ? correction::correct_process_json(model, text, defaults, o.input, model_name)
@@ -112,6 +125,12 @@ int run_correct(const CorrectOptions& o) {
     for (const auto& w : std::set<std::string>(out.warnings.begin(), out.warnings.end())) spdlog::warn("{}", w);
     if (flow) {
       for (const auto& w : flow->warnings()) spdlog::warn("{}", w);
+    }
+    if (!o.output.empty()) awcc::check_output_folder(o.output);
+    if (!o.mat.path.empty()) {
+      awcc::check_output_folder(o.mat.path);
+      const auto document = nlohmann::json::parse(out.text);
+      awcc::write_mat(o.mat.path, document, profile_mat_tables(document), o.mat.version());
     }
     if (o.output.empty()) {
       fmt::print("{}", out.text);

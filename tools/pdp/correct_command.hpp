@@ -11,6 +11,7 @@
 
 #include "cli_options.hpp"
 #include "command.hpp"
+#include "mat_cli.hpp"
 
 namespace pdp {
 
@@ -24,6 +25,7 @@ struct CorrectOptions {
   std::string duration; ///< record length where the input lacks it (units allowed)
   std::string weighting; ///< AWCC's moments where the input does not record them: duration | none; empty = not known
   OptionSet flow;       ///< a profile's flow quantities (awcc/profile_flow.hpp)
+  MatOption mat;        ///< --mat, --mat-v73 (a JSON input)
 };
 
 void setup_correct(CLI::App& app, Command& command, CorrectOptions& options);

@@ -42,15 +42,7 @@ void setup_process(CLI::App& app, Command& command, ProcessCommandOptions& o) {
   const auto* out = "Output";
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"))->group(out);
   path_option(cmd->add_option("--csv", o.csv, "profile CSV file (several recordings; default: stdout)"))->group(out);
-  path_option(cmd->add_option("--mat", o.mat,
-                              "write the results as MATLAB variables: the JSON's content as structs (the profile's "
-                              "rows a struct array), and tables ready for struct2table with their units (one "
-                              "recording: its AWCC windows and bubbles; a profile: profile_table); version 5 "
-                              "(docs/output.md)"))
-      ->group(out);
-  cmd->add_flag("--mat-v73", o.mat_v73,
-                "--mat as MATLAB version 7.3 (HDF5; chosen anyway when a variable exceeds version 5's 2 GiB)")
-      ->group(out);
+  add_mat_options(cmd, o.mat, "the AWCC windows and bubbles (one recording) or profile_table (a profile)", out);
   path_option(cmd->add_option("--windows", o.windows, "AWCC per-window table as CSV (one recording)"))->group(out);
   path_option(cmd->add_option("--bubbles", o.bubbles,
                               "per-bubble table as CSV (one recording): the multi-tip vectors, or event detection's "

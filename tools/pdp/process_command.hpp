@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_options.hpp"
+#include "mat_cli.hpp"
 #include "command.hpp"
 
 namespace pdp {
@@ -15,8 +16,8 @@ struct ProcessCommandOptions {
   std::vector<std::string> files;
   OptionSet library;                                 // the libraries' options (awcc/options.hpp)
   OptionSet flow;                                    // a profile's flow quantities (awcc/profile_flow.hpp)
-  std::string json, csv, windows, bubbles, correlation_functions, spectrum, report, mat;  // output files
-  bool mat_v73 = false;  ///< --mat as MATLAB version 7.3 (HDF5)
+  std::string json, csv, windows, bubbles, correlation_functions, spectrum, report;  // output files
+  MatOption mat;                                     // --mat, --mat-v73
   std::string preset;                                // named option values (awcc::preset_settings)
   std::string positions, manifest;                   // profile positions
   std::string correct;                               // correction model (.qrf); empty = no correction

@@ -25,7 +25,7 @@ study::ProfileRun process_files(const ProcessCommandOptions& o, const Plan& plan
   options.flow = plan.flow;
   options.model = plan.model ? &*plan.model : nullptr;
   // The JSON (or the report made from it) records each input's SHA-256: hashed as the file is read.
-  options.hash_inputs = !o.json.empty() || !o.report.empty() || !o.mat.empty();
+  options.hash_inputs = !o.json.empty() || !o.report.empty() || !o.mat.path.empty();
   options.manifest = o.manifest;
   options.on_result = [](awcc::ProcessResult& r) { add_flag_hints(r); };
   options.progress = [&progress](double f) { progress(f); };

@@ -60,7 +60,7 @@ void check_output_names(const ProcessCommandOptions& o) {
   const std::vector<std::pair<const char*, const std::string*>> named = {
       {"--json", &o.json},       {"--csv", &o.csv},
       {"--windows", &o.windows}, {"--bubbles", &o.bubbles}, {"--correlation-functions", &o.correlation_functions},
-      {"--spectrum", &o.spectrum}, {"--report", &o.report}, {"--mat", &o.mat}};
+      {"--spectrum", &o.spectrum}, {"--report", &o.report}, {"--mat", &o.mat.path}};
   for (std::size_t a = 0; a < named.size(); ++a) {
     for (std::size_t b = a + 1; b < named.size(); ++b) {
       const auto& x = *named[a].second;
@@ -74,7 +74,7 @@ void check_output_names(const ProcessCommandOptions& o) {
     }
   }
   for (const auto& output :
-       {o.json, o.csv, o.windows, o.bubbles, o.correlation_functions, o.spectrum, o.report, o.mat}) {
+       {o.json, o.csv, o.windows, o.bubbles, o.correlation_functions, o.spectrum, o.report, o.mat.path}) {
     if (output.empty() || !std::filesystem::exists(output)) continue;
     for (const auto& input : o.files) {
       if (std::filesystem::equivalent(output, input)) {

@@ -78,9 +78,7 @@ awcc::MatTable mat_table(std::string name, const Columns& columns, const std::ve
 }
 
 // The tables of --mat (awcc/mat_output.hpp): one recording's AWCC windows
-// and bubbles; a profile's rows as the profile CSV's columns, each read from
-// the row's JSON at its pointer (a number, a switch as 1/0, a text; NaN or
-// "" where the row has none).
+// and bubbles; a profile's rows.
 std::vector<awcc::MatTable> mat_tables(const std::vector<awcc::ProcessResult>& results, const nlohmann::json& j) {
   std::vector<awcc::MatTable> out;
   if (results.size() == 1) {
@@ -89,34 +87,7 @@ std::vector<awcc::MatTable> mat_tables(const std::vector<awcc::ProcessResult>& r
     if (r.events) out.push_back(mat_table("event_bubbles", awcc::event_bubble_columns(), r.events->bubbles));
     if (r.probe) out.push_back(mat_table("bubbles", awcc::multi_tip_bubble_columns(), r.probe->vectors.bubbles));
   }
-  if (j.contains(awcc::process_key::profile)) {
-    awcc::MatTable t{"profile_table", {}};
-    for (const auto& c : awcc::profile_csv_columns()) {
-      if (c.json_pointer.empty()) continue;
-      const nlohmann::json::json_pointer at{std::string(c.json_pointer)};
-      const bool text = c.unit.empty();
-      std::vector<double> numbers;
-      std::vector<std::string> texts;
-      for (const auto& row : j[awcc::process_key::profile]) {
-        const auto* v = row.contains(at) ? &row[at] : nullptr;
-        if (text) {
-          std::string cell = !v || v->is_null() ? std::string() : v->is_string() ? v->get<std::string>() : v->dump();
-          // The CSV's rule: a file by its name.
-          if (c.name == awcc::profile_column::file) cell = std::filesystem::path(cell).filename().string();
-          texts.push_back(std::move(cell));
-        } else {
-          numbers.push_back(!v || !(v->is_number() || v->is_boolean()) ? std::nan("")
-                            : v->is_boolean()                          ? (v->get<bool>() ? 1.0 : 0.0)
-                                                                       : v->get<double>());
-        }
-      }
-      awcc::MatTable::Column col{std::string(c.name), std::string(c.unit), {}};
-      if (text) col.values = std::move(texts);
-      else col.values = std::move(numbers);
-      t.columns.push_back(std::move(col));
-    }
-    out.push_back(std::move(t));
-  }
+  for (auto& t : profile_mat_tables(j)) out.push_back(std::move(t));
   return out;
 }
 
@@ -147,15 +118,13 @@ Rendered render(const ProcessCommandOptions& o, const Plan& plan, const study::P
   const bool corrected = plan.model.has_value();
   const auto& flow = p.flow;
   Rendered out;
-  if (!o.json.empty() || !o.report.empty() || !o.mat.empty()) {
+  if (!o.json.empty() || !o.report.empty() || !o.mat.path.empty()) {
     auto j = study::profile_run_json(p, std::filesystem::path(o.correct).filename().string());
     // The inputs' digests were taken as they were read (process_files asks for them when the JSON is written).
     std::vector<awcc::ProvenanceInput> inputs;
     for (std::size_t i = 0; i < p.inputs.size(); ++i) inputs.push_back({p.inputs[i], results[i].input_sha256});
     j["provenance"] = awcc::provenance_json(plan.options, inputs, command_line());
-    if (!o.mat.empty()) {
-      out.mat = Rendered::Mat{o.mat, j, mat_tables(results, j), o.mat_v73 ? awcc::MatVersion::v7_3 : awcc::MatVersion::v5};
-    }
+    if (!o.mat.path.empty()) out.mat = Rendered::Mat{o.mat.path, j, mat_tables(results, j), o.mat.version()};
     if (!o.json.empty()) out.outputs.emplace_back(o.json, awcc::json_text(j));
     else if (!o.report.empty()) out.json_for_report = awcc::json_text(j);
   }

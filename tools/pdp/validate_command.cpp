@@ -23,6 +23,7 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
   cmd->add_option("--repeat", o.repeat, "runs with different seeds; means and 95 % intervals of every error")
       ->check(CLI::Range(1, 100000))->capture_default_str();
   path_option(cmd->add_option("--json", o.json, "write the results as JSON (keys in docs/output.md)"));
+  add_mat_options(cmd, o.mat, "");
   path_option(cmd->add_option("--profile", o.profile,
                               "a synthetic profile (samples/stepped-profile.toml): every position synthesised and "
                               "processed, every profile quantity (Y90, C_mean, d, N, q_w, the model's D, ...) "
@@ -36,12 +37,14 @@ void setup_validate(CLI::App& app, Command& command, ValidateOptions& o) {
 
 namespace {
 
-// The results printed, the JSON written when asked (under a temporary name):
-// the exit status.
+// The results printed, the JSON and the MAT file written when asked (each
+// under a temporary name): the exit status.
 int finish(const ValidateOptions& o, const nlohmann::json& j) {
-  if (o.json.empty()) return exit_ok;
   try {
-    awcc::write_text_atomically(o.json, awcc::json_text(j));
+    if (!o.json.empty()) awcc::check_output_folder(o.json);
+    if (!o.mat.path.empty()) awcc::check_output_folder(o.mat.path);
+    if (!o.json.empty()) awcc::write_text_atomically(o.json, awcc::json_text(j));
+    if (!o.mat.path.empty()) awcc::write_mat(o.mat.path, j, {}, o.mat.version());
   } catch (const std::exception& e) {
     return report_error(e);
   }
