@@ -49,10 +49,9 @@ double conformal_offset(std::vector<double> e, double alpha) {
   return e[rank - 1];
 }
 
-// A row's conformity scores for the 50, 80, 95 % intervals of a forest's quantiles.
-std::array<double, 3> interval_scores(const std::vector<double>& t, double target) {
-  std::array<double, 3> e{};
-  for (std::size_t k = 0; k < 3; ++k) e[k] = std::max(t[2 - k] - target, target - t[4 + k]);
+IntervalOffsets interval_scores(const std::vector<double>& t, double target) {
+  IntervalOffsets e{};
+  for (std::size_t k = 0; k < interval_count; ++k) e[k] = std::max(t[lower_level(k)] - target, target - t[upper_level(k)]);
   return e;
 }
 
@@ -117,9 +116,10 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
   Calibration c;
   c.window_edges = window_edges;
   c.tu_edges = tu_edges;
-  // Scores of each row: velocity then Tu, intervals 50, 80, 95 %; its
-  // window band and Tu band (the Tu forest's median, as correct() finds it).
-  std::vector<std::array<double, 6>> scores(rows.size());
+  // Scores of each row: velocity then Tu, each interval of
+  // interval_coverages; its window band and Tu band (the Tu forest's
+  // median, as correct() finds it).
+  std::vector<std::array<double, 2 * interval_count>> scores(rows.size());
   std::vector<int> band(rows.size()), tu_band(rows.size());
   // The truth's shift from the measurement (model.hpp, trust rule (a)): velocity, Tu.
   std::vector<std::array<double, 2>> shifts(rows.size());
@@ -135,15 +135,15 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
       const auto e = interval_scores(t, target);
       const double measured = f == 0 ? r.features.velocity : r.features.turbulence_intensity;
       shifts[i][static_cast<std::size_t>(f)] = target - to_target(form, measured, measured);
-      for (std::size_t k = 0; k < 3; ++k) scores[i][static_cast<std::size_t>(3 * f) + k] = e[k];
-      if (f == 1) tu_band[i] = c.tu_band(from_target(form, t[3], r.features.turbulence_intensity));
+      for (std::size_t k = 0; k < interval_count; ++k) scores[i][interval_count * static_cast<std::size_t>(f) + k] = e[k];
+      if (f == 1) tu_band[i] = c.tu_band(from_target(form, t[median_level], r.features.turbulence_intensity));
     }
     band[i] = c.band(r.features.windows_accepted);
   });
   // The offsets of the rows that `in` admits.
   auto offsets = [&](const std::function<bool(std::size_t)>& in, std::size_t column0) {
-    std::array<double, 3> q{};
-    for (std::size_t k = 0; k < 3; ++k) {
+    IntervalOffsets q{};
+    for (std::size_t k = 0; k < interval_count; ++k) {
       std::vector<double> e;
       for (std::size_t i = 0; i < rows.size(); ++i)
         if (in(i)) e.push_back(scores[i][column0 + k]);
@@ -168,7 +168,7 @@ Calibration calibrate(const CorrectionModel& model, const std::vector<TrainingRo
         in = [&band, w](std::size_t i) { return band[i] == w; };
       }
       c.velocity.push_back(offsets(in, 0));
-      c.turbulence_intensity.push_back(offsets(in, 3));
+      c.turbulence_intensity.push_back(offsets(in, interval_count));
     }
   }
   set_envelopes(c, model, band, tu_band, shifts);
@@ -206,8 +206,8 @@ int Calibration::tu_band(double tu_median) const {
   return h;
 }
 
-std::array<double, 3> Calibration::offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
-                                           double tu_median) const {
+IntervalOffsets Calibration::offsets(const std::vector<IntervalOffsets>& groups, std::int64_t windows,
+                                     double tu_median) const {
   return group_value(*this, groups, windows, tu_median);
 }
 
@@ -251,15 +251,14 @@ std::optional<std::array<double, 2>> envelope_of(std::vector<double> shifts, dou
   return std::array<double, 2>{std::max(0.0, -shifts[shifts.size() - k]), std::max(0.0, shifts[k - 1])};
 }
 
-void Calibration::apply(const std::array<double, 3>& offsets, std::vector<double>& t) {
-  // Levels 0.025 0.1 0.25 0.5 0.75 0.9 0.975: pairs (2, 4), (1, 5), (0, 6).
-  for (std::size_t k = 0; k < 3; ++k) {
-    t[2 - k] -= offsets[k];
-    t[4 + k] += offsets[k];
+void Calibration::apply(const IntervalOffsets& offsets, std::vector<double>& t) {
+  for (std::size_t k = 0; k < interval_count; ++k) {
+    t[lower_level(k)] -= offsets[k];
+    t[upper_level(k)] += offsets[k];
   }
   // A narrowed interval may not cross a narrower one or the median.
-  for (std::size_t k = 3; k-- > 0;) t[k] = std::min(t[k], t[k + 1]);
-  for (std::size_t k = 4; k < 7; ++k) t[k] = std::max(t[k], t[k - 1]);
+  for (std::size_t k = median_level; k-- > 0;) t[k] = std::min(t[k], t[k + 1]);
+  for (std::size_t k = median_level + 1; k < t.size(); ++k) t[k] = std::max(t[k], t[k - 1]);
 }
 
 }  // namespace correction

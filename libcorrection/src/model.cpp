@@ -397,7 +397,7 @@ Attempt awcc_attempt(const CorrectionModel& m, const Features& f) {
   auto velocity_t = quantiles_of(velocity_d);
   auto tu_t = quantiles_of(tu_d);
   // The group's Tu band: the Tu forest's own median, before calibration.
-  const double tu_median = from_target(m.turbulence_form, tu_t[3], f.turbulence_intensity);
+  const double tu_median = from_target(m.turbulence_form, tu_t[median_level], f.turbulence_intensity);
   if (!cal.empty()) {
     Calibration::apply(cal.offsets(cal.velocity, f.windows_accepted, tu_median), velocity_t);
     Calibration::apply(cal.offsets(cal.turbulence_intensity, f.windows_accepted, tu_median), tu_t);

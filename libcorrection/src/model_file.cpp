@@ -190,6 +190,25 @@ QuantileForest read_forest_v2(Reader& r, const std::string& expected, TargetForm
   }
 }
 
+// The offsets of one calibration group. Format 7 stores the four intervals
+// of interval_coverages; older formats the 50, 80 and 95 % ones, and their
+// 90 % offset is interpolated between the 80 and 95 % ones linearly in the
+// normal score z((1 + coverage) / 2): exact for normal forest errors, not a
+// conformal guarantee (model.hpp, Calibration).
+IntervalOffsets read_offsets(Reader& r, std::uint32_t version) {
+  IntervalOffsets o{};
+  for (std::size_t k = 0; k < interval_count; ++k) {
+    if (version < 7 && k == interval90) continue;
+    o[k] = r.f64();
+    if (!std::isfinite(o[k])) r.damaged("a calibration offset is not finite");
+  }
+  if (version < 7) {
+    constexpr double z80 = 1.2815515655446004, z90 = 1.6448536269514722, z95 = 1.959963984540054;
+    o[interval90] = o[interval80] + (o[interval95] - o[interval80]) * (z90 - z80) / (z95 - z80);
+  }
+  return o;
+}
+
 // Format 5: u32 E, then E x 2 values per quantity (the model's header).
 void write_envelopes(Writer& w, const Calibration& c,
                      std::initializer_list<const std::vector<std::array<double, 2>>*> quantities) {
@@ -360,11 +379,7 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
       }
       for (auto* b : {&c.velocity, &c.turbulence_intensity}) {
         b->resize(bands * tu_bands);
-        for (auto& band : *b)
-          for (double& o : band) {
-            o = r.f64();
-            if (!std::isfinite(o)) r.damaged("a calibration offset is not finite");
-          }
+        for (auto& band : *b) band = read_offsets(r, version);
       }
     }
   }
@@ -400,11 +415,7 @@ CorrectionModel CorrectionModel::parse(std::shared_ptr<const void> owner, std::s
       const auto calibrated = r.u32();
       if (calibrated > 1) r.damaged("FSCC calibration flag");
       if (calibrated == 1) {
-        f.calibration.velocity.resize(1);
-        for (double& o : f.calibration.velocity.front()) {
-          o = r.f64();
-          if (!std::isfinite(o)) r.damaged("a calibration offset is not finite");
-        }
+        f.calibration.velocity = {read_offsets(r, version)};
       }
       if (version >= 5) read_envelopes(r, 1, {&f.calibration.velocity_envelope});
       f.velocity = forest("fscc_velocity", f.form, static_cast<std::uint32_t>(fscc_names.size()));

@@ -24,9 +24,9 @@ ProfileRowOf profile_row(const RowFields& f) {
   const auto& v = f.velocities;
   if (v.correction && v.correction->corrected && v.correction->forest == "awcc" && v.correction->velocity) {
     const auto& c = *v.correction;
-    const auto& q = *c.velocity;  // at correction_levels: q[3] the median, front and back 2.5 and 97.5 %
+    const auto& q = *c.velocity;  // at correction_levels: front and back 2.5 and 97.5 %
     if (!(c.fscc && c.fscc_ci95 && (q.back() < c.fscc_ci95->lower || q.front() > c.fscc_ci95->upper))) {
-      row.u = q[3];
+      row.u = q[median_level];
       row.u_source = awcc::FlowVelocitySource::corrected_awcc;
       for (std::size_t i = 0; i < correction_levels.size(); ++i) row.u_quantiles.push_back({correction_levels[i], q[i]});
       row.u_sampling_ci95 = c.awcc_ci95;
@@ -35,7 +35,7 @@ ProfileRowOf profile_row(const RowFields& f) {
     out.note = fmt::format("{}: the corrected AWCC velocity {:.3f} m/s (95 % {:.3f}-{:.3f}) excludes FSCC's {:.3f} "
                            "m/s (95 % {:.3f}-{:.3f}): the methods disagree beyond their uncertainty, so the row "
                            "contributes its uncorrected velocity (METHOD 12 as docs/validation.md decides it)",
-                           row.name, q[3], q.front(), q.back(), *c.fscc, c.fscc_ci95->lower, c.fscc_ci95->upper);
+                           row.name, q[median_level], q.front(), q.back(), *c.fscc, c.fscc_ci95->lower, c.fscc_ci95->upper);
   }
   switch (v.source) {
     case awcc::VelocitySource::awcc:

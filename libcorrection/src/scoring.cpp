@@ -40,7 +40,7 @@ struct QuantityScores {
   double pinball = 0.0, covered80 = 0.0, covered95 = 0.0;
   std::vector<double> abs_raw, abs_corrected, losses;
 
-  void add(double raw_error, double corrected_error, double truth, const std::array<double, 7>& q, double loss) {
+  void add(double raw_error, double corrected_error, double truth, const std::array<double, correction_levels.size()>& q, double loss) {
     square_raw += raw_error * raw_error;
     square_corrected += corrected_error * corrected_error;
     sum_raw += raw_error;
@@ -49,8 +49,8 @@ struct QuantityScores {
     abs_corrected.push_back(std::fabs(corrected_error));
     losses.push_back(loss);
     pinball += loss;
-    covered80 += (truth >= q[1] && truth <= q[5]) ? 1.0 : 0.0;
-    covered95 += (truth >= q[0] && truth <= q[6]) ? 1.0 : 0.0;
+    covered80 += (truth >= q[lower_level(interval80)] && truth <= q[upper_level(interval80)]) ? 1.0 : 0.0;
+    covered95 += (truth >= q[lower_level(interval95)] && truth <= q[upper_level(interval95)]) ? 1.0 : 0.0;
   }
 
   /// rmse, median |error|, mean error (raw, corrected), pinball, coverages.
@@ -136,9 +136,9 @@ FsccScores score_fscc(const CorrectionModel& scorer, const std::vector<TrainingR
     sq_corrected += corrected * corrected;
     abs_raw.push_back(std::fabs(raw));
     abs_corrected.push_back(std::fabs(corrected));
-    const auto& q = c.velocity->quantiles;
-    sc.coverage80 += q[1] <= r.true_velocity && r.true_velocity <= q[5];
-    sc.coverage95 += q[0] <= r.true_velocity && r.true_velocity <= q[6];
+    const auto& q = *c.velocity;
+    sc.coverage80 += q.lower(interval80) <= r.true_velocity && r.true_velocity <= q.upper(interval80);
+    sc.coverage95 += q.lower(interval95) <= r.true_velocity && r.true_velocity <= q.upper(interval95);
     ++sc.rows;
   }
   if (sc.rows > 0) {
@@ -301,18 +301,18 @@ std::vector<BandScores> scores_by_band(const std::vector<HeldOutPrediction>& pre
       if (!b.holds(p)) continue;
       ++c.runs;
       if (!p.correction.velocity || !p.correction.turbulence_intensity) continue;  // untrusted rows scored too
-      const auto& u = p.correction.velocity->quantiles;
-      const auto& t = p.correction.turbulence_intensity->quantiles;
+      const auto& u = *p.correction.velocity;
+      const auto& t = *p.correction.turbulence_intensity;
       const double uu = p.row.true_velocity, tt = p.row.true_turbulence_intensity;
       const double ur = p.row.features.velocity / uu - 1.0, uc = p.correction.velocity->median() / uu - 1.0;
       const double tr = p.row.features.turbulence_intensity - tt, tc = p.correction.turbulence_intensity->median() - tt;
       u_sq_raw += ur * ur, u_sq_corrected += uc * uc, t_sq_raw += tr * tr, t_sq_corrected += tc * tc;
       u_raw.push_back(std::fabs(ur)), u_corrected.push_back(std::fabs(uc));
       t_raw.push_back(std::fabs(tr)), t_corrected.push_back(std::fabs(tc));
-      c.velocity80 += u[1] <= uu && uu <= u[5];
-      c.velocity95 += u[0] <= uu && uu <= u[6];
-      c.tu80 += t[1] <= tt && tt <= t[5];
-      c.tu95 += t[0] <= tt && tt <= t[6];
+      c.velocity80 += u.lower(interval80) <= uu && uu <= u.upper(interval80);
+      c.velocity95 += u.lower(interval95) <= uu && uu <= u.upper(interval95);
+      c.tu80 += t.lower(interval80) <= tt && tt <= t.upper(interval80);
+      c.tu95 += t.lower(interval95) <= tt && tt <= t.upper(interval95);
       ++c.rows;
     }
     if (c.rows == 0) continue;  // a band the runs do not reach (fs bands of a 500 kHz campaign)

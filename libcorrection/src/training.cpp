@@ -109,14 +109,14 @@ void train_fscc(const TrainingSet& set, const TrainOptions& o, const ForestOptio
             ? fmt::format("calibrated on the {} calibration runs AWCC cannot serve", unserved.size())
             : fmt::format("calibrated on all {} calibration runs (only {} that AWCC cannot serve, fewer than 100)",
                           calibration_rows.size(), unserved.size());
-    std::vector<std::array<double, 3>> scores(calibrating_rows.size());
+    std::vector<IntervalOffsets> scores(calibrating_rows.size());
     parallel_for(calibrating_rows.size(), o.threads, [&](std::size_t i) {
       const auto& r = calibrating_rows[i];
       scores[i] = interval_scores(f.velocity.quantiles(vector_of(r.features, names), correction_levels),
                                   to_target(f.form, r.true_velocity, r.features.fscc_velocity));
     });
-    std::array<double, 3> q{};
-    for (std::size_t k = 0; k < 3; ++k) {
+    IntervalOffsets q{};
+    for (std::size_t k = 0; k < interval_count; ++k) {
       std::vector<double> e;
       for (const auto& sc : scores) e.push_back(sc[k]);
       q[k] = conformal_offset(std::move(e), calibration_alpha[k]);

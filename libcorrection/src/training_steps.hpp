@@ -53,13 +53,14 @@ Split split_runs(std::vector<TrainingRow> rows, const TrainOptions& o);
 std::vector<TrainingRow> with_unweighted_twins(const std::vector<TrainingRow>& rows);
 
 // --- Calibration's scores (calibration.cpp) ---
-/// The 50, 80 and 95 % intervals' miscoverage.
-inline constexpr std::array<double, 3> calibration_alpha{0.5, 0.2, 0.05};
+/// The intervals' miscoverage, 1 - interval_coverages (model.hpp).
+inline constexpr IntervalOffsets calibration_alpha{0.5, 0.2, 0.1, 0.05};
 /// Q = E_k, k = ceil((n + 1)(1 - alpha)) of the scores (model.hpp,
 /// Calibration); infinity-needing k > n is refused.
 double conformal_offset(std::vector<double> e, double alpha);
-/// A row's conformity scores for the 50, 80, 95 % intervals of a forest's quantiles.
-std::array<double, 3> interval_scores(const std::vector<double>& t, double target);
+/// A row's conformity scores for the intervals of a forest's quantiles t at
+/// correction_levels: max(lower - target, target - upper) of each.
+IntervalOffsets interval_scores(const std::vector<double>& t, double target);
 /// The envelopes of trust rule (a) from rows' shifts {velocity, Tu} and their groups.
 void set_envelopes(Calibration& c, const CorrectionModel& model, const std::vector<int>& band,
                    const std::vector<int>& tu_band, const std::vector<std::array<double, 2>>& shifts);

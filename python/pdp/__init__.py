@@ -653,7 +653,7 @@ def correct(results, model, *, dx=None, dy=None, np=None, **options):
     correction model (.qrf from ``pdp train``): ``results`` is what
     ``pdp.process`` returns (one recording or a profile) or a process JSON
     loaded as a dict. Returns the results with a ``correction`` object per
-    recording (median, 80 % and 95 % quantiles of u and Tu, or why not
+    recording (median and nine quantiles, 2.5-97.5 %, of u and Tu, or why not
     corrected), as ``pdp correct`` writes them, each recording's windows,
     correlation, spectrum, bubbles and vectors kept. ``dx``, ``dy`` (m) and ``np``
     fill values the results lack. A profile with every position gets its

@@ -164,7 +164,7 @@ c = j["correction"]
 assert c["in_range"] is True and c["reason"] is None, c
 for q in ("velocity", "turbulence_intensity"):
     qs = c[q]["quantiles"]
-    assert list(qs) == ["0.025", "0.1", "0.25", "0.5", "0.75", "0.9", "0.975"], list(qs)
+    assert list(qs) == ["0.025", "0.05", "0.1", "0.25", "0.5", "0.75", "0.9", "0.95", "0.975"], list(qs)
     v = list(qs.values())
     assert v == sorted(v), v
     assert c[q]["median"] == qs["0.5"]

@@ -181,8 +181,8 @@ TEST(Correction, FileIsLittleEndianWhateverTheMachine) {
   const auto bytes = small_model().serialise();
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "pdp-qrf\n");
-  // Format version 6 as u32 little-endian.
-  EXPECT_EQ(bytes[8], 6);
+  // Format version 7 as u32 little-endian.
+  EXPECT_EQ(bytes[8], 7);
   EXPECT_EQ(bytes[9], 0);
   EXPECT_EQ(bytes[10], 0);
   EXPECT_EQ(bytes[11], 0);
@@ -214,8 +214,8 @@ TEST(Correction, DamagedForeignAndNewerFilesAreRefused) {
   const std::string text = "velocity,turbulence_intensity\n1,2\n";
   EXPECT_NE(message({text.begin(), text.end()}).find("not a pdp model file"), std::string::npos);
   auto newer = bytes;
-  newer[8] = 7;
-  EXPECT_NE(message(newer).find("version 7"), std::string::npos) << message(newer);
+  newer[8] = 8;
+  EXPECT_NE(message(newer).find("version 8"), std::string::npos) << message(newer);
   // A structural fault with a valid checksum: the reader checks the trees too.
   auto forged = bytes;
   // The first tree's root node follows the velocity targets; find it by
@@ -354,8 +354,11 @@ TEST(Correction, JsonHasTheDocumentedKeys) {
   EXPECT_TRUE(j["reason"].is_null());
   for (const char* q : {"velocity", "turbulence_intensity"}) {
     const auto& quantiles = j[q]["quantiles"];
-    ASSERT_EQ(quantiles.size(), 7u);
-    for (const char* key : {"0.025", "0.1", "0.25", "0.5", "0.75", "0.9", "0.975"}) ASSERT_TRUE(quantiles.contains(key)) << key;
+    // pdp-uq's nine levels.
+    ASSERT_EQ(quantiles.size(), 9u);
+    for (const char* key : {"0.025", "0.05", "0.1", "0.25", "0.5", "0.75", "0.9", "0.95", "0.975"}) {
+      ASSERT_TRUE(quantiles.contains(key)) << key;
+    }
     EXPECT_EQ(j[q]["median"], quantiles["0.5"]);
   }
 }
@@ -523,11 +526,11 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   std::vector<double> x;
   for (const auto& n : names) x.push_back(*f.value(n));
   const auto q = m.velocity.quantiles(x, correction::correction_levels);
-  EXPECT_DOUBLE_EQ(c.velocity->median(), correction::from_target(m.velocity_form, q[3], f.velocity));
+  EXPECT_DOUBLE_EQ(c.velocity->median(), correction::from_target(m.velocity_form, q[correction::median_level], f.velocity));
   const auto bytes = m.serialise();
   std::uint32_t version = 0;
   std::memcpy(&version, bytes.data() + 8, 4);
-  EXPECT_EQ(version, 6u);
+  EXPECT_EQ(version, 7u);
   EXPECT_EQ(CorrectionModel::parse(bytes, "x.qrf").serialise(), bytes);
   // The data yield: accepted over formed windows, when both are known.
   Features y = inside();
@@ -961,3 +964,41 @@ TEST(Correction, TheModelForSixtySecondRecordsAt500kHzStillCorrects) {
 }
 
 }  // namespace
+
+TEST(Correction, OlderFilesTakeTheirNinetyPercentOffsetBetweenTheirEightyAndNinetyFive) {
+  // Files before format 7 hold the 50, 80 and 95 % offsets only; the 90 %
+  // one is read as their interpolation in the normal score, where z(0.90) =
+  // 1.6449 lies 0.5355 of the way from z(0.80) = 1.2816 to z(0.95) = 1.9600.
+  // The model shipped before the time-prior retrain is of format 6.
+  const auto path = pdp_test::source_dir() / "samples" / "model" / "awcc.qrf";
+  std::ifstream in(path, std::ios::binary);
+  char head[12] = {};
+  in.read(head, 12);
+  ASSERT_EQ(head[8], 6) << path << " is no longer of format 6: point this test at the file kept from before";
+  const auto m = CorrectionModel::load(path);
+  ASSERT_FALSE(m.calibration.empty());
+  for (const auto* groups : {&m.calibration.velocity, &m.calibration.turbulence_intensity}) {
+    for (const auto& o : *groups) {
+      const double w = (1.6448536269514722 - 1.2815515655446004) / (1.959963984540054 - 1.2815515655446004);
+      EXPECT_NEAR(w, 0.5355, 1e-4);
+      EXPECT_NEAR(o[correction::interval90], (1 - w) * o[correction::interval80] + w * o[correction::interval95], 1e-15);
+    }
+  }
+  // A corrected row's nine quantiles are in order, the 90 % interval inside the 95 % and around the 80 %.
+  Features f = inside();
+  f.velocity = 3.0;
+  f.fs = 20e3;
+  f.duration = 45;
+  f.windows_accepted = 30;
+  f.windows_total = 300;
+  f.time_scale_ratio = 2.0;
+  const auto c = m.correct(f);
+  ASSERT_TRUE(c.corrected()) << c.message;
+  const auto& q = c.velocity->quantiles;
+  EXPECT_TRUE(std::is_sorted(q.begin(), q.end()));
+  EXPECT_LE(c.velocity->lower(correction::interval95), c.velocity->lower(correction::interval90));
+  EXPECT_LE(c.velocity->lower(correction::interval90), c.velocity->lower(correction::interval80));
+  // Written again, it is format 7 with the same numbers.
+  const auto back = CorrectionModel::parse(m.serialise(), "again.qrf");
+  EXPECT_EQ(back.calibration.velocity, m.calibration.velocity);
+}

@@ -176,7 +176,7 @@ correction::RowFields corrected_fields(awcc::Interval95 fscc_ci95, bool awcc_low
   correction::RowVelocities::Corrected c;
   c.corrected = true;
   c.forest = "awcc";
-  c.velocity = std::array<double, 7>{2.0, 2.05, 2.1, 2.2, 2.3, 2.35, 2.4};
+  c.velocity = std::array<double, 9>{2.0, 2.03, 2.05, 2.1, 2.2, 2.3, 2.35, 2.37, 2.4};
   c.awcc_ci95 = v.awcc_ci95;
   c.fscc = v.fscc;
   c.fscc_ci95 = fscc_ci95;

@@ -694,14 +694,20 @@ TEST(Calibration, TooFewRunsAreRefusedNotGuessed) {
 
 TEST(Calibration, ApplyKeepsTheQuantilesInOrder) {
   // A narrowing larger than an interval's half width stops at the median.
-  std::vector<double> t{-3, -2, -1, 0, 1, 2, 3};
-  correction::Calibration::apply({5.0, -10.0, 1.0}, t);
-  // 50 % widened to -6..6; 80 % narrowed past the median and 95 % to -4..4:
-  // both are held at least as wide as the 50 % interval.
-  EXPECT_EQ(t, (std::vector<double>{-6, -6, -6, 0, 6, 6, 6}));
-  std::vector<double> u{-3, -2, -1, 0, 1, 2, 3};
-  correction::Calibration::apply({-5.0, 0.0, 0.0}, u);
-  EXPECT_EQ(u, (std::vector<double>{-3, -2, 0, 0, 0, 2, 3}));
+  // Levels 0.025 0.05 0.1 0.25 0.5 0.75 0.9 0.95 0.975; offsets of the 50,
+  // 80, 90 and 95 % intervals.
+  std::vector<double> t{-4, -3, -2, -1, 0, 1, 2, 3, 4};
+  correction::Calibration::apply({5.0, -10.0, 0.0, 1.0}, t);
+  // 50 % widened to -6..6; 80 % narrowed past the median, 90 % kept at
+  // -3..3 and 95 % widened to -5..5: all held at least as wide as the 50 %.
+  EXPECT_EQ(t, (std::vector<double>{-6, -6, -6, -6, 0, 6, 6, 6, 6}));
+  std::vector<double> u{-4, -3, -2, -1, 0, 1, 2, 3, 4};
+  correction::Calibration::apply({-5.0, 0.0, 0.0, 0.0}, u);
+  EXPECT_EQ(u, (std::vector<double>{-4, -3, -2, 0, 0, 0, 2, 3, 4}));
+  // Each offset moves its own pair of levels.
+  std::vector<double> w{-4, -3, -2, -1, 0, 1, 2, 3, 4};
+  correction::Calibration::apply({0.0, 0.0, 0.5, 0.0}, w);
+  EXPECT_EQ(w, (std::vector<double>{-4, -3.5, -2, -1, 0, 1, 2, 3.5, 4}));
 }
 
 TEST(Training, ScoresByBandCountEachBandsRowsInsideTheirIntervalsAndTheirErrors) {
@@ -717,8 +723,8 @@ TEST(Training, ScoresByBandCountEachBandsRowsInsideTheirIntervalsAndTheirErrors)
     p.row.features.turbulence_intensity = 0.12;  // raw AWCC
     p.correction.status = correction::CorrectionStatus::corrected;
     correction::CorrectedQuantity u, t;
-    u.quantiles = {7, 8, 9, 10, 11, 12, 13};
-    t.quantiles = {0.0, 0.1, 0.12, 0.15, 0.18, 0.2, 0.4};
+    u.quantiles = {7, 7.5, 8, 9, 10, 11, 12, 12.5, 13};
+    t.quantiles = {0.0, 0.05, 0.1, 0.12, 0.15, 0.18, 0.2, 0.3, 0.4};
     p.correction.velocity = u;
     p.correction.turbulence_intensity = t;
     return p;

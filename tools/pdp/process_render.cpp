@@ -36,15 +36,16 @@ std::string correction_report(const correction::Correction& c) {
     out = fmt::format(
         "  correction (quantile regression forest, {} forest):\n"
         "    velocity             {:.4f} m/s median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
-        c.forest == "fscc" ? "FSCC" : "AWCC", u.median(), u.quantiles[1], u.quantiles[5], u.quantiles[0],
-        u.quantiles[6], u.measured);
+        c.forest == "fscc" ? "FSCC" : "AWCC", u.median(), u.lower(correction::interval80),
+        u.upper(correction::interval80), u.lower(correction::interval95), u.upper(correction::interval95), u.measured);
     if (const auto& t = c.turbulence_intensity; t && c.large_bubbles) {
       out += fmt::format("    turbulence intensity: {} (forest's median {:.4f}, measured {:.4f})\n", c.turbulence_message,
                          t->median(), t->measured);
     } else if (t) {
       out += fmt::format(
           "    turbulence intensity {:.4f} median; 80 % {:.4f} - {:.4f}, 95 % {:.4f} - {:.4f} (measured {:.4f})\n",
-          t->median(), t->quantiles[1], t->quantiles[5], t->quantiles[0], t->quantiles[6], t->measured);
+          t->median(), t->lower(correction::interval80), t->upper(correction::interval80),
+          t->lower(correction::interval95), t->upper(correction::interval95), t->measured);
     } else {
       out += "    turbulence intensity not corrected (the FSCC forest corrects the velocity only)\n";
     }

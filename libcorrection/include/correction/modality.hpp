@@ -47,7 +47,10 @@
 
 namespace correction {
 
-/// The levels the test reads: the reported ones (model.hpp, correction_levels).
+/// The levels the test reads: those the limit was set on (docs/validation.md),
+/// the reported ones before format 7 added 0.05 and 0.95 (model.hpp,
+/// correction_levels). Their own list, so that reporting more levels does
+/// not move a decided rule.
 inline constexpr std::array<double, 7> modality_levels{0.025, 0.1, 0.25, 0.5, 0.75, 0.9, 0.975};
 
 struct Dip {

@@ -113,6 +113,8 @@
 // ("fscc_velocity"). Version 5 adds, after the calibration offsets, the
 // envelopes of rule (a): u32 E (0: none, 1: pooled, or B x T: per group),
 // then E x 2 values (below, above) for the velocity and E x 2 for Tu.
+// Version 7 stores 4 offsets wherever earlier versions store 3 (the 50, 80,
+// 90 and 95 % intervals of the nine reported levels, against 50, 80, 95 %).
 // A file that is not a model, of a newer version, truncated or damaged is
 // refused with a message naming the file and the fix.
 
@@ -133,10 +135,25 @@
 
 namespace correction {
 
-/// The quantile levels every correction reports.
-inline constexpr std::array<double, 7> correction_levels{0.025, 0.1, 0.25, 0.5, 0.75, 0.9, 0.975};
+/// The quantile levels every correction reports: pdp-uq's nine (issue 51).
+/// Pairs symmetric about the median bound the central intervals of
+/// interval_coverages.
+inline constexpr std::array<double, 9> correction_levels{0.025, 0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95, 0.975};
 /// Their JSON keys and CSV suffixes.
-inline constexpr std::array<const char*, 7> correction_level_names{"0.025", "0.1", "0.25", "0.5", "0.75", "0.9", "0.975"};
+inline constexpr std::array<const char*, 9> correction_level_names{"0.025", "0.05", "0.1",  "0.25", "0.5",
+                                                                   "0.75",  "0.9",  "0.95", "0.975"};
+/// The median's index in correction_levels.
+inline constexpr std::size_t median_level = 4;
+/// The central intervals, narrowest first: interval k runs from the level
+/// lower_level(k) to upper_level(k).
+inline constexpr std::array<double, 4> interval_coverages{0.5, 0.8, 0.9, 0.95};
+inline constexpr std::size_t interval_count = interval_coverages.size();
+inline constexpr std::size_t interval80 = 1, interval90 = 2, interval95 = 3;
+constexpr std::size_t lower_level(std::size_t interval) { return median_level - 1 - interval; }
+constexpr std::size_t upper_level(std::size_t interval) { return median_level + 1 + interval; }
+static_assert(2 * interval_count + 1 == correction_levels.size());
+/// A conformal offset per central interval (Calibration), in target units.
+using IntervalOffsets = std::array<double, interval_count>;
 
 /// The keys of a correction as to_json(Correction) writes it that are read
 /// back (a profile's flow reads the corrected velocity), and the key of a
@@ -183,8 +200,11 @@ FeatureRange accepted_range(const FeatureRange& training, double margin);
 
 struct CorrectedQuantity {
   double measured = 0.0;
-  std::array<double, 7> quantiles{};  ///< at correction_levels
-  [[nodiscard]] double median() const { return quantiles[3]; }
+  std::array<double, correction_levels.size()> quantiles{};  ///< at correction_levels
+  [[nodiscard]] double median() const { return quantiles[median_level]; }
+  /// The bounds of central interval k (interval80, interval95, ...).
+  [[nodiscard]] double lower(std::size_t interval) const { return quantiles[lower_level(interval)]; }
+  [[nodiscard]] double upper(std::size_t interval) const { return quantiles[upper_level(interval)]; }
 };
 
 /// The correction of one row: a value with a status.
@@ -267,8 +287,11 @@ struct Calibration {
   /// empty: one Tu band (format 3 files).
   std::vector<double> tu_edges;
   /// Per group (window band w, Tu band h at w x (tu_edges.size() + 1) + h):
-  /// Q of the 50 %, 80 % and 95 % intervals, in target units.
-  std::vector<std::array<double, 3>> velocity, turbulence_intensity;
+  /// Q of the intervals of interval_coverages (50, 80, 90, 95 %), in
+  /// target units. A model of format 6 or older has no 90 % offset; it is
+  /// read as the 80 and 95 % offsets' interpolation in the normal score
+  /// (model_file.cpp), not a conformal one.
+  std::vector<IntervalOffsets> velocity, turbulence_intensity;
   /// The envelopes of rule (a) (the trust rules above): {below, above}, the
   /// truth's shift from the measurement held by envelope_coverage of the
   /// runs, in target units; per group, one pooled, or none.
@@ -284,8 +307,8 @@ struct Calibration {
   [[nodiscard]] std::size_t tu_bands() const { return tu_edges.size() + 1; }
   /// The offsets of a row: its group's, or with unknown windows each
   /// interval's widest over the window bands at its Tu band.
-  [[nodiscard]] std::array<double, 3> offsets(const std::vector<std::array<double, 3>>& groups, std::int64_t windows,
-                                              double tu_median) const;
+  [[nodiscard]] IntervalOffsets offsets(const std::vector<IntervalOffsets>& groups, std::int64_t windows,
+                                        double tu_median) const;
   /// The envelope of a row the same way (the pooled one when there is one);
   /// empty when there is none.
   [[nodiscard]] std::optional<std::array<double, 2>> envelope(const std::vector<std::array<double, 2>>& groups,
@@ -294,7 +317,7 @@ struct Calibration {
   [[nodiscard]] std::string group_text(std::int64_t windows, double tu_median) const;
   /// Applies the offsets of `band` to the quantiles t at correction_levels
   /// (target units), keeping them in order.
-  static void apply(const std::array<double, 3>& offsets, std::vector<double>& t);
+  static void apply(const IntervalOffsets& offsets, std::vector<double>& t);
 };
 
 /// The second forest of an extended model: the mean velocity from FSCC's
@@ -308,7 +331,7 @@ struct FsccForest {
 };
 
 struct CorrectionModel {
-  static constexpr std::uint32_t format_version = 6;
+  static constexpr std::uint32_t format_version = 7;
 
   std::string provenance;             ///< how the model was made (sweep, rows, options, held-out scores)
   std::vector<FeatureRange> ranges;   ///< training data [min, max] per feature, feature order
