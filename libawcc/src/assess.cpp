@@ -93,6 +93,34 @@ std::optional<EventsComparison> compare_multi_tip(const MultiTipResult& vectors,
 // band (event_detection.hpp): the comparison is what catches that.
 void judge_events(EventResult& e, const ProcessResult& out) {
   if (!e.ok()) return;
+  // The resolution rule: paired bubbles whose centre lags spread less than
+  // least_crossing_spread of a sample (sd) have no spread the interface
+  // times resolve. Interpolated crossings of edges that carry little time
+  // (libsynth's voltages at 20 kHz, lags of 5 samples: Tu 0.002 for a true
+  // 0.05) pass the one-lag rule with such a spread; whole-sample lags that
+  // are not all one have a spread of 0.2 sample or more.
+  if (e.turbulence_measured && out.info.fs > 0.0) {
+    std::vector<double> lags;
+    for (const auto& b : e.bubbles)
+      if (b.fate == BubbleFate::paired) lags.push_back(b.centre_lag * out.info.fs);
+    if (lags.size() >= 2) {
+      double mean = 0.0;
+      for (double l : lags) mean += l;
+      mean /= static_cast<double>(lags.size());
+      double ss = 0.0;
+      for (double l : lags) ss += (l - mean) * (l - mean);
+      const double sd = std::sqrt(ss / static_cast<double>(lags.size() - 1));
+      if (sd < least_crossing_spread) {
+        e.turbulence_measured = false;
+        if (e.quality == AwccQuality::ok) e.quality = AwccQuality::low;
+        const std::string why = fmt::format(
+            "the {} paired bubbles' centre lags spread by {:.3f} of a sample (sd), less than the {} the interface "
+            "times resolve: Tu is not measured (sample faster)",
+            lags.size(), sd, least_crossing_spread);
+        e.quality_reason = e.quality_reason.empty() ? why : e.quality_reason + "; " + why;
+      }
+    }
+  }
   const auto c = compare_events(e, out);
   if (!c || !c->disagree()) return;
   if (e.quality == AwccQuality::ok) e.quality = AwccQuality::low;

@@ -13,6 +13,10 @@ namespace awcc {
 
 std::string_view to_string(Pairing pairing) { return pairing == Pairing::kramer ? "kramer" : "shen"; }
 
+std::string_view to_string(InterfaceTiming timing) {
+  return timing == InterfaceTiming::midpoint ? "midpoint" : "crossing";
+}
+
 std::string_view to_string(BubbleFate fate) {
   const auto i = static_cast<std::size_t>(fate);
   return i < bubble_fate_names.size() ? bubble_fate_names[i] : "?";
@@ -234,8 +238,11 @@ void summarise_events(EventResult& result, const EventOptions& options) {
       detail::reported_quality(result.bubbles_paired, result.bubbles_complete, options.bubbles_ok,
                                options.pairing_yield_ok, intervals,
                                {"paired bubbles", "pairing yield", "complete leading bubbles paired", "the paired bubbles"});
-  // The spread rule: bubbles that all share one centre lag have no measured spread.
-  if (std::all_of(values.begin(), values.end(), [&](double v) { return v == values.front(); })) {
+  // The spread rule: bubbles that all share one centre lag have no measured
+  // spread. One lag, not one double: interface times at different places of
+  // the record round differently (1e-13 of a lag), which is no spread.
+  if (std::all_of(values.begin(), values.end(),
+                  [&](double v) { return std::fabs(v - values.front()) <= 1e-9 * std::fabs(values.front()); })) {
     result.turbulence_measured = false;
     result.quality = AwccQuality::low;
     result.quality_reason = fmt::format(

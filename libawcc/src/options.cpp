@@ -470,6 +470,13 @@ const OptionField<M> kMultiTip[] = {
 
 using E = EventOptions;
 const OptionField<E> kEvents[] = {
+    {"interface-times", "",
+     "event detection's and the multi-tip pairing's interface times: midpoint (half way between the samples that "
+     "straddle the edge: lags of whole samples) | crossing (where the voltage crosses the threshold, interpolated "
+     "between the two samples: lags below a sample; one more pass over the file; a binary signal gives the "
+     "midpoint)",
+     [](E& o, std::string_view t) { o.interface_times = choice(t, values::interface_timing); },
+     [](const E& o) { return name_of(o.interface_times); }},
     {"pairing", "",
      "event detection's interface pairing: kramer (Kramer et al. 2020: centre lag and chord-time disparity) | shen "
      "(Shen et al. 2005: lags within |S| / (f V_gas), V_gas from FSCC or AWCC)",

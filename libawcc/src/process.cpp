@@ -658,6 +658,139 @@ BinarisedRecording binarise_recording(Recording& opened, const ProcessOptions& g
   return out;
 }
 
+std::vector<Crossing> BinarisedRecording::tip_crossings(std::size_t k) const {
+  if (k < crossings.size()) return crossings[k];
+  const AirIntervals& signal = k == 0 ? leading : k == 1 ? trailing : further_tips.at(k - 2).signal;
+  return awcc::crossings(signal);
+}
+
+namespace {
+
+// One tip's edges in time order (front of interval j at 2j, rear at 2j + 1),
+// each timed from the two samples around it as the blocks pass.
+class EdgeTimer {
+ public:
+  EdgeTimer(const Threshold& t, const AirIntervals& signal, std::vector<Crossing>& out)
+      : signal_(signal), out_(out) {
+    const bool air_low = t.probe == ProbeType::conductivity;
+    // The level each direction compares with (Binariser::feed).
+    if (t.rule == ThresholdRule::hysteresis) {
+      front_level_ = air_low ? t.lower : t.upper;
+      rear_level_ = air_low ? t.upper : t.lower;
+    } else {
+      front_level_ = rear_level_ = air_low ? t.upper : t.lower;
+    }
+  }
+
+  // Samples [first, first + frames) of this tip: values[first_value + i * stride].
+  void feed(std::span<const float> values, std::size_t first_value, std::size_t stride, std::int64_t first,
+            std::int64_t frames) {
+    const auto& intervals = signal_.intervals;
+    const std::size_t edges = 2 * intervals.size();
+    auto value = [&](std::int64_t n) { return static_cast<double>(values[first_value + static_cast<std::size_t>(n - first) * stride]); };
+    for (; next_ < edges; ++next_) {
+      const auto& interval = intervals[next_ / 2];
+      const bool front = next_ % 2 == 0;
+      const std::int64_t n = front ? interval.start : interval.stop;
+      if (n >= first + frames) break;
+      // At the record's ends the interface is outside the record: the midpoint stays.
+      if (n == 0 || n >= signal_.sample_count) continue;
+      const double before = n - 1 >= first ? value(n - 1) : previous_;
+      const double at = value(n);
+      double f = ((front ? front_level_ : rear_level_) - before) / (at - before);
+      if (!std::isfinite(f)) f = 0.5;
+      f = std::clamp(f, 0.0, 1.0);
+      (front ? fronts_ : rears_).push_back(f);
+      (front ? out_[next_ / 2].front : out_[next_ / 2].rear) = (static_cast<double>(n - 1) + f) / signal_.fs;
+    }
+    if (frames > 0) previous_ = value(first + frames - 1);
+  }
+
+  // Edges sharper than a sample cross the level at one fraction, whatever
+  // the interface's true time: their crossings hold no sub-sample time, only
+  // noise, which would break the ties of whole-sample lags and pass as a
+  // measured spread (event_detection.hpp, item 9). Such an edge direction
+  // (the middle half of its fractions narrower than `least_spread` of a
+  // sample) keeps the midpoints; says which, or "".
+  std::string keep_informative(double least_spread, const std::string& tip) {
+    std::string out;
+    for (const bool front : {true, false}) {
+      auto& f = front ? fronts_ : rears_;
+      if (f.size() < 20) continue;
+      std::sort(f.begin(), f.end());
+      const double spread = f[3 * f.size() / 4] - f[f.size() / 4];
+      if (spread >= least_spread) continue;
+      const auto midpoints = crossings(signal_);
+      for (std::size_t j = 0; j < midpoints.size(); ++j) {
+        if (front) out_[j].front = midpoints[j].front;
+        else out_[j].rear = midpoints[j].rear;
+      }
+      out += fmt::format("{}{}'s {} at the midpoints: the middle half of their crossings lies within {:.3f} of a "
+                         "sample (edges sharper than a sample hold no sub-sample time)",
+                         out.empty() ? "" : "; ", tip, front ? "fronts" : "rears", spread);
+    }
+    return out;
+  }
+
+ private:
+  const AirIntervals& signal_;
+  std::vector<Crossing>& out_;
+  double front_level_ = 0.0, rear_level_ = 0.0;
+  std::size_t next_ = 0;
+  double previous_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> fronts_, rears_;  // the fractions of the timed edges
+};
+
+}  // namespace
+
+ThresholdCrossings threshold_crossings(Recording& recording, const BinarisedRecording& b,
+                                       const ProcessOptions& given) {
+  const ResolvedTips resolved = resolve_tips(given, recording.info());
+  ChannelSelection ch{static_cast<std::size_t>(recording.info().channels), {}};
+  for (int c : resolved.options.tip_channels()) ch.tips.push_back(static_cast<std::size_t>(c));
+  std::vector<const Threshold*> thresholds{&b.leading_threshold, &b.trailing_threshold};
+  for (const auto& t : b.further_tips) thresholds.push_back(&t.threshold);
+  if (thresholds.size() != ch.tips.size()) {
+    throw std::invalid_argument(fmt::format("threshold_crossings: {} binarised tips, {} channels", thresholds.size(),
+                                            ch.tips.size()));
+  }
+  ThresholdCrossings result;
+  auto& out = result.tips;
+  out.resize(thresholds.size());
+  std::vector<EdgeTimer> timers;
+  std::vector<std::size_t> timed;  // the tips whose voltages are read (a binary signal's midpoints are exact)
+  timers.reserve(out.size());
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    out[k] = b.tip_crossings(k);
+    if (thresholds[k]->binary_input || thresholds[k]->constant) continue;
+    const AirIntervals& signal = k == 0 ? b.leading : k == 1 ? b.trailing : b.further_tips[k - 2].signal;
+    timers.emplace_back(*thresholds[k], signal, out[k]);
+    timed.push_back(k);
+  }
+  if (timed.empty()) {
+    result.note = "every tip's signal is binary: the midpoints are its crossings";
+    return result;
+  }
+  recording.rewind();
+  std::int64_t position = 0;
+  auto reader = blocks<float>(recording, resolved.options, ch);
+  for (auto used = reader.next(); !used.empty(); used = reader.next()) {
+    const auto frames = static_cast<std::int64_t>(used.size() / ch.stride);
+    for (std::size_t i = 0; i < timed.size(); ++i) timers[i].feed(used, ch.tips[timed[i]], ch.stride, position, frames);
+    position += frames;
+  }
+  if (position != b.leading.sample_count) {
+    throw InputError(fmt::format("{}: reading the voltages again for the interfaces' crossings gave {} frames instead "
+                                 "of {}; the file changed while being read",
+                                 recording.info().path.string(), position, b.leading.sample_count));
+  }
+  for (std::size_t i = 0; i < timed.size(); ++i) {
+    const auto kept = timers[i].keep_informative(least_crossing_spread, fmt::format("tip {}", timed[i]));
+    if (!kept.empty()) result.note += (result.note.empty() ? "" : "; ") + kept;
+  }
+  return result;
+}
+
 namespace {
 
 // A binary channel as a binary file reads (TwoLevelScan): the histogram of
@@ -831,7 +964,8 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
   const auto velocity = first_velocity(out);
   const EventOptions event_options = options.effective_event_options();
   if (options.events) {
-    out.events = event_detection(r.leading, r.trailing, options.dx, event_options, velocity);
+    out.events = event_detection(r.tip_crossings(0), r.tip_crossings(1), options.dx, event_options, velocity);
+    out.events->interface_times_note = r.crossings_note;
     judge_events(*out.events, out);
   }
   const std::size_t tips = r.tip_positions.size();
@@ -855,10 +989,8 @@ void add_bubble_methods(ProcessResult& out, const BinarisedRecording& r, const P
   po.velocity = out.velocity();
   std::vector<std::vector<Crossing>> crossings;
   crossings.reserve(tips);
-  crossings.push_back(awcc::crossings(r.leading));
-  crossings.push_back(awcc::crossings(r.trailing));
+  for (std::size_t k = 0; k < tips; ++k) crossings.push_back(r.tip_crossings(k));
   for (const auto& t : r.further_tips) {
-    crossings.push_back(awcc::crossings(t.signal));
     const auto& names = r.info.channel_names;
     const auto c = static_cast<std::size_t>(t.channel);
     probe.further_tips.push_back(
@@ -1117,7 +1249,13 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
   if (given.hash_input) recording.hash_while_reading();
   recording.rewind();
   // From the options as given: a declared probe's positions are the binarised tips'.
-  const auto binarised = binarise_recording(recording, given);
+  auto binarised = binarise_recording(recording, given);
+  if (options.effective_event_options().interface_times == InterfaceTiming::crossing &&
+      (options.events || wants_multi_tip(options.multi_tip, binarised.tip_positions.size()))) {
+    auto timed = threshold_crossings(recording, binarised, given);
+    binarised.crossings = std::move(timed.tips);
+    binarised.crossings_note = std::move(timed.note);
+  }
   ProcessResult out;
   if (options.awcc_options.signal == CorrelationSignal::binary) {
     out = process_binarised(binarised, options);

@@ -602,6 +602,8 @@ json events_json(const EventResult& e) {
       {"quality", to_string(e.quality)},
       {"quality_reason", e.quality_reason.empty() ? json(nullptr) : json(e.quality_reason)},
       {"pairing", to_string(e.options.pairing)},
+      {"interface_times", to_string(e.options.interface_times)},
+      {"interface_times_note", e.interface_times_note.empty() ? json(nullptr) : json(e.interface_times_note)},
       {"first_velocity", optional(e.first_velocity)},
       {process_key::velocity, value(e.velocity)},
       {"velocity_ci95", interval(e.velocity_ci95)},

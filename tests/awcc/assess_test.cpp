@@ -559,3 +559,32 @@ TEST(AcquisitionFaults, AGainOrOffsetChangeNoiseOrHumIsRefusedAsNoFlatLevel) {
 }
 
 }  // namespace
+
+TEST(EventResolution, LagsSpreadLessThanATenthOfASampleAreNoMeasuredTu) {
+  // judge_events's resolution rule at and around its limit: 100 paired
+  // bubbles at 20 kHz whose centre lags (in samples) alternate 5 -/+ h have
+  // the sample sd h sqrt(100 / 99); Tu is measured from 0.1 of a sample on.
+  auto judged = [](double h) {
+    awcc::EventResult e;
+    e.status = awcc::EventStatus::ok;
+    e.quality = awcc::AwccQuality::ok;
+    for (int i = 0; i < 100; ++i) {
+      awcc::EventBubble b;
+      b.fate = awcc::BubbleFate::paired;
+      b.centre_lag = (5.0 + (i % 2 == 0 ? -h : h)) / 20e3;
+      e.bubbles.push_back(b);
+    }
+    awcc::ProcessResult out;
+    out.info.fs = 20e3;
+    awcc::judge_events(e, out);
+    return e;
+  };
+  const double at = awcc::least_crossing_spread * std::sqrt(99.0 / 100.0);
+  const auto below = judged(0.999 * at);
+  EXPECT_FALSE(below.turbulence_measured);
+  EXPECT_EQ(below.quality, awcc::AwccQuality::low);
+  EXPECT_NE(below.quality_reason.find("less than the 0.1 the interface times resolve"), std::string::npos)
+      << below.quality_reason;
+  EXPECT_TRUE(judged(1.001 * at).turbulence_measured);
+  EXPECT_TRUE(judged(0.5).turbulence_measured);  // whole-sample lags 4.5 / 5.5
+}

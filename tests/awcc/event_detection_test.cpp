@@ -634,3 +634,147 @@ TEST(EventDetectionSynthetic, MeanVelocityMatchesTheTruthAndAgreesWithAwcc) {
 }
 
 }  // namespace
+
+namespace {
+
+// A conductivity probe's two channels at 20 kHz, water 4 V and air 0 V, each
+// edge a linear ramp of 1 V per sample: bubble i's leading front starts
+// falling at sample T_i (a fractional time), reaches air 4 samples later,
+// stays for 20 samples and rises over 4; the trailing tip sees it D_i samples
+// later. The level L is crossed at T_i + 4 - L (front) and R_i + L (rear,
+// R_i = T_i + 24), exactly as the interpolation between two samples on a
+// ramp finds it.
+struct Ramps {
+  std::vector<float> interleaved;
+  std::vector<double> fronts, delays;  // T_i and D_i, samples
+};
+
+Ramps ramps(int bubbles) {
+  Ramps r;
+  const std::int64_t n = 200 + 60 * static_cast<std::int64_t>(bubbles) + 100;
+  r.interleaved.assign(static_cast<std::size_t>(2 * n), 4.0f);
+  auto edge = [](double t, double start) {  // the voltage of one bubble at t, its front ramp starting at `start`
+    const double rear = start + 24.0;
+    if (t <= start || t >= rear + 4.0) return 4.0;
+    if (t < start + 4.0) return 4.0 - (t - start);
+    if (t <= rear) return 0.0;
+    return t - rear;
+  };
+  for (int i = 0; i < bubbles; ++i) {
+    const double t = 200.0 + 60.0 * i + std::fmod(0.137 * i, 1.0);
+    const double d = 7.0 + std::fmod(0.618 * i, 1.0) * 0.9;
+    r.fronts.push_back(t);
+    r.delays.push_back(d);
+    for (std::int64_t s = static_cast<std::int64_t>(t); s < static_cast<std::int64_t>(t + d) + 30; ++s) {
+      const auto k = static_cast<std::size_t>(s);
+      r.interleaved[2 * k] = std::min(r.interleaved[2 * k], static_cast<float>(edge(static_cast<double>(s), t)));
+      r.interleaved[2 * k + 1] =
+          std::min(r.interleaved[2 * k + 1], static_cast<float>(edge(static_cast<double>(s), t + d)));
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(InterfaceTimes, CrossingsRecoverPlantedFractionalEdges) {
+  const double fs = 20e3;
+  const auto r = ramps(300);
+  awcc::ProcessOptions o;
+  o.dx = 5e-3;
+  auto recording = awcc::memory_recording(r.interleaved, 2, fs);
+  const auto b = awcc::binarise_recording(*recording, o);
+  ASSERT_EQ(b.leading.intervals.size(), 300u);
+  const auto timed = awcc::threshold_crossings(*recording, b, o);
+  EXPECT_EQ(timed.note, "");  // ramps spread the crossings over the sample
+  const auto& crossings = timed.tips;
+  ASSERT_EQ(crossings.size(), 2u);
+  for (std::size_t tip = 0; tip < 2; ++tip) {
+    const auto& t = tip == 0 ? b.leading_threshold : b.trailing_threshold;
+    const double level = t.upper;  // conductivity: air below the level
+    ASSERT_GT(level, 0.5);
+    ASSERT_LT(level, 3.5);
+    for (std::size_t i = 0; i < 300; ++i) {
+      const double start = r.fronts[i] + (tip == 1 ? r.delays[i] : 0.0);
+      // Float samples: the ramp's values carry 1e-7 V of rounding.
+      EXPECT_NEAR(crossings[tip][i].front * fs, start + 4.0 - level, 1e-5) << tip << " " << i;
+      EXPECT_NEAR(crossings[tip][i].rear * fs, start + 24.0 + level, 1e-5) << tip << " " << i;
+    }
+  }
+  // The midpoints are off by up to half a sample.
+  const auto midpoints = awcc::crossings(b.leading);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < 300; ++i) worst = std::max(worst, std::fabs(midpoints[i].front - crossings[0][i].front) * fs);
+  EXPECT_GT(worst, 0.4);
+  EXPECT_LE(worst, 0.5 + 1e-9);
+}
+
+TEST(InterfaceTimes, EventDetectionWithCrossingsRecoversEachBubblesSubSampleLag) {
+  const double fs = 20e3;
+  const auto r = ramps(300);
+  awcc::ProcessOptions o;
+  o.dx = 5e-3;
+  o.events = true;
+  o.event_options.interface_times = awcc::InterfaceTiming::crossing;
+  auto recording = awcc::memory_recording(r.interleaved, 2, fs);
+  const auto crossing = awcc::process_recording(*recording, o);
+  o.event_options.interface_times = awcc::InterfaceTiming::midpoint;
+  const auto midpoint = awcc::process_recording(*recording, o);
+  ASSERT_TRUE(crossing.events && midpoint.events);
+  ASSERT_EQ(crossing.events->bubbles.size(), 300u);
+  double worst_crossing = 0.0, worst_midpoint = 0.0;
+  std::size_t paired = 0;
+  for (std::size_t i = 0; i < 300; ++i) {
+    const auto& c = crossing.events->bubbles[i];
+    const auto& m = midpoint.events->bubbles[i];
+    if (c.fate != awcc::BubbleFate::paired || m.fate != awcc::BubbleFate::paired) continue;
+    ++paired;
+    worst_crossing = std::max(worst_crossing, std::fabs(c.centre_lag * fs - r.delays[i]));
+    worst_midpoint = std::max(worst_midpoint, std::fabs(m.centre_lag * fs - r.delays[i]));
+  }
+  EXPECT_GT(paired, 250u);
+  EXPECT_LT(worst_crossing, 1e-5);   // the planted lag, to the float samples' rounding
+  EXPECT_GT(worst_midpoint, 0.5);    // whole samples: up to one sample off
+  EXPECT_TRUE(crossing.events->turbulence_measured);
+  EXPECT_EQ(crossing.events->interface_times_note, "");
+}
+
+TEST(InterfaceTimes, EdgesSharperThanASampleKeepTheirMidpoints) {
+  // Steps with a little noise: every crossing falls at one fraction (the
+  // level's place between the levels) give or take the noise, which holds
+  // no time. Around the limit: noise spreading the middle half of the
+  // fractions by about 0.06 of a sample keeps the midpoints; ramps (0.5)
+  // do not.
+  const double fs = 20e3;
+  std::mt19937_64 g(5);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  std::vector<float> v(2 * 20000, 4.0f);
+  for (std::size_t n = 0; n < 20000; ++n) {
+    const bool air0 = (n % 60) >= 10 && (n % 60) < 30, air1 = (n % 60) >= 17 && (n % 60) < 37;
+    v[2 * n] = static_cast<float>((air0 ? 0.0 : 4.0) + noise(g));
+    v[2 * n + 1] = static_cast<float>((air1 ? 0.0 : 4.0) + noise(g));
+  }
+  awcc::ProcessOptions o;
+  o.dx = 5e-3;
+  auto recording = awcc::memory_recording(v, 2, fs);
+  const auto b = awcc::binarise_recording(*recording, o);
+  const auto timed = awcc::threshold_crossings(*recording, b, o);
+  for (std::size_t tip = 0; tip < 2; ++tip) {
+    const auto midpoints = b.tip_crossings(tip);
+    ASSERT_EQ(timed.tips[tip].size(), midpoints.size());
+    for (std::size_t i = 0; i < midpoints.size(); ++i) {
+      EXPECT_EQ(timed.tips[tip][i].front, midpoints[i].front);
+      EXPECT_EQ(timed.tips[tip][i].rear, midpoints[i].rear);
+    }
+  }
+  EXPECT_NE(timed.note.find("tip 0's fronts at the midpoints"), std::string::npos) << timed.note;
+  EXPECT_NE(timed.note.find("tip 1's rears at the midpoints"), std::string::npos) << timed.note;
+  // The same through processing: event detection's lags are whole samples
+  // (7), so every bubble has one lag and Tu is not reported as measured.
+  o.events = true;
+  o.event_options.interface_times = awcc::InterfaceTiming::crossing;
+  const auto r = awcc::process_recording(*recording, o);
+  ASSERT_TRUE(r.events);
+  EXPECT_FALSE(r.events->turbulence_measured) << r.events->turbulence_intensity << " " << r.events->bubbles_paired << " " << r.events->message;
+  EXPECT_EQ(r.events->interface_times_note, timed.note);
+}

@@ -196,7 +196,39 @@ struct BinarisedRecording {
   /// trailing, further tips), where the probe's tips are declared or stated
   /// by the recording; else empty.
   std::vector<Vec3> tip_positions;
+  /// Every tip's interfaces timed at the threshold crossing, same order
+  /// (threshold_crossings, EventOptions::interface_times); empty: the
+  /// midpoints of the air intervals.
+  std::vector<std::vector<Crossing>> crossings;
+  std::string crossings_note;  ///< ThresholdCrossings::note
+  /// Tip k's interfaces as event detection and the multi-tip pairing use them.
+  [[nodiscard]] std::vector<Crossing> tip_crossings(std::size_t k) const;
 };
+
+/// The interfaces of every binarised tip timed at the threshold crossing.
+struct ThresholdCrossings {
+  std::vector<std::vector<Crossing>> tips;  ///< leading, trailing, further tips
+  /// Which tips' fronts or rears kept their midpoints, and why ("" when none).
+  std::string note;
+};
+
+/// An edge direction whose crossings' middle half spans less of a sample
+/// holds no sub-sample time (edges sharper than a sample) and keeps its
+/// midpoints, -. Sharp edges give a spread of noise only (libsynth's 2 us
+/// rise at 20 kHz: 0.005-0.01); edges spanning a sample spread their
+/// fractions over most of [0, 1] (0.5 for a linear ramp).
+inline constexpr double least_crossing_spread = 0.1;
+
+/// Every binarised tip's interfaces timed where its voltage crosses the level
+/// that switched the phase (event_detection.hpp, item 9), from one more pass
+/// over `recording` (rewound first); `b` is binarise_recording's result of
+/// the same recording and options. Tips of a binary signal, and edge
+/// directions sharper than a sample (least_crossing_spread), keep their
+/// midpoints, and the note says so. Throws InputError naming the file when it
+/// holds another number of frames than at binarisation (it changed while
+/// being read).
+ThresholdCrossings threshold_crossings(Recording& recording, const BinarisedRecording& b,
+                                       const ProcessOptions& options);
 
 /// FSCC and AWCC of the leading tip with one more trailing tip of a
 /// multi-tip probe, as labs compare them with the bubble-by-bubble vector.

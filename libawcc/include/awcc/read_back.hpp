@@ -34,6 +34,7 @@ inline constexpr ThresholdRule threshold_rule[] = {ThresholdRule::histogram, Thr
                                                    ThresholdRule::hysteresis};
 inline constexpr ProbeType probe[] = {ProbeType::conductivity, ProbeType::optical};
 inline constexpr Pairing pairing[] = {Pairing::kramer, Pairing::shen};
+inline constexpr InterfaceTiming interface_timing[] = {InterfaceTiming::midpoint, InterfaceTiming::crossing};
 }  // namespace values
 
 /// A switch as pdp writes it (a profile CSV's "on"/"off", an option's value).
