@@ -72,6 +72,18 @@ Features inside() {
   return f;
 }
 
+// A 45 s, 20 kHz row at 3 m/s with 30 of 300 windows: what labs record.
+Features lab_row() {
+  Features f = inside();
+  f.velocity = 3.0;
+  f.fs = 20e3;
+  f.duration = 45;
+  f.windows_accepted = 30;
+  f.windows_total = 300;
+  f.time_scale_ratio = 2.0;
+  return f;
+}
+
 // A model of 300 runs drawn by `draw` on the feature set `set`: its ranges
 // those of the draws, its velocity forest learning `velocity_target(f)`
 // (ratio form), its Tu forest 0.01 (difference form); 5 trees, min windows 10.
@@ -935,13 +947,7 @@ TEST(Correction, TheShippedModelCorrectsTheRecordsLabsMake) {
   ASSERT_TRUE(m.fscc.has_value());
   ASSERT_TRUE(m.reduced);
   EXPECT_FALSE(m.calibration.empty());
-  Features f = inside();
-  f.velocity = 3.0;
-  f.fs = 20e3;
-  f.duration = 45;
-  f.windows_accepted = 30;
-  f.windows_total = 300;
-  f.time_scale_ratio = 2.0;
+  Features f = lab_row();
   const auto c = m.correct(f);
   ASSERT_TRUE(c.corrected()) << c.message;
   EXPECT_EQ(c.forest, "awcc");
@@ -985,14 +991,7 @@ TEST(Correction, OlderFilesTakeTheirNinetyPercentOffsetBetweenTheirEightyAndNine
     }
   }
   // A corrected row's nine quantiles are in order, the 90 % interval inside the 95 % and around the 80 %.
-  Features f = inside();
-  f.velocity = 3.0;
-  f.fs = 20e3;
-  f.duration = 45;
-  f.windows_accepted = 30;
-  f.windows_total = 300;
-  f.time_scale_ratio = 2.0;
-  const auto c = m.correct(f);
+  const auto c = m.correct(lab_row());
   ASSERT_TRUE(c.corrected()) << c.message;
   const auto& q = c.velocity->quantiles;
   EXPECT_TRUE(std::is_sorted(q.begin(), q.end()));
