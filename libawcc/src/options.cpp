@@ -474,7 +474,7 @@ const OptionField<E> kEvents[] = {
      "event detection's and the multi-tip pairing's interface times: midpoint (half way between the samples that "
      "straddle the edge: lags of whole samples) | crossing (where the voltage crosses the threshold, interpolated "
      "between the two samples: lags below a sample; one more pass over the file; a binary signal gives the "
-     "midpoint)",
+     "midpoint; refused where neither event detection nor a multi-tip probe runs)",
      [](E& o, std::string_view t) { o.interface_times = choice(t, values::interface_timing); },
      [](const E& o) { return name_of(o.interface_times); }},
     {"pairing", "",

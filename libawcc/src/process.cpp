@@ -1246,12 +1246,23 @@ ProcessResult process_recording(Recording& recording, const ProcessOptions& give
   given.validate().throw_if_failed();
   // The tip pair of a declared (or recorded) probe, once: every step below reads it.
   const ProcessOptions options = tip_pair_options(given, recording.info());
+  // Only bubble-by-bubble lags read interface times: a run without them
+  // would report numbers the option did not touch as if it had.
+  if (options.effective_event_options().interface_times == InterfaceTiming::crossing && !options.events &&
+      !wants_multi_tip(options.multi_tip, options.tip_channels().size())) {
+    throw OptionError(
+        fmt::format("{}: interface-times = crossing times the interfaces of event detection and of the multi-tip "
+                    "pairing, and this run does neither (FSCC and AWCC correlate whole signals; their lags below a "
+                    "sample come from subsample): add events to the method (method = events, or awcc+events), or "
+                    "process a probe of four or more tips; or leave interface-times at midpoint",
+                    recording.info().path.string()),
+        "interface-times");
+  }
   if (given.hash_input) recording.hash_while_reading();
   recording.rewind();
   // From the options as given: a declared probe's positions are the binarised tips'.
   auto binarised = binarise_recording(recording, given);
-  if (options.effective_event_options().interface_times == InterfaceTiming::crossing &&
-      (options.events || wants_multi_tip(options.multi_tip, binarised.tip_positions.size()))) {
+  if (options.effective_event_options().interface_times == InterfaceTiming::crossing) {
     auto timed = threshold_crossings(recording, binarised, given);
     binarised.crossings = std::move(timed.tips);
     binarised.crossings_note = std::move(timed.note);

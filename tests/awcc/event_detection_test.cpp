@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "awcc/awcc.hpp"
+#include "awcc/errors.hpp"
 #include "awcc/options.hpp"
 #include "awcc/process.hpp"
 #include "awcc/serialise.hpp"
@@ -777,4 +778,28 @@ TEST(InterfaceTimes, EdgesSharperThanASampleKeepTheirMidpoints) {
   ASSERT_TRUE(r.events);
   EXPECT_FALSE(r.events->turbulence_measured) << r.events->turbulence_intensity << " " << r.events->bubbles_paired << " " << r.events->message;
   EXPECT_EQ(r.events->interface_times_note, timed.note);
+}
+
+TEST(InterfaceTimes, CrossingWithoutBubbleByBubbleLagsIsRefused) {
+  // FSCC and AWCC correlate whole signals and never read interface times:
+  // asked for them without event detection (or a multi-tip probe), the
+  // option would change nothing while the output said crossing.
+  const auto r = ramps(20);
+  awcc::ProcessOptions o;
+  o.dx = 5e-3;
+  o.event_options.interface_times = awcc::InterfaceTiming::crossing;
+  auto recording = awcc::memory_recording(r.interleaved, 2, 20e3);
+  try {
+    (void)awcc::process_recording(*recording, o);
+    FAIL() << "interface-times crossing without events was accepted";
+  } catch (const awcc::OptionError& e) {
+    EXPECT_EQ(e.quantity(), "interface-times");
+    EXPECT_NE(std::string(e.what()).find("add events to the method"), std::string::npos) << e.what();
+  }
+  // The same with events runs; midpoint without events runs as before.
+  o.events = true;
+  EXPECT_NO_THROW((void)awcc::process_recording(*recording, o));
+  o.events = false;
+  o.event_options.interface_times = awcc::InterfaceTiming::midpoint;
+  EXPECT_NO_THROW((void)awcc::process_recording(*recording, o));
 }

@@ -252,6 +252,16 @@ refused 2 "unknown unit 'khz' (units are case-sensitive: did you mean kHz?)" \
 printf 'dx = ["5mm", "6mm"]\n' >"$dir/list.toml"
 refused 2 "list.toml:1: dx: '5mm,6mm' is not a length: it is a list; give one value" \
   "$pdp" process "$dir/rec.wav" --config "$dir/list.toml" --json "$dir/out.json"
+# Interface times at the threshold crossing reach only bubble-by-bubble lags:
+# without event detection or a multi-tip probe the option touched nothing.
+refused 2 "interface-times = crossing times the interfaces of event detection and of the multi-tip pairing, and this run does neither" \
+  "$pdp" process "$dir/rec.wav" --dx 5mm --interface-times crossing --json "$dir/out.json"
+refused 2 "add events to the method (method = events, or awcc+events)" \
+  "$pdp" process "$dir/rec.wav" --dx 5mm --method fscc --interface-times crossing --json "$dir/out.json"
+"$pdp" --log-level error process "$dir/rec.wav" --dx 5mm --method awcc+events --interface-times crossing \
+  --json "$dir/out.json" || fail "interface-times crossing with events refused"
+[[ $(py -c "import json; print(json.load(open('$dir/out.json'))['events']['interface_times'])") == crossing ]] ||
+  fail "events.interface_times is not crossing"
 
 [[ $failures -eq 0 ]] && echo "inputs CLI: all checks passed"
 exit $((failures > 0))
