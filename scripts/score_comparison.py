@@ -27,7 +27,7 @@ import statistics
 import sys
 
 
-NEEDED = ["run", "status", "true_velocity", "true_turbulence_intensity", "windows_accepted", "fs", "duration"] + [
+NEEDED = ["run", "status", "velocity", "turbulence_intensity", "true_velocity", "true_turbulence_intensity", "windows_accepted", "fs", "duration"] + [
     f"corrected_{q}_q{p}" for q in ("velocity", "turbulence_intensity") for p in ("0.025", "0.1", "0.5", "0.9", "0.975")]
 
 
@@ -57,6 +57,8 @@ def rows(path):
             "band_of": {"windows": q("windows_accepted"), "fs": q("fs"), "true Tu": tu,
                         "duration": q("duration")},
             "truth": (r["true_velocity"], r["true_turbulence_intensity"]),
+            "raw_u_err": q("velocity") / u - 1.0,
+            "raw_tu_err": q("turbulence_intensity") - tu,
             "u_err": q("corrected_velocity_q0.5") / u - 1.0,
             "tu_err": q("corrected_turbulence_intensity_q0.5") - tu,
             "u80": q("corrected_velocity_q0.1") <= u <= q("corrected_velocity_q0.9"),
