@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Which arrival rule a real record's bubbles follow, from AWCC's weighting gap
-g = u_unweighted / u_duration_weighted - 1 (docs/validation.md, "Which arrival
-rule the real bubbles follow").
+g = u_unweighted / u_duration_weighted - 1
+(docs/history/correction-foreign-conventions.md, "Which arrival rule the
+real bubbles follow").
 
 When bubbles are spaced along the flow, a window of Np bubbles lasts less
 when the flow is fast, so the unweighted mean of the windows' velocities

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Offline comparison of interval calibrations (scripts/calibration-alternatives,
-which passes the model's offsets; docs/validation.md, "The intervals'
+which passes the model's offsets;
+docs/history/correction-foreign-conventions.md, "The intervals'
 calibration: what it can and cannot fix").
 
 Each corrected row's Tu interval is taken back to the forest's own by

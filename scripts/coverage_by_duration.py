@@ -4,7 +4,9 @@
 |u / u_true - 1| and the mean error of the corrected median, the same for Tu
 (absolute; rows whose Tu is corrected), and the 80 / 95 % coverage of u and
 Tu, with the binomial standard error of the 80 % coverage,
-sqrt(p (1 - p) / n). docs/validation.md, "Coverage by record length".
+sqrt(p (1 - p) / n). docs/history/correction-foreign-conventions.md,
+"The model of the complete campaign, shipped" (its coverage by record
+length), and "The intervals' calibration: what it can and cannot fix".
 
 Usage: coverage_by_duration.py [--edges 300,600,900,1200,1500] NAME PREDICTIONS.csv [NAME PREDICTIONS.csv ...]
 """

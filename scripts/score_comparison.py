@@ -11,7 +11,8 @@ rows, seed 0); coverage's is also sqrt(p (1 - p) / n). The two sets are
 independent, so z = (b - a) / sqrt(se_a^2 + se_b^2).
 
 With --paired the two files are two models' predictions of the same runs
-(candidate models, docs/validation.md "The time scale"): only the rows both
+(candidate models, docs/history/correction-foreign-conventions.md "The time
+scale: a feature the record carries"): only the rows both
 corrected are scored (a row is a run and its weighting), and the standard
 error is that of the difference, from resampling the rows as pairs, so the
 runs' own spread cancels. --bands adds the paired medians and coverages band

@@ -315,7 +315,8 @@ namespace {
 // fs and duration included: without the two at 60 s and 500 kHz (a fifth of
 // the campaign's runs) it scored worse on the foreign sets as peers' rows
 // (u median error 1.5 to 1.95 %, Tu bias +0.008 to +0.022 on the control
-// set; docs/validation.md), whose records are also at 500 kHz.
+// set; docs/history/correction-foreign-conventions.md, "The model of the
+// complete campaign, shipped"), whose records are also at 500 kHz.
 void train_reduced(const Split& split, const TrainOptions& o, const Hyperparameters& h, const Processing& processing,
                    TrainResult& result) {
   const auto names = feature_set_names(result.model.takes_weighting() ? "measured+weighting" : "measured");

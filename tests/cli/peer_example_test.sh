@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # A peer's profile corrected by the shipped model (issue 33, "keep the pdp-uq
-# example profile within the agreement shown in docs/validation.md"):
+# example profile within the agreement shown in docs/validation.md"; now
+# docs/history/correction-foreign-conventions.md, "Peers' rows: the
+# reduced model" and "The model of the complete campaign, shipped"):
 # pdp-uq's example (Bürgler et al. 2024; its example/pdp_data.csv, a
 # stepped-spillway profile in pdp-uq's layout: u, u_rms, c, d_32a, no fs,
 # duration or windows; dx 5 mm, dy 1 mm, Np 10, unweighted moments) with

@@ -456,7 +456,9 @@ TEST(TrustRules, TheTwoMillimetreRowOfTheRealProfileIsCorrectedWithOneMode) {
   // then flagged untrusted; with the logarithmic range margin the model of
   // issue 29 refused it (its FSCC forest's least c was 0.0041). The cause
   // was the training: the forest had no runs at c below 0.004 at 20 kHz, and
-  // its leaves mixed rows whose FSCC lag was quantised (docs/validation.md).
+  // its leaves mixed rows whose FSCC lag was quantised
+  // (docs/history/correction-foreign-conventions.md, "The FSCC forest at
+  // low void fraction: fixed by the campaign's prior").
   // The model trained on the conventions campaign (c from 0.002) corrects it
   // with one mode around FSCC's own value: at c = 0.004 a bubble crosses
   // both tips alone, so FSCC's peak is the lag of single bubbles (the

@@ -146,7 +146,8 @@ VelocitySpectrum velocity_spectrum(const AwccResult& awcc, double duration, cons
 
 /// Where AWCC's T_u / T_W is capped (AwccResult::time_scale_ratio, the bias
 /// correction's feature): an oracle test (the true T / T_W clipped to
-/// 0.5-20 as a feature, docs/validation.md "The time scale") kept most of the
+/// 0.5-20 as a feature, docs/history/correction-foreign-conventions.md
+/// "The time scale: a feature the record carries") kept most of the
 /// unclipped ratio's gain, and windows 20 times shorter than T_u follow the
 /// velocity; the cap also bounds the cost (below).
 inline constexpr double time_scale_ratio_cap = 20.0;

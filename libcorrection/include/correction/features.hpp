@@ -53,7 +53,8 @@
 // otherwise correct every record by the campaign's average of that loss. On
 // the foreign control set the shipped model's corrected Tu was off by -0.04
 // where the true scale T was under 3 ms and +0.035 above 0.3 s, and u by
-// +1.4 % to -2.2 % (docs/validation.md, "The time scale"). The cap bounds the
+// +1.4 % to -2.2 % (docs/history/correction-foreign-conventions.md, "The time
+// scale: a feature the record carries"). The cap bounds the
 // computation (a few pairs per window) where T_u is long; there the windows
 // follow the velocity and the ratio no longer matters. A file that does not
 // give it (another tool's) is corrected by the reduced model.
@@ -184,7 +185,9 @@ struct Features {
   /// product among dx, fs and u by splits, and a broad campaign (fs over
   /// two decades) leaves too few runs at any one rate for that: without it,
   /// the corrected Tu at 300 s and 500 kHz was off by +0.09 below 15
-  /// samples and +0.004 above 120 (docs/validation.md, "The lag in samples").
+  /// samples and +0.004 above 120
+  /// (docs/history/correction-foreign-conventions.md, "The model trained on
+  /// the campaign before its last sweeps").
   static constexpr const char* lag_name = "lag_samples";
   /// The time-scale feature (T_u / T_W, see the file's comment); 0: not known.
   double time_scale_ratio = 0.0;

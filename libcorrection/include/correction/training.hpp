@@ -30,8 +30,10 @@
 // the longest runs whatever else they are: a candidate trained on 20-300 s
 // records corrected 300 s records at 500 kHz and low Tu by +30 % and +60 %
 // (its three longest low-Tu runs were lag-quantised at 11-15 kHz), against
-// +0.3 % at 295 s (docs/validation.md). With the cap the edge holds 1 % of
-// the runs, as long as one another in what the model learns from duration.
+// +0.3 % at 295 s (docs/history/correction-foreign-conventions.md, "The first
+// candidates: what the campaign's runs teach"). With the cap the edge holds
+// 1 % of the runs, as long as one another in what the model learns from
+// duration.
 //
 // Cross-validation: for each target, every (target form, min leaf, features
 // per split) of the grid is scored by the mean pinball loss over k folds of
