@@ -14,8 +14,10 @@ A target given to a set is checked and marked: u mean (|mean u error| <=
 than 2 points), no zero Tu. A band of fewer than 10 runs is shown in
 parentheses and not checked: its mean is not a measurement.
 
-Usage: must_show.py SET MODEL PREDICTIONS.csv[@duration=S] TARGETS [SET MODEL ... TARGETS ...]
-  @duration=S keeps the runs of that record length (s): one set of a grid
+Usage: must_show.py SET MODEL PREDICTIONS.csv[@SELECTION] TARGETS [SET MODEL ... TARGETS ...]
+  SELECTION keeps some runs: conditions joined by commas on duration (s),
+  fs (Hz), lag (AWCC's, samples) or windows, with =, >= or <=, e.g.
+  @duration=60 (one record length of a grid) or @fs<=40000,lag>=5
   TARGETS: comma-separated names from: u-mean, tu-mean-0.01, tu-mean-0.005,
   u-median-1.1, u-median-1.5, bands, coverage, no-zero-tu; or "-" (none)
 """
@@ -32,11 +34,42 @@ TARGETS = {"u-mean", "tu-mean-0.01", "tu-mean-0.005", "u-median-1.1", "u-median-
            "no-zero-tu"}
 
 
-def zero_tu_runs(path, duration):
-    """Runs whose AWCC Tu is exactly zero, among all the file's rows."""
-    return sum(1 for r in csv.DictReader(open(path)) if r["turbulence_intensity"] not in ("", "nan")
-               and float(r["turbulence_intensity"]) == 0.0
-               and (duration is None or float(r["duration"]) == duration))
+# A selection after the file name: conditions joined by commas, each a
+# band quantity of score_comparison.rows() (duration s, fs Hz, lag samples,
+# windows) compared with = (to 1e-9), >= or <=.
+def selector(text, path):
+    tests = []
+    for cond in filter(None, text.split(",")):
+        for op in (">=", "<=", "="):
+            key, found, value = cond.partition(op)
+            if found:
+                break
+        if not found or key not in ("duration", "fs", "lag", "windows"):
+            sys.exit(f"{path}@{text}: a condition is duration|fs|lag|windows followed by =, >= or <= and a number")
+        v = float(value)
+        tests.append((key, op, v))
+
+    def keep(band_of):
+        for key, op, v in tests:
+            x = band_of[key]
+            if not (abs(x - v) <= 1e-9 * max(1.0, abs(v)) if op == "=" else x >= v if op == ">=" else x <= v):
+                return False
+        return True
+    return keep
+
+
+def zero_tu_runs(path, keep):
+    """Runs whose AWCC Tu is exactly zero, among all the file's rows selected."""
+    n = 0
+    for r in csv.DictReader(open(path)):
+        try:
+            band_of = {"duration": float(r["duration"]), "fs": float(r["fs"]), "windows": float(r["windows_accepted"]),
+                       "lag": float(r["fs"]) * float(r["dx"]) / float(r["velocity"])}
+            tu = float(r["turbulence_intensity"])
+        except (ValueError, ZeroDivisionError):
+            continue
+        n += tu == 0.0 and keep(band_of)
+    return n
 
 
 def mark(ok):
@@ -45,13 +78,8 @@ def mark(ok):
 
 def row(set_name, model, path, targets):
     path, _, selection = path.partition("@")
-    duration = None
-    if selection:
-        key, _, value = selection.partition("=")
-        if key != "duration" or not value:
-            sys.exit(f"{path}@{selection}: the selection is @duration=S (seconds)")
-        duration = float(value)
-    rs = [r for r in rows(path) if duration is None or r["band_of"]["duration"] == duration]
+    keep = selector(selection, path)
+    rs = [r for r in rows(path) if keep(r["band_of"])]
     if not rs:
         return f"| {set_name} | {model} | 0 | - | - | - | - | - | - | - | - | - |", [f"{set_name} {model}: no run corrected"]
     failed = []
@@ -84,7 +112,7 @@ def row(set_name, model, path, targets):
     bands_cell = " / ".join(bands) + check("bands", bands_ok)
     cov = {k: 100 * statistics.fmean(r[k] for r in rs) for k in ("u80", "u95", "tu80", "tu95")}
     cov_ok = cov["u80"] >= 78 and cov["u95"] >= 93 and cov["tu80"] >= 78 and cov["tu95"] >= 93
-    zeros = zero_tu_runs(path, duration)
+    zeros = zero_tu_runs(path, keep)
     line = (f"| {set_name} | {model} | {len(rs)} | {med_raw:.2f} -> {med:.2f}{median_mark} | "
             f"{mean_u:+.2f}{check('u-mean', abs(mean_u) <= 1.0)} | {mean_tu:+.4f}{tu_mark} | {bands_cell} | "
             f"{cov['u80']:.0f} / {cov['u95']:.0f} | {cov['tu80']:.0f} / {cov['tu95']:.0f}{check('coverage', cov_ok)} | "

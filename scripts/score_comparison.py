@@ -28,7 +28,7 @@ import statistics
 import sys
 
 
-NEEDED = ["run", "status", "velocity", "turbulence_intensity", "true_velocity", "true_turbulence_intensity", "windows_accepted", "fs", "duration"] + [
+NEEDED = ["run", "status", "velocity", "turbulence_intensity", "dx", "true_velocity", "true_turbulence_intensity", "windows_accepted", "fs", "duration"] + [
     f"corrected_{q}_q{p}" for q in ("velocity", "turbulence_intensity") for p in ("0.025", "0.1", "0.5", "0.9", "0.975")]
 
 
@@ -56,7 +56,9 @@ def rows(path):
         out.append({
             "key": run + (seen[run],),
             "band_of": {"windows": q("windows_accepted"), "fs": q("fs"), "true Tu": tu,
-                        "duration": q("duration")},
+                        "duration": q("duration"),
+                        # AWCC's lag in samples, from what it measured
+                        "lag": q("fs") * q("dx") / q("velocity")},
             "truth": (r["true_velocity"], r["true_turbulence_intensity"]),
             "raw_u_err": q("velocity") / u - 1.0,
             "raw_tu_err": q("turbulence_intensity") - tu,
