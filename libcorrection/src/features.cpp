@@ -121,6 +121,7 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == lag_name && fs > 0.0 && velocity > 0.0) return dx * fs / velocity;
   if (name == scale_name && time_scale_ratio > 0.0) return time_scale_ratio;
   if (name == size_name && d32 > 0.0 && dx > 0.0) return d32 / dx;
+  if (name == fscc_ratio_name && fscc_velocity > 0.0 && velocity > 0.0) return fscc_velocity / velocity;
   return std::nullopt;
 }
 
@@ -135,8 +136,8 @@ std::vector<std::string> feature_set_names(std::string_view set) {
     return std::invalid_argument(fmt::format(
         "feature set '{}': use measured (the seven of METHOD 7), extended (with fs, duration and accepted windows) "
         "or extended-yield (fs, duration and the data yield), the extended two optionally followed by +lag (the lag "
-        "in samples), then +scale (the time-scale ratio T_u / T_W), then +size (d32 / dx), each then optionally by "
-        "+weighting",
+        "in samples), then +scale (the time-scale ratio T_u / T_W), then +size (d32 / dx), then +fscc (FSCC's "
+        "velocity over AWCC's and FSCC's R12max), each then optionally by +weighting",
         set));
   };
   const auto plus = set.find('+');
@@ -152,12 +153,15 @@ std::vector<std::string> feature_set_names(std::string_view set) {
     rest.remove_prefix(suffix.size());
     return true;
   };
-  for (const auto& [suffix, name, extended_only] :
-       {std::tuple{"+lag", Features::lag_name, true}, std::tuple{"+scale", Features::scale_name, true},
-        std::tuple{"+size", Features::size_name, true}, std::tuple{"+weighting", Features::weighting_name, false}}) {
+  using Names = std::vector<const char*>;
+  for (const auto& [suffix, names, extended_only] :
+       {std::tuple{"+lag", Names{Features::lag_name}, true}, std::tuple{"+scale", Names{Features::scale_name}, true},
+        std::tuple{"+size", Names{Features::size_name}, true},
+        std::tuple{"+fscc", Names{Features::fscc_ratio_name, "r12_max"}, true},
+        std::tuple{"+weighting", Names{Features::weighting_name}, false}}) {
     if (!take(suffix)) continue;
     if (extended_only && base == "measured") throw bad();
-    out.emplace_back(name);
+    out.insert(out.end(), names.begin(), names.end());
   }
   if (!rest.empty()) throw bad();
   return out;
@@ -168,10 +172,12 @@ std::string feature_set_of(const std::vector<std::string>& names) {
     for (const char* lag : {"", "+lag"}) {
       for (const char* scale : {"", "+scale"}) {
         for (const char* size : {"", "+size"}) {
-          for (const char* weighting : {"", "+weighting"}) {
-            const std::string set = std::string(base) + lag + scale + size + weighting;
-            if (std::string_view(base) == "measured" && (*lag || *scale || *size)) continue;
-            if (names == feature_set_names(set)) return set;
+          for (const char* fscc : {"", "+fscc"}) {
+            for (const char* weighting : {"", "+weighting"}) {
+              const std::string set = std::string(base) + lag + scale + size + fscc + weighting;
+              if (std::string_view(base) == "measured" && (*lag || *scale || *size || *fscc)) continue;
+              if (names == feature_set_names(set)) return set;
+            }
           }
         }
       }

@@ -263,14 +263,14 @@ std::string provenance_of(const TrainingSet& set, const TrainOptions& o, const s
   for (const auto& s : set.sources) sources += (sources.empty() ? "" : ", ") + s;
   std::string provenance = fmt::format(
       "pdp train {}: {} (generator version {}); {} features ({}); processed with {}{}; {} runs read, {} used ({} failed, {} without an AWCC velocity, {} with fewer than {} accepted "
-      "windows); trained on {}, {} set aside to calibrate the intervals, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
+      "windows, {} without a feature of the set); trained on {}, {} set aside to calibrate the intervals, {} held out (seed {}). Velocity: target {}, {} trees, min leaf {}, {} features per "
       "split. Tu: target {}, {} trees, min leaf {}, {} features per split. Held out: velocity RMSE {:.2f} % raw, "
       "{:.2f} % corrected, 80/95 % coverage {:.1f}/{:.1f} %; Tu RMSE {:.4f} raw, {:.4f} corrected, 80/95 % coverage "
       "{:.1f}/{:.1f} %.",
       awcc::version, sources, fmt::join(set.generator_versions, " and "), o.feature_set, fmt::join(names, ", "),
       describe(set.processing),
-      set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size(), set.excluded_error, set.excluded_undefined,
-      set.excluded_windows, o.min_windows, split.training.size(), split.calibration.size(), split.held_out.size(), o.seed,
+      set.processing_assumed ? " (assumed: the sweep CSVs do not record it)" : "", set.total, set.rows.size() - static_cast<std::size_t>(result.excluded_features), set.excluded_error,
+      set.excluded_undefined, set.excluded_windows, o.min_windows, result.excluded_features, split.training.size(), split.calibration.size(), split.held_out.size(), o.seed,
       to_string(hp.velocity_form), vopt.trees, vopt.min_leaf, vopt.features_per_split, to_string(hp.turbulence_form),
       topt.trees, topt.min_leaf, topt.features_per_split, 100 * h.velocity_rmse_raw, 100 * h.velocity_rmse_corrected,
       100 * h.velocity_coverage80, 100 * h.velocity_coverage95, h.tu_rmse_raw, h.tu_rmse_corrected,
@@ -342,9 +342,28 @@ void train_reduced(const Split& split, const TrainOptions& o, const Hyperparamet
 TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std::function<void(double)>& progress) {
   o.validate().throw_if_failed();
   const auto names = feature_set_names(o.feature_set);
-  Split split = split_runs(set.rows, o);
+  // Runs without a feature of the set are left out and counted (the FSCC
+  // forest still takes them from set.fscc_rows where it can).
+  std::vector<TrainingRow> rows;
+  rows.reserve(set.rows.size());
+  std::copy_if(set.rows.begin(), set.rows.end(), std::back_inserter(rows), [&](const TrainingRow& r) {
+    return std::all_of(names.begin(), names.end(), [&](const std::string& n) { return r.features.value(n).has_value(); });
+  });
+  if (rows.empty() && !set.rows.empty()) {
+    for (const auto& n : names) {
+      if (!set.rows.front().features.value(n)) {
+        throw awcc::OptionError(fmt::format("no training run has {} (the sweep CSVs lack the column, or no run has a "
+                                            "value): train another feature set, or give sweeps that record it",
+                                            n),
+                                "feature-set");
+      }
+    }
+  }
+  TrainResult result;
+  result.excluded_features = static_cast<std::int64_t>(set.rows.size() - rows.size());
+  Split split = split_runs(rows, o);
   split.training = with_saturated_durations(std::move(split.training));
-  const std::size_t runs = set.rows.size();
+  const std::size_t runs = rows.size();
   const bool twins = names.back() == Features::weighting_name;
   if (twins) {
     // Each run measured both ways, its twins side by side in its part.
@@ -363,7 +382,6 @@ TrainResult train_model(const TrainingSet& set, const TrainOptions& o, const std
                             "calibration");
   }
 
-  TrainResult result;
   result.training_rows = static_cast<std::int64_t>(split.training.size());
   Hyperparameters h = initial_hyperparameters(o);
   const auto cv_start = std::chrono::steady_clock::now();

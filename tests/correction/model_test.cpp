@@ -611,6 +611,30 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
   for (const char* set : {"measured+size", "extended+size+scale", "extended+weighting+size"})
     EXPECT_THROW(correction::feature_set_names(set), std::invalid_argument) << set;
   EXPECT_TRUE(Features::on_log_scale("size_ratio"));
+  // FSCC beside AWCC: its velocity over AWCC's and its R12max, after the
+  // size ratio and before the weighting; unknown without an FSCC velocity.
+  Features fscc = inside();
+  fscc.velocity = 4.0;
+  fscc.fscc_velocity = 3.8;
+  fscc.r12_max = 0.42;
+  EXPECT_DOUBLE_EQ(*fscc.value("fscc_awcc_ratio"), 0.95);
+  EXPECT_DOUBLE_EQ(*fscc.value("r12_max"), 0.42);
+  fscc.fscc_velocity = 0.0;
+  EXPECT_FALSE(fscc.value("fscc_awcc_ratio"));
+  EXPECT_FALSE(fscc.value("r12_max"));
+  const auto fscc_set = correction::feature_set_names("extended-yield+lag+scale+fscc+weighting");
+  ASSERT_EQ(fscc_set.size(), 15u);
+  EXPECT_EQ(fscc_set[11], "time_scale_ratio");
+  EXPECT_EQ(fscc_set[12], "fscc_awcc_ratio");
+  EXPECT_EQ(fscc_set[13], "r12_max");
+  EXPECT_EQ(fscc_set[14], "awcc_unweighted");
+  for (const char* set : {"extended+fscc", "extended-yield+lag+scale+fscc+weighting",
+                          "extended-yield+lag+scale+size+fscc+weighting"})
+    EXPECT_EQ(correction::feature_set_of(correction::feature_set_names(set)), set);
+  for (const char* set : {"measured+fscc", "extended+fscc+size", "extended+weighting+fscc", "extended+fscc+fscc"})
+    EXPECT_THROW(correction::feature_set_names(set), std::invalid_argument) << set;
+  // A ratio near 1 is not drawn over decades: its range margin is linear.
+  EXPECT_FALSE(Features::on_log_scale("fscc_awcc_ratio"));
   correction::Measurement stated;
   stated.velocity = 3.0;
   stated.turbulence_intensity = 0.2;

@@ -361,6 +361,49 @@ TEST(Training, TheScaleFeatureLearnsABiasOfTheTimeScaleRatio) {
   }
 }
 
+TEST(Training, TheFsccFeaturesLearnAwccsFilterBiasAndRunsWithoutFsccAreLeftOut) {
+  // AWCC reads high by a factor 1 + b, b uniform over 0-0.2 and independent
+  // of every AWCC feature (the windows its filter dropped), while FSCC takes
+  // every bubble and reads the truth: only FSCC's velocity over AWCC's shows
+  // b. Without +fscc the forest cannot do better than b's spread (RMSE about
+  // 0.2 / sqrt(12) = 5.8 %); with it one split variable carries b. The 100
+  // runs without an FSCC velocity train the set without +fscc and are left
+  // out, counted, by the set with it.
+  std::mt19937_64 g(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::string csv = kHeader + "\n";
+  for (int i = 0; i < 1600; ++i) {
+    const double truth = 1 + 49 * u(g), b = 0.2 * u(g);
+    auto v = good(truth * (1 + b), truth, 500);
+    if (i % 16 != 0) {
+      v["fscc_velocity"] = fmt::format("{:.10g}", truth);
+      v["fscc_r12_max"] = "0.5";
+    }
+    csv += row(i, v);
+  }
+  const auto set = correction::load_training_set({write("fscc.csv", csv)}, 10);
+  const auto [without, with] = without_and_with(set, "extended-yield", "extended-yield+fscc");
+  EXPECT_EQ(without.excluded_features, 0);
+  EXPECT_EQ(with.excluded_features, 100);
+  EXPECT_NE(with.model.provenance.find("100 without a feature of the set"), std::string::npos) << with.model.provenance;
+  EXPECT_EQ(with.model.ranges[with.model.ranges.size() - 2].name, "fscc_awcc_ratio");
+  EXPECT_GT(without.held_out.velocity_rmse_corrected, 0.04);
+  EXPECT_LT(with.held_out.velocity_rmse_corrected, 0.5 * without.held_out.velocity_rmse_corrected)
+      << with.held_out.velocity_rmse_corrected << " against " << without.held_out.velocity_rmse_corrected;
+  // No run with FSCC at all: refused, naming the feature.
+  std::string none = kHeader + "\n";
+  for (int i = 0; i < 200; ++i) none += row(i, good(2.0 + 0.01 * i, 2.0));
+  try {
+    auto o = quick_training(5);
+    o.reduced = false;
+    o.feature_set = "extended-yield+fscc";
+    (void)correction::train_model(correction::load_training_set({write("no-fscc.csv", none)}, 10), o);
+    ADD_FAILURE() << "runs without FSCC trained a +fscc model";
+  } catch (const awcc::OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("fscc_awcc_ratio"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
   // The bias depends on the sampling rate only (true u = measured u at
   // 1 MHz, 20 % below it at 10 kHz): a forest that sees fs removes it, one

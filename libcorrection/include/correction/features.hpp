@@ -70,6 +70,19 @@
 // (docs/validation.md). The forests see d32 and dx, but a ratio takes them
 // many splits to find.
 //
+// FSCC beside AWCC as features (issue 51; the extended sets followed by
+// "+fscc", after "+size"): fscc_awcc_ratio, FSCC's velocity over AWCC's, and
+// FSCC's correlation peak r12_max. AWCC's Tu says little of the true Tu
+// above about 0.25: its filter and outlier cutoff drop the windows the
+// turbulence decorrelates, so the measured Tu flattens (at a measured 0.2
+// the campaign's true Tu spans 0.11-0.44) and the forest answers with the
+// prior's average. The filter's work shows where AWCC and FSCC part: FSCC
+// takes every bubble, AWCC the windows it keeps, and the more the filter
+// drops, the further AWCC reads above FSCC (0.96 at true Tu 0.35-0.5
+// against 1.01 at 0.2-0.25, at the same measured Tu); R12max falls as the
+// tips decorrelate. A row without an FSCC velocity lacks the features and is
+// not corrected by such a forest (missing_feature).
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -194,6 +207,9 @@ struct Features {
   static constexpr const char* scale_name = "time_scale_ratio";
   /// The size-ratio feature, d32 / dx (the file's comment).
   static constexpr const char* size_name = "size_ratio";
+  /// The FSCC features of the AWCC forest (the file's comment): FSCC's
+  /// velocity over AWCC's, then "r12_max".
+  static constexpr const char* fscc_ratio_name = "fscc_awcc_ratio";
   /// Where the ratio is capped (AWCC's result holds it capped, and says why).
   static constexpr double time_scale_ratio_cap = awcc::time_scale_ratio_cap;
   [[nodiscard]] std::array<double, 7> vector() const {
@@ -209,7 +225,8 @@ struct Features {
 /// data yield for the accepted windows), "fscc" or "fscc-2" (the FSCC
 /// forest's); the two extended sets may end in "+lag" (the lag in samples
 /// after the record's features), then in "+scale" (the time-scale ratio),
-/// then in "+size" (d32 / dx), and the first three, after those, in
+/// then in "+size" (d32 / dx), then in "+fscc" (FSCC's velocity over AWCC's
+/// and R12max), and the first three, after those, in
 /// "+weighting" (the weighting feature last). Throws std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// The set of a model's names in order ("measured", "extended-yield+weighting", ...); empty when they are none.

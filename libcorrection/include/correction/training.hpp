@@ -215,6 +215,10 @@ struct FsccScores {
 struct TrainResult {
   CorrectionModel model;
   std::int64_t training_rows = 0;
+  /// Usable runs left out because they lack a feature of the set (a run
+  /// without an FSCC velocity under "+fscc"): a row like them is not
+  /// corrected by the AWCC forests either (missing_feature).
+  std::int64_t excluded_features = 0;
   std::int64_t calibration_rows = 0;    ///< set aside to calibrate the intervals
   std::int64_t fscc_training_rows = 0;  ///< the FSCC forest's (extended feature set)
   FsccScores fscc_held_out;             ///< all held-out runs with an FSCC velocity
