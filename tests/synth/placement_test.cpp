@@ -101,6 +101,68 @@ TEST(LateralPlacement, AvxAndSseGiveTheSameBits) {
   EXPECT_GT(failed, 300);
 }
 
+// The rule itself, one attempt at a time, against the batched placement
+// on dense tiles (50-300 discs covering most of the cross-section, as in a
+// flow at c 0.4-0.6), where most batches stop testing before the last disc
+// (placement.hpp, look_every). The reference draws attempt i from the i-th
+// draw of the stream (the halves as 32-bit fractions, written here from the
+// rule), tests it against every disc with this file's own minimum image,
+// and takes the first free one; the batch consumes whole batches of eight.
+// Centres are drawn inside the tile, where the placement keeps them as
+// given, so both compute the same squared distances to the bit: the same
+// outcome, positions and next draw, with AVX2 and with SSE2.
+TEST(LateralPlacement, DenseTilesGiveTheOneAttemptAtATimeOutcome) {
+  auto fraction = [](std::uint64_t bits32) {
+    return std::bit_cast<double>((bits32 << 20) | 0x3ff0000000000000ull) - 1.0;
+  };
+  awcc::Rng shape(2027, synth::Stream::bubbles);
+  int placed = 0, failed = 0;
+  for (const bool avx2 : {true, false}) {
+    LateralPlacement placement(ly, lz);
+    if (placement.allow_avx2(avx2) != avx2) continue;  // no AVX2 here: SSE2 alone
+    for (int trial = 0; trial < 1500; ++trial) {
+      placement.clear();
+      std::vector<std::array<double, 3>> discs;
+      const int count = 50 + static_cast<int>(shape.next() % 251);
+      // Mean disc area so that the discs' total is 1.5-4 cross-sections.
+      const double area = (1.5 + 2.5 * shape.uniform()) * ly * lz / count;
+      for (int k = 0; k < count; ++k) {
+        const double y = (shape.uniform() - 0.5) * ly, z = (shape.uniform() - 0.5) * lz;
+        const double rho2 = 2.0 * shape.uniform() * area / pi;
+        discs.push_back({y, z, rho2});
+        placement.add_disc(y, z, rho2);
+      }
+      const int n = 1 + static_cast<int>(shape.next() % 40);
+      awcc::Rng a(static_cast<std::uint64_t>(trial), synth::Stream::bubbles);
+      awcc::Rng b(static_cast<std::uint64_t>(trial), synth::Stream::bubbles);
+      const auto got = placement.place(a, n);
+      int winner = -1;
+      std::vector<double> ys, zs;
+      for (int i = 0; i < n && winner < 0; ++i) {
+        const std::uint64_t r = b.next();
+        ys.push_back((fraction(r >> 32) - 0.5) * ly);
+        zs.push_back((fraction(r & 0xffffffffu) - 0.5) * lz);
+        bool covered = false;
+        for (const auto& d : discs) covered = covered || torus_distance2(ys.back(), zs.back(), d[0], d[1]) < d[2];
+        if (!covered) winner = i;
+      }
+      const int drawn = static_cast<int>(ys.size());
+      for (int i = drawn; i % LateralPlacement::batch != 0; ++i) b.next();  // the rest of the batch
+      ASSERT_EQ(got.placed, winner >= 0) << "trial " << trial;
+      ASSERT_EQ(got.attempts, drawn) << "trial " << trial;
+      for (int i = 0; i < drawn; ++i) {
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(placement.y(i)), std::bit_cast<std::uint64_t>(ys[static_cast<std::size_t>(i)]));
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(placement.z(i)), std::bit_cast<std::uint64_t>(zs[static_cast<std::size_t>(i)]));
+      }
+      ASSERT_EQ(a.next(), b.next()) << "trial " << trial;
+      (got.placed ? placed : failed) += 1;
+    }
+  }
+  // Both outcomes met many times.
+  EXPECT_GT(placed, 300);
+  EXPECT_GT(failed, 300);
+}
+
 // N calls of n = 4 attempts on the two discs. The outcome of a call is a
 // category: placed at attempt k (probability p (1 - p)^(k - 1), k = 1..4)
 // or failed ((1 - p)^4 = 0.2401). The calls are independent, so the counts
