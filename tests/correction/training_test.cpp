@@ -390,6 +390,26 @@ TEST(Training, TheFsccFeaturesLearnAwccsFilterBiasAndRunsWithoutFsccAreLeftOut) 
   EXPECT_GT(without.held_out.velocity_rmse_corrected, 0.04);
   EXPECT_LT(with.held_out.velocity_rmse_corrected, 0.5 * without.held_out.velocity_rmse_corrected)
       << with.held_out.velocity_rmse_corrected << " against " << without.held_out.velocity_rmse_corrected;
+  // A row as the training runs, AWCC reading 10 % high: with FSCC the +fscc
+  // forest corrects it to the truth; without FSCC it is not corrected and
+  // the message names the feature it lacks.
+  correction::Measurement m;
+  m.velocity = 22.0;
+  m.turbulence_intensity = 0.18;
+  m.void_fraction = 0.2;
+  m.bubble_count_rate = 2200;
+  m.dx = 0.005, m.dy = 0.001, m.np = 10, m.fs = 20000, m.duration = 45, m.windows_accepted = 500;
+  m.windows_total = 1000;
+  m.fscc_velocity = 20.0;
+  m.r12_max = 0.5;
+  const auto corrected = with.model.correct(m);
+  ASSERT_TRUE(corrected.corrected()) << corrected.message;
+  EXPECT_NEAR(corrected.velocity->median(), 20.0, 0.6);
+  m.fscc_velocity.reset();
+  m.r12_max.reset();
+  const auto lacking = with.model.correct(m);
+  EXPECT_EQ(lacking.status, correction::CorrectionStatus::missing_feature);
+  EXPECT_NE(lacking.message.find("fscc_awcc_ratio"), std::string::npos) << lacking.message;
   // No run with FSCC at all: refused, naming the feature.
   std::string none = kHeader + "\n";
   for (int i = 0; i < 200; ++i) none += row(i, good(2.0 + 0.01 * i, 2.0));
