@@ -171,6 +171,11 @@ TrainingSet load_training_set(const std::vector<std::filesystem::path>& csvs, st
       m.duration = optional_number(Scene::duration).value_or(0.0);
       m.fscc_velocity = optional_number(column_name(C::fscc_velocity));
       m.r12_max = optional_number(column_name(C::fscc_r12_max));
+      // Empty where Chanson's Tu is undefined: 0 (correction/features.hpp);
+      // a CSV without the column does not state it.
+      if (const auto chanson = column_name(C::fscc_turbulence_intensity_chanson); col.count(chanson)) {
+        m.tu_chanson = optional_number(chanson).value_or(0.0);
+      }
       m.time_scale_ratio = optional_number(column_name(C::awcc_time_scale_ratio));
       // Every row of a set shares one processing (checked above); runs
       // without the columns were processed with the defaults.

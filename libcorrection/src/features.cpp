@@ -71,6 +71,7 @@ FeatureResult make_features(const Measurement& m) {
   if (m.fscc_velocity && *m.fscc_velocity > 0.0) {
     f.fscc_velocity = *m.fscc_velocity;
     f.r12_max = m.r12_max.value_or(0.0);
+    f.tu_chanson = m.tu_chanson;
     f.fscc_d32 = d32_of(f.fscc_velocity);
   }
   if (!m.velocity || !m.turbulence_intensity) {
@@ -122,6 +123,7 @@ std::optional<double> Features::value(std::string_view name) const {
   if (name == scale_name && time_scale_ratio > 0.0) return time_scale_ratio;
   if (name == size_name && d32 > 0.0 && dx > 0.0) return d32 / dx;
   if (name == fscc_ratio_name && fscc_velocity > 0.0 && velocity > 0.0) return fscc_velocity / velocity;
+  if (name == chanson_name && fscc_velocity > 0.0) return tu_chanson;
   return std::nullopt;
 }
 
@@ -137,7 +139,8 @@ std::vector<std::string> feature_set_names(std::string_view set) {
         "feature set '{}': use measured (the seven of METHOD 7), extended (with fs, duration and accepted windows) "
         "or extended-yield (fs, duration and the data yield), the extended two optionally followed by +lag (the lag "
         "in samples), then +scale (the time-scale ratio T_u / T_W), then +size (d32 / dx), then +fscc (FSCC's "
-        "velocity over AWCC's and FSCC's R12max), each then optionally by +weighting",
+        "velocity over AWCC's and FSCC's R12max), then +chanson (FSCC's Chanson Tu), each then optionally by "
+        "+weighting",
         set));
   };
   const auto plus = set.find('+');
@@ -158,6 +161,7 @@ std::vector<std::string> feature_set_names(std::string_view set) {
        {std::tuple{"+lag", Names{Features::lag_name}, true}, std::tuple{"+scale", Names{Features::scale_name}, true},
         std::tuple{"+size", Names{Features::size_name}, true},
         std::tuple{"+fscc", Names{Features::fscc_ratio_name, "r12_max"}, true},
+        std::tuple{"+chanson", Names{Features::chanson_name}, true},
         std::tuple{"+weighting", Names{Features::weighting_name}, false}}) {
     if (!take(suffix)) continue;
     if (extended_only && base == "measured") throw bad();
@@ -173,10 +177,12 @@ std::string feature_set_of(const std::vector<std::string>& names) {
       for (const char* scale : {"", "+scale"}) {
         for (const char* size : {"", "+size"}) {
           for (const char* fscc : {"", "+fscc"}) {
-            for (const char* weighting : {"", "+weighting"}) {
-              const std::string set = std::string(base) + lag + scale + size + fscc + weighting;
-              if (std::string_view(base) == "measured" && (*lag || *scale || *size || *fscc)) continue;
-              if (names == feature_set_names(set)) return set;
+            for (const char* chanson : {"", "+chanson"}) {
+              for (const char* weighting : {"", "+weighting"}) {
+                const std::string set = std::string(base) + lag + scale + size + fscc + chanson + weighting;
+                if (std::string_view(base) == "measured" && (*lag || *scale || *size || *fscc || *chanson)) continue;
+                if (names == feature_set_names(set)) return set;
+              }
             }
           }
         }
@@ -201,6 +207,7 @@ MeasurementResult measurement_of(const awcc::ProcessResult& r) {
   if (r.fscc && r.fscc->ok()) {
     m.fscc_velocity = r.fscc->velocity;
     m.r12_max = r.fscc->r12_max;
+    m.tu_chanson = r.fscc->turbulence_intensity_chanson.value_or(0.0);
   }
   if (r.awcc) {
     m.np = r.awcc->np;

@@ -289,6 +289,7 @@ MeasurementResult measurement_of_json(const nlohmann::json& r, const RowDefaults
     res.status = status_of(f, res.status, awcc::parse_fscc_status, row + "/fscc", file);
     res.velocity = number(f, key::velocity).value_or(0.0);
     res.r12_max = number(f, key::r12_max).value_or(0.0);
+    res.turbulence_intensity_chanson = number(f, key::turbulence_intensity_chanson);
     p.fscc = std::move(res);
   }
   if (p.awcc) {
@@ -313,6 +314,7 @@ MeasurementResult measurement_of_json(const nlohmann::json& r, const RowDefaults
   if (!(fs && samples)) m.duration = number(r, key::duration).value_or(d.duration.value_or(0.0));
   if (!number(a, key::windows_accepted)) m.windows_accepted = -1;
   if (!number(a, key::windows_total)) m.windows_total = -1;
+  if (!(has(r, key::fscc) && has(r[key::fscc], key::turbulence_intensity_chanson))) m.tu_chanson.reset();
   return result;
 }
 
@@ -428,6 +430,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
         f.status = awcc::parse_fscc_status(status, at(column::fscc_status));
         f.velocity = value(column::fscc_velocity).value_or(0.0);
         f.r12_max = value(column::fscc_r12_max).value_or(0.0);
+        f.turbulence_intensity_chanson = value(column::fscc_turbulence_intensity_chanson);
         p.fscc = std::move(f);
       }
       const auto accepted = value(column::awcc_windows_accepted), total = value(column::awcc_windows_total);
@@ -450,6 +453,7 @@ FileCorrection correct_profile_csv(const CorrectionModel& model, const std::stri
       m.duration = value(column::duration).value_or(d.duration.value_or(0.0));
       if (!accepted) m.windows_accepted = -1;
       if (!total) m.windows_total = -1;
+      if (!col.count(column::fscc_turbulence_intensity_chanson)) m.tu_chanson.reset();
       return result;
     };
     auto processing = [&]() -> std::optional<Processing> {

@@ -635,6 +635,37 @@ TEST(Correction, ExtendedModelsNeedTheRecordsFeaturesAndRoundTrip) {
     EXPECT_THROW(correction::feature_set_names(set), std::invalid_argument) << set;
   // A ratio near 1 is not drawn over decades: its range margin is linear.
   EXPECT_FALSE(Features::on_log_scale("fscc_awcc_ratio"));
+  // Chanson's Tu after FSCC's two: a number, 0 where undefined, wherever
+  // FSCC gave a velocity and the source stated it; unknown otherwise.
+  Features chanson = inside();
+  chanson.fscc_velocity = 3.8;
+  chanson.tu_chanson = 0.0;
+  EXPECT_EQ(chanson.value("fscc_tu_chanson"), 0.0);
+  chanson.tu_chanson = 0.31;
+  EXPECT_EQ(chanson.value("fscc_tu_chanson"), 0.31);
+  chanson.tu_chanson.reset();
+  EXPECT_FALSE(chanson.value("fscc_tu_chanson"));
+  chanson.tu_chanson = 0.31;
+  chanson.fscc_velocity = 0.0;
+  EXPECT_FALSE(chanson.value("fscc_tu_chanson"));
+  const auto chanson_set = correction::feature_set_names("extended-yield+lag+scale+fscc+chanson+weighting");
+  ASSERT_EQ(chanson_set.size(), 16u);
+  EXPECT_EQ(chanson_set[13], "r12_max");
+  EXPECT_EQ(chanson_set[14], "fscc_tu_chanson");
+  EXPECT_EQ(chanson_set[15], "awcc_unweighted");
+  for (const char* set : {"extended+chanson", "extended-yield+lag+scale+fscc+chanson+weighting"})
+    EXPECT_EQ(correction::feature_set_of(correction::feature_set_names(set)), set);
+  for (const char* set : {"measured+chanson", "extended+chanson+fscc", "extended+weighting+chanson"})
+    EXPECT_THROW(correction::feature_set_names(set), std::invalid_argument) << set;
+  EXPECT_FALSE(Features::on_log_scale("fscc_tu_chanson"));  // 0 is a value it takes
+  // From a result: FSCC's Chanson Tu, or 0 where FSCC left it undefined.
+  awcc::ProcessResult processed;
+  processed.fscc.emplace();
+  processed.fscc->status = awcc::FsccStatus::ok;
+  processed.fscc->velocity = 3.8;
+  EXPECT_EQ(correction::measurement_of(processed).measurement.tu_chanson, 0.0);
+  processed.fscc->turbulence_intensity_chanson = 0.27;
+  EXPECT_EQ(correction::measurement_of(processed).measurement.tu_chanson, 0.27);
   correction::Measurement stated;
   stated.velocity = 3.0;
   stated.turbulence_intensity = 0.2;

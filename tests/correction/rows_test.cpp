@@ -109,6 +109,18 @@ TEST(Rows, FilesAreCorrectedAsTheResultsInMemory) {
     // The time-scale feature too: the JSON's awcc.time_scale_ratio, and the
     // CSV's awcc_time_scale_ratio cell that the CSV reader takes.
     EXPECT_EQ(read.measurement.time_scale_ratio, in_memory.measurement.time_scale_ratio) << i;
+    // Chanson's Tu (the +chanson feature): known wherever FSCC gave a
+    // velocity, 0 where the JSON states it null (undefined), not known where
+    // the JSON does not state it (an earlier pdp's, another writer's).
+    EXPECT_EQ(read.measurement.tu_chanson, in_memory.measurement.tu_chanson) << i;
+    EXPECT_EQ(in_memory.measurement.tu_chanson.has_value(), in_memory.measurement.fscc_velocity.has_value()) << i;
+    if (in_memory.measurement.fscc_velocity) {
+      auto j = awcc::to_json(rs[i]);
+      j["fscc"]["turbulence_intensity_chanson"] = nullptr;
+      EXPECT_EQ(correction::measurement_of_json(j, {}, "p.json").measurement.tu_chanson, 0.0) << i;
+      j["fscc"].erase("turbulence_intensity_chanson");
+      EXPECT_FALSE(correction::measurement_of_json(j, {}, "p.json").measurement.tu_chanson) << i;
+    }
     EXPECT_EQ(in_memory.measurement.time_scale_ratio.has_value(), in_memory.measurement.velocity.has_value()) << i;
     const auto names = awcc::split_cells(awcc::profile_csv_header());
     const auto cells = awcc::split_cells(awcc::profile_csv_row(rs[i], 0.01));

@@ -2,11 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <fstream>
 #include <random>
 #include <set>
+#include <sstream>
 
 #include "awcc/csv.hpp"
 #include "awcc/errors.hpp"
@@ -17,7 +19,8 @@ namespace {
 // The columns of a pdp sweep CSV that training reads (and a scene column).
 const std::string kHeader =
     "study,run,velocity,fs,duration,dx,dy,np,truth_velocity,truth_turbulence_intensity,awcc_velocity,awcc_turbulence_intensity,"
-    "awcc_void_fraction,awcc_count_rate,awcc_windows_accepted,awcc_windows_total,fscc_velocity,fscc_r12_max,reason";
+    "awcc_void_fraction,awcc_count_rate,awcc_windows_accepted,awcc_windows_total,fscc_velocity,fscc_r12_max,"
+    "fscc_turbulence_intensity_chanson,reason";
 
 // A sweep CSV row with the columns pdp train reads set, the rest empty.
 std::string row(std::int64_t run, const std::map<std::string, std::string>& values) {
@@ -421,6 +424,61 @@ TEST(Training, TheFsccFeaturesLearnAwccsFilterBiasAndRunsWithoutFsccAreLeftOut) 
     ADD_FAILURE() << "runs without FSCC trained a +fscc model";
   } catch (const awcc::OptionError& e) {
     EXPECT_NE(std::string(e.what()).find("fscc_awcc_ratio"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Training, ChansonsTuIdentifiesTheTruthAwccsTuCannotAndUndefinedIsZero) {
+  // AWCC's Tu reads 0.2 whatever the truth (its flattening, at its worst),
+  // true Tu uniform over 0.05-0.45: without a second reading the forest can
+  // do no better than the truth's spread (RMSE 0.4 / sqrt(12) = 0.115).
+  // Chanson's Tu reads the truth within 2 %, and is undefined (an empty
+  // cell) below a true 0.1, as tau05 < T05 leaves it at low Tu: those runs
+  // train with 0, none is left out, and the Tu RMSE falls below a third.
+  std::mt19937_64 g(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::string csv = kHeader + "\n";
+  for (int i = 0; i < 1600; ++i) {
+    const double truth = 1 + 49 * u(g), tu = 0.05 + 0.4 * u(g);
+    auto v = good(truth, truth, 500);
+    v["truth_turbulence_intensity"] = fmt::format("{:.10g}", tu);
+    v["awcc_turbulence_intensity"] = "0.2";
+    v["fscc_velocity"] = fmt::format("{:.10g}", truth);
+    v["fscc_r12_max"] = "0.5";
+    if (tu >= 0.1) v["fscc_turbulence_intensity_chanson"] = fmt::format("{:.10g}", tu * (0.98 + 0.04 * u(g)));
+    csv += row(i, v);
+  }
+  const auto set = correction::load_training_set({write("chanson.csv", csv)}, 10);
+  const auto [without, with] = without_and_with(set, "extended-yield+fscc", "extended-yield+fscc+chanson");
+  EXPECT_EQ(with.excluded_features, 0);
+  EXPECT_EQ(with.model.ranges.back().name, "fscc_tu_chanson");
+  EXPECT_EQ(with.model.ranges.back().min, 0.0);  // the undefined ones, as 0
+  EXPECT_GT(without.held_out.tu_rmse_corrected, 0.09);
+  EXPECT_LT(with.held_out.tu_rmse_corrected, without.held_out.tu_rmse_corrected / 3.0)
+      << with.held_out.tu_rmse_corrected << " against " << without.held_out.tu_rmse_corrected;
+  // A sweep CSV without the column does not state it: no run can train the set.
+  std::string stripped;
+  {
+    std::stringstream in(csv);
+    std::string line;
+    const auto names = awcc::split_cells(kHeader);
+    const auto drop = static_cast<std::size_t>(
+        std::find(names.begin(), names.end(), "fscc_turbulence_intensity_chanson") - names.begin());
+    while (std::getline(in, line)) {
+      const auto cells = awcc::split_cells(line);
+      std::string out;
+      for (std::size_t k = 0; k < cells.size(); ++k)
+        if (k != drop) out += (k == 0 ? "" : ",") + cells[k];
+      stripped += out + "\n";
+    }
+  }
+  try {
+    auto o = quick_training(5);
+    o.reduced = false;
+    o.feature_set = "extended-yield+fscc+chanson";
+    (void)correction::train_model(correction::load_training_set({write("no-chanson.csv", stripped)}, 10), o);
+    ADD_FAILURE() << "runs without Chanson's Tu trained a +chanson model";
+  } catch (const awcc::OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("fscc_tu_chanson"), std::string::npos) << e.what();
   }
 }
 

@@ -108,6 +108,9 @@ inline constexpr std::string_view bubble_count_rate_ci95 = "bubble_count_rate_ci
 inline constexpr std::string_view velocity = "velocity";
 inline constexpr std::string_view velocity_ci95 = "velocity_ci95";  ///< FSCC's or AWCC's; null when none
 inline constexpr std::string_view r12_max = "r12_max";
+/// FSCC's: Chanson's Tu from the half-widths; null where tau05 < T05 or a
+/// half-width is not found (libcorrection's "+chanson" feature reads it).
+inline constexpr std::string_view turbulence_intensity_chanson = "turbulence_intensity_chanson";
 inline constexpr std::string_view turbulence_intensity = "turbulence_intensity";
 /// AWCC's: false when every accepted window peaks at one lag (Tu then null);
 /// absent from a JSON of an earlier pdp (measured).
@@ -170,6 +173,7 @@ inline constexpr std::string_view events_quality = "events_quality";
 inline constexpr std::string_view multi_tip_status = "multi_tip_status";
 inline constexpr std::string_view multi_tip_quality = "multi_tip_quality";
 inline constexpr std::string_view fscc_r12_max = "fscc_r12_max";
+inline constexpr std::string_view fscc_turbulence_intensity_chanson = "fscc_turbulence_intensity_chanson";
 inline constexpr std::string_view awcc_velocity = "awcc_velocity";
 inline constexpr std::string_view awcc_turbulence_intensity = "awcc_turbulence_intensity";
 inline constexpr std::string_view awcc_windows_accepted = "awcc_windows_accepted";

@@ -83,6 +83,18 @@
 // tips decorrelate. A row without an FSCC velocity lacks the features and is
 // not corrected by such a forest (missing_feature).
 //
+// Chanson's Tu as a feature (issue 51; "+chanson", after "+fscc"):
+// fscc_tu_chanson, 0.851 sqrt(tau05^2 - T05^2) / T from FSCC's correlation
+// half-widths, and 0 where that is undefined (tau05 < T05, or a half-width
+// not found): a second reading of the turbulence, made of every bubble and
+// not by AWCC's windows, so it does not flatten where AWCC's does. As a
+// trial feature (undefined left out, so 2-6 % of the runs went uncorrected)
+// it halved the control set's over-correction at true Tu 0.1-0.2 and took
+// the all-time set's median error from 0.79-0.88 % to 0.65-0.76 %
+// (docs/validation.md, "The prior's top on the must-show's sets"). Taken as
+// 0 where undefined it is defined wherever FSCC gave a velocity; a file that
+// does not state it (no such key or column) lacks it.
+//
 // A measurement has features only when AWCC gave a positive velocity and the
 // leading tip saw bubbles; otherwise make_features says why, as a status.
 //
@@ -137,6 +149,8 @@ struct Measurement {
   double duration = 0.0;                       ///< record duration, s (0: not known)
   std::optional<double> fscc_velocity;         ///< FSCC's velocity, m/s (empty: none)
   std::optional<double> r12_max;               ///< FSCC's correlation peak, -
+  /// FSCC's Chanson Tu, 0 where undefined; empty: not known (Features::chanson_name).
+  std::optional<double> tu_chanson;
   /// How AWCC's moments were taken; empty: not known (another tool's file).
   std::optional<awcc::Weighting> weighting;
   /// T_u / T_W, capped (Features::time_scale_ratio_cap); empty: not known.
@@ -210,6 +224,9 @@ struct Features {
   /// The FSCC features of the AWCC forest (the file's comment): FSCC's
   /// velocity over AWCC's, then "r12_max".
   static constexpr const char* fscc_ratio_name = "fscc_awcc_ratio";
+  /// Chanson's Tu (the file's comment), 0 where undefined; empty: not known.
+  std::optional<double> tu_chanson = std::nullopt;
+  static constexpr const char* chanson_name = "fscc_tu_chanson";
   /// Where the ratio is capped (AWCC's result holds it capped, and says why).
   static constexpr double time_scale_ratio_cap = awcc::time_scale_ratio_cap;
   [[nodiscard]] std::array<double, 7> vector() const {
@@ -226,7 +243,7 @@ struct Features {
 /// forest's); the two extended sets may end in "+lag" (the lag in samples
 /// after the record's features), then in "+scale" (the time-scale ratio),
 /// then in "+size" (d32 / dx), then in "+fscc" (FSCC's velocity over AWCC's
-/// and R12max), and the first three, after those, in
+/// and R12max), then in "+chanson" (Chanson's Tu), and the first three, after those, in
 /// "+weighting" (the weighting feature last). Throws std::invalid_argument otherwise.
 std::vector<std::string> feature_set_names(std::string_view set);
 /// The set of a model's names in order ("measured", "extended-yield+weighting", ...); empty when they are none.
