@@ -297,6 +297,21 @@ std::pair<correction::TrainResult, correction::TrainResult> without_and_with(con
   return {std::move(first), correction::train_model(set, o)};
 }
 
+// The message with which training a feature set on these runs is refused
+// (a test failure, and empty, when it trains).
+std::string training_refusal(const std::string& file, const std::string& csv, const std::string& feature_set) {
+  try {
+    auto o = quick_training(5);
+    o.reduced = false;
+    o.feature_set = feature_set;
+    (void)correction::train_model(correction::load_training_set({write(file, csv)}, 10), o);
+  } catch (const awcc::OptionError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << file << " trained a " << feature_set << " model";
+  return {};
+}
+
 TEST(Training, TheLagFeatureLearnsABiasOfTheLagInSamples) {
   // The bias depends on the lag in samples L = dx fs / u only (AWCC's lag
   // quantisation: 30 % at L -> 0, 1.5 % at L = 100): the lag feature makes it
@@ -416,15 +431,8 @@ TEST(Training, TheFsccFeaturesLearnAwccsFilterBiasAndRunsWithoutFsccAreLeftOut) 
   // No run with FSCC at all: refused, naming the feature.
   std::string none = kHeader + "\n";
   for (int i = 0; i < 200; ++i) none += row(i, good(2.0 + 0.01 * i, 2.0));
-  try {
-    auto o = quick_training(5);
-    o.reduced = false;
-    o.feature_set = "extended-yield+fscc";
-    (void)correction::train_model(correction::load_training_set({write("no-fscc.csv", none)}, 10), o);
-    ADD_FAILURE() << "runs without FSCC trained a +fscc model";
-  } catch (const awcc::OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("fscc_awcc_ratio"), std::string::npos) << e.what();
-  }
+  const auto refused = training_refusal("no-fscc.csv", none, "extended-yield+fscc");
+  EXPECT_NE(refused.find("fscc_awcc_ratio"), std::string::npos) << refused;
 }
 
 TEST(Training, ChansonsTuIdentifiesTheTruthAwccsTuCannotAndUndefinedIsZero) {
@@ -471,15 +479,8 @@ TEST(Training, ChansonsTuIdentifiesTheTruthAwccsTuCannotAndUndefinedIsZero) {
       stripped += out + "\n";
     }
   }
-  try {
-    auto o = quick_training(5);
-    o.reduced = false;
-    o.feature_set = "extended-yield+fscc+chanson";
-    (void)correction::train_model(correction::load_training_set({write("no-chanson.csv", stripped)}, 10), o);
-    ADD_FAILURE() << "runs without Chanson's Tu trained a +chanson model";
-  } catch (const awcc::OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("fscc_tu_chanson"), std::string::npos) << e.what();
-  }
+  const auto refused = training_refusal("no-chanson.csv", stripped, "extended-yield+fscc+chanson");
+  EXPECT_NE(refused.find("fscc_tu_chanson"), std::string::npos) << refused;
 }
 
 TEST(Training, TheExtendedFeatureSetLearnsFromTheRecord) {
