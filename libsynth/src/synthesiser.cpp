@@ -625,9 +625,12 @@ class Synthesiser {
   // Places waiting bubbles in arrival order. Bubbles never move relative to
   // each other, so an overlap at entry is an overlap for ever. When every
   // lateral position tried overlaps a neighbour, the bubble waits and tries
-  // again each time the flow has advanced by a quarter of the largest
-  // diameter, until it has advanced by one largest diameter; then it is
-  // placed overlapping (Truth::overlaps_unresolved). Waiting keeps the bubble
+  // again at each later arrival (the ones behind it wait in the queue) and
+  // each time the flow has advanced by a quarter of the largest diameter,
+  // until it has advanced by one largest diameter; then it is placed
+  // overlapping (Truth::overlaps_unresolved). In a dense flow that is about
+  // two tries a bubble (c 0.42, log-normal sizes at sd 0.6: 4.67 M tries,
+  // 2.49 M of them failed, for 2.18 M bubbles). Waiting keeps the bubble
   // flux (a bubble is late, never lost) and lets the void fraction reach c
   // above the jamming limit of random sequential placement (about 0.38 for
   // spheres), where placing overlapping bubbles at once would lose the
