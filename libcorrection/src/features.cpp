@@ -179,7 +179,7 @@ std::string feature_set_of(const std::vector<std::string>& names) {
           for (const char* fscc : {"", "+fscc"}) {
             for (const char* chanson : {"", "+chanson"}) {
               for (const char* weighting : {"", "+weighting"}) {
-                const std::string set = std::string(base) + lag + scale + size + fscc + chanson + weighting;
+                std::string set = std::string(base) + lag + scale + size + fscc + chanson + weighting;
                 if (std::string_view(base) == "measured" && (*lag || *scale || *size || *fscc || *chanson)) continue;
                 if (names == feature_set_names(set)) return set;
               }

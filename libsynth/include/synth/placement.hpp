@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -104,7 +105,7 @@ class LateralPlacement {
 
   /// Up to n attempts (n >= 1) from rng.
   Outcome place(awcc::Rng& rng, int n) {
-    const auto rounded = static_cast<std::size_t>((n + batch - 1) / batch * batch);
+    const auto rounded = static_cast<std::size_t>((n + batch - 1) / batch) * std::size_t{batch};
     if (ys_.size() < rounded) {
       ys_.resize(rounded);
       zs_.resize(rounded);
@@ -159,8 +160,8 @@ class LateralPlacement {
       const __m128d fz = _mm_sub_pd(_mm_castsi128_pd(_mm_or_si128(_mm_slli_epi64(low, 20), exponent)), one);
       yv[h] = _mm_mul_pd(_mm_sub_pd(fy, half), ly);
       zv[h] = _mm_mul_pd(_mm_sub_pd(fz, half), lz);
-      _mm_storeu_pd(y + 2 * h, yv[h]);
-      _mm_storeu_pd(z + 2 * h, zv[h]);
+      _mm_storeu_pd(y + static_cast<std::ptrdiff_t>(2 * h), yv[h]);
+      _mm_storeu_pd(z + static_cast<std::ptrdiff_t>(2 * h), zv[h]);
       m[h] = _mm_set1_pd(std::numeric_limits<double>::infinity());
     }
     auto covered = [&] {
@@ -231,8 +232,8 @@ class LateralPlacement {
       const __m256d fz = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(_mm256_slli_epi64(low, 20), exponent)), one);
       yv[h] = _mm256_mul_pd(_mm256_sub_pd(fy, half), ly);
       zv[h] = _mm256_mul_pd(_mm256_sub_pd(fz, half), lz);
-      _mm256_storeu_pd(y + 4 * h, yv[h]);
-      _mm256_storeu_pd(z + 4 * h, zv[h]);
+      _mm256_storeu_pd(y + static_cast<std::ptrdiff_t>(4 * h), yv[h]);
+      _mm256_storeu_pd(z + static_cast<std::ptrdiff_t>(4 * h), zv[h]);
       m[h] = _mm256_set1_pd(std::numeric_limits<double>::infinity());
     }
     auto covered = [&]() __attribute__((target("avx2"))) {
