@@ -905,6 +905,59 @@ TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
                awcc::InputError);
 }
 
+TEST(Correction, AProfileCsvStatesChansonsTuByItsColumn) {
+  // A "+chanson" model and pdp's profile CSV: Chanson's Tu is read from its
+  // column (an empty cell is FSCC's undefined Tu, which the feature takes as
+  // 0); a CSV without the column (an earlier pdp's) does not state it, and
+  // its rows go to the reduced forest, or are refused naming the feature
+  // without one. The velocity target depends on Chanson's Tu alone, so the
+  // row's corrected u says which value the forest saw.
+  auto m = model_of(
+      "extended+fscc+chanson", 23,
+      [](Features& f, std::mt19937_64& g) {
+        f.fs = 1e5 + 9e5 * uniform(g);
+        f.duration = 20 + 280 * uniform(g);
+        f.windows_accepted = 100 + static_cast<std::int64_t>(800 * uniform(g));
+        f.fscc_velocity = f.velocity * (0.9 + 0.2 * uniform(g));
+        f.r12_max = 0.2 + 0.6 * uniform(g);
+        const double draw = uniform(g);
+        f.tu_chanson = draw < 0.3 ? 0.0 : 0.5 * draw;
+      },
+      [](const Features& f) { return 1.0 + 0.2 * f.tu_chanson.value_or(-1.0); });
+  m.reduced = std::make_shared<const CorrectionModel>(reduced_model());
+  // inside()'s row: u 10 m/s, Tu 0.2, c 0.2, d32 = 1.5 u c / F = 5 mm at F = 600 Hz.
+  const std::string head =
+      "void_fraction,bubble_count_rate,awcc_velocity,awcc_turbulence_intensity,awcc_windows_accepted,awcc_status,"
+      "fs,duration,dx,dy,np,fscc_status,fscc_velocity,fscc_r12_max";
+  const std::string row = "0.2,600,10,0.2,500,ok,500000,100,0.005,0.001,10,ok,10,0.5";
+  auto corrected = [&](const std::string& extra_head, const std::string& extra_row) {
+    const auto out = correction::correct_profile_csv(m, head + extra_head + "\n" + row + extra_row + "\n", {}, "p.csv");
+    const auto names = awcc::split_cells(out.text.substr(0, out.text.find('\n')));
+    const auto cells = awcc::split_cells(out.text.substr(out.text.find('\n') + 1, out.text.rfind('\n') - out.text.find('\n') - 1));
+    std::map<std::string, std::string> by_name;
+    for (std::size_t i = 0; i < names.size() && i < cells.size(); ++i) by_name[names[i]] = cells[i];
+    return by_name;
+  };
+  auto u_of = [](std::map<std::string, std::string>& r) { return awcc::cell_number(r["corrected_velocity"]).value_or(-1); };
+  auto stated = corrected(",fscc_turbulence_intensity_chanson", ",0.4");
+  ASSERT_EQ(stated["correction_status"], "corrected") << stated["correction_reason"];
+  EXPECT_EQ(stated["correction_forest"], "awcc");
+  // The forest's leaves near Chanson's Tu 0.4 hold targets 1.07-1.10: u 10.7-11.0.
+  EXPECT_NEAR(u_of(stated), 10.0 * (1 + 0.2 * 0.4), 0.15);
+  auto undefined = corrected(",fscc_turbulence_intensity_chanson", ",");
+  ASSERT_EQ(undefined["correction_status"], "corrected") << undefined["correction_reason"];
+  EXPECT_EQ(undefined["correction_forest"], "awcc");
+  EXPECT_NEAR(u_of(undefined), 10.0, 0.05);  // the draws at 0 learnt the target 1 exactly
+  auto absent = corrected("", "");
+  ASSERT_EQ(absent["correction_status"], "corrected") << absent["correction_reason"];
+  EXPECT_EQ(absent["correction_forest"], "awcc-reduced");
+  EXPECT_NE(absent["correction_notes"].find("fscc_tu_chanson"), std::string::npos) << absent["correction_notes"];
+  m.reduced = nullptr;
+  auto refused = corrected("", "");
+  EXPECT_EQ(refused["correction_status"], "missing_feature");
+  EXPECT_NE(refused["correction_reason"].find("fscc_tu_chanson"), std::string::npos) << refused["correction_reason"];
+}
+
 TEST(Correction, DropletFlowIsNamedAsOutsideWhatTheModelLearnt) {
   const auto m = small_model();
   auto f = inside();
