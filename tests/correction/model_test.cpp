@@ -862,6 +862,16 @@ TEST(Correction, TheWeightingAsAFeatureCorrectsEitherAndMixesAnUnknownOne) {
   EXPECT_EQ(*correction::make_features(meas).features.value("awcc_unweighted"), 1.0);
 }
 
+// The first row of a corrected CSV, cell by column name.
+std::map<std::string, std::string> first_row_by_name(const std::string& text) {
+  const auto first = text.find('\n');
+  const auto names = awcc::split_cells(text.substr(0, first));
+  const auto cells = awcc::split_cells(text.substr(first + 1, text.find('\n', first + 1) - first - 1));
+  std::map<std::string, std::string> by_name;
+  for (std::size_t i = 0; i < names.size() && i < cells.size(); ++i) by_name[names[i]] = cells[i];
+  return by_name;
+}
+
 TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
   // An extended-yield model (data yield = accepted / formed windows) and the
   // CSV other AWCC tools write: with the columns fs, duration,
@@ -883,12 +893,8 @@ TEST(Correction, AnotherToolsCsvGivesTheRecordsFeaturesByColumnOrOption) {
   const std::string head = "u [m/s],u_rms [m/s],c [-],d_32a [m]";
   const std::string row = "5,1,0.1,0.003";
   auto corrected = [&](const std::string& extra_head, const std::string& extra_row, const correction::RowDefaults& defaults) {
-    const auto out = correction::correct_profile_csv(m, head + extra_head + "\n" + row + extra_row + "\n", defaults, "tool.csv");
-    const auto lines = awcc::split_cells(out.text.substr(0, out.text.find('\n')));
-    const auto cells = awcc::split_cells(out.text.substr(out.text.find('\n') + 1, out.text.rfind('\n') - out.text.find('\n') - 1));
-    std::map<std::string, std::string> by_name;
-    for (std::size_t i = 0; i < lines.size() && i < cells.size(); ++i) by_name[lines[i]] = cells[i];
-    return by_name;
+    return first_row_by_name(
+        correction::correct_profile_csv(m, head + extra_head + "\n" + row + extra_row + "\n", defaults, "tool.csv").text);
   };
   auto all = corrected(",fs,duration,awcc_windows_accepted,awcc_windows_total", ",50000,60,40,80", d);
   EXPECT_EQ(all["correction_status [-]"], "corrected") << all["correction_reason [-]"];
@@ -931,12 +937,8 @@ TEST(Correction, AProfileCsvStatesChansonsTuByItsColumn) {
       "fs,duration,dx,dy,np,fscc_status,fscc_velocity,fscc_r12_max";
   const std::string row = "0.2,600,10,0.2,500,ok,500000,100,0.005,0.001,10,ok,10,0.5";
   auto corrected = [&](const std::string& extra_head, const std::string& extra_row) {
-    const auto out = correction::correct_profile_csv(m, head + extra_head + "\n" + row + extra_row + "\n", {}, "p.csv");
-    const auto names = awcc::split_cells(out.text.substr(0, out.text.find('\n')));
-    const auto cells = awcc::split_cells(out.text.substr(out.text.find('\n') + 1, out.text.rfind('\n') - out.text.find('\n') - 1));
-    std::map<std::string, std::string> by_name;
-    for (std::size_t i = 0; i < names.size() && i < cells.size(); ++i) by_name[names[i]] = cells[i];
-    return by_name;
+    return first_row_by_name(
+        correction::correct_profile_csv(m, head + extra_head + "\n" + row + extra_row + "\n", {}, "p.csv").text);
   };
   auto u_of = [](std::map<std::string, std::string>& r) { return awcc::cell_number(r["corrected_velocity"]).value_or(-1); };
   auto stated = corrected(",fscc_turbulence_intensity_chanson", ",0.4");
