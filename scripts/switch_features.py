@@ -16,10 +16,9 @@ variants:
 and candidate features from the two tips' signals: the arrival structure
 (the share of water gaps shorter than a quarter of the mean air chord, the
 gaps' coefficient of variation), the chords' skewness (their CV is among
-the forest's features' stand-ins below), the two
-tips (the share of leading-tip bubbles seen by the trailing tip at dx/u, the
-count and chord ratios) and FSCC's correlation maximum r12 (a feature of the
-`+fscc` forests already).
+the stand-ins below), the two tips (the share of leading-tip bubbles seen
+by the trailing tip at dx/u, the count and chord ratios) and FSCC's
+correlation maximum r12 (a feature of the `+fscc` forests already).
 
 A candidate helps only where it moves with the switch beyond what the
 features the forest has already explain. So each candidate is fitted on the
@@ -27,8 +26,9 @@ reference runs (A, C, E of every scene: spheres, overlap avoided) by a ridge
 regression on those features (log c, log count rate, log mean chord length,
 chord CV, Tu, log dx, dy, log u; linear, or with their products), leaving
 the scene out, and the switch's runs' residuals are given in units of the
-reference's residual sd (their mean less the reference's), with the share above the reference's median
-residual (0.5 = no separation) and the paired t of switch minus control.
+reference's residual sd (their mean less the reference's), with the share
+above the reference's median residual (0.5 = no separation) and the paired
+t of switch minus control.
 
 Usage: switch_features.py measure N OUT.json [PDP]   (about 30 s a scene beside a campaign)
        switch_features.py analyse OUT.json [--quadratic] [--with-r12]
@@ -95,7 +95,11 @@ def features(lead, trail, lag):
 
 
 def measure(n, out, pdp):
-    rows = list(csv.DictReader(open(CONTROL)))[:n]
+    rows = list(csv.DictReader(open(CONTROL)))
+    if not 3 <= n <= len(rows):
+        sys.exit(f"switch_features.py: N = {n}: give 3 to {len(rows)} scenes (the rows of {CONTROL}); "
+                 "the analysis leaves one scene out of a fit on the others")
+    rows = rows[:n]
     results = []
     with tempfile.TemporaryDirectory() as workdir:
         for row in rows:
